@@ -1,0 +1,173 @@
+// System, Data and the named stages of the Lagrange formulation.
+#include "bindings.hpp"
+#include "rigidfem/lagrange.hpp"
+
+namespace rigidfem::bindings {
+
+namespace {
+
+using RefV = Eigen::Ref<const VecX>;
+
+// A fresh workspace at state (t, q, q̇) with kinematics done (calls from Python are not per-step).
+Data at(const System& s, double t, const RefV& q, const RefV& qd) {
+  Data d(s);
+  set_state(s, d, t, q, qd);
+  kinematics(s, d);
+  return d;
+}
+
+Data at(const System& s, double t, const RefV& q) { return at(s, t, q, VecX::Zero(s.nq)); }
+
+void check_body(const System& s, int body) {
+  if (body < 0 || body >= s.nbodies)
+    throw std::invalid_argument("body: expected a body of this system (index 0.." + std::to_string(s.nbodies - 1) +
+                                "), got index " + std::to_string(body));
+}
+
+}  // namespace
+
+void bind_dynamics(py::module_& m) {
+  py::class_<System, std::shared_ptr<System>>(m, "_System")
+      // The System is immutable: only const methods are bound.
+      .def(py::init([](const Model& model) { return std::const_pointer_cast<System>(model.compile()); }),
+           py::arg("model"))
+      .def_readonly("nq", &System::nq, "Number of free joint coordinates (the unknowns).")
+      .def_readonly("np", &System::np, "Number of prescribed (driven) coordinates.")
+      .def_readonly("nc", &System::nc, "Number of all joint coordinates, nq + np.")
+      .def_readonly("nbodies", &System::nbodies)
+      .def_readonly("body_names", &System::body_names)
+      .def_readonly("parent", &System::parent, "Parent index of every body (-1: ground), parent[p] < p.")
+      .def_readonly("gravity", &System::gravity, "Gravitational acceleration (m/s^2), global.")
+      .def_property_readonly("coordinate_names", &System::coordinate_names,
+                             "Names 'body.axis' of the free coordinates, in the order of q.")
+      .def_property_readonly("prescribed_names", &System::prescribed_names,
+                             "Names of the prescribed coordinates, in the order of driving_forces().")
+      .def_property_readonly("pseudo_inertias", [](const System& s) { return s.H; },
+                             "Pseudo-inertia H_p = int r r^T dm (4, 4) of every body, body frame (kg, kg m, kg m^2).")
+      .def_property_readonly("placements", [](const System& s) { return s.B; },
+                             "Constant joint placements B_p (4, 4) in the parent frame.")
+      .def(
+          "forward_dynamics", [](const System& s, double t, const RefV& q, const RefV& qd) {
+            Data d(s);
+            return VecX(rigidfem::forward_dynamics(s, d, t, q, qd));
+          },
+          py::arg("t"), py::arg("q"), py::arg("qd"),
+          "Accelerations qdd (nq,) solving A(q) qdd = f(q, qd, t); t in s, q in m/rad, qd in m/s, rad/s.")
+      .def(
+          "mass_matrix", [](const System& s, const RefV& q, double t) {
+            Data d = at(s, t, q);
+            rigidfem::mass_matrix(s, d);
+            return d.A;
+          },
+          py::arg("q"), py::arg("t") = 0.0, "Mass matrix A(q) (nq, nq), a_ij = sum_p tr(T_p,i H_p T_p,j^T).")
+      .def(
+          "generalized_forces", [](const System& s, double t, const RefV& q, const RefV& qd) {
+            Data d = at(s, t, q, qd);
+            rigidfem::generalized_forces(s, d);
+            return d.f;
+          },
+          py::arg("t"), py::arg("q"), py::arg("qd"),
+          "Right-hand side f (nq,) of A qdd = f: loads, gravity, springs, dampers minus velocity terms (N, N m).")
+      .def(
+          "driving_forces", [](const System& s, double t, const RefV& q, const RefV& qd) {
+            Data d(s);
+            rigidfem::forward_dynamics(s, d, t, q, qd);
+            rigidfem::driving_forces(s, d);
+            return d.tau;
+          },
+          py::arg("t"), py::arg("q"), py::arg("qd"),
+          "Forces/torques (np,) the drives exert on the prescribed coordinates (N or N m).")
+      .def(
+          "rhs", [](const System& s, double t, const RefV& y) {
+            Data d(s);
+            return rigidfem::rhs(s, d, t, y);
+          },
+          py::arg("t"), py::arg("y"), "dy/dt = [qd, qdd] for y = [q, qd] (2 nq,): the signature of scipy's solve_ivp.")
+      .def(
+          "jacobian", [](const System& s, double t, const RefV& y) {
+            Data d(s);
+            return rhs_jacobian(s, d, t, y);
+          },
+          py::arg("t"), py::arg("y"), "d(rhs)/dy (2 nq, 2 nq) by central finite differences, for solve_ivp(jac=...).")
+      .def(
+          "transform", [](const System& s, int body, const RefV& q, double t) {
+            check_body(s, body);
+            return at(s, t, q).T[body];
+          },
+          py::arg("body"), py::arg("q"), py::arg("t") = 0.0, "Pose T_p (4, 4) of a body (by index) in the global frame.")
+      .def(
+          "_position", [](const System& s, const Point& p, const RefV& q, double t) {
+            check_body(s, p.body);
+            return Vec3((at(s, t, q).T[p.body] * p.r.homogeneous()).head<3>());
+          },
+          py::arg("point"), py::arg("q"), py::arg("t"))
+      .def(
+          "_velocity", [](const System& s, const Point& p, const RefV& q, const RefV& qd, double t) {
+            check_body(s, p.body);
+            return Vec3((at(s, t, q, qd).Td[p.body] * p.r.homogeneous()).head<3>());
+          },
+          py::arg("point"), py::arg("q"), py::arg("qd"), py::arg("t"))
+      .def(
+          "kinetic_energy", [](const System& s, const RefV& q, const RefV& qd, double t) {
+            return rigidfem::kinetic_energy(s, at(s, t, q, qd));
+          },
+          py::arg("q"), py::arg("qd"), py::arg("t") = 0.0, "Kinetic energy 1/2 sum tr(dT H dT^T) (J).")
+      .def(
+          "gravity_energy", [](const System& s, const RefV& q, double t) {
+            return rigidfem::gravity_energy(s, at(s, t, q));
+          },
+          py::arg("q"), py::arg("t") = 0.0, "Potential energy of gravity -sum m g^T r_C (J).")
+      .def(
+          "elastic_energy", [](const System& s, const RefV& q, double t) {
+            return rigidfem::elastic_energy(s, at(s, t, q));
+          },
+          py::arg("q"), py::arg("t") = 0.0, "Energy of the joint springs 1/2 sum c (q - q_rest)^2 (J).")
+      .def(
+          "potential_energy", [](const System& s, const RefV& q, double t) {
+            const Data d = at(s, t, q);
+            return rigidfem::gravity_energy(s, d) + rigidfem::elastic_energy(s, d);
+          },
+          py::arg("q"), py::arg("t") = 0.0, "Gravity plus elastic energy (J).")
+      .def(
+          "dissipated_power", [](const System& s, const RefV& q, const RefV& qd, double t) {
+            return rigidfem::dissipated_power(s, at(s, t, q, qd));
+          },
+          py::arg("q"), py::arg("qd"), py::arg("t") = 0.0, "Power dissipated by the joint dampers, sum b qd^2 (W).")
+      .def("make_data", [](const System& s) { return Data(s); }, "A fresh workspace for the stage functions.");
+
+  py::class_<Data>(m, "Data", "Workspace of the algorithms; after each stage it holds that stage's results.")
+      .def_readonly("t", &Data::t)
+      .def_readonly("qa", &Data::qa, "All coordinates (nc,), free and prescribed.")
+      .def_readonly("qda", &Data::qda)
+      .def_readonly("qdda", &Data::qdda)
+      .def_readonly("T", &Data::T, "Global pose T_p (4, 4) of every body.")
+      .def_readonly("Td", &Data::Td, "dT_p/dt.")
+      .def_readonly("Tdd", &Data::Tdd, "d2T_p/dt2 (with the free accelerations zero unless driving_forces ran).")
+      .def_readonly("U", &Data::U, "U_i (4, 4) of every coordinate: dT_p/dq_i = U_i T_p.")
+      .def_readonly("Hbar", &Data::Hbar, "Subtree sums of T_p H_p T_p^T.")
+      .def_readonly("Wbar", &Data::Wbar, "Subtree sums of T_p H_p Tdd_p^T.")
+      .def_readonly("Zbar", &Data::Zbar, "Subtree sums of the load moments.")
+      .def_readonly("A", &Data::A, "Mass matrix (nq, nq).")
+      .def_readonly("f", &Data::f, "Right-hand side (nq,).")
+      .def_readonly("qdd", &Data::qdd, "Accelerations (nq,).")
+      .def_readonly("tau", &Data::tau, "Driving forces (np,).");
+
+  auto stages = m.def_submodule("stages", "The named stages of forward dynamics, each writing into a Data.");
+  stages.def("set_state", &set_state, py::arg("system"), py::arg("data"), py::arg("t"), py::arg("q"), py::arg("qd"),
+             "(t, q, qd) => data.qa, qda, qdda (drives evaluated).");
+  stages.def("kinematics", &kinematics, py::arg("system"), py::arg("data"), "(qa, qda, qdda) => data.T, Td, Tdd, U.");
+  stages.def(
+      "generalized_forces", [](const System& s, Data& d) { rigidfem::generalized_forces(s, d); return d.f; },
+      py::arg("system"), py::arg("data"), "=> data.f (loads, velocity terms, springs, dampers); returns it.");
+  stages.def(
+      "mass_matrix", [](const System& s, Data& d) { rigidfem::mass_matrix(s, d); return d.A; }, py::arg("system"),
+      py::arg("data"), "=> data.A; returns it.");
+  stages.def(
+      "accelerations", [](const System& s, Data& d) { rigidfem::accelerations(s, d); return d.qdd; },
+      py::arg("system"), py::arg("data"), "=> data.qdd solving A qdd = f; returns it.");
+  stages.def(
+      "driving_forces", [](const System& s, Data& d) { rigidfem::driving_forces(s, d); return d.tau; },
+      py::arg("system"), py::arg("data"), "=> data.tau (needs accelerations); returns it.");
+}
+
+}  // namespace rigidfem::bindings

@@ -1,0 +1,85 @@
+// rigidfem._core: the C++ core. Errors: std::invalid_argument -> ValueError,
+// rigidfem::SimulationError -> rigidfem.SimulationError (a RuntimeError).
+#include "bindings.hpp"
+#include "rigidfem/errors.hpp"
+#include "rigidfem/model.hpp"
+#include "rigidfem/profiles.hpp"
+#include "rigidfem/transforms.hpp"
+
+namespace rigidfem::bindings {
+
+void bind_transforms(py::module_& m) {
+  m.def("R1", &R1, py::arg("phi1"), "Rotation matrix about x by phi1 (rad), (3, 3).");
+  m.def("R2", &R2, py::arg("phi2"), "Rotation matrix about y by phi2 (rad), (3, 3).");
+  m.def("R3", &R3, py::arg("phi3"), "Rotation matrix about z by phi3 (rad), (3, 3).");
+  m.def("euler_zyx", &euler_zyx, py::arg("phi3"), py::arg("phi2"), py::arg("phi1"),
+        "R3(phi3) R2(phi2) R1(phi1), book eq. (2.7): yaw, pitch, roll in rad. (3, 3).");
+  m.def("skew", &skew, py::arg("w"), "Skew-symmetric S(w) with S(w) x = w x x. (3, 3).");
+  m.def("homogeneous", &homogeneous, py::arg("R"), py::arg("r"), "[[R, r], [0, 1]] (4, 4); r in m.");
+  m.def("inverse", &inverse, py::arg("T"), "Inverse of a homogeneous transform, [[R^T, -R^T r], [0, 1]] (4, 4).");
+
+  auto axes_of = [](const std::vector<std::string>& names) {
+    std::vector<Axis> axes;
+    for (const auto& n : names) axes.push_back(parse_coordinate(n, "coordinates"));
+    return Joint::make("custom", axes).axes;
+  };
+  m.def(
+      "joint_transform",
+      [axes_of](const std::vector<std::string>& c, const VecX& q) { return joint_transform(axes_of(c), q); },
+      py::arg("coordinates"), py::arg("q"),
+      "Joint transform Trans(x, y, z) R3(phi3) R2(phi2) R1(phi1) restricted to `coordinates`\n"
+      "(names from 'x', 'y', 'z', 'rz', 'ry', 'rx', taken in the book's order); q in m and rad. (4, 4).");
+  m.def(
+      "joint_transform_derivative",
+      [axes_of](const std::vector<std::string>& c, const VecX& q, int i) {
+        return joint_transform_derivative(axes_of(c), q, i);
+      },
+      py::arg("coordinates"), py::arg("q"), py::arg("i"), "dT/dq_i of joint_transform (4, 4).");
+  m.def(
+      "joint_transform_second_derivative",
+      [axes_of](const std::vector<std::string>& c, const VecX& q, int i, int j) {
+        return joint_transform_second_derivative(axes_of(c), q, i, j);
+      },
+      py::arg("coordinates"), py::arg("q"), py::arg("i"), py::arg("j"), "d2T/dq_i dq_j of joint_transform (4, 4).");
+}
+
+void bind_profiles(py::module_& m) {
+  py::class_<Profile, ProfilePtr>(m, "Profile", "A prescribed motion q(t) with its rates (see rigidfem.motion).")
+      .def(
+          "__call__",
+          [](const Profile& p, double t) {
+            const MotionState s = p.at(t);
+            return py::make_tuple(s.q, s.qd, s.qdd);
+          },
+          py::arg("t"), "(q, qd, qdd) at time t (s).")
+      .def("__repr__", [](const Profile& p) { return "<rigidfem motion " + p.describe() + ">"; });
+  m.def("constant_profile", &constant_profile, py::arg("value"));
+  m.def("polynomial_profile", &polynomial_profile, py::arg("coefficients"));
+  m.def("harmonic_profile", &harmonic_profile, py::arg("amplitude"), py::arg("omega"), py::arg("phase"),
+        py::arg("offset"));
+  m.def("spin_up_profile", &spin_up_profile, py::arg("omega"), py::arg("duration"));
+  m.def("spline_profile", &spline_profile, py::arg("t"), py::arg("q"));
+  m.def(
+      "callback_profile",
+      [](std::function<std::tuple<double, double, double>(double)> f) {
+        // pybind11's function wrapper takes the GIL for the call and the conversion.
+        return callback_profile([f = std::move(f)](double t) {
+          const auto [q, qd, qdd] = f(t);
+          return MotionState{q, qd, qdd};
+        });
+      },
+      py::arg("function"));
+}
+
+}  // namespace rigidfem::bindings
+
+PYBIND11_MODULE(_core, m) {
+  namespace py = pybind11;
+  using namespace rigidfem::bindings;
+  m.doc() = "rigidfem C++ core: homogeneous transforms, models, the book's Lagrange formulation.";
+  py::register_exception<rigidfem::SimulationError>(m, "SimulationError", PyExc_RuntimeError);
+  bind_transforms(m);
+  bind_profiles(m);
+  bind_model(m);
+  bind_dynamics(m);
+}

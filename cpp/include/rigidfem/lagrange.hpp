@@ -1,0 +1,56 @@
+/// The book's Lagrange formulation (ch. 2.4-2.7) as named stages.
+///
+/// With T_p the global pose of body p, H_p its pseudo-inertia and
+/// ∂T_p/∂q_i = U_i T_p (U_i the 4x4 global twist of coordinate i, equal for every
+/// body below coordinate i), Lagrange's equations read A(q) q̈ = f(q, q̇, t):
+///   a_ij = Σ_p tr(T_{p,i} H_p T_{p,j}ᵀ) = tr(U_i H̄_b U_jᵀ),
+///   f_i  = tr(U_i (Z̄_b − W̄_b)) − c_i (q_i − q_i⁰) − b_i q̇_i + Q_i,
+/// where b is the deeper of the two coordinates' bodies and the bars are sums over
+/// the subtree of b (the book's link-by-link accumulation):
+///   H̄_b = Σ T_k H_k T_kᵀ,  W̄_b = Σ T_k H_k T̈_kᵀ (T̈ with q̈_free = 0: velocity terms),
+///   Z̄_b = Σ (T_k H_k e₄) g̃ᵀ + Σ loads (Q_i = tr(U_i Z̄) is their virtual work).
+/// Cost: O(n) for everything but the mass matrix, O(n·depth) for A, O(n³) to solve.
+#pragma once
+
+#include "rigidfem/system.hpp"
+
+namespace rigidfem {
+
+/// (t, q, q̇) => qa, qda, qdda: the free coordinates from q, q̇ (q̈ = 0), the
+/// prescribed ones from their drives. Checks sizes and finiteness.
+void set_state(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q, const Eigen::Ref<const VecX>& qd);
+/// (qa, qda, qdda) => T_p, Ṫ_p, T̈_p (nbodies) and U_i (nc): forward recursion
+/// T_p = T_parent B_p T̃_p(q_p) with the joint's elementary factors differentiated in time.
+void kinematics(const System& sys, Data& d);
+/// (T, T̈) => W̄_p = Σ_{k in subtree(p)} T_k H_k T̈_kᵀ.
+void inertia_composites(const System& sys, Data& d);
+/// (T) => Z̄_p = Σ_{k in subtree(p)} (T_k H_k e₄) g̃ᵀ + (T_k r) F̃ᵀ + [[−½ S(τ), 0], [0, 0]].
+void load_composites(const System& sys, Data& d);
+/// Q_i of springs, dampers and applied generalised forces on coordinate i (all coordinates).
+double passive_force(const System& sys, const Data& d, int i);
+/// => f (nq): loads, velocity terms and passive forces. Needs kinematics.
+void generalized_forces(const System& sys, Data& d);
+/// => A (nq, nq): a_ij = tr(U_i H̄_b U_jᵀ). Needs kinematics.
+void mass_matrix(const System& sys, Data& d);
+/// => q̈ (nq) solving A q̈ = f; SimulationError if A is singular.
+void accelerations(const System& sys, Data& d);
+/// => τ (np): driving forces of the prescribed coordinates from the full
+/// accelerations (inverse dynamics of their rows). Needs accelerations.
+void driving_forces(const System& sys, Data& d);
+
+/// The pipeline: set_state, kinematics, generalized_forces, mass_matrix, accelerations.
+const VecX& forward_dynamics(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                             const Eigen::Ref<const VecX>& qd);
+/// dy/dt = [q̇, q̈] for y = [q, q̇] (2 nq).
+VecX rhs(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& y);
+/// ∂(dy/dt)/∂y (2nq, 2nq) by central differences.
+MatX rhs_jacobian(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& y);
+
+/// Energies after kinematics (J): ½ Σ tr(Ṫ_p H_p Ṫ_pᵀ); −Σ m_p gᵀ r_Cp; ½ Σ c_i (q_i − q_i⁰)².
+double kinetic_energy(const System& sys, const Data& d);
+double gravity_energy(const System& sys, const Data& d);
+double elastic_energy(const System& sys, const Data& d);
+/// Power dissipated by the dampers, Σ b_i q̇_i² (W).
+double dissipated_power(const System& sys, const Data& d);
+
+}  // namespace rigidfem

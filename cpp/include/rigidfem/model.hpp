@@ -1,0 +1,120 @@
+/// The mutable description of a multibody system (bodies, joints, springs, drives,
+/// loads) and its compilation into an immutable System (see system.hpp).
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rigidfem/profiles.hpp"
+#include "rigidfem/transforms.hpp"
+
+namespace rigidfem {
+
+class System;
+
+/// A joint: the active elementary motions, in the book's order x, y, z, φ3, φ2, φ1,
+/// with a linear spring (stiffness, rest value) and a viscous damper on each.
+struct Joint {
+  std::vector<Axis> axes;
+  std::vector<double> stiffness;  ///< (ncoords) N/m or N·m/rad
+  std::vector<double> rest;       ///< (ncoords) m or rad
+  std::vector<double> damping;    ///< (ncoords) N·s/m or N·m·s/rad
+  std::string kind;               ///< "revolute", "free", ... (for printing)
+
+  /// Joint with the given axes (any order; stored in the book's order), no springs.
+  static Joint make(const std::string& kind, std::vector<Axis> axes);
+  int ncoords() const { return static_cast<int>(axes.size()); }
+};
+
+/// Parses "x", "y", "z" (a translation or, for rotations, the axis) into an Axis.
+Axis parse_axis(const std::string& name, bool rotation, const std::string& argument);
+/// Parses "x", "y", "z", "rz", "ry", "rx" (also "phi3", "phi2", "phi1").
+Axis parse_coordinate(const std::string& name, const std::string& argument);
+
+/// A handle to a body; index −1 is the ground.
+struct Body {
+  int index = -1;
+  std::string name = "ground";
+};
+
+/// A material point of a body, r in the body frame (m).
+struct Point {
+  int body = -1;
+  Vec3 r = Vec3::Zero();
+  Point() = default;
+  Point(int b, const Vec3& r_) : body(b), r(r_) {}
+  Point(const Body& b) : body(b.index), r(Vec3::Zero()) {}  // NOLINT: implicit, the body's origin
+};
+
+/// Generalised force law Q(t, q, q̇) of one coordinate (the slow path through Python).
+using ForceLaw = std::function<double(double, double, double)>;
+
+/// A point force and/or torque on a body. Global components, or body components
+/// when follower; optionally scaled in time by a profile's value.
+struct Load {
+  int body = -1;
+  Vec3 point = Vec3::Zero();   ///< m, body frame
+  Vec3 force = Vec3::Zero();   ///< N
+  Vec3 torque = Vec3::Zero();  ///< N·m
+  bool follower = false;
+  ProfilePtr scale;  ///< null: constant
+};
+
+/// Per-body description as given by the user.
+struct BodySpec {
+  std::string name;
+  int parent = -1;
+  Mat4 placement = Mat4::Identity();  ///< T of the joint frame in the parent frame
+  Joint joint;
+  double mass = 0.0;
+  Vec3 com = Vec3::Zero();
+  Mat3 inertia = Mat3::Zero();  ///< about the centre of mass, body axes (kg·m²)
+};
+
+/// What the user says about one joint coordinate beyond its spring and damper.
+struct CoordinateSpec {
+  ProfilePtr drive;         ///< prescribed motion, or null
+  double force = 0.0;       ///< constant applied generalised force (N or N·m)
+  ForceLaw force_law;       ///< or a law Q(t, q, q̇) of the coordinate itself
+};
+
+/// Pseudo-inertia H = ∫ r rᵀ dm (4x4, body frame) of a body of mass m, centre of
+/// mass c and inertia tensor I_C about c: H = [[½ tr(I_O) 1 − I_O, m c], [m cᵀ, m]]
+/// with I_O = I_C + m(|c|² 1 − c cᵀ) the inertia about the body origin.
+Mat4 pseudo_inertia(double mass, const Vec3& com, const Mat3& inertia);
+
+class Model {
+ public:
+  explicit Model(const Vec3& gravity = Vec3(0.0, 0.0, -9.81));
+
+  /// Adds a body on `parent` (−1: ground); returns its handle. Throws
+  /// std::invalid_argument naming the argument for every bad value.
+  Body add_body(const std::string& name, int parent, const Joint& joint, const Mat4& placement, double mass,
+                const Vec3& com, const Mat3& inertia);
+  /// Prescribes coordinate `coordinate` (−1: the joint's only one) of a body's joint.
+  void prescribe(int body, int coordinate, ProfilePtr motion);
+  /// Adds a constant generalised force, or a law Q(t, q, q̇), on one joint coordinate.
+  void add_generalized_force(int body, int coordinate, double value, ForceLaw law);
+  void add_load(const Load& load);
+  void set_gravity(const Vec3& g);
+
+  const Vec3& gravity() const { return gravity_; }
+  const std::vector<BodySpec>& bodies() const { return bodies_; }
+  int body_index(const std::string& name) const;  ///< −1 for "ground"; throws if unknown
+  int coordinate_index(int body, const std::string& coordinate) const;
+
+  /// Freezes the description into an immutable System.
+  std::shared_ptr<const System> compile() const;
+
+ private:
+  void check_body(int body, const char* argument) const;
+  int resolve_coordinate(int body, int coordinate) const;
+  Vec3 gravity_;
+  std::vector<BodySpec> bodies_;
+  std::vector<std::vector<CoordinateSpec>> coords_;  // (nbodies) x (ncoords of the joint)
+  std::vector<Load> loads_;
+};
+
+}  // namespace rigidfem

@@ -1,0 +1,73 @@
+/// The compiled, immutable multibody system and its workspace.
+///
+/// System holds topology (bodies in order parent[p] < p), constant placements B_p,
+/// pseudo-inertias H_p and flat coordinate tables. Every scratch array lives in
+/// Data, so one System may be used by several threads, each with its own Data.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rigidfem/model.hpp"
+
+namespace rigidfem {
+
+/// One joint coordinate of the compiled system ("all coordinates": free and prescribed).
+struct Coordinate {
+  int body = -1;           ///< body whose joint it belongs to
+  int slot = 0;            ///< position within that joint
+  Axis axis = Axis::X;
+  int free_index = -1;     ///< index in q (free coordinates) or −1
+  int drive_index = -1;    ///< index in the prescribed list or −1
+  double stiffness = 0.0, rest = 0.0, damping = 0.0;
+  double force = 0.0;      ///< constant applied generalised force
+  ForceLaw force_law;      ///< optional Q(t, q, q̇)
+  ProfilePtr drive;        ///< prescribed motion, or null
+  std::string name;        ///< "body.rz"
+};
+
+class System {
+ public:
+  int nbodies = 0;
+  int nq = 0;  ///< free coordinates (the unknowns)
+  int np = 0;  ///< prescribed coordinates
+  int nc = 0;  ///< all joint coordinates, nq + np
+
+  std::vector<std::string> body_names;  // (nbodies)
+  std::vector<int> parent;              // (nbodies), −1 = ground, parent[p] < p
+  std::vector<std::vector<int>> children;  // (nbodies)
+  std::vector<Mat4> B;                  // (nbodies) 4x4 joint placement in the parent frame
+  std::vector<Mat4> H;                  // (nbodies) 4x4 pseudo-inertia, body frame
+  std::vector<double> mass;             // (nbodies)
+  std::vector<Joint> joint;             // (nbodies)
+  std::vector<int> coord_start;         // (nbodies + 1) first coordinate of body p in `coords`
+  std::vector<Coordinate> coords;       // (nc) in body order, within a joint in the book's order
+  std::vector<int> free_coords;         // (nq) -> index in coords
+  std::vector<int> drive_coords;        // (np) -> index in coords
+  Vec3 gravity = Vec3::Zero();          // m/s², global
+  std::vector<Load> loads;
+
+  std::vector<std::string> coordinate_names() const;  ///< (nq)
+  std::vector<std::string> prescribed_names() const;  ///< (np)
+};
+
+/// Workspace of the algorithms. "(nbodies) 4x4" are global quantities.
+struct Data {
+  explicit Data(const System& sys);
+  double t = 0.0;
+  VecX qa, qda, qdda;          // (nc) all coordinates: value, rate, acceleration
+  std::vector<Mat4> T;         // (nbodies) 4x4 T_p, pose of body p in the global frame
+  std::vector<Mat4> Td, Tdd;   // (nbodies) 4x4 Ṫ_p, T̈_p
+  std::vector<Mat4> U;         // (nc) 4x4 U_i with ∂T_p/∂q_i = U_i T_p (global twist of coordinate i)
+  std::vector<Mat4> Hbar;      // (nbodies) Σ_{k in subtree(p)} T_k H_k T_kᵀ
+  std::vector<Mat4> Wbar;      // (nbodies) Σ_{k in subtree(p)} T_k H_k T̈_kᵀ  (inertia)
+  std::vector<Mat4> Zbar;      // (nbodies) Σ_{k in subtree(p)} load moments   (gravity, forces)
+  MatX A;                      // (nq, nq) mass matrix
+  VecX f;                      // (nq) right-hand side: loads − velocity terms − springs − dampers
+  VecX qdd;                    // (nq)
+  VecX tau;                    // (np) driving forces of the prescribed coordinates
+  Eigen::LLT<MatX> llt;
+};
+
+}  // namespace rigidfem

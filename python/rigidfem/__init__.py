@@ -1,0 +1,57 @@
+"""rigidfem: flexible multibody dynamics by the rigid finite element method.
+
+Kinematic chains and trees in joint coordinates with homogeneous transformations,
+and the equations of motion of Wittbrodt, Adamiec-Wójcik & Wojciech, *Dynamics of
+Flexible Multibody Systems: Rigid Finite Element Method* (Springer 2006), with a
+C++ core. SI units throughout.
+"""
+
+from . import motion, samples, stages
+from ._core import (
+    R1,
+    R2,
+    R3,
+    Body,
+    Data,
+    JointSpec,
+    Point,
+    Profile,
+    SimulationError,
+    euler_zyx,
+    homogeneous,
+    inverse,
+    joint_transform,
+    joint_transform_derivative,
+    joint_transform_second_derivative,
+    skew,
+)
+from .joints import Joint
+from .model import Model, System, transform
+
+__version__ = "0.1.0"
+
+__all__ = [
+    "R1",
+    "R2",
+    "R3",
+    "Body",
+    "Data",
+    "Joint",
+    "JointSpec",
+    "Model",
+    "Point",
+    "Profile",
+    "SimulationError",
+    "System",
+    "euler_zyx",
+    "homogeneous",
+    "inverse",
+    "joint_transform",
+    "joint_transform_derivative",
+    "joint_transform_second_derivative",
+    "motion",
+    "samples",
+    "skew",
+    "stages",
+    "transform",
+]

@@ -1,0 +1,202 @@
+"""Model (the mutable description) and System (the compiled, immutable system).
+
+Build a Model body by body, then ``compile()`` it into a System whose methods
+evaluate the book's equations of motion A(q) q̈ = f(q, q̇, t). SI units throughout.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from . import _checks, _core
+from ._core import Body, JointSpec, Point, Profile
+
+
+def transform(translation=(0.0, 0.0, 0.0), euler_zyx=(0.0, 0.0, 0.0)) -> np.ndarray:
+    """Homogeneous transform Trans(translation) · R3(φ3) R2(φ2) R1(φ1) (4, 4).
+
+    ``translation`` in m, ``euler_zyx = (φ3, φ2, φ1)`` in rad (yaw, pitch, roll).
+    """
+    r = _checks.vec3(translation, "translation")
+    phi = _checks.vec3(euler_zyx, "euler_zyx")
+    return _core.homogeneous(_core.euler_zyx(*phi), r)
+
+
+def _inertia(inertia) -> np.ndarray:
+    a = np.asarray(inertia, dtype=float)
+    if a.shape == (3,):
+        a = np.diag(a)
+    if a.shape != (3, 3):
+        raise ValueError(
+            f"inertia: expected principal moments (3,) or a tensor (3, 3) in kg·m², got shape {np.shape(inertia)}"
+        )
+    return _checks.array(a, (3, 3), "inertia")
+
+
+class Model(_core._Model):
+    """A multibody system under construction.
+
+    Parameters
+    ----------
+    gravity : (3,) array or None
+        Gravitational acceleration in m/s², global frame; ``None`` for none.
+        Default ``(0, 0, -9.81)``.
+
+    Bodies are added after their parents, so the compiled system has parent[p] < p.
+    """
+
+    def __init__(self, gravity=(0.0, 0.0, -9.81)):
+        super().__init__(np.zeros(3) if gravity is None else _checks.vec3(gravity, "gravity"))
+
+    @property
+    def ground(self) -> Body:
+        """The ground (global frame), parent of the first bodies."""
+        return Body()
+
+    def body(self, name: str) -> Body:
+        """The handle of the body called ``name``."""
+        index = self._body_index(name)
+        return Body() if index < 0 else self._handle(index)
+
+    def _handle(self, index: int) -> Body:
+        return Body(index, self.body_names[index])
+
+    def _parent_index(self, parent) -> int:
+        if isinstance(parent, Body):
+            if parent.index >= self.nbodies:
+                raise ValueError(f"parent: expected a body of this model, got {parent!r}")
+            return parent.index
+        if isinstance(parent, str):
+            return self._body_index(parent)
+        raise ValueError(f"parent: expected a Body handle or a body name, got {parent!r}")
+
+    def add_body(
+        self,
+        name: str,
+        parent,
+        joint: JointSpec,
+        mass: float,
+        inertia,
+        com=(0.0, 0.0, 0.0),
+        placement=None,
+    ) -> Body:
+        """Add a rigid body hanging from ``parent`` through ``joint``.
+
+        Parameters
+        ----------
+        name : str
+            Unique name.
+        parent : Body or str
+            ``model.ground`` or an earlier body (handle or name).
+        joint : JointSpec
+            From ``rigidfem.Joint``: how the body moves relative to the joint frame.
+        mass : float
+            Mass in kg, positive.
+        inertia : (3,) or (3, 3) array
+            Principal moments (Ixx, Iyy, Izz) or the full tensor about the centre of
+            mass in body axes, kg·m². Positive definite, triangle inequality.
+        com : (3,) array
+            Centre of mass in the body frame, m.
+        placement : (4, 4) array, optional
+            Pose of the joint frame in the parent's frame (``rigidfem.transform``);
+            identity by default. The body frame is the joint frame moved by the joint.
+        """
+        if not isinstance(joint, JointSpec):
+            raise ValueError(f"joint: expected a joint from rigidfem.Joint, got {joint!r}")
+        B = np.eye(4) if placement is None else _checks.array(placement, (4, 4), "placement")
+        return self._add_body(
+            str(name),
+            self._parent_index(parent),
+            joint,
+            B,
+            _checks.scalar(mass, "mass"),
+            _checks.vec3(com, "com"),
+            _inertia(inertia),
+        )
+
+    def _coordinate(self, body: Body, coordinate: str | None) -> int:
+        if not isinstance(body, Body) or not 0 <= body.index < self.nbodies:
+            raise ValueError(f"body: expected a body of this model, got {body!r}")
+        return -1 if coordinate is None else self._coordinate_index(body.index, coordinate)
+
+    def prescribe(self, body: Body, motion: Profile, coordinate: str | None = None) -> None:
+        """Drive a coordinate of ``body``'s joint by ``motion`` (``rigidfem.motion.*``).
+
+        The coordinate leaves the unknowns q; ``System.driving_forces`` reports the
+        force (N) or torque (N·m) the drive must exert. ``coordinate`` names it
+        ("x", ..., "rx") when the joint has more than one.
+        """
+        if not isinstance(motion, Profile):
+            raise ValueError(f"motion: expected a profile from rigidfem.motion, got {motion!r}")
+        k = self._coordinate(body, coordinate)
+        self._prescribe(body.index, k, motion)
+
+    def add_generalized_force(
+        self, body: Body, force: float | Callable[[float, float, float], float], coordinate: str | None = None
+    ) -> None:
+        """Apply a generalised force (N or N·m) on a joint coordinate of ``body``.
+
+        ``force`` is a constant or a Python function ``Q(t, q, qd)`` of that
+        coordinate's own value and rate (slow path: called from C++ under the GIL).
+        """
+        k = self._coordinate(body, coordinate)
+        if callable(force):
+            self._add_generalized_force(body.index, k, 0.0, force)
+        else:
+            self._add_generalized_force(body.index, k, _checks.scalar(force, "force"), None)
+
+    def add_force(self, point, force, *, follower: bool = False, scale: Profile | None = None) -> None:
+        """Apply a point force (N) at ``point`` (a ``Point`` or a ``Body``'s origin).
+
+        ``force`` has global components, or body components turning with the body
+        when ``follower=True``. ``scale`` (a ``rigidfem.motion`` profile) multiplies
+        it by its value q(t).
+        """
+        p = self._point(point)
+        self._add_load(p.body, p.r, _checks.vec3(force, "force"), np.zeros(3), bool(follower), scale)
+
+    def add_torque(self, body: Body, torque, *, follower: bool = False, scale: Profile | None = None) -> None:
+        """Apply a torque (N·m) on ``body``: global components, or body ones if ``follower``."""
+        p = self._point(body)
+        self._add_load(p.body, np.zeros(3), np.zeros(3), _checks.vec3(torque, "torque"), bool(follower), scale)
+
+    def _point(self, point) -> Point:
+        if isinstance(point, Body):
+            point = point.origin
+        if not isinstance(point, Point) or not 0 <= point.body < self.nbodies:
+            raise ValueError(f"point: expected a Point or Body of this model, got {point!r}")
+        return point
+
+    def compile(self) -> System:
+        """Freeze the model into an immutable ``System``."""
+        return System(self)
+
+
+class System(_core._System):
+    """A compiled multibody system: the book's A(q) q̈ = f(q, q̇, t).
+
+    q holds the free joint coordinates (``coordinate_names``; m and rad), body by
+    body in the order the bodies were added, within a joint in the order x, y, z,
+    rz, ry, rx. Prescribed coordinates are not part of q; their drives are
+    evaluated at time t (s), which is why some methods take ``t``.
+    """
+
+    def position(self, point, q, t: float = 0.0) -> np.ndarray:
+        """Global position (3,) in m of a ``Point`` (or a ``Body``'s origin)."""
+        return self._position(point, q, t)
+
+    def velocity(self, point, q, qd, t: float = 0.0) -> np.ndarray:
+        """Global velocity (3,) in m/s of a ``Point`` (or a ``Body``'s origin)."""
+        return self._velocity(point, q, qd, t)
+
+    def coordinate_index(self, name: str) -> int:
+        """Index in q of the coordinate called ``name`` (e.g. ``"link1.rz"``)."""
+        names = self.coordinate_names
+        if name not in names:
+            raise ValueError(f"name: expected one of {names}, got {name!r}")
+        return names.index(name)
+
+    def __repr__(self) -> str:
+        return f"<rigidfem System: {self.nbodies} bodies, nq={self.nq}, {self.np} prescribed>"

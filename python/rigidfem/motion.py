@@ -1,0 +1,50 @@
+"""Prescribed motions q(t) of a joint coordinate, used by ``Model.prescribe`` (and to
+scale loads in time). Each returns a profile ``p`` with ``p(t) -> (q, qd, qdd)``;
+units follow the coordinate (m or rad; per s; per s²). All but ``function`` are
+evaluated in C++ at no Python cost.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable, Sequence
+
+import numpy as np
+
+from . import _core
+
+
+def constant(value: float) -> _core.Profile:
+    """q(t) = value (a locked coordinate)."""
+    return _core.constant_profile(value)
+
+
+def polynomial(coefficients: Sequence[float]) -> _core.Profile:
+    """q(t) = c0 + c1 t + c2 t² + ... (``coefficients`` = [c0, c1, ...])."""
+    return _core.polynomial_profile([float(c) for c in coefficients])
+
+
+def harmonic(amplitude: float, omega: float, phase: float = 0.0, offset: float = 0.0) -> _core.Profile:
+    """q(t) = offset + amplitude · sin(omega t + phase); omega in rad/s."""
+    return _core.harmonic_profile(amplitude, omega, phase, offset)
+
+
+def spin_up(omega: float, duration: float) -> _core.Profile:
+    """Kane's spin-up of a hub to the rate ``omega`` (rad/s) over ``duration`` T (s):
+    θ = (Ω/T)[t²/2 + (T/2π)²(cos(2πt/T) − 1)] for t < T, θ = Ω(t − T/2) after."""
+    return _core.spin_up_profile(omega, duration)
+
+
+def spline(t: Sequence[float], q: Sequence[float]) -> _core.Profile:
+    """Natural cubic spline through tabulated (t, q); outside the table q continues
+    linearly with the end slope."""
+    t = np.asarray(t, dtype=float).ravel()
+    q = np.asarray(q, dtype=float).ravel()
+    return _core.spline_profile(list(t), list(q))
+
+
+def function(f: Callable[[float], tuple[float, float, float]]) -> _core.Profile:
+    """A Python function ``f(t) -> (q, qd, qdd)``. Slow path: Python is called at every
+    evaluation, under the GIL."""
+    if not callable(f):
+        raise ValueError(f"f: expected a callable f(t) -> (q, qd, qdd), got {f!r}")
+    return _core.callback_profile(f)
