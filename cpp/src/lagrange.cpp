@@ -17,9 +17,11 @@ void check_vector(const Eigen::Ref<const VecX>& v, int n, const char* name, cons
   if (!v.allFinite()) throw std::invalid_argument(std::string(name) + ": expected finite values, got NaN or inf");
 }
 
+// Every stage checks its workspace: a Data made for another system would be written out of bounds.
 void check_data(const System& sys, const Data& d) {
-  if (static_cast<int>(d.T.size()) != sys.nbodies || d.qa.size() != sys.nc)
-    throw std::invalid_argument("data: expected a workspace made for this system");
+  if (static_cast<int>(d.T.size()) != sys.nbodies || d.qa.size() != sys.nc || d.A.rows() != sys.nq ||
+      d.f.size() != sys.nq || d.qdd.size() != sys.nq || d.tau.size() != sys.np)
+    throw std::invalid_argument("data: expected a workspace made by this system's make_data(), got one of another system");
 }
 
 // tr(U M) for U = [[S(w), v], [0, 0]]: only the first three rows of U are non-zero.
@@ -64,6 +66,7 @@ void set_state(const System& sys, Data& d, double t, const Eigen::Ref<const VecX
 }
 
 void kinematics(const System& sys, Data& d) {
+  check_data(sys, d);
   static const Mat4 I4 = Mat4::Identity(), O4 = Mat4::Zero();
   for (int p = 0; p < sys.nbodies; ++p) {
     // Joint frame F = T_parent B_p and its time derivatives.
@@ -101,11 +104,13 @@ void kinematics(const System& sys, Data& d) {
 }
 
 void inertia_composites(const System& sys, Data& d) {
+  check_data(sys, d);
   for (int p = 0; p < sys.nbodies; ++p) d.Wbar[p].noalias() = d.T[p] * sys.H[p] * d.Tdd[p].transpose();
   accumulate_subtrees(sys, d.Wbar);
 }
 
 void load_composites(const System& sys, Data& d) {
+  check_data(sys, d);
   const Vec4 g(sys.gravity.x(), sys.gravity.y(), sys.gravity.z(), 0.0);
   // Gravity: V = −Σ m gᵀ r_C, so Q_i = g̃ᵀ U_i T_p H_p e₄ = tr(U_i (T_p H_p e₄) g̃ᵀ).
   for (int p = 0; p < sys.nbodies; ++p) d.Zbar[p].noalias() = (d.T[p] * sys.H[p].col(3)) * g.transpose();
@@ -131,6 +136,7 @@ double passive_force(const System& sys, const Data& d, int i) {
 }
 
 void generalized_forces(const System& sys, Data& d) {
+  check_data(sys, d);
   load_composites(sys, d);
   inertia_composites(sys, d);
   // f_i = tr(U_i (Z̄_b − W̄_b)) + Q_i^passive: loads minus the velocity (and drive) terms.
@@ -141,6 +147,7 @@ void generalized_forces(const System& sys, Data& d) {
 }
 
 void mass_matrix(const System& sys, Data& d) {
+  check_data(sys, d);
   for (int p = 0; p < sys.nbodies; ++p) d.Hbar[p].noalias() = d.T[p] * sys.H[p] * d.T[p].transpose();
   accumulate_subtrees(sys, d.Hbar);
   // a_ij = tr(U_i H̄_b U_jᵀ) for coordinate i on the path from the root to j's body b.
@@ -159,6 +166,7 @@ void mass_matrix(const System& sys, Data& d) {
 }
 
 void accelerations(const System& sys, Data& d) {
+  check_data(sys, d);
   if (sys.nq == 0) return;
   d.llt.compute(d.A);
   if (d.llt.info() != Eigen::Success)
@@ -168,6 +176,7 @@ void accelerations(const System& sys, Data& d) {
 }
 
 void driving_forces(const System& sys, Data& d) {
+  check_data(sys, d);
   if (sys.np == 0) return;
   for (int k = 0; k < sys.nq; ++k) d.qdda(sys.free_coords[k]) = d.qdd(k);
   kinematics(sys, d);  // T̈ now holds the full accelerations
@@ -190,9 +199,7 @@ const VecX& forward_dynamics(const System& sys, Data& d, double t, const Eigen::
 }
 
 VecX rhs(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& y) {
-  if (y.size() != 2 * sys.nq)
-    throw std::invalid_argument("y: expected size " + std::to_string(2 * sys.nq) + " (2 nq), got " +
-                                std::to_string(y.size()));
+  check_vector(y, 2 * sys.nq, "y", "2 nq");
   VecX ydot(2 * sys.nq);
   ydot.head(sys.nq) = y.tail(sys.nq);
   ydot.tail(sys.nq) = forward_dynamics(sys, d, t, y.head(sys.nq), y.tail(sys.nq));
@@ -217,24 +224,28 @@ MatX rhs_jacobian(const System& sys, Data& d, double t, const Eigen::Ref<const V
 }
 
 double kinetic_energy(const System& sys, const Data& d) {
+  check_data(sys, d);
   double E = 0.0;
   for (int p = 0; p < sys.nbodies; ++p) E += 0.5 * (d.Td[p] * sys.H[p] * d.Td[p].transpose()).trace();
   return E;
 }
 
 double gravity_energy(const System& sys, const Data& d) {
+  check_data(sys, d);
   double V = 0.0;
   for (int p = 0; p < sys.nbodies; ++p) V -= sys.gravity.dot((d.T[p] * sys.H[p].col(3)).head<3>());
   return V;
 }
 
 double elastic_energy(const System& sys, const Data& d) {
+  check_data(sys, d);
   double V = 0.0;
   for (int i = 0; i < sys.nc; ++i) V += 0.5 * sys.coords[i].stiffness * std::pow(d.qa(i) - sys.coords[i].rest, 2);
   return V;
 }
 
 double dissipated_power(const System& sys, const Data& d) {
+  check_data(sys, d);
   double P = 0.0;
   for (int i = 0; i < sys.nc; ++i) P += sys.coords[i].damping * d.qda(i) * d.qda(i);
   return P;

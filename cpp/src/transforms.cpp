@@ -82,18 +82,21 @@ Mat4 generator(Axis a) {
 }
 
 namespace {
-void check_joint_args(const std::vector<Axis>& axes, const VecX& q, int i, int j) {
-  const int n = static_cast<int>(axes.size());
-  if (q.size() != n)
-    throw std::invalid_argument("q: expected size " + std::to_string(n) + " (joint coordinates), got " +
+void check_size(const std::vector<Axis>& axes, const VecX& q) {
+  if (q.size() != static_cast<int>(axes.size()))
+    throw std::invalid_argument("q: expected size " + std::to_string(axes.size()) + " (joint coordinates), got " +
                                 std::to_string(q.size()));
-  if (i < -1 || i >= n || j < -1 || j >= n)
-    throw std::invalid_argument("coordinate index: expected 0.." + std::to_string(n - 1));
 }
 
-// Π_k E_k(q_k), with the factors i and j multiplied on the right by their generators.
+void check_index(const std::vector<Axis>& axes, int i, const char* name) {
+  if (i < 0 || i >= static_cast<int>(axes.size()))
+    throw std::invalid_argument(std::string(name) + ": expected a coordinate index 0.." +
+                                std::to_string(static_cast<int>(axes.size()) - 1) + ", got " + std::to_string(i));
+}
+
+// Π_k E_k(q_k), with the factors i and j (−1: none) multiplied on the right by their generators.
 Mat4 product_with_generators(const std::vector<Axis>& axes, const VecX& q, int i, int j) {
-  check_joint_args(axes, q, i, j);
+  check_size(axes, q);
   Mat4 T = Mat4::Identity();
   for (int k = 0; k < static_cast<int>(axes.size()); ++k) {
     Mat4 E = elementary(axes[k], q(k));
@@ -108,10 +111,13 @@ Mat4 product_with_generators(const std::vector<Axis>& axes, const VecX& q, int i
 Mat4 joint_transform(const std::vector<Axis>& axes, const VecX& q) { return product_with_generators(axes, q, -1, -1); }
 
 Mat4 joint_transform_derivative(const std::vector<Axis>& axes, const VecX& q, int i) {
+  check_index(axes, i, "i");
   return product_with_generators(axes, q, i, -1);
 }
 
 Mat4 joint_transform_second_derivative(const std::vector<Axis>& axes, const VecX& q, int i, int j) {
+  check_index(axes, i, "i");
+  check_index(axes, j, "j");
   return product_with_generators(axes, q, i, j);
 }
 

@@ -20,6 +20,19 @@ def array(x, shape: tuple[int, ...], name: str) -> np.ndarray:
     return a
 
 
+def vector(x, name: str, min_length: int = 0) -> np.ndarray:
+    """``x`` as a finite 1-D float array of at least ``min_length`` values."""
+    try:
+        a = np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: expected a 1-D sequence of numbers, got {x!r}") from None
+    if a.ndim != 1 or a.size < min_length:
+        raise ValueError(f"{name}: expected a 1-D sequence of at least {min_length} numbers, got shape {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name}: expected finite values, got NaN or inf")
+    return a
+
+
 def vec3(x, name: str) -> np.ndarray:
     return array(x, (3,), name)
 
@@ -42,7 +55,9 @@ def per_coordinate(x, n: int, name: str, *, nonnegative: bool = False) -> list[f
     """A scalar (same for every coordinate) or a sequence of ``n`` values."""
     if np.ndim(x) == 0:
         return [scalar(x, name, nonnegative=nonnegative)] * n
-    values = list(np.asarray(x, dtype=float).ravel())
+    if np.ndim(x) != 1:
+        raise ValueError(f"{name}: expected a number or a 1-D sequence of {n} values, got shape {np.shape(x)}")
+    values = list(x)
     if len(values) != n:
         raise ValueError(f"{name}: expected a number or {n} values (one per joint coordinate), got {len(values)}")
     return [scalar(v, name, nonnegative=nonnegative) for v in values]

@@ -25,7 +25,10 @@ def transform(translation=(0.0, 0.0, 0.0), euler_zyx=(0.0, 0.0, 0.0)) -> np.ndar
 
 
 def _inertia(inertia) -> np.ndarray:
-    a = np.asarray(inertia, dtype=float)
+    try:
+        a = np.asarray(inertia, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"inertia: expected principal moments (3,) or a tensor (3, 3) in kg·m², got {inertia!r}") from None
     if a.shape == (3,):
         a = np.diag(a)
     if a.shape != (3, 3):
@@ -33,6 +36,12 @@ def _inertia(inertia) -> np.ndarray:
             f"inertia: expected principal moments (3,) or a tensor (3, 3) in kg·m², got shape {np.shape(inertia)}"
         )
     return _checks.array(a, (3, 3), "inertia")
+
+
+def _scale(scale):
+    if scale is not None and not isinstance(scale, Profile):
+        raise ValueError(f"scale: expected None or a profile from rigidfem.motion, got {scale!r}")
+    return scale
 
 
 class Model(_core._Model):
@@ -63,9 +72,13 @@ class Model(_core._Model):
     def _handle(self, index: int) -> Body:
         return Body(index, self.body_names[index])
 
+    def _owns(self, body: Body) -> bool:
+        """Whether the handle names a body of this model (or the ground)."""
+        return body.index == -1 or (0 <= body.index < self.nbodies and self.body_names[body.index] == body.name)
+
     def _parent_index(self, parent) -> int:
         if isinstance(parent, Body):
-            if parent.index >= self.nbodies:
+            if not self._owns(parent):
                 raise ValueError(f"parent: expected a body of this model, got {parent!r}")
             return parent.index
         if isinstance(parent, str):
@@ -117,7 +130,7 @@ class Model(_core._Model):
         )
 
     def _coordinate(self, body: Body, coordinate: str | None) -> int:
-        if not isinstance(body, Body) or not 0 <= body.index < self.nbodies:
+        if not isinstance(body, Body) or body.index < 0 or not self._owns(body):
             raise ValueError(f"body: expected a body of this model, got {body!r}")
         return -1 if coordinate is None else self._coordinate_index(body.index, coordinate)
 
@@ -155,15 +168,17 @@ class Model(_core._Model):
         it by its value q(t).
         """
         p = self._point(point)
-        self._add_load(p.body, p.r, _checks.vec3(force, "force"), np.zeros(3), bool(follower), scale)
+        self._add_load(p.body, p.r, _checks.vec3(force, "force"), np.zeros(3), bool(follower), _scale(scale))
 
     def add_torque(self, body: Body, torque, *, follower: bool = False, scale: Profile | None = None) -> None:
         """Apply a torque (N·m) on ``body``: global components, or body ones if ``follower``."""
         p = self._point(body)
-        self._add_load(p.body, np.zeros(3), np.zeros(3), _checks.vec3(torque, "torque"), bool(follower), scale)
+        self._add_load(p.body, np.zeros(3), np.zeros(3), _checks.vec3(torque, "torque"), bool(follower), _scale(scale))
 
     def _point(self, point) -> Point:
         if isinstance(point, Body):
+            if not self._owns(point):
+                raise ValueError(f"point: expected a Point or Body of this model, got {point!r}")
             point = point.origin
         if not isinstance(point, Point) or not 0 <= point.body < self.nbodies:
             raise ValueError(f"point: expected a Point or Body of this model, got {point!r}")

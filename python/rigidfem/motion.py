@@ -10,7 +10,7 @@ from collections.abc import Callable, Sequence
 
 import numpy as np
 
-from . import _core
+from . import _checks, _core
 
 
 def constant(value: float) -> _core.Profile:
@@ -37,9 +37,7 @@ def spin_up(omega: float, duration: float) -> _core.Profile:
 def spline(t: Sequence[float], q: Sequence[float]) -> _core.Profile:
     """Natural cubic spline through tabulated (t, q); outside the table q continues
     linearly with the end slope."""
-    t = np.asarray(t, dtype=float).ravel()
-    q = np.asarray(q, dtype=float).ravel()
-    return _core.spline_profile(list(t), list(q))
+    return _core.spline_profile(list(_checks.vector(t, "t")), list(_checks.vector(q, "q")))
 
 
 def function(f: Callable[[float], tuple[float, float, float]]) -> _core.Profile:
@@ -47,4 +45,11 @@ def function(f: Callable[[float], tuple[float, float, float]]) -> _core.Profile:
     evaluation, under the GIL."""
     if not callable(f):
         raise ValueError(f"f: expected a callable f(t) -> (q, qd, qdd), got {f!r}")
-    return _core.callback_profile(f)
+
+    def checked(t):
+        value = f(t)
+        if np.shape(value) != (3,):
+            raise ValueError(f"f: expected f(t) to return (q, qd, qdd), got {value!r} at t = {t}")
+        return tuple(float(v) for v in value)
+
+    return _core.callback_profile(checked)

@@ -1,0 +1,365 @@
+"""
+rigidfem C++ core: homogeneous transforms, models, the book's Lagrange formulation.
+"""
+from __future__ import annotations
+import collections.abc
+import numpy
+import numpy.typing
+import typing
+from . import stages
+__all__: list[str] = ['Body', 'Data', 'JointSpec', 'Point', 'Profile', 'R1', 'R2', 'R3', 'SimulationError', 'callback_profile', 'constant_profile', 'euler_zyx', 'harmonic_profile', 'homogeneous', 'inverse', 'joint_transform', 'joint_transform_derivative', 'joint_transform_second_derivative', 'polynomial_profile', 'skew', 'spin_up_profile', 'spline_profile', 'stages']
+class SimulationError(RuntimeError):
+    pass
+class Profile:
+    """
+    A prescribed motion q(t) with its rates (see rigidfem.motion).
+    """
+    def __call__(self, t: typing.SupportsFloat | typing.SupportsIndex) -> tuple[float, float, float]:
+        """
+        (q, qd, qdd) at time t (s).
+        """
+    def __repr__(self) -> str:
+        ...
+class JointSpec:
+    """
+    Active coordinates of a joint with their springs and dampers.
+    """
+    def __init__(self, kind: str, coordinates: collections.abc.Sequence[str]) -> None:
+        ...
+    @property
+    def coordinates(self) -> list[str]:
+        ...
+    @property
+    def damping(self) -> list[float]:
+        ...
+    @damping.setter
+    def damping(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def kind(self) -> str:
+        ...
+    @property
+    def ncoords(self) -> int:
+        ...
+    @property
+    def rest(self) -> list[float]:
+        ...
+    @rest.setter
+    def rest(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    @property
+    def stiffness(self) -> list[float]:
+        ...
+    @stiffness.setter
+    def stiffness(self, arg0: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+class Body:
+    """
+    Handle of a body of a Model (index -1 is the ground).
+    """
+    @typing.overload
+    def __init__(self) -> None:
+        """
+        The ground.
+        """
+    @typing.overload
+    def __init__(self, index: typing.SupportsInt | typing.SupportsIndex, name: str) -> None:
+        ...
+    def __repr__(self) -> str:
+        ...
+    def point(self, r: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> ...:
+        """
+        The material point at r (m, body frame).
+        """
+    @property
+    def index(self) -> int:
+        ...
+    @property
+    def name(self) -> str:
+        ...
+    @property
+    def origin(self) -> ...:
+        """
+        The point at the body frame's origin.
+        """
+class Point:
+    """
+    A material point: body index and position r (m) in the body frame.
+    """
+    @typing.overload
+    def __init__(self, body: typing.SupportsInt | typing.SupportsIndex, r: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
+    @typing.overload
+    def __init__(self, body: Body) -> None:
+        ...
+    @property
+    def body(self) -> int:
+        ...
+    @property
+    def r(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+class _Model:
+    def __init__(self, gravity: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
+    def _add_body(self, name: str, parent: typing.SupportsInt | typing.SupportsIndex, joint: JointSpec, placement: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"], mass: typing.SupportsFloat | typing.SupportsIndex, com: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], inertia: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 3]"]) -> Body:
+        ...
+    def _add_generalized_force(self, body: typing.SupportsInt | typing.SupportsIndex, coordinate: typing.SupportsInt | typing.SupportsIndex, value: typing.SupportsFloat | typing.SupportsIndex, law: collections.abc.Callable[[float, float, float], typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        ...
+    def _add_load(self, body: typing.SupportsInt | typing.SupportsIndex, point: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], force: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], torque: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], follower: bool, scale: Profile) -> None:
+        ...
+    def _body_index(self, name: str) -> int:
+        ...
+    def _coordinate_index(self, body: typing.SupportsInt | typing.SupportsIndex, coordinate: str) -> int:
+        ...
+    def _prescribe(self, body: typing.SupportsInt | typing.SupportsIndex, coordinate: typing.SupportsInt | typing.SupportsIndex, motion: Profile) -> None:
+        ...
+    @property
+    def body_names(self) -> list[str]:
+        ...
+    @property
+    def gravity(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        """
+        Gravitational acceleration (m/s^2), global.
+        """
+    @gravity.setter
+    def gravity(self, arg1: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+        ...
+    @property
+    def nbodies(self) -> int:
+        ...
+class _System:
+    def __init__(self, model: _Model) -> None:
+        ...
+    def _position(self, point: Point, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], t: typing.SupportsFloat | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    def _velocity(self, point: Point, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], t: typing.SupportsFloat | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        ...
+    def dissipated_power(self, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], t: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> float:
+        """
+        Power dissipated by the joint dampers, sum b qd^2 (W).
+        """
+    def driving_forces(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        Forces/torques (np,) the drives exert on the prescribed coordinates (N or N m).
+        """
+    def elastic_energy(self, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], t: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> float:
+        """
+        Energy of the joint springs 1/2 sum c (q - q_rest)^2 (J).
+        """
+    def forward_dynamics(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        Accelerations qdd (nq,) solving A(q) qdd = f(q, qd, t); t in s, q in m/rad, qd in m/s, rad/s.
+        """
+    def generalized_forces(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        Right-hand side f (nq,) of A qdd = f: loads, gravity, springs, dampers minus velocity terms (N, N m).
+        """
+    def gravity_energy(self, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], t: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> float:
+        """
+        Potential energy of gravity -sum m g^T r_C (J).
+        """
+    def jacobian(self, t: typing.SupportsFloat | typing.SupportsIndex, y: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        """
+        d(rhs)/dy (2 nq, 2 nq) by central finite differences, for solve_ivp(jac=...).
+        """
+    def kinetic_energy(self, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], t: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> float:
+        """
+        Kinetic energy 1/2 sum tr(dT H dT^T) (J).
+        """
+    def make_data(self) -> ...:
+        """
+        A fresh workspace for the stage functions.
+        """
+    def mass_matrix(self, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], t: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        """
+        Mass matrix A(q) (nq, nq), a_ij = sum_p tr(T_p,i H_p T_p,j^T).
+        """
+    def potential_energy(self, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], t: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> float:
+        """
+        Gravity plus elastic energy (J).
+        """
+    def rhs(self, t: typing.SupportsFloat | typing.SupportsIndex, y: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        dy/dt = [qd, qdd] for y = [q, qd] (2 nq,): the signature of scipy's solve_ivp.
+        """
+    def transform(self, body: typing.SupportsInt | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], t: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
+        """
+        Pose T_p (4, 4) of a body (by index) in the global frame.
+        """
+    @property
+    def body_names(self) -> list[str]:
+        ...
+    @property
+    def coordinate_names(self) -> list[str]:
+        """
+        Names 'body.axis' of the free coordinates, in the order of q.
+        """
+    @property
+    def gravity(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
+        """
+        Gravitational acceleration (m/s^2), global.
+        """
+    @property
+    def nbodies(self) -> int:
+        ...
+    @property
+    def nc(self) -> int:
+        """
+        Number of all joint coordinates, nq + np.
+        """
+    @property
+    def np(self) -> int:
+        """
+        Number of prescribed (driven) coordinates.
+        """
+    @property
+    def nq(self) -> int:
+        """
+        Number of free joint coordinates (the unknowns).
+        """
+    @property
+    def parent(self) -> list[int]:
+        """
+        Parent index of every body (-1: ground), parent[p] < p.
+        """
+    @property
+    def placements(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
+        """
+        Constant joint placements B_p (4, 4) in the parent frame.
+        """
+    @property
+    def prescribed_names(self) -> list[str]:
+        """
+        Names of the prescribed coordinates, in the order of driving_forces().
+        """
+    @property
+    def pseudo_inertias(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
+        """
+        Pseudo-inertia H_p = int r r^T dm (4, 4) of every body, body frame (kg, kg m, kg m^2).
+        """
+class Data:
+    """
+    Workspace of the algorithms; after each stage it holds that stage's results.
+    """
+    @property
+    def A(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        """
+        Mass matrix (nq, nq).
+        """
+    @property
+    def Hbar(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
+        """
+        Subtree sums of T_p H_p T_p^T.
+        """
+    @property
+    def T(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
+        """
+        Global pose T_p (4, 4) of every body.
+        """
+    @property
+    def Td(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
+        """
+        dT_p/dt.
+        """
+    @property
+    def Tdd(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
+        """
+        d2T_p/dt2 (with the free accelerations zero unless driving_forces ran).
+        """
+    @property
+    def U(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
+        """
+        U_i (4, 4) of every coordinate: dT_p/dq_i = U_i T_p.
+        """
+    @property
+    def Wbar(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
+        """
+        Subtree sums of T_p H_p Tdd_p^T.
+        """
+    @property
+    def Zbar(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
+        """
+        Subtree sums of the load moments.
+        """
+    @property
+    def f(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        Right-hand side (nq,).
+        """
+    @property
+    def qa(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        All coordinates (nc,), free and prescribed.
+        """
+    @property
+    def qda(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def qdd(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        Accelerations (nq,).
+        """
+    @property
+    def qdda(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def t(self) -> float:
+        ...
+    @property
+    def tau(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        Driving forces (np,).
+        """
+def R1(phi1: typing.SupportsFloat | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
+    """
+    Rotation matrix about x by phi1 (rad), (3, 3).
+    """
+def R2(phi2: typing.SupportsFloat | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
+    """
+    Rotation matrix about y by phi2 (rad), (3, 3).
+    """
+def R3(phi3: typing.SupportsFloat | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
+    """
+    Rotation matrix about z by phi3 (rad), (3, 3).
+    """
+def callback_profile(function: collections.abc.Callable[[float], tuple[typing.SupportsFloat | typing.SupportsIndex, typing.SupportsFloat | typing.SupportsIndex, typing.SupportsFloat | typing.SupportsIndex]]) -> Profile:
+    ...
+def constant_profile(value: typing.SupportsFloat | typing.SupportsIndex) -> Profile:
+    ...
+def euler_zyx(phi3: typing.SupportsFloat | typing.SupportsIndex, phi2: typing.SupportsFloat | typing.SupportsIndex, phi1: typing.SupportsFloat | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
+    """
+    R3(phi3) R2(phi2) R1(phi1), book eq. (2.7): yaw, pitch, roll in rad. (3, 3).
+    """
+def harmonic_profile(amplitude: typing.SupportsFloat | typing.SupportsIndex, omega: typing.SupportsFloat | typing.SupportsIndex, phase: typing.SupportsFloat | typing.SupportsIndex, offset: typing.SupportsFloat | typing.SupportsIndex) -> Profile:
+    ...
+def homogeneous(R: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 3]"], r: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
+    """
+    [[R, r], [0, 1]] (4, 4); r in m.
+    """
+def inverse(T: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
+    """
+    Inverse of a homogeneous transform, [[R^T, -R^T r], [0, 1]] (4, 4).
+    """
+def joint_transform(coordinates: collections.abc.Sequence[str], q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
+    """
+    Joint transform Trans(x, y, z) R3(phi3) R2(phi2) R1(phi1) restricted to `coordinates`
+    (names from 'x', 'y', 'z', 'rz', 'ry', 'rx', taken in the book's order); q in m and rad. (4, 4).
+    """
+def joint_transform_derivative(coordinates: collections.abc.Sequence[str], q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], i: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
+    """
+    dT/dq_i of joint_transform (4, 4).
+    """
+def joint_transform_second_derivative(coordinates: collections.abc.Sequence[str], q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], i: typing.SupportsInt | typing.SupportsIndex, j: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
+    """
+    d2T/dq_i dq_j of joint_transform (4, 4).
+    """
+def polynomial_profile(coefficients: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> Profile:
+    ...
+def skew(w: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
+    """
+    Skew-symmetric S(w) with S(w) x = w x x. (3, 3).
+    """
+def spin_up_profile(omega: typing.SupportsFloat | typing.SupportsIndex, duration: typing.SupportsFloat | typing.SupportsIndex) -> Profile:
+    ...
+def spline_profile(t: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], q: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> Profile:
+    ...
