@@ -61,13 +61,40 @@ void bind_dynamics(py::module_& m) {
           },
           py::arg("q"), py::arg("t") = 0.0, "Mass matrix A(q) (nq, nq), a_ij = sum_p tr(T_p,i H_p T_p,j^T).")
       .def(
-          "generalized_forces", [](const System& s, double t, const RefV& q, const RefV& qd) {
-            Data d = at(s, t, q, qd);
+          "generalized_forces",
+          [](const System& s, double t, const RefV& q, const RefV& qd, double load_factor) {
+            Data d(s);
+            d.load_factor = load_factor;
+            set_state(s, d, t, q, qd);
+            kinematics(s, d);
             rigidfem::generalized_forces(s, d);
             return d.f;
           },
-          py::arg("t"), py::arg("q"), py::arg("qd"),
-          "Right-hand side f (nq,) of A qdd = f: loads, gravity, springs, dampers minus velocity terms (N, N m).")
+          py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("load_factor") = 1.0,
+          "Right-hand side f (nq,) of A qdd = f: loads, gravity, springs, dampers minus velocity terms (N, N m).\n"
+          "load_factor scales gravity, loads and applied generalised forces.")
+      .def(
+          "static_forces",
+          [](const System& s, double t, const RefV& q, double load_factor) {
+            Data d(s);
+            d.load_factor = load_factor;
+            set_static_state(s, d, t, q);
+            kinematics(s, d);
+            rigidfem::generalized_forces(s, d);
+            return d.f;
+          },
+          py::arg("t"), py::arg("q"), py::arg("load_factor") = 1.0,
+          "Static residual f(q) (nq,): generalised forces at rest, prescribed coordinates held at their values at t.")
+      .def(
+          "force_jacobians",
+          [](const System& s, double t, const RefV& q, const RefV& qd, double load_factor, bool static_drives) {
+            Data d(s);
+            d.load_factor = load_factor;
+            return rigidfem::force_jacobians(s, d, t, q, qd, static_drives);
+          },
+          py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("load_factor") = 1.0, py::arg("static") = false,
+          "(df/dq, df/dqd), each (nq, nq), by central differences. -df/dq is the tangent stiffness K,\n"
+          "-df/dqd the damping and gyroscopic matrix C. static=True holds the prescribed coordinates at t.")
       .def(
           "driving_forces", [](const System& s, double t, const RefV& q, const RefV& qd) {
             Data d(s);
@@ -143,7 +170,8 @@ void bind_dynamics(py::module_& m) {
       .def_readonly("T", &Data::T, "Global pose T_p (4, 4) of every body.")
       .def_readonly("Td", &Data::Td, "dT_p/dt.")
       .def_readonly("Tdd", &Data::Tdd, "d2T_p/dt2 (with the free accelerations zero unless driving_forces ran).")
-      .def_readonly("U", &Data::U, "U_i (4, 4) of every coordinate: dT_p/dq_i = U_i T_p.")
+      .def_readonly("U", &Data::U, "U (4, 4) of every coordinate use: dT_p/dq_i = U_i T_p for the bodies p below\n"
+                                   "coordinate i (without linear-model couplings, use i is coordinate i).")
       .def_readonly("Hbar", &Data::Hbar, "Subtree sums of T_p H_p T_p^T.")
       .def_readonly("Wbar", &Data::Wbar, "Subtree sums of T_p H_p Tdd_p^T.")
       .def_readonly("Zbar", &Data::Zbar, "Subtree sums of the load moments.")

@@ -24,7 +24,13 @@ void bind_model(py::module_& m) {
       .def_readwrite("stiffness", &Joint::stiffness)
       .def_readwrite("rest", &Joint::rest)
       .def_readwrite("damping", &Joint::damping)
-      .def_property_readonly("ncoords", &Joint::ncoords);
+      .def_readwrite("linear", &Joint::linear, "The book's linear model: T = [[1 + S(phi), r], [0, 1]].")
+      .def_property_readonly("ncoords", &Joint::ncoords)
+      .def(
+          "add_coupling", [](Joint& j, int body, int slot, const Mat4& G) { j.coupled.push_back({body, slot, G}); },
+          py::arg("body"), py::arg("slot"), py::arg("G"),
+          "Let coordinate `slot` of an earlier body (index) also move this linear joint, with generator G (4, 4)\n"
+          "in this joint's frame: T = 1 + sum G q (used by the linear model of beams).");
 
   py::class_<Body>(m, "Body", "Handle of a body of a Model (index -1 is the ground).")
       .def(py::init<>(), "The ground.")
@@ -44,6 +50,10 @@ void bind_model(py::module_& m) {
       .def_readonly("body", &Point::body)
       .def_readonly("r", &Point::r);
   py::implicitly_convertible<Body, Point>();
+
+  m.def("pseudo_inertia", &pseudo_inertia, py::arg("mass"), py::arg("com"), py::arg("inertia"),
+        "Pseudo-inertia H = int r r^T dm (4, 4) of a body: mass (kg), centre of mass com (3,) m and\n"
+        "inertia tensor (3, 3) about the centre of mass (kg m^2), all in the body frame.");
 
   py::class_<Model>(m, "_Model")
       .def(py::init<const Vec3&>(), py::arg("gravity"))

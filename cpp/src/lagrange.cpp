@@ -65,41 +65,76 @@ void set_state(const System& sys, Data& d, double t, const Eigen::Ref<const VecX
   }
 }
 
+void set_static_state(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q) {
+  set_state(sys, d, t, q, VecX::Zero(sys.nq));
+  for (int i : sys.drive_coords) d.qda(i) = d.qdda(i) = 0.0;
+}
+
+namespace {
+
+// Motion of body p's joint in its own frame ("jcalc", the one place that knows joint
+// types): T̃, Ṫ̃, T̃̈ and, per use u, the local twist X_u = (∂T̃/∂q_u) T̃⁻¹ (in d.X).
+void jcalc(const System& sys, int p, Data& d, Mat4& T, Mat4& Td, Mat4& Tdd) {
+  const int u0 = sys.use_start[p], n = sys.use_start[p + 1] - u0;
+  if (sys.joint[p].linear) {
+    // T̃ = 1 + Σ_u G_u q_u: Ṫ̃ = Σ G_u q̇_u, T̃̈ = Σ G_u q̈_u, ∂T̃/∂q_u = G_u.
+    T.setIdentity();
+    Td.setZero();
+    Tdd.setZero();
+    for (int k = 0; k < n; ++k) {
+      const int i = sys.use_coord[u0 + k];
+      const Mat4& G = sys.use_G[u0 + k];
+      T += G * d.qa(i);
+      Td += G * d.qda(i);
+      Tdd += G * d.qdda(i);
+    }
+    const Mat4 Ti = affine_inverse(T);
+    for (int k = 0; k < n; ++k) d.X[k].noalias() = sys.use_G[u0 + k] * Ti;
+    return;
+  }
+  // Exact: T̃ = Π_k E_k(q_k); multiply in the elementary factors with the product rule
+  // in time, Ė = E Q q̇, Ë = E (Q q̈ + Q² q̇²), (P E)¨ = P̈ E + 2 Ṗ Ė + P Ë.
+  Mat4 P = Mat4::Identity(), Pd = Mat4::Zero(), Pdd = Mat4::Zero();
+  for (int k = 0; k < n; ++k) {
+    const int i = sys.use_coord[u0 + k];
+    const Mat4& Q = sys.use_G[u0 + k];
+    const Mat4 E = elementary(sys.coords[i].axis, d.qa(i));
+    const Mat4 EQ = E * Q;
+    const double qd = d.qda(i);
+    const Mat4 Ed = EQ * qd, Edd = EQ * d.qdda(i) + EQ * Q * (qd * qd);
+    Pdd = Pdd * E + 2.0 * Pd * Ed + P * Edd;
+    Pd = Pd * E + P * Ed;
+    P = P * E;
+    // ∂T̃/∂q_k = P_k Q_k (E_{k+1} ...) = (P_k Q_k P_k⁻¹) T̃ with P_k = E_1 ... E_k rigid.
+    d.X[k].noalias() = P * Q * inverse(P);
+  }
+  T = P;
+  Td = Pd;
+  Tdd = Pdd;
+}
+
+}  // namespace
+
 void kinematics(const System& sys, Data& d) {
   check_data(sys, d);
   static const Mat4 I4 = Mat4::Identity(), O4 = Mat4::Zero();
+  Mat4 Tj, Tjd, Tjdd;
   for (int p = 0; p < sys.nbodies; ++p) {
     // Joint frame F = T_parent B_p and its time derivatives.
-    Mat4 P = frame_of_parent(sys, d.T, p, I4) * sys.B[p];
-    Mat4 Pd = frame_of_parent(sys, d.Td, p, O4) * sys.B[p];
-    Mat4 Pdd = frame_of_parent(sys, d.Tdd, p, O4) * sys.B[p];
-    // Multiply in the elementary factors E_k of T̃_p, product rule in time:
-    // Ė = E Q q̇, Ë = E (Q q̈ + Q² q̇²); (PE)¨ = P̈E + 2ṖĖ + PË.
-    for (int i = sys.coord_start[p]; i < sys.coord_start[p + 1]; ++i) {
-      const Axis a = sys.coords[i].axis;
-      const double qd = d.qda(i), qdd = d.qdda(i);
-      const Mat4 E = elementary(a, d.qa(i)), Q = generator(a);
-      const Mat4 EQ = E * Q;
-      const Mat4 Ed = EQ * qd, Edd = EQ * qdd + EQ * Q * (qd * qd);
-      Pdd = Pdd * E + 2.0 * Pd * Ed + P * Edd;
-      Pd = Pd * E + P * Ed;
-      P = P * E;
-      // U_i = F_i Q_i F_i⁻¹ with F_i the frame just after E_i: rotation about the
-      // global axis w = R e through the frame origin p, U = [[S(w), p × w], [0, 0]];
-      // translation along v = R e, U = [[0, v], [0, 0]].
-      const Vec3 e = P.topLeftCorner<3, 3>() * axis_direction(a);
-      Mat4& U = d.U[i];
-      U.setZero();
-      if (is_rotation(a)) {
-        U.topLeftCorner<3, 3>() = skew(e);
-        U.topRightCorner<3, 1>() = P.topRightCorner<3, 1>().cross(e);
-      } else {
-        U.topRightCorner<3, 1>() = e;
-      }
-    }
-    d.T[p] = P;
-    d.Td[p] = Pd;
-    d.Tdd[p] = Pdd;
+    const Mat4 F = frame_of_parent(sys, d.T, p, I4) * sys.B[p];
+    const Mat4 Fd = frame_of_parent(sys, d.Td, p, O4) * sys.B[p];
+    const Mat4 Fdd = frame_of_parent(sys, d.Tdd, p, O4) * sys.B[p];
+    jcalc(sys, p, d, Tj, Tjd, Tjdd);
+    // T_p = F T̃, Ṫ_p = Ḟ T̃ + F Ṫ̃, T̈_p = F̈ T̃ + 2 Ḟ Ṫ̃ + F T̃̈.
+    d.T[p].noalias() = F * Tj;
+    d.Td[p].noalias() = Fd * Tj + F * Tjd;
+    d.Tdd[p].noalias() = Fdd * Tj + 2.0 * Fd * Tjd + F * Tjdd;
+    // ∂T_k/∂q = F X_u F⁻¹ T_k = U_u T_k for every body k at or below p. F is affine but
+    // not always rigid (below a linear joint), hence the affine inverse.
+    const int u0 = sys.use_start[p], n = sys.use_start[p + 1] - u0;
+    if (n == 0) continue;
+    const Mat4 Fi = affine_inverse(F);
+    for (int k = 0; k < n; ++k) d.U[u0 + k].noalias() = F * d.X[k] * Fi;
   }
 }
 
@@ -111,11 +146,12 @@ void inertia_composites(const System& sys, Data& d) {
 
 void load_composites(const System& sys, Data& d) {
   check_data(sys, d);
-  const Vec4 g(sys.gravity.x(), sys.gravity.y(), sys.gravity.z(), 0.0);
+  const Vec3 gl = d.load_factor * sys.gravity;
+  const Vec4 g(gl.x(), gl.y(), gl.z(), 0.0);
   // Gravity: V = −Σ m gᵀ r_C, so Q_i = g̃ᵀ U_i T_p H_p e₄ = tr(U_i (T_p H_p e₄) g̃ᵀ).
   for (int p = 0; p < sys.nbodies; ++p) d.Zbar[p].noalias() = (d.T[p] * sys.H[p].col(3)) * g.transpose();
   for (const Load& L : sys.loads) {
-    const double s = L.scale ? L.scale->at(d.t).q : 1.0;
+    const double s = d.load_factor * (L.scale ? L.scale->at(d.t).q : 1.0);
     const Mat3 R = d.T[L.body].topLeftCorner<3, 3>();
     const Vec3 F = s * (L.follower ? Vec3(R * L.force) : L.force);
     const Vec3 tau = s * (L.follower ? Vec3(R * L.torque) : L.torque);
@@ -130,36 +166,45 @@ void load_composites(const System& sys, Data& d) {
 
 double passive_force(const System& sys, const Data& d, int i) {
   const Coordinate& c = sys.coords[i];
-  double Q = -c.stiffness * (d.qa(i) - c.rest) - c.damping * d.qda(i) + c.force;
-  if (c.force_law) Q += c.force_law(d.t, d.qa(i), d.qda(i));
-  return Q;
+  double applied = c.force;
+  if (c.force_law) applied += c.force_law(d.t, d.qa(i), d.qda(i));
+  return -c.stiffness * (d.qa(i) - c.rest) - c.damping * d.qda(i) + d.load_factor * applied;
 }
 
 void generalized_forces(const System& sys, Data& d) {
   check_data(sys, d);
   load_composites(sys, d);
   inertia_composites(sys, d);
-  // f_i = tr(U_i (Z̄_b − W̄_b)) + Q_i^passive: loads minus the velocity (and drive) terms.
-  for (int k = 0; k < sys.nq; ++k) {
-    const int i = sys.free_coords[k], b = sys.coords[i].body;
-    d.f(k) = trace_product(d.U[i], d.Zbar[b] - d.Wbar[b]) + passive_force(sys, d, i);
-  }
+  // f_i = Σ_{uses of q_i} tr(U_u (Z̄_b − W̄_b)) + Q_i^passive: loads minus the velocity (and drive) terms.
+  for (int k = 0; k < sys.nq; ++k) d.f(k) = passive_force(sys, d, sys.free_coords[k]);
+  for (int b = 0; b < sys.nbodies; ++b)
+    for (int u = sys.use_start[b]; u < sys.use_start[b + 1]; ++u) {
+      const int k = sys.coords[sys.use_coord[u]].free_index;
+      if (k >= 0) d.f(k) += trace_product(d.U[u], d.Zbar[b] - d.Wbar[b]);
+    }
 }
 
 void mass_matrix(const System& sys, Data& d) {
   check_data(sys, d);
   for (int p = 0; p < sys.nbodies; ++p) d.Hbar[p].noalias() = d.T[p] * sys.H[p] * d.T[p].transpose();
   accumulate_subtrees(sys, d.Hbar);
-  // a_ij = tr(U_i H̄_b U_jᵀ) for coordinate i on the path from the root to j's body b.
-  for (int l = 0; l < sys.nq; ++l) {
-    const int j = sys.free_coords[l], b = sys.coords[j].body;
-    const Mat4 P = d.Hbar[b] * d.U[j].transpose();
-    for (int body = b; body >= 0; body = sys.parent[body]) {
-      const int last = body == b ? j : sys.coord_start[body + 1] - 1;
-      for (int i = sys.coord_start[body]; i <= last; ++i) {
-        const int k = sys.coords[i].free_index;
-        if (k < 0) continue;  // prescribed
-        d.A(k, l) = d.A(l, k) = trace_product(d.U[i], P);
+  // a_ij = Σ tr(U_u H̄_b U_vᵀ) over the pairs of uses u of q_i and v of q_j (on body b)
+  // with u on the path from the root to b: each pair once, mirrored.
+  d.A.setZero();
+  for (int b = 0; b < sys.nbodies; ++b) {
+    for (int v = sys.use_start[b]; v < sys.use_start[b + 1]; ++v) {
+      const int l = sys.coords[sys.use_coord[v]].free_index;
+      if (l < 0) continue;  // prescribed
+      const Mat4 P = d.Hbar[b] * d.U[v].transpose();
+      for (int body = b; body >= 0; body = sys.parent[body]) {
+        const int last = body == b ? v : sys.use_start[body + 1] - 1;
+        for (int u = sys.use_start[body]; u <= last; ++u) {
+          const int k = sys.coords[sys.use_coord[u]].free_index;
+          if (k < 0) continue;
+          const double a = trace_product(d.U[u], P);
+          d.A(k, l) += a;
+          if (u != v) d.A(l, k) += a;
+        }
       }
     }
   }
@@ -182,10 +227,12 @@ void driving_forces(const System& sys, Data& d) {
   kinematics(sys, d);  // T̈ now holds the full accelerations
   inertia_composites(sys, d);
   // Row i of the full equations: Σ tr(T_{p,i} H T̈ᵀ) = Q_i^loads + Q_i^passive + τ_i.
-  for (int k = 0; k < sys.np; ++k) {
-    const int i = sys.drive_coords[k], b = sys.coords[i].body;
-    d.tau(k) = trace_product(d.U[i], d.Wbar[b] - d.Zbar[b]) - passive_force(sys, d, i);
-  }
+  for (int k = 0; k < sys.np; ++k) d.tau(k) = -passive_force(sys, d, sys.drive_coords[k]);
+  for (int b = 0; b < sys.nbodies; ++b)
+    for (int u = sys.use_start[b]; u < sys.use_start[b + 1]; ++u) {
+      const int k = sys.coords[sys.use_coord[u]].drive_index;
+      if (k >= 0) d.tau(k) += trace_product(d.U[u], d.Wbar[b] - d.Zbar[b]);
+    }
 }
 
 const VecX& forward_dynamics(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
@@ -221,6 +268,40 @@ MatX rhs_jacobian(const System& sys, Data& d, double t, const Eigen::Ref<const V
     J.col(j) = (fp - fm) / (2.0 * h);
   }
   return J;
+}
+
+std::pair<MatX, MatX> force_jacobians(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                                      const Eigen::Ref<const VecX>& qd, bool static_drives) {
+  auto f = [&](const VecX& x, const VecX& xd) -> VecX {
+    if (static_drives)
+      set_static_state(sys, d, t, x);
+    else
+      set_state(sys, d, t, x, xd);
+    kinematics(sys, d);
+    generalized_forces(sys, d);
+    return d.f;
+  };
+  MatX dq(sys.nq, sys.nq), dqd = MatX::Zero(sys.nq, sys.nq);
+  VecX x = q, xd = static_drives ? VecX::Zero(sys.nq) : VecX(qd);
+  for (int j = 0; j < sys.nq; ++j) {
+    // Central differences, step ∝ ε^(1/3).
+    const double h = 6e-6 * std::max(1.0, std::abs(x(j)));
+    x(j) += h;
+    const VecX fp = f(x, xd);
+    x(j) -= 2.0 * h;
+    const VecX fm = f(x, xd);
+    x(j) += h;
+    dq.col(j) = (fp - fm) / (2.0 * h);
+    if (static_drives) continue;
+    const double hv = 6e-6 * std::max(1.0, std::abs(xd(j)));
+    xd(j) += hv;
+    const VecX gp = f(x, xd);
+    xd(j) -= 2.0 * hv;
+    const VecX gm = f(x, xd);
+    xd(j) += hv;
+    dqd.col(j) = (gp - gm) / (2.0 * hv);
+  }
+  return {dq, dqd};
 }
 
 double kinetic_energy(const System& sys, const Data& d) {

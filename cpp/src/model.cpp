@@ -131,6 +131,13 @@ Body Model::add_body(const std::string& name, int parent, const Joint& joint, co
       bad("damping", "non-negative finite values", num(joint.damping[k]));
     if (!std::isfinite(joint.rest[k])) bad("rest", "finite values", num(joint.rest[k]));
   }
+  for (const auto& c : joint.coupled) {
+    if (!joint.linear) bad("joint", "coupled coordinates only on a linear joint", "an exact joint");
+    if (c.body < 0 || c.body >= static_cast<int>(bodies_.size()) || c.slot < 0 ||
+        c.slot >= bodies_[c.body].joint.ncoords())
+      bad("joint", "coupled coordinates of bodies already in the model", "body " + std::to_string(c.body));
+    require_finite(c.G, "coupling generator");
+  }
   bodies_.push_back({name, parent, placement, joint, mass, com, 0.5 * (inertia + inertia.transpose())});
   coords_.emplace_back(n);
   return Body{static_cast<int>(bodies_.size()) - 1, name};
@@ -226,6 +233,21 @@ std::shared_ptr<const System> Model::compile() const {
     }
     s.coord_start.push_back(static_cast<int>(s.coords.size()));
   }
+  // Uses: own coordinates with their elementary generators, then the coupled ones.
+  for (int p = 0; p < s.nbodies; ++p) {
+    s.use_start.push_back(static_cast<int>(s.use_coord.size()));
+    for (int i = s.coord_start[p]; i < s.coord_start[p + 1]; ++i) {
+      s.use_coord.push_back(i);
+      s.use_G.push_back(generator(s.coords[i].axis));
+    }
+    for (const auto& c : s.joint[p].coupled) {
+      s.use_coord.push_back(s.coord_start[c.body] + c.slot);
+      s.use_G.push_back(c.G);
+    }
+    s.max_uses = std::max(s.max_uses, static_cast<int>(s.use_coord.size()) - s.use_start.back());
+  }
+  s.use_start.push_back(static_cast<int>(s.use_coord.size()));
+  s.nuses = static_cast<int>(s.use_coord.size());
   s.nc = static_cast<int>(s.coords.size());
   s.nq = static_cast<int>(s.free_coords.size());
   s.np = static_cast<int>(s.drive_coords.size());
@@ -251,7 +273,8 @@ Data::Data(const System& s)
       T(s.nbodies, Mat4::Identity()),
       Td(s.nbodies, Mat4::Zero()),
       Tdd(s.nbodies, Mat4::Zero()),
-      U(s.nc, Mat4::Zero()),
+      U(s.nuses, Mat4::Zero()),
+      X(s.max_uses, Mat4::Zero()),
       Hbar(s.nbodies, Mat4::Zero()),
       Wbar(s.nbodies, Mat4::Zero()),
       Zbar(s.nbodies, Mat4::Zero()),

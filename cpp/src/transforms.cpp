@@ -59,6 +59,11 @@ Mat4 inverse(const Mat4& T) {
   return homogeneous(Rt, -Rt * T.topRightCorner<3, 1>());
 }
 
+Mat4 affine_inverse(const Mat4& T) {
+  const Mat3 Mi = T.topLeftCorner<3, 3>().inverse();
+  return homogeneous(Mi, -Mi * T.topRightCorner<3, 1>());
+}
+
 Mat4 elementary(Axis a, double q) {
   switch (a) {
     case Axis::X: return translation(Vec3(q, 0, 0));

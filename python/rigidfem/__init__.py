@@ -20,12 +20,16 @@ from ._core import (
     euler_zyx,
     homogeneous,
     inverse,
+    pseudo_inertia,
     joint_transform,
     joint_transform_derivative,
     joint_transform_second_derivative,
     skew,
 )
+from .analysis import Equilibrium, Modes, modal_analysis, static_equilibrium
+from .beams import Beam, rfe_parameters, sde_parameters
 from .joints import Joint
+from .materials import Material, Section
 from .model import Model, System, transform
 
 __version__ = "0.1.0"
@@ -34,24 +38,34 @@ __all__ = [
     "R1",
     "R2",
     "R3",
+    "Beam",
     "Body",
     "Data",
+    "Equilibrium",
     "Joint",
     "JointSpec",
+    "Material",
     "Model",
+    "Modes",
     "Point",
     "Profile",
+    "Section",
     "SimulationError",
     "System",
     "euler_zyx",
     "homogeneous",
     "inverse",
+    "pseudo_inertia",
     "joint_transform",
     "joint_transform_derivative",
     "joint_transform_second_derivative",
+    "modal_analysis",
     "motion",
+    "rfe_parameters",
+    "sde_parameters",
     "samples",
     "skew",
     "stages",
+    "static_equilibrium",
     "transform",
 ]

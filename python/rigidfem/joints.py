@@ -26,11 +26,15 @@ def _axis(axis: str) -> str:
 
 
 def _make(kind: str, coordinates: Sequence[str], stiffness=0.0, damping=0.0, rest=0.0) -> JointSpec:
+    """A joint spec; per-coordinate values follow ``coordinates`` as given and are
+    reordered with them into the book's order."""
     spec = JointSpec(kind, list(coordinates))
     n = spec.ncoords
-    spec.stiffness = _checks.per_coordinate(stiffness, n, "stiffness", nonnegative=True)
-    spec.damping = _checks.per_coordinate(damping, n, "damping", nonnegative=True)
-    spec.rest = _checks.per_coordinate(rest, n, "rest")
+    given = [JointSpec(kind, [c]).coordinates[0] for c in coordinates]  # canonical names, caller's order
+    order = [given.index(c) for c in spec.coordinates]
+    spec.stiffness = [_checks.per_coordinate(stiffness, n, "stiffness", nonnegative=True)[k] for k in order]
+    spec.damping = [_checks.per_coordinate(damping, n, "damping", nonnegative=True)[k] for k in order]
+    spec.rest = [_checks.per_coordinate(rest, n, "rest")[k] for k in order]
     return spec
 
 

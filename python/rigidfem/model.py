@@ -184,6 +184,58 @@ class Model(_core._Model):
             raise ValueError(f"point: expected a Point or Body of this model, got {point!r}")
         return point
 
+    def add_beam(self, name: str, parent, length: float, material, section, elements: int,
+                 formulation: str = "modified", deform=None, linear: bool = False, joint=None, placement=None,
+                 tip_mass: float = 0.0, tip_inertia=(0.0, 0.0, 0.0), tip_offset=(0.0, 0.0, 0.0)):
+        """Add a flexible beam divided into ``elements`` sdes and ``elements + 1`` rfes.
+
+        Parameters
+        ----------
+        name : str
+            The rfes are named ``name.rfe0`` ... ``name.rfe<m>``.
+        parent : Body or str
+            What the beam's first rfe hangs from.
+        length : float
+            L, m; the beam lies along the x axis of its frame.
+        material : Material, function of s, or list of m
+            ``rigidfem.Material`` (constant), a function of the arc length s (m), or one
+            per segment (stepped beams).
+        section : Section, function of s, or list of m
+            ``rigidfem.Section``, likewise (tapered beams).
+        elements : int
+            m >= 1, the number of sdes (primary division).
+        formulation : "classical" or "modified"
+            Classical: rfes with up to 6 relative coordinates (axial, shear, torsion,
+            bending); modified: spherical joints, 3 rotations at most.
+        deform : sequence of str
+            Deformations given coordinates, from ``axial, shear_y, shear_z, torsion,
+            bend_y, bend_z`` (modified: the last three only); the rest are rigid.
+            Default: all the formulation allows. ``bend_z`` bends in the x–y plane.
+        linear : bool
+            The book's linear model: each sde's relative transformation is linearised to
+            first order in its coordinates (sin φ ≈ φ, cos φ ≈ 1, products dropped:
+            T̃ = [[1 + S(φ1, φ2, φ3), (x, y, z)], [0, 1]]); the equations are then
+            derived exactly from these transformations, and the beam's rigid motion
+            (its joint on the parent) stays exact. Loses geometric stiffening.
+        joint : JointSpec
+            How rfe 0 sits on the parent; default ``Joint.fixed()`` (clamped root).
+        placement : (4, 4) array
+            Pose of that joint's frame on the parent.
+        tip_mass, tip_inertia, tip_offset
+            A concentrated body (kg; kg·m² about its c.o.m.; offset in m of its c.o.m.
+            from the tip, beam axes) merged into the last rfe.
+
+        Returns
+        -------
+        Beam
+            Handle with ``tip``, ``point(s)``, ``rfes``, ``centerline(system, q)``, and
+            the rfe/sde parameters ``rfe`` and ``sde``.
+        """
+        from .beams import add_beam
+
+        return add_beam(self, name, parent, length, material, section, elements, formulation, deform, linear,
+                        joint, placement, tip_mass, tip_inertia, tip_offset)
+
     def compile(self) -> System:
         """Freeze the model into an immutable ``System``."""
         return System(self)

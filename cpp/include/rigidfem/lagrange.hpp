@@ -19,6 +19,9 @@ namespace rigidfem {
 /// (t, q, q̇) => qa, qda, qdda: the free coordinates from q, q̇ (q̈ = 0), the
 /// prescribed ones from their drives. Checks sizes and finiteness.
 void set_state(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q, const Eigen::Ref<const VecX>& qd);
+/// (t, q) => qa, with q̇ = q̈ = 0 for every coordinate, the prescribed ones held at
+/// their values at t (statics).
+void set_static_state(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q);
 /// (qa, qda, qdda) => T_p, Ṫ_p, T̈_p (nbodies) and U_i (nc): forward recursion
 /// T_p = T_parent B_p T̃_p(q_p) with the joint's elementary factors differentiated in time.
 void kinematics(const System& sys, Data& d);
@@ -45,6 +48,12 @@ const VecX& forward_dynamics(const System& sys, Data& d, double t, const Eigen::
 VecX rhs(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& y);
 /// ∂(dy/dt)/∂y (2nq, 2nq) by central differences.
 MatX rhs_jacobian(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& y);
+
+/// ∂f/∂q and ∂f/∂q̇ (nq, nq) at (t, q, q̇) by central differences, with the prescribed
+/// coordinates moving (static = false) or held at their values at t (static = true, q̇ ignored).
+/// −∂f/∂q is the tangent stiffness, −∂f/∂q̇ the damping and gyroscopic matrix.
+std::pair<MatX, MatX> force_jacobians(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                                      const Eigen::Ref<const VecX>& qd, bool static_drives);
 
 /// Energies after kinematics (J): ½ Σ tr(Ṫ_p H_p Ṫ_pᵀ); −Σ m_p gᵀ r_Cp; ½ Σ c_i (q_i − q_i⁰)².
 double kinetic_energy(const System& sys, const Data& d);

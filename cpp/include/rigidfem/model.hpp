@@ -22,6 +22,18 @@ struct Joint {
   std::vector<double> rest;       ///< (ncoords) m or rad
   std::vector<double> damping;    ///< (ncoords) N·s/m or N·m·s/rad
   std::string kind;               ///< "revolute", "free", ... (for printing)
+  /// Linear joint: T̃ = 1 + Σ_k G_k q_k, first order in its coordinates (G_k the
+  /// elementary generators for its own coordinates). Used by the book's linear model.
+  bool linear = false;
+  /// A coordinate of an earlier body that also moves this (linear) joint, with its
+  /// generator G in this joint's frame. In the linear model of a link, rfe i hangs on
+  /// rfe 0 and moves with the coordinates of every sde up to i.
+  struct Coupling {
+    int body;
+    int slot;
+    Mat4 G;
+  };
+  std::vector<Coupling> coupled;
 
   /// Joint with the given axes (any order; stored in the book's order), no springs.
   static Joint make(const std::string& kind, std::vector<Axis> axes);

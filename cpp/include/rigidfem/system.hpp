@@ -45,6 +45,13 @@ class System {
   std::vector<Coordinate> coords;       // (nc) in body order, within a joint in the book's order
   std::vector<int> free_coords;         // (nq) -> index in coords
   std::vector<int> drive_coords;        // (np) -> index in coords
+  // Coordinate uses: the coordinates that move each body's joint, its own ones first
+  // (so without couplings use u is coordinate u), then coupled ones (linear model).
+  int nuses = 0;
+  std::vector<int> use_start;           // (nbodies + 1) first use of body p
+  std::vector<int> use_coord;           // (nuses) -> index in coords
+  std::vector<Mat4> use_G;              // (nuses) generator in the joint frame (linear joints)
+  int max_uses = 0;                     // largest number of uses of one body
   Vec3 gravity = Vec3::Zero();          // m/s², global
   std::vector<Load> loads;
 
@@ -56,10 +63,12 @@ class System {
 struct Data {
   explicit Data(const System& sys);
   double t = 0.0;
+  double load_factor = 1.0;    // input: scales gravity, loads and applied generalised forces (load stepping)
   VecX qa, qda, qdda;          // (nc) all coordinates: value, rate, acceleration
   std::vector<Mat4> T;         // (nbodies) 4x4 T_p, pose of body p in the global frame
   std::vector<Mat4> Td, Tdd;   // (nbodies) 4x4 Ṫ_p, T̈_p
-  std::vector<Mat4> U;         // (nc) 4x4 U_i with ∂T_p/∂q_i = U_i T_p (global twist of coordinate i)
+  std::vector<Mat4> U;         // (nuses) 4x4 U_u with ∂T_k/∂q_i = U_u T_k for the bodies k below the use u of q_i
+  std::vector<Mat4> X;         // (max_uses) scratch of jcalc: local twists (∂T̃/∂q) T̃⁻¹
   std::vector<Mat4> Hbar;      // (nbodies) Σ_{k in subtree(p)} T_k H_k T_kᵀ
   std::vector<Mat4> Wbar;      // (nbodies) Σ_{k in subtree(p)} T_k H_k T̈_kᵀ  (inertia)
   std::vector<Mat4> Zbar;      // (nbodies) Σ_{k in subtree(p)} load moments   (gravity, forces)

@@ -41,6 +41,9 @@ Mat4 homogeneous(const Mat3& R, const Vec3& r);
 Mat4 translation(const Vec3& r);
 /// T⁻¹ = [[Rᵀ, −Rᵀ r], [0, 1]] (no general matrix inverse needed).
 Mat4 inverse(const Mat4& T);
+/// Inverse of an affine [[M, r], [0, 1]] whose M need not be a rotation (linear model):
+/// [[M⁻¹, −M⁻¹ r], [0, 1]].
+Mat4 affine_inverse(const Mat4& T);
 
 /// Elementary transform E_a(q): Trans(q e_a) for a translation, the rotation R_a(q) otherwise.
 Mat4 elementary(Axis a, double q);
