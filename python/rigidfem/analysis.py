@@ -84,10 +84,15 @@ class Modes:
 
     omega: np.ndarray           #: (k,) natural (undamped) circular frequencies |λ|, rad/s
     frequencies_hz: np.ndarray  #: (k,) omega / 2π, Hz
-    damping_ratios: np.ndarray  #: (k,) ζ = −Re λ / |λ| (zero without damping)
+    damping_ratios: np.ndarray  #: (k,) ζ = −Re λ / |λ| (zero without damping, negative when unstable)
     shapes: np.ndarray          #: (nq, k) mode shapes (real parts), max |entry| = 1
-    eigenvalues: np.ndarray     #: (k,) λ = −ζω + iω√(1 − ζ²) (purely imaginary without damping)
+    eigenvalues: np.ndarray     #: (k,) λ = −ζω + iω√(1 − ζ²); Re λ > 0 marks an unstable mode
     q: np.ndarray               #: (nq,) configuration linearised about
+
+    @property
+    def stable(self) -> bool:
+        """No eigenvalue with a positive real part (to 1e-9 of its modulus)."""
+        return bool(np.all(self.eigenvalues.real <= 1e-9 * np.abs(self.eigenvalues)))
     M: np.ndarray = field(repr=False)  #: (nq, nq) mass matrix
     K: np.ndarray = field(repr=False)  #: (nq, nq) tangent stiffness −∂f/∂q
     C: np.ndarray = field(repr=False)  #: (nq, nq) −∂f/∂q̇
@@ -113,9 +118,10 @@ def modal_analysis(system, q=None, qd=None, t: float = 0.0) -> Modes:
     if np.max(np.abs(C)) <= 1e-12 * scale * np.sqrt(np.max(np.abs(M)) / scale) and \
             np.max(np.abs(K - K.T)) <= 1e-6 * scale:
         w2, X = scipy.linalg.eigh(0.5 * (K + K.T), M)
-        omega = np.sqrt(np.abs(w2)) * np.sign(w2)  # negative: unstable (divergence), reported as −ω
-        lam = 1j * np.sqrt(w2.astype(complex))
-        zeta = np.zeros(n)
+        # λ = ±iω for ω² > 0; a negative ω² is a divergence, reported by its growing root λ = +sqrt(−ω²).
+        lam = np.where(w2 >= 0, 1j * np.sqrt(np.abs(w2)), np.sqrt(np.abs(w2)) + 0j)
+        omega = np.abs(lam)
+        zeta = -lam.real / np.where(omega > 0, omega, 1.0)
         shapes = X
     else:
         Minv = np.linalg.inv(M)

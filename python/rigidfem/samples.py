@@ -9,7 +9,15 @@ the middle, inertia m l²/12 about the transverse axes and a small axial one.
 from __future__ import annotations
 
 from .joints import Joint
+from .materials import Material, Section
 from .model import Model, transform
+from .motion import spin_up
+
+#: Kane, Ryan & Banerjee (1987) beam: L (m), E (Pa), ρ (kg/m³), A (m²), I (m⁴).
+KANE_PARAMETERS = {
+    "kane": dict(L=10.0, E=68.952e9, rho=2766.67, A=7.2968e-5, I=8.2189e-9),
+    "simo": dict(L=10.0, E=7.0e10, rho=3000.0, A=4.0e-4, I=2.0e-7),
+}
 
 
 def rod_inertia(mass: float, length: float, axis: str = "z", axial_fraction: float = 1e-3) -> list[float]:
@@ -76,3 +84,34 @@ def spring_mass(mass: float = 2.0, stiffness: float = 800.0, damping: float = 0.
         mass=mass, inertia=(1e-3, 1e-3, 1e-3),
     )
     return model, {"block": block}
+
+
+def cantilever(elements: int = 10, length: float = 1.0, material: Material | None = None,
+               section: Section | None = None, formulation: str = "modified", deform=("bend_z",),
+               linear: bool = False, gravity=None):
+    """A beam clamped at the origin along x (steel, 20 × 5 mm rectangle by default: 20 mm
+    along y, so ``bend_z`` bends it in the x–y plane about its stiff axis). Handles:
+    ``beam``."""
+    model = Model(gravity=gravity)
+    beam = model.add_beam(
+        "beam", model.ground, length, material or Material(E=2.1e11, rho=7850.0, nu=0.3),
+        section or Section.rectangle(0.02, 0.005), elements, formulation=formulation, deform=deform,
+        linear=linear,
+    )
+    return model, {"beam": beam}
+
+
+def kane_beam(omega: float = 6.0, duration: float = 15.0, elements: int = 10, linear: bool = False,
+              parameters: str = "kane", deform=("bend_z",), formulation: str = "modified"):
+    """Kane's spin-up manipulator: a beam clamped on the axis of a hub turned about z by
+    ``rigidfem.motion.spin_up(omega, duration)``; no gravity. ``parameters``: "kane"
+    (L = 10 m, E = 68.952 GPa, ρ = 2766.67 kg/m³, A = 7.2968e-5 m², I = 8.2189e-9 m⁴) or
+    "simo" (E = 70 GPa, ρ = 3000 kg/m³, A = 4e-4 m², I = 2e-7 m⁴). Handles: ``hub``, ``beam``."""
+    p = KANE_PARAMETERS[parameters]
+    model = Model(gravity=None)
+    hub = model.add_body("hub", model.ground, Joint.revolute("z"), mass=1.0, inertia=(1.0, 1.0, 1.0))
+    model.prescribe(hub, spin_up(omega, duration))
+    section = Section(A=p["A"], Iy=p["I"], Iz=p["I"], J=2 * p["I"])
+    beam = model.add_beam("beam", hub, p["L"], Material(E=p["E"], rho=p["rho"]), section, elements,
+                          formulation=formulation, deform=deform, linear=linear)
+    return model, {"hub": hub, "beam": beam}
