@@ -482,6 +482,43 @@ def test_tip_mass_total_mass_and_centre_of_mass(offset, linear):
     assert system.gravity_energy(q0) - V_bare == pytest.approx(M0 * g * z(L + ox, oz), rel=1e-10)
 
 
+def test_tip_inertia_is_merged_into_the_last_rfe():
+    """H_last = H_piece + ∫r rᵀ dm of the tip body: ½ tr(I) 1 − I + M c cᵀ, M c, M."""
+    L, m, M0 = 2.0, 4, 2.0
+    I0 = np.diag([0.1, 0.2, 0.25])
+    offset = np.array([0.05, 0.0, -0.02])
+    mat, sec = steel(), strip()
+    model, beam = cantilever(L, m, mat, sec, tip_mass=M0, tip_inertia=(0.1, 0.2, 0.25), tip_offset=offset)
+    system = model.compile()
+    d = L / m
+    rho, A = mat.rho, sec.A
+    H = np.zeros((4, 4))
+    H[0, 0] = rho * A * (d / 2) ** 3 / 3
+    H[1, 1], H[2, 2] = rho * sec.Iz * d / 2, rho * sec.Iy * d / 2
+    H[0, 3] = H[3, 0] = rho * A * (d / 2) ** 2 / 2
+    H[3, 3] = rho * A * d / 2
+    c = offset + [d / 2, 0, 0]  # from the last rfe's frame at L − Δ/2
+    H[:3, :3] += 0.5 * np.trace(I0) * np.eye(3) - I0 + M0 * np.outer(c, c)
+    H[:3, 3] += M0 * c
+    H[3, :3] += M0 * c
+    H[3, 3] += M0
+    np.testing.assert_allclose(beam.rfe[m].H, H, rtol=1e-12, atol=1e-15)
+    np.testing.assert_allclose(system.pseudo_inertias[beam.rfes[m].index], H, rtol=1e-10, atol=1e-14)
+    # the other rfes are untouched
+    assert beam.rfe[m - 1].mass == pytest.approx(rho * A * d, rel=1e-13)
+
+
+def test_material_varying_along_the_beam():
+    L, m = 2.0, 3
+    sec = strip()
+    rho = lambda s: 7850.0 * (1.0 + 0.5 * s)  # noqa: E731
+    model, beam = cantilever(L, m, lambda s: rf.Material(E=2.1e11, rho=rho(s)), sec)
+    assert sum(p.mass for p in beam.rfe) == pytest.approx(quad(lambda s: rho(s) * sec.A, 0, L)[0], rel=1e-12)
+    for p, (a, b, x0) in zip(beam.rfe, seg_pieces(L, m)):
+        assert p.H[0, 3] == pytest.approx(quad(lambda s: rho(s) * sec.A * (s - x0), a, b)[0], rel=1e-10)
+        assert p.H[1, 1] == pytest.approx(quad(lambda s: rho(s) * sec.Iz, a, b)[0], rel=1e-12)
+
+
 # ----------------------------------------------------------------------------------------
 # 6. Static deflections: classical vs modified, linear vs nonlinear
 # ----------------------------------------------------------------------------------------

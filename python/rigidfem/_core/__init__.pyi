@@ -7,7 +7,7 @@ import numpy
 import numpy.typing
 import typing
 from . import stages
-__all__: list[str] = ['Body', 'Data', 'JointSpec', 'Point', 'Profile', 'R1', 'R2', 'R3', 'SimulationError', 'callback_profile', 'constant_profile', 'euler_zyx', 'harmonic_profile', 'homogeneous', 'inverse', 'joint_transform', 'joint_transform_derivative', 'joint_transform_second_derivative', 'polynomial_profile', 'skew', 'spin_up_profile', 'spline_profile', 'stages']
+__all__: list[str] = ['Body', 'Data', 'JointSpec', 'Point', 'Profile', 'R1', 'R2', 'R3', 'SimulationError', 'callback_profile', 'constant_profile', 'euler_zyx', 'harmonic_profile', 'homogeneous', 'inverse', 'joint_transform', 'joint_transform_derivative', 'joint_transform_second_derivative', 'polynomial_profile', 'pseudo_inertia', 'skew', 'spin_up_profile', 'spline_profile', 'stages']
 class SimulationError(RuntimeError):
     pass
 class Profile:
@@ -26,6 +26,11 @@ class JointSpec:
     """
     def __init__(self, kind: str, coordinates: collections.abc.Sequence[str]) -> None:
         ...
+    def add_coupling(self, body: typing.SupportsInt | typing.SupportsIndex, slot: typing.SupportsInt | typing.SupportsIndex, G: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"]) -> None:
+        """
+        Let coordinate `slot` of an earlier body (index) also move this linear joint, with generator G (4, 4)
+        in this joint's frame: T = 1 + sum G q (used by the linear model of beams).
+        """
     @property
     def coordinates(self) -> list[str]:
         ...
@@ -37,6 +42,14 @@ class JointSpec:
         ...
     @property
     def kind(self) -> str:
+        ...
+    @property
+    def linear(self) -> bool:
+        """
+        The book's linear model: T = [[1 + S(phi), r], [0, 1]].
+        """
+    @linear.setter
+    def linear(self, arg0: bool) -> None:
         ...
     @property
     def ncoords(self) -> int:
@@ -146,13 +159,19 @@ class _System:
         """
         Energy of the joint springs 1/2 sum c (q - q_rest)^2 (J).
         """
+    def force_jacobians(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], load_factor: typing.SupportsFloat | typing.SupportsIndex = 1.0, static: bool = False) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]]:
+        """
+        (df/dq, df/dqd), each (nq, nq), by central differences. -df/dq is the tangent stiffness K,
+        -df/dqd the damping and gyroscopic matrix C. static=True holds the prescribed coordinates at t.
+        """
     def forward_dynamics(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
         Accelerations qdd (nq,) solving A(q) qdd = f(q, qd, t); t in s, q in m/rad, qd in m/s, rad/s.
         """
-    def generalized_forces(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+    def generalized_forces(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], load_factor: typing.SupportsFloat | typing.SupportsIndex = 1.0) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
         Right-hand side f (nq,) of A qdd = f: loads, gravity, springs, dampers minus velocity terms (N, N m).
+        load_factor scales gravity, loads and applied generalised forces.
         """
     def gravity_energy(self, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], t: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> float:
         """
@@ -181,6 +200,10 @@ class _System:
     def rhs(self, t: typing.SupportsFloat | typing.SupportsIndex, y: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
         dy/dt = [qd, qdd] for y = [q, qd] (2 nq,): the signature of scipy's solve_ivp.
+        """
+    def static_forces(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], load_factor: typing.SupportsFloat | typing.SupportsIndex = 1.0) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        Static residual f(q) (nq,): generalised forces at rest, prescribed coordinates held at their values at t.
         """
     def transform(self, body: typing.SupportsInt | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], t: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
         """
@@ -269,7 +292,8 @@ class Data:
     @property
     def U(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
         """
-        U_i (4, 4) of every coordinate: dT_p/dq_i = U_i T_p.
+        U (4, 4) of every coordinate use: dT_p/dq_i = U_i T_p for the bodies p below
+        coordinate i (without linear-model couplings, use i is coordinate i).
         """
     @property
     def Wbar(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
@@ -355,6 +379,11 @@ def joint_transform_second_derivative(coordinates: collections.abc.Sequence[str]
     """
 def polynomial_profile(coefficients: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> Profile:
     ...
+def pseudo_inertia(mass: typing.SupportsFloat | typing.SupportsIndex, com: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], inertia: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 3]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
+    """
+    Pseudo-inertia H = int r r^T dm (4, 4) of a body: mass (kg), centre of mass com (3,) m and
+    inertia tensor (3, 3) about the centre of mass (kg m^2), all in the body frame.
+    """
 def skew(w: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
     """
     Skew-symmetric S(w) with S(w) x = w x x. (3, 3).
