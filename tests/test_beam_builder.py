@@ -664,3 +664,15 @@ def test_bad_tip_mass():
 def test_point_outside_the_beam(s):
     _, beam = cantilever(2.0, 4)
     _raises("s", beam.point, s)
+
+
+def test_failed_add_beam_leaves_the_model_unchanged():
+    m = rf.Model(gravity=None)
+    mat, sec = rf.Material(E=2.1e11, rho=7850.0), rf.Section.rectangle(0.05, 0.01)
+    with pytest.raises(ValueError, match=r"^tip_inertia\b"):
+        m.add_beam("c", m.ground, 2.0, mat, sec, 4, tip_mass=2.0, tip_inertia=(0.1, 0.2, 0.5))  # 0.1 + 0.2 < 0.5
+    assert m.body_names == []
+    m.add_beam("c", m.ground, 2.0, mat, sec, 4, tip_mass=2.0)  # a point mass: zero inertia is fine
+    with pytest.raises(ValueError, match=r"^name\b"):
+        m.add_beam("c", m.ground, 2.0, mat, sec, 4)
+    assert len(m.body_names) == 5

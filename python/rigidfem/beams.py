@@ -228,10 +228,14 @@ def add_beam(
     ends = np.array([0.5 * d] + [min((i + 0.5) * d, L) for i in range(1, m + 1)])
     rfe = [rfe_parameters(mat, sec, lo, hi, origin=x) for lo, hi, x in zip([0.0, *frames[1:]], ends, frames)]
     sde = [sde_parameters(mat, sec, (i - 1) * d, i * d) for i in range(1, m + 1)]
+    names = [f"{name}.rfe{i}" for i in range(m + 1)]
+    taken = set(model.body_names) & set(names)
+    if taken:
+        raise ValueError(f"name: expected a beam name whose rfe bodies are not in the model yet, got {name!r} "
+                         f"({sorted(taken)[0]} exists)")
     if tip_m > 0.0:
         # A concentrated body at the tip (offset from s = L in beam axes) joins the last rfe.
-        inertia = np.diag(tip_inertia) if np.shape(tip_inertia) == (3,) else np.asarray(tip_inertia, float)
-        inertia = _checks.array(inertia, (3, 3), "tip_inertia")
+        inertia = _tip_inertia(tip_inertia)
         offset = _checks.vec3(tip_offset, "tip_offset") + [L - frames[-1], 0.0, 0.0]
         H = rfe[-1].H + _core.pseudo_inertia(tip_m, offset, inertia)
         rfe[-1] = RfeParameters(H[3, 3], H[:3, 3] / H[3, 3], _inertia_about_com(H), H)
@@ -250,9 +254,24 @@ def add_beam(
             else:
                 up, B = bodies[-1], transform(translation=(frames[i] - frames[i - 1], 0.0, 0.0))
         p = rfe[i]
-        bodies.append(model.add_body(f"{name}.rfe{i}", up, j, mass=p.mass, com=p.com, inertia=p.inertia,
-                                     placement=B))
+        bodies.append(model.add_body(names[i], up, j, mass=p.mass, com=p.com, inertia=p.inertia, placement=B))
     return Beam(name, L, m, formulation, tuple(deform), bool(linear), bodies, frames, rfe, sde)
+
+
+def _tip_inertia(tip_inertia) -> np.ndarray:
+    """A tip body's inertia about its centre of mass (kg·m²): principal moments (3,) or a
+    tensor (3, 3), positive semi-definite (zero for a point mass) with I1 + I2 >= I3."""
+    try:
+        I = np.diag(tip_inertia) if np.shape(tip_inertia) == (3,) else np.asarray(tip_inertia, float)
+    except (TypeError, ValueError):
+        raise ValueError(f"tip_inertia: expected (3,) moments or a (3, 3) tensor in kg·m², got {tip_inertia!r}") from None
+    I = _checks.array(I, (3, 3), "tip_inertia")
+    if not np.allclose(I, I.T, rtol=1e-12, atol=0.0):
+        raise ValueError("tip_inertia: expected a symmetric tensor, got an asymmetric one")
+    moments = np.linalg.eigvalsh(I)
+    if moments[0] < -1e-12 * max(moments[-1], 0.0) or moments[0] + moments[1] < moments[2] * (1 - 1e-9):
+        raise ValueError(f"tip_inertia: expected principal moments >= 0 with I1 + I2 >= I3, got {moments}")
+    return I
 
 
 def _couple_linear(j, bodies, frames, i):
