@@ -35,6 +35,19 @@ void accumulate_subtrees(const System& sys, std::vector<Mat4>& X) {
     if (sys.parent[p] >= 0) X[sys.parent[p]] += X[p];
 }
 
+// Column j of ∂g/∂x by central differences, g reading x by reference; step ∝ ε^(1/3)
+// for an error O(ε^(2/3)). x is restored.
+template <class G>
+VecX central_difference(G&& g, VecX& x, int j) {
+  const double xj = x(j), h = 6e-6 * std::max(1.0, std::abs(xj));
+  x(j) = xj + h;
+  const VecX gp = g();
+  x(j) = xj - h;
+  const VecX gm = g();
+  x(j) = xj;
+  return (gp - gm) / (2.0 * h);
+}
+
 const Mat4& frame_of_parent(const System& sys, const std::vector<Mat4>& X, int p, const Mat4& ground) {
   return sys.parent[p] >= 0 ? X[sys.parent[p]] : ground;
 }
@@ -257,22 +270,14 @@ MatX rhs_jacobian(const System& sys, Data& d, double t, const Eigen::Ref<const V
   const int n = 2 * sys.nq;
   MatX J(n, n);
   VecX yp = y;
-  for (int j = 0; j < n; ++j) {
-    // Central differences, step ∝ ε^(1/3) for O(ε^(2/3)) error.
-    const double h = 6e-6 * std::max(1.0, std::abs(y(j)));
-    yp(j) = y(j) + h;
-    const VecX fp = rhs(sys, d, t, yp);
-    yp(j) = y(j) - h;
-    const VecX fm = rhs(sys, d, t, yp);
-    yp(j) = y(j);
-    J.col(j) = (fp - fm) / (2.0 * h);
-  }
+  for (int j = 0; j < n; ++j) J.col(j) = central_difference([&] { return rhs(sys, d, t, yp); }, yp, j);
   return J;
 }
 
 std::pair<MatX, MatX> force_jacobians(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
                                       const Eigen::Ref<const VecX>& qd, bool static_drives) {
-  auto f = [&](const VecX& x, const VecX& xd) -> VecX {
+  VecX x = q, xd = static_drives ? VecX::Zero(sys.nq) : VecX(qd);
+  auto f = [&]() -> VecX {
     if (static_drives)
       set_static_state(sys, d, t, x);
     else
@@ -282,24 +287,9 @@ std::pair<MatX, MatX> force_jacobians(const System& sys, Data& d, double t, cons
     return d.f;
   };
   MatX dq(sys.nq, sys.nq), dqd = MatX::Zero(sys.nq, sys.nq);
-  VecX x = q, xd = static_drives ? VecX::Zero(sys.nq) : VecX(qd);
   for (int j = 0; j < sys.nq; ++j) {
-    // Central differences, step ∝ ε^(1/3).
-    const double h = 6e-6 * std::max(1.0, std::abs(x(j)));
-    x(j) += h;
-    const VecX fp = f(x, xd);
-    x(j) -= 2.0 * h;
-    const VecX fm = f(x, xd);
-    x(j) += h;
-    dq.col(j) = (fp - fm) / (2.0 * h);
-    if (static_drives) continue;
-    const double hv = 6e-6 * std::max(1.0, std::abs(xd(j)));
-    xd(j) += hv;
-    const VecX gp = f(x, xd);
-    xd(j) -= 2.0 * hv;
-    const VecX gm = f(x, xd);
-    xd(j) += hv;
-    dqd.col(j) = (gp - gm) / (2.0 * hv);
+    dq.col(j) = central_difference(f, x, j);
+    if (!static_drives) dqd.col(j) = central_difference(f, xd, j);
   }
   return {dq, dqd};
 }
