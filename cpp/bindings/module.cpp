@@ -82,4 +82,5 @@ PYBIND11_MODULE(_core, m) {
   bind_profiles(m);
   bind_model(m);
   bind_dynamics(m);
+  bind_integrators(m);
 }

@@ -223,9 +223,28 @@ void mass_matrix(const System& sys, Data& d) {
   }
 }
 
+std::string gimbal_lock_hint(const System& sys, const VecX& q, double tol) {
+  std::string hint;
+  for (int i : sys.zyx_pitch) {
+    const int k = sys.coords[i].free_index;
+    if (k < 0 || k >= q.size() || std::abs(std::cos(q(k))) >= tol) continue;
+    hint += "; the ZYX angles of " + sys.coords[i].name.substr(0, sys.coords[i].name.size() - 3) +
+            " are at pitch phi2 = " + std::to_string(q(k)) +
+            " rad, near +-pi/2 where they are singular (gimbal lock): turn the joint frame (placement) so "
+            "the motion keeps away from it";
+  }
+  return hint;
+}
+
 void accelerations(const System& sys, Data& d) {
   check_data(sys, d);
   if (sys.nq == 0) return;
+  // ZYX Euler angles at pitch ±π/2: the mass matrix is singular (gimbal lock).
+  for (int i : sys.zyx_pitch)
+    if (std::abs(std::cos(d.qa(i))) < 1e-9)
+      throw SimulationError(d.t, "gimbal lock: the ZYX angles of " + sys.coords[i].name.substr(0, sys.coords[i].name.size() - 3) +
+                                     " reached pitch phi2 = +-pi/2, where the mass matrix is singular; turn the joint "
+                                     "frame (placement) so the motion keeps away from it");
   d.llt.compute(d.A);
   if (d.llt.info() != Eigen::Success)
     throw SimulationError(d.t, "mass matrix is not positive definite (singular configuration or massless chain)");
@@ -276,6 +295,9 @@ MatX rhs_jacobian(const System& sys, Data& d, double t, const Eigen::Ref<const V
 
 std::pair<MatX, MatX> force_jacobians(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
                                       const Eigen::Ref<const VecX>& qd, bool static_drives) {
+  // The springs and dampers, −c_i (q_i − q_i⁰) − b_i q̇_i, are differentiated exactly; only the
+  // rest (loads, inertia, force laws) by central differences, so stiff sdes (EA/Δ ~ 1e10)
+  // add no round-off to the soft terms.
   VecX x = q, xd = static_drives ? VecX::Zero(sys.nq) : VecX(qd);
   auto f = [&]() -> VecX {
     if (static_drives)
@@ -284,14 +306,59 @@ std::pair<MatX, MatX> force_jacobians(const System& sys, Data& d, double t, cons
       set_state(sys, d, t, x, xd);
     kinematics(sys, d);
     generalized_forces(sys, d);
-    return d.f;
+    VecX g = d.f;
+    for (int k = 0; k < sys.nq; ++k) {
+      const Coordinate& c = sys.coords[sys.free_coords[k]];
+      g(k) += c.stiffness * (x(k) - c.rest) + c.damping * xd(k);
+    }
+    return g;
   };
   MatX dq(sys.nq, sys.nq), dqd = MatX::Zero(sys.nq, sys.nq);
   for (int j = 0; j < sys.nq; ++j) {
     dq.col(j) = central_difference(f, x, j);
     if (!static_drives) dqd.col(j) = central_difference(f, xd, j);
   }
+  for (int k = 0; k < sys.nq; ++k) {
+    const Coordinate& c = sys.coords[sys.free_coords[k]];
+    dq(k, k) -= c.stiffness;
+    dqd(k, k) -= c.damping;
+  }
   return {dq, dqd};
+}
+
+StateOutputs evaluate_outputs(const System& sys, const VecX& t, const MatX& Q, const MatX& QD) {
+  const Eigen::Index N = t.size();
+  if (Q.rows() != N || QD.rows() != N || Q.cols() != sys.nq || QD.cols() != sys.nq)
+    throw std::invalid_argument("q, qd: expected (len(t), nq) arrays");
+  StateOutputs out{MatX(N, sys.nq), MatX(N, sys.np), VecX(N), VecX(N), VecX(N)};
+  Data d(sys);
+  for (Eigen::Index k = 0; k < N; ++k) {
+    forward_dynamics(sys, d, t(k), Q.row(k).transpose(), QD.row(k).transpose());
+    out.qdd.row(k) = d.qdd.transpose();
+    out.kinetic(k) = kinetic_energy(sys, d);
+    out.gravity(k) = gravity_energy(sys, d);
+    out.elastic(k) = elastic_energy(sys, d);
+    driving_forces(sys, d);
+    out.tau.row(k) = d.tau.transpose();
+  }
+  return out;
+}
+
+MatX point_positions(const System& sys, int body, const Vec3& r, int frame, const VecX& t, const MatX& Q) {
+  if (body < 0 || body >= sys.nbodies || frame < -1 || frame >= sys.nbodies)
+    throw std::invalid_argument("point, frame: expected bodies of this system");
+  if (Q.rows() != t.size() || Q.cols() != sys.nq) throw std::invalid_argument("q: expected a (len(t), nq) array");
+  MatX P(t.size(), 3);
+  Data d(sys);
+  const VecX zero = VecX::Zero(sys.nq);
+  for (Eigen::Index k = 0; k < t.size(); ++k) {
+    set_state(sys, d, t(k), Q.row(k).transpose(), zero);
+    kinematics(sys, d);
+    Vec4 x = d.T[body] * r.homogeneous();
+    if (frame >= 0) x = affine_inverse(d.T[frame]) * x;
+    P.row(k) = x.head<3>().transpose();
+  }
+  return P;
 }
 
 double kinetic_energy(const System& sys, const Data& d) {

@@ -247,6 +247,12 @@ std::shared_ptr<const System> Model::compile() const {
     s.max_uses = std::max(s.max_uses, static_cast<int>(s.use_coord.size()) - s.use_start.back());
   }
   s.use_start.push_back(static_cast<int>(s.use_coord.size()));
+  for (int p = 0; p < s.nbodies; ++p) {
+    const auto& ax = s.joint[p].axes;
+    auto has = [&](Axis a) { return std::find(ax.begin(), ax.end(), a) != ax.end(); };
+    if (!s.joint[p].linear && has(Axis::RZ) && has(Axis::RY) && has(Axis::RX))
+      s.zyx_pitch.push_back(s.coord_start[p] + static_cast<int>(std::find(ax.begin(), ax.end(), Axis::RY) - ax.begin()));
+  }
   s.nuses = static_cast<int>(s.use_coord.size());
   s.nc = static_cast<int>(s.coords.size());
   s.nq = static_cast<int>(s.free_coords.size());

@@ -31,6 +31,7 @@ from .beams import Beam, rfe_parameters, sde_parameters
 from .joints import Joint
 from .materials import Material, Section
 from .model import Model, System, transform
+from .simulation import Result, simulate
 
 __version__ = "0.1.0"
 
@@ -49,6 +50,7 @@ __all__ = [
     "Modes",
     "Point",
     "Profile",
+    "Result",
     "Section",
     "SimulationError",
     "System",
@@ -64,6 +66,7 @@ __all__ = [
     "rfe_parameters",
     "sde_parameters",
     "samples",
+    "simulate",
     "skew",
     "stages",
     "static_equilibrium",

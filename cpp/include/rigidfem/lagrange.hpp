@@ -55,6 +55,21 @@ MatX rhs_jacobian(const System& sys, Data& d, double t, const Eigen::Ref<const V
 std::pair<MatX, MatX> force_jacobians(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
                                       const Eigen::Ref<const VecX>& qd, bool static_drives);
 
+/// "" or a sentence naming the ZYX joints whose pitch φ2 (free coordinates q) is within
+/// `tol` of ±π/2 in cos φ2, where Euler angles are singular (gimbal lock).
+std::string gimbal_lock_hint(const System& sys, const VecX& q, double tol);
+
+/// Quantities at a batch of states (t_k, q_k, q̇_k), rows k: accelerations, driving
+/// forces and energies (J). Used for simulation results.
+struct StateOutputs {
+  MatX qdd, tau;  // (N, nq), (N, np)
+  VecX kinetic, gravity, elastic;  // (N)
+};
+StateOutputs evaluate_outputs(const System& sys, const VecX& t, const MatX& Q, const MatX& QD);
+/// Global positions (N, 3) of the point r (body frame) of `body` at (t_k, q_k), expressed in
+/// the frame of body `frame` (−1: global).
+MatX point_positions(const System& sys, int body, const Vec3& r, int frame, const VecX& t, const MatX& Q);
+
 /// Energies after kinematics (J): ½ Σ tr(Ṫ_p H_p Ṫ_pᵀ); −Σ m_p gᵀ r_Cp; ½ Σ c_i (q_i − q_i⁰)².
 double kinetic_energy(const System& sys, const Data& d);
 double gravity_energy(const System& sys, const Data& d);

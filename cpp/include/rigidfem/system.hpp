@@ -52,6 +52,7 @@ class System {
   std::vector<int> use_coord;           // (nuses) -> index in coords
   std::vector<Mat4> use_G;              // (nuses) generator in the joint frame (linear joints)
   int max_uses = 0;                     // largest number of uses of one body
+  std::vector<int> zyx_pitch;           // coordinate index of φ2 in every exact joint with φ3, φ2 and φ1
   Vec3 gravity = Vec3::Zero();          // m/s², global
   std::vector<Load> loads;
 

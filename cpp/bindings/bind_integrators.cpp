@@ -1,0 +1,79 @@
+// The C++ integrators: options, the run (GIL released), and batch outputs for results.
+#include "bindings.hpp"
+#include "rigidfem/integrators.hpp"
+#include "rigidfem/lagrange.hpp"
+
+namespace rigidfem::bindings {
+
+namespace {
+MatX stack(const std::vector<VecX>& rows, int n) {
+  MatX M(rows.size(), n);
+  for (size_t k = 0; k < rows.size(); ++k) M.row(k) = rows[k].transpose();
+  return M;
+}
+}  // namespace
+
+void bind_integrators(py::module_& m) {
+  py::class_<IntegratorOptions>(m, "IntegratorOptions", "Options of the C++ integrators (see rigidfem.simulate).")
+      .def(py::init<>())
+      .def_readwrite("method", &IntegratorOptions::method)
+      .def_readwrite("dt", &IntegratorOptions::dt)
+      .def_readwrite("adaptive", &IntegratorOptions::adaptive, "-1: the method's default, 0: fixed dt, 1: adaptive")
+      .def_readwrite("rtol", &IntegratorOptions::rtol)
+      .def_readwrite("atol", &IntegratorOptions::atol)
+      .def_readwrite("max_step", &IntegratorOptions::max_step)
+      .def_readwrite("max_steps", &IntegratorOptions::max_steps)
+      .def_readwrite("beta", &IntegratorOptions::beta)
+      .def_readwrite("gamma", &IntegratorOptions::gamma)
+      .def_readwrite("alpha", &IntegratorOptions::alpha)
+      .def_readwrite("rho_inf", &IntegratorOptions::rho_inf)
+      .def_readwrite("newton_tol", &IntegratorOptions::newton_tol)
+      .def_readwrite("newton_max_iterations", &IntegratorOptions::newton_max_iterations);
+
+  m.def(
+      "_integrate",
+      [](const System& s, double t0, double t_end, const VecX& q0, const VecX& qd0, const VecX& t_eval,
+         const IntegratorOptions& o, py::object progress) {
+        // Runs with the GIL released; every ~0.05 s the monitor takes it back to look for
+        // Ctrl-C (PyErr_CheckSignals) and to call the progress callback.
+        Monitor monitor = [&progress](double t) {
+          py::gil_scoped_acquire gil;
+          if (PyErr_CheckSignals() != 0) {
+            PyErr_Clear();
+            return false;
+          }
+          if (!progress.is_none()) progress(t);
+          return true;
+        };
+        Trajectory tr;
+        {
+          py::gil_scoped_release release;
+          tr = integrate(s, t0, t_end, q0, qd0, t_eval, o, monitor);
+        }
+        const auto& st = tr.stats;
+        py::dict stats;
+        stats["steps"] = st.steps;
+        stats["rejected_steps"] = st.rejected;
+        stats["rhs_evaluations"] = st.rhs_evaluations;
+        stats["jacobians"] = st.jacobians;
+        stats["factorizations"] = st.factorizations;
+        stats["newton_iterations"] = st.newton_iterations;
+        stats["wall_time"] = st.wall_time;
+        return py::make_tuple(VecX(Eigen::Map<const VecX>(tr.t.data(), tr.t.size())), stack(tr.q, s.nq),
+                              stack(tr.qd, s.nq), stats, tr.interrupted);
+      },
+      py::arg("system"), py::arg("t0"), py::arg("t_end"), py::arg("q0"), py::arg("qd0"), py::arg("t_eval"),
+      py::arg("options"), py::arg("progress"));
+
+  m.def(
+      "_evaluate_outputs",
+      [](const System& s, const VecX& t, const MatX& Q, const MatX& QD) {
+        StateOutputs o = evaluate_outputs(s, t, Q, QD);
+        return py::make_tuple(o.qdd, o.tau, o.kinetic, o.gravity, o.elastic);
+      },
+      py::arg("system"), py::arg("t"), py::arg("q"), py::arg("qd"));
+  m.def("_point_positions", &point_positions, py::arg("system"), py::arg("body"), py::arg("r"), py::arg("frame"),
+        py::arg("t"), py::arg("q"));
+}
+
+}  // namespace rigidfem::bindings

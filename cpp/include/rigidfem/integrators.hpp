@@ -1,0 +1,59 @@
+/// Time integration of A(q) q̈ = f(q, q̇, t) in C++ (book ch. 5.2): no Python per step.
+///
+/// Explicit methods integrate the first-order form y = [q, q̇], ẏ = [q̇, q̈]; the Newmark
+/// family integrates the second-order form directly with Newton iterations on
+/// M(q) q̈ − f(q, q̇, t) = 0. Every failure raises SimulationError with t, h and the cause.
+#pragma once
+
+#include <functional>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "rigidfem/system.hpp"
+
+namespace rigidfem {
+
+struct IntegratorOptions {
+  /// "euler", "symplectic_euler", "rk4" (fixed step); "dopri5", "rkf45" (adaptive);
+  /// "newmark", "hht", "generalized_alpha" (implicit, fixed step or adaptive).
+  std::string method = "dopri5";
+  double dt = 0.0;           ///< s: the step of fixed-step methods (first step of adaptive ones if > 0)
+  /// Step-size control: dopri5/rkf45 by their embedded pair (default), the Newmark family by
+  /// a local error estimate (off by default); false runs every method at the fixed step dt.
+  int adaptive = -1;         ///< −1: the method's default, 0: fixed step dt, 1: adaptive
+  double rtol = 1e-6;
+  VecX atol = VecX::Constant(1, 1e-9);  ///< (1) or (2 nq): per component of y = [q, q̇]
+  double max_step = std::numeric_limits<double>::infinity();
+  long max_steps = 1000000;
+  double beta = 0.25, gamma = 0.5;  ///< Newmark (average acceleration by default)
+  double alpha = -0.05;             ///< HHT-α, in [−1/3, 0]
+  double rho_inf = 0.8;             ///< generalised-α: spectral radius at infinite frequency, in [0, 1]
+  double newton_tol = 1e-10;        ///< Newton: increments below newton_tol (1 + |q|), relative for adaptive runs
+  int newton_max_iterations = 10;
+};
+
+struct IntegratorStats {
+  long steps = 0, rejected = 0, rhs_evaluations = 0, jacobians = 0, factorizations = 0, newton_iterations = 0;
+  double wall_time = 0.0;  ///< s
+};
+
+/// States at the output times (every accepted step when no output times are given).
+struct Trajectory {
+  std::vector<double> t;
+  std::vector<VecX> q, qd;  // (len t) x (nq)
+  IntegratorStats stats;
+  bool interrupted = false;  ///< the monitor asked to stop: the trajectory ends early
+};
+
+/// Called about every 0.05 s of wall time with the current time; returning false stops
+/// the run (Ctrl-C), which then returns what it has.
+using Monitor = std::function<bool(double)>;
+
+/// Integrates from (t0, q0, q̇0) to t_end. Output at `t_eval` (increasing, within
+/// [t0, t_end]) by each method's dense output — Dormand–Prince's own continuous extension,
+/// cubic Hermite interpolation of y and ẏ otherwise — or at every step if it is empty.
+Trajectory integrate(const System& sys, double t0, double t_end, const VecX& q0, const VecX& qd0,
+                     const VecX& t_eval, const IntegratorOptions& options, const Monitor& monitor);
+
+}  // namespace rigidfem
