@@ -235,7 +235,8 @@ class NewmarkFamily {
         mass_matrix(sys_, d_);
         ++stats_.rhs_evaluations;
         const VecX r = d_.A * s1.qdd - d_.f;
-        if (!valid_ || h != h_) build(t + h, h, s1, bp, gp);
+        // The iteration matrix only steers Newton: keep it while h stays within 30 % of its own.
+        if (!valid_ || std::abs(h / h_ - 1.0) > 0.3) build(t + h, h, s1, bp, gp);
         const VecX dx = -lu_.solve(r);
         ++stats_.newton_iterations;
         if (!dx.allFinite()) break;
@@ -454,7 +455,8 @@ Trajectory run(const System& sys, double t0, double t_end, const VecX& q0, const
       if (!s1.q.allFinite() || !s1.v.allFinite()) fail(t, hs, "the state became NaN or inf");
       if (adaptive) {
         const double err = error_norm(nm.error_estimate(hs, s, s1), s.q, s1.q, atol.head(n), o.rtol);
-        const double factor = std::min(5.0, std::max(0.2, 0.9 * std::pow(std::max(err, 1e-10), -1.0 / 3.0)));
+        double factor = std::min(5.0, std::max(0.2, 0.9 * std::pow(std::max(err, 1e-10), -1.0 / 3.0)));
+        if (factor >= 1.0 && factor < 1.25) factor = 1.0;  // keep h (and the iteration matrix) for small gains
         if (err > 1.0) {
           ++stats.rejected;
           h = hs * factor;

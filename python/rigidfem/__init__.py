@@ -6,7 +6,7 @@ Flexible Multibody Systems: Rigid Finite Element Method* (Springer 2006), with a
 C++ core. SI units throughout.
 """
 
-from . import motion, samples, stages
+from . import motion, samples, stages, study
 from ._core import (
     R1,
     R2,
@@ -70,5 +70,6 @@ __all__ = [
     "skew",
     "stages",
     "static_equilibrium",
+    "study",
     "transform",
 ]
