@@ -70,6 +70,15 @@ def test_adaptive_methods_meet_their_tolerance_and_count_work(pendulum2):
         s = r.stats
         assert s["rhs_evaluations"] >= 6 * (s["steps"] + s["rejected_steps"])
         assert s["wall_time"] > 0
+    # Tolerances per component of y = [q, q̇]: one tight component drives the step size.
+    same = rf.simulate(system, 1.0, q0=Y0[:2], rtol=np.full(4, 1e-6), atol=1e-8)
+    loose = rf.simulate(system, 1.0, q0=Y0[:2], rtol=1e-3, atol=1e-8)
+    one_tight = rf.simulate(system, 1.0, q0=Y0[:2], rtol=[1e-9, 1e-3, 1e-3, 1e-3], atol=1e-8)
+    np.testing.assert_array_equal(same.q, rf.simulate(system, 1.0, q0=Y0[:2], rtol=1e-6, atol=1e-8).q)
+    assert one_tight.stats["steps"] > 2 * loose.stats["steps"]
+    assert abs(one_tight.q[-1, 0] - ref.y[0, -1]) < 1e-7
+    first = rf.simulate(system, 1.0, q0=Y0[:2], rtol=1e-6, first_step=1e-7, t_eval=[1.0])
+    assert first.stats["steps"] > 0 and abs(first.q[-1, 0] - ref.y[0, -1]) < 1e-4
     r = rf.simulate(system, 1.0, method="newmark", adaptive=True, q0=Y0[:2], rtol=1e-6, atol=1e-8)
     assert np.max(np.abs(r.q[-1] - ref.y[:2, -1])) < 1e-3
     assert r.stats["jacobians"] >= 1 and r.stats["factorizations"] >= 1 and r.stats["newton_iterations"] > 0
@@ -257,7 +266,8 @@ def test_bad_options_are_value_errors():
                     (dict(method="generalized_alpha", dt=0.01, rho_inf=2.0), "rho_inf"),
                     (dict(method="newmark", dt=0.01, beta=0.1), "beta"), (dict(q0=[0.0, 1.0]), "q0"),
                     (dict(t_eval=[0.5, 0.2]), "t_eval"), (dict(method="rk4", dt=0.01, adaptive=True), "adaptive"),
-                    (dict(method="scipy:Euler"), "method")):
+                    (dict(method="scipy:Euler"), "method"), (dict(rtol=[1e-6, 1e-6, 1e-6]), "rtol"),
+                    (dict(atol=-1.0), "atol"), (dict(first_step=0.0), "first_step")):
         args = {"t_end": 1.0, **kw}
         with pytest.raises(ValueError, match=rf"^{arg}\b"):
             rf.simulate(system, **args)

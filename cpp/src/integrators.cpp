@@ -45,9 +45,9 @@ class FirstOrder {
   IntegratorStats& stats_;
 };
 
-/// Scaled RMS norm of an error e against the weights atol + rtol max(|y0|, |y1|).
-double error_norm(const VecX& e, const VecX& y0, const VecX& y1, const VecX& atol, double rtol) {
-  const VecX sc = atol.array() + rtol * y0.cwiseAbs().cwiseMax(y1.cwiseAbs()).array();
+/// Scaled RMS norm of an error e against the weights atol + rtol max(|y0|, |y1|), per component.
+double error_norm(const VecX& e, const VecX& y0, const VecX& y1, const VecX& atol, const VecX& rtol) {
+  const VecX sc = atol.array() + rtol.array() * y0.cwiseAbs().cwiseMax(y1.cwiseAbs()).array();
   return std::sqrt((e.array() / sc.array()).square().mean());
 }
 
@@ -120,7 +120,7 @@ class ExplicitRK {
 
   /// Fills y1, f1 = ẏ(t + h, y1) and returns the error norm (0 without an estimate).
   double step(double t, double h, const VecX& y0, const VecX& f0, VecX& y1, VecX& f1, const VecX& atol,
-              double rtol) {
+              const VecX& rtol) {
     const int s = static_cast<int>(tab_.b.size());
     k_[0] = f0;
     VecX yi;
@@ -365,9 +365,13 @@ void check_options(const System& sys, double t0, double t_end, const VecX& q0, c
   if (fixed && !(o.dt > 0.0 && std::isfinite(o.dt)))
     throw std::invalid_argument("dt: expected a positive step in s for the fixed-step method '" + o.method + "', got " +
                                 num(o.dt));
-  if (!(o.rtol >= 0.0) || o.atol.size() == 0 || !(o.atol.minCoeff() >= 0.0) ||
-      (o.atol.size() != 1 && o.atol.size() != 2 * sys.nq) || (o.rtol == 0.0 && o.atol.minCoeff() == 0.0))
-    throw std::invalid_argument("atol: expected non-negative tolerances, one or 2 nq of them, not all zero with rtol");
+  for (const auto& [tol, name] : {std::pair<const VecX*, const char*>{&o.rtol, "rtol"}, {&o.atol, "atol"}})
+    if (tol->size() == 0 || (tol->size() != 1 && tol->size() != 2 * sys.nq) || !(tol->minCoeff() >= 0.0) ||
+        !tol->allFinite())
+      throw std::invalid_argument(std::string(name) + ": expected non-negative tolerances, one or 2 nq = " +
+                                  std::to_string(2 * sys.nq) + " of them");
+  if (o.rtol.maxCoeff() == 0.0 && o.atol.minCoeff() == 0.0)
+    throw std::invalid_argument("atol: expected positive values when rtol is zero");
   if (!(o.max_step > 0.0)) throw std::invalid_argument("max_step: expected a positive step in s");
   if (o.max_steps < 1) throw std::invalid_argument("max_steps: expected a positive number of steps");
   if (o.method == "newmark" && !(o.gamma >= 0.5 && o.beta >= 0.25 * (0.5 + o.gamma) * (0.5 + o.gamma) - 1e-15))
@@ -383,9 +387,9 @@ void check_options(const System& sys, double t0, double t_end, const VecX& q0, c
 }
 
 /// Hairer's starting step for a method of order p.
-double initial_step(FirstOrder& ode, double t0, const VecX& y0, const VecX& f0, const VecX& atol, double rtol,
+double initial_step(FirstOrder& ode, double t0, const VecX& y0, const VecX& f0, const VecX& atol, const VecX& rtol,
                     int p, double max_step, double span) {
-  const VecX sc = atol.array() + rtol * y0.cwiseAbs().array();
+  const VecX sc = atol.array() + rtol.array() * y0.cwiseAbs().array();
   const double d0 = std::sqrt((y0.array() / sc.array()).square().mean());
   const double d1 = std::sqrt((f0.array() / sc.array()).square().mean());
   double h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
@@ -411,6 +415,7 @@ Trajectory run(const System& sys, double t0, double t_end, const VecX& q0, const
   Recorder out(traj, t_eval, sys.nq);
   const int n = sys.nq;
   const VecX atol = o.atol.size() == 1 ? VecX::Constant(2 * n, o.atol(0)) : o.atol;
+  const VecX rtol = o.rtol.size() == 1 ? VecX::Constant(2 * n, o.rtol(0)) : o.rtol;
   const bool newmark = is_newmark(o);
   const bool adaptive = is_adaptive(o);
   const double span = t_end - t0;
@@ -454,7 +459,7 @@ Trajectory run(const System& sys, double t0, double t_end, const VecX& q0, const
       }
       if (!s1.q.allFinite() || !s1.v.allFinite()) fail(t, hs, "the state became NaN or inf");
       if (adaptive) {
-        const double err = error_norm(nm.error_estimate(hs, s, s1), s.q, s1.q, atol.head(n), o.rtol);
+        const double err = error_norm(nm.error_estimate(hs, s, s1), s.q, s1.q, atol.head(n), rtol.head(n));
         double factor = std::min(5.0, std::max(0.2, 0.9 * std::pow(std::max(err, 1e-10), -1.0 / 3.0)));
         if (factor >= 1.0 && factor < 1.25) factor = 1.0;  // keep h (and the iteration matrix) for small gains
         if (err > 1.0) {
@@ -517,14 +522,14 @@ Trajectory run(const System& sys, double t0, double t_end, const VecX& q0, const
   const Tableau& tab = tableau(o.method);
   ExplicitRK rk(ode, tab, o.method == "dopri5");
   double h = adaptive ? (o.dt > 0.0 ? std::min(o.dt, span)
-                                    : initial_step(ode, t0, y0, f0, atol, o.rtol, tab.order, o.max_step, span))
+                                    : initial_step(ode, t0, y0, f0, atol, rtol, tab.order, o.max_step, span))
                       : o.dt;
   bool rejected_last = false;
   while (t < t_end) {
     double hs = std::min({h, o.max_step, t_end - t});
     if (t + hs > t_end - 1e-12 * span) hs = t_end - t;
     check_budget(t, hs);
-    const double err = rk.step(t, hs, y, f0, y1, f1, atol, o.rtol);
+    const double err = rk.step(t, hs, y, f0, y1, f1, atol, rtol);
     if (adaptive) {
       // h_new = h · min(f_max, max(0.2, 0.9 err^(−1/(p̂+1)))), p̂ the lower order of the pair.
       const double expo = -1.0 / std::min(tab.order, 5);

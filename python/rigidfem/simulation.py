@@ -108,8 +108,9 @@ class Result:
                 f"{', interrupted' if self.interrupted else ''}>")
 
 
-def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = None, rtol: float = 1e-6,
+def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = None, rtol=1e-6,
              atol=1e-9, t_eval=None, q0=None, qd0=None, t0: float = 0.0, progress: bool = False,
+             first_step: float | None = None,
              max_steps: int = 1_000_000, max_step: float = np.inf, adaptive: bool | None = None, beta: float = 0.25,
              gamma: float = 0.5, alpha: float = -0.05, rho_inf: float = 0.8, newton_tol: float = 1e-10,
              newton_max_iterations: int = 10) -> Result:
@@ -121,9 +122,11 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
         See the module docstring: "euler", "symplectic_euler", "rk4", "dopri5", "rkf45",
         "newmark", "hht", "generalized_alpha", or "scipy:Radau", "scipy:BDF", "scipy:LSODA".
     dt : float
-        Step (s) of the fixed-step methods; first step of adaptive ones.
+        Step (s) of the fixed-step methods.
     rtol, atol : float or (2 nq,) array
-        Error control of adaptive methods, per component of y = [q, q̇].
+        Error control of adaptive methods, per component of y = [q, q̇] (m, rad; per s).
+    first_step : float, optional
+        First step (s) of an adaptive run; estimated (Hairer's rule) by default.
     t_eval : array, optional
         Output times (within [t0, t_end]) by dense output; default: every step.
     q0, qd0 : (nq,) arrays
@@ -163,8 +166,10 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
     opt = _core.IntegratorOptions()
     opt.method = method
     opt.dt = 0.0 if dt is None else _checks.scalar(dt, "dt", positive=True)
-    opt.rtol = _checks.scalar(rtol, "rtol", nonnegative=True)
-    opt.atol = np.atleast_1d(np.asarray(atol, dtype=float))
+    if first_step is not None:
+        opt.dt = _checks.scalar(first_step, "first_step", positive=True)
+    opt.rtol = _tolerance(rtol, "rtol", n)
+    opt.atol = _tolerance(atol, "atol", n)
     opt.max_step = float(max_step)
     opt.max_steps = int(max_steps)
     opt.adaptive = -1 if adaptive is None else int(bool(adaptive))
@@ -181,6 +186,13 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
         warnings.warn(f"simulation interrupted at t = {t[-1] if len(t) else t0:g} s: returning the partial result",
                       RuntimeWarning, stacklevel=2)
     return Result(system, t, q, qd, stats, method, interrupted)
+
+
+def _tolerance(x, name, n) -> np.ndarray:
+    tol = np.atleast_1d(np.asarray(x, dtype=float))
+    if tol.ndim != 1 or tol.size not in (1, 2 * n) or not np.all(np.isfinite(tol)) or np.any(tol < 0):
+        raise ValueError(f"{name}: expected a non-negative number or {2 * n} (2 nq) of them, got {x!r}")
+    return tol
 
 
 def _simulate_scipy(system, name, t0, t_end, q0, qd0, t_eval, rtol, atol, max_step) -> Result:

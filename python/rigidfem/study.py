@@ -112,7 +112,8 @@ class Table:
         return path
 
     def column(self, name) -> np.ndarray:
-        return np.array([r[name] for r in self.rows])
+        """The column as an array (NaN where a row has no value)."""
+        return np.array([r.get(name, np.nan) for r in self.rows], dtype=float)
 
     def plot(self, ax=None, x: str = "wall_time_s", y: str = "tip_error_final_m", by=("scene", "method")):
         """Log–log plot of ``y`` against ``x``, one line per group of ``by``."""
@@ -178,6 +179,7 @@ def work_precision(scene: Scene, methods, repeats: int = 3, ref=None, max_steps:
         extra = entry[3] if len(entry) > 3 else {}
         for value in values:
             kw = dict(extra, **{key: value})
+            kw.setdefault("max_steps", max_steps)
             if key == "rtol":
                 kw.setdefault("atol", value * 1e-2)
             row = {"scene": scene.name, "method": method, "setting": key, "value": value, "note": ""}
@@ -185,7 +187,7 @@ def work_precision(scene: Scene, methods, repeats: int = 3, ref=None, max_steps:
                 times = []
                 for k in range(repeats + 1):
                     r = simulate(scene.system, scene.t_end, method=method, t_eval=scene.t_eval, q0=scene.q0,
-                                 qd0=scene.qd0, max_steps=max_steps, **kw)
+                                 qd0=scene.qd0, **kw)
                     if k > 0 or repeats == 0:
                         times.append(r.stats["wall_time"])
                 tip_err = np.linalg.norm(_observe(scene, r) - tip_ref, axis=1)

@@ -22,8 +22,8 @@ struct IntegratorOptions {
   /// Step-size control: dopri5/rkf45 by their embedded pair (default), the Newmark family by
   /// a local error estimate (off by default); false runs every method at the fixed step dt.
   int adaptive = -1;         ///< −1: the method's default, 0: fixed step dt, 1: adaptive
-  double rtol = 1e-6;
-  VecX atol = VecX::Constant(1, 1e-9);  ///< (1) or (2 nq): per component of y = [q, q̇]
+  VecX rtol = VecX::Constant(1, 1e-6);  ///< (1) or (2 nq): per component of y = [q, q̇]
+  VecX atol = VecX::Constant(1, 1e-9);  ///< (1) or (2 nq)
   double max_step = std::numeric_limits<double>::infinity();
   long max_steps = 1000000;
   double beta = 0.25, gamma = 0.5;  ///< Newmark (average acceleration by default)
