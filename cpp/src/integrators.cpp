@@ -106,21 +106,36 @@ const Tableau& tableau(const std::string& method) {
        -2.0 / 55},
       4,
       false};
-  if (method == "euler") return euler;
+  if (method == "euler" || method == "symplectic_euler") return euler;
   if (method == "rk4") return rk4;
   if (method == "dopri5") return dopri5;
   return rkf45;
 }
 
-/// One explicit Runge–Kutta step y0 -> y1 with its dense output.
+/// One explicit step y0 -> y1 with its dense output: a Runge–Kutta tableau, or the
+/// semi-implicit (symplectic) Euler rule.
 class ExplicitRK {
  public:
-  ExplicitRK(FirstOrder& ode, const Tableau& tab, bool dopri_dense)
-      : ode_(ode), tab_(tab), k_(tab.b.size()), dopri_(dopri_dense) {}
+  ExplicitRK(FirstOrder& ode, const std::string& method)
+      : ode_(ode), tab_(tableau(method)), k_(tab_.b.size()), dopri_(method == "dopri5"),
+        symplectic_(method == "symplectic_euler") {}
+
+  int order() const { return tab_.order; }
 
   /// Fills y1, f1 = ẏ(t + h, y1) and returns the error norm (0 without an estimate).
   double step(double t, double h, const VecX& y0, const VecX& f0, VecX& y1, VecX& f1, const VecX& atol,
               const VecX& rtol) {
+    t0_ = t, h_ = h, y0_ = y0, f0_ = f0;
+    if (symplectic_) {
+      // q̇_{n+1} = q̇_n + h q̈(t_n, q_n, q̇_n), then q_{n+1} = q_n + h q̇_{n+1}.
+      const int n = static_cast<int>(y0.size()) / 2;
+      y1 = y0;
+      y1.tail(n) += h * f0.tail(n);
+      y1.head(n) += h * y1.tail(n);
+      ode_.eval(t + h, y1, f1);
+      y1_ = y1, f1_ = f1;
+      return 0.0;
+    }
     const int s = static_cast<int>(tab_.b.size());
     k_[0] = f0;
     VecX yi;
@@ -139,7 +154,7 @@ class ExplicitRK {
       f1 = k_[s - 1];
     else
       ode_.eval(t + h, y1, f1);
-    t0_ = t, h_ = h, y0_ = y0, y1_ = y1, f0_ = f0, f1_ = f1;
+    y1_ = y1, f1_ = f1;
     if (dopri_) {
       // Shampine's continuous extension of order 4 (as in Hairer's dopri5).
       static const double d[7] = {-12715105075.0 / 11282082432.0, 0.0, 87487479700.0 / 32700410799.0,
@@ -168,7 +183,7 @@ class ExplicitRK {
   FirstOrder& ode_;
   const Tableau& tab_;
   std::vector<VecX> k_;
-  bool dopri_;
+  bool dopri_, symplectic_;
   double t0_ = 0, h_ = 1;
   VecX y0_, y1_, f0_, f1_, rcont5_;
 };
@@ -441,6 +456,17 @@ Trajectory run(const System& sys, double t0, double t_end, const VecX& q0, const
   VecX y0(2 * n);
   y0 << q0, qd0;
   double t = t0;
+  // An accepted step of size h ending in state y1: advance t (landing on t_end exactly),
+  // record the outputs it covers by dense output, ask the monitor; false: interrupted.
+  auto accept = [&](double h, const VecX& y1, auto&& dense) {
+    t = (t + h >= t_end - 1e-12 * span) ? t_end : t + h;
+    ++stats.steps;
+    out.step(t, y1, dense);
+    last_q = y1.head(n);
+    if (keep_going(t)) return true;
+    traj.interrupted = true;
+    return false;
+  };
 
   if (newmark) {
     NewmarkFamily nm(sys, stats, o);
@@ -475,15 +501,8 @@ Trajectory run(const System& sys, double t0, double t_end, const VecX& q0, const
       fa << s.v, s.qdd;
       fb << s1.v, s1.qdd;
       const double ta = t;
-      t = (t + hs >= t_end - 1e-12 * span) ? t_end : t + hs;
-      ++stats.steps;
-      out.step(t, yb, [&](double tt) { return hermite((tt - ta) / hs, hs, ya, fa, yb, fb); });
       s = s1;
-      last_q = s.q;
-      if (!keep_going(t)) {
-        traj.interrupted = true;
-        break;
-      }
+      if (!accept(hs, yb, [&](double tt) { return hermite((tt - ta) / hs, hs, ya, fa, yb, fb); })) break;
     }
     return finish();
   }
@@ -494,35 +513,9 @@ Trajectory run(const System& sys, double t0, double t_end, const VecX& q0, const
   out.start(t0, y0);
   VecX y = y0;
 
-  if (o.method == "symplectic_euler") {
-    // Semi-implicit Euler: q̇_{n+1} = q̇_n + h q̈(t_n, q_n, q̇_n), q_{n+1} = q_n + h q̇_{n+1}.
-    while (t < t_end) {
-      const double h = (t + o.dt > t_end - 1e-12 * span) ? t_end - t : o.dt;
-      check_budget(t, h);
-      y1 = y;
-      y1.tail(n) += h * f0.tail(n);
-      y1.head(n) += h * y1.tail(n);
-      ode.eval(t + h, y1, f1);
-      const double ta = t;
-      const VecX ya = y, fa = f0;
-      t = ta + h == t_end - 0.0 ? t_end : ta + h;
-      ++stats.steps;
-      out.step(t, y1, [&](double tt) { return hermite((tt - ta) / h, h, ya, fa, y1, f1); });
-      y = y1;
-      f0 = f1;
-      last_q = y.head(n);
-      if (!keep_going(t)) {
-        traj.interrupted = true;
-        break;
-      }
-    }
-    return finish();
-  }
-
-  const Tableau& tab = tableau(o.method);
-  ExplicitRK rk(ode, tab, o.method == "dopri5");
+  ExplicitRK rk(ode, o.method);
   double h = adaptive ? (o.dt > 0.0 ? std::min(o.dt, span)
-                                    : initial_step(ode, t0, y0, f0, atol, rtol, tab.order, o.max_step, span))
+                                    : initial_step(ode, t0, y0, f0, atol, rtol, rk.order(), o.max_step, span))
                       : o.dt;
   bool rejected_last = false;
   while (t < t_end) {
@@ -532,7 +525,7 @@ Trajectory run(const System& sys, double t0, double t_end, const VecX& q0, const
     const double err = rk.step(t, hs, y, f0, y1, f1, atol, rtol);
     if (adaptive) {
       // h_new = h · min(f_max, max(0.2, 0.9 err^(−1/(p̂+1)))), p̂ the lower order of the pair.
-      const double expo = -1.0 / std::min(tab.order, 5);
+      const double expo = -1.0 / std::min(rk.order(), 5);
       const double fmax = rejected_last ? 1.0 : 10.0;
       const double factor = std::min(fmax, std::max(0.2, 0.9 * std::pow(std::max(err, 1e-10), expo)));
       if (!(err <= 1.0)) {
@@ -545,16 +538,9 @@ Trajectory run(const System& sys, double t0, double t_end, const VecX& q0, const
       rejected_last = false;
       h = hs * factor;
     }
-    t = (t + hs >= t_end - 1e-12 * span) ? t_end : t + hs;
-    ++stats.steps;
-    out.step(t, y1, [&](double tt) { return rk.dense(tt); });
     y = y1;
     f0 = f1;
-    last_q = y.head(n);
-    if (!keep_going(t)) {
-      traj.interrupted = true;
-      break;
-    }
+    if (!accept(hs, y, [&](double tt) { return rk.dense(tt); })) break;
   }
   return finish();
 }
