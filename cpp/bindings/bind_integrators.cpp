@@ -59,6 +59,7 @@ void bind_integrators(py::module_& m) {
         stats["factorizations"] = st.factorizations;
         stats["newton_iterations"] = st.newton_iterations;
         stats["wall_time"] = st.wall_time;
+        stats["stiff_at"] = st.stiff_at;
         return py::make_tuple(VecX(Eigen::Map<const VecX>(tr.t.data(), tr.t.size())), stack(tr.q, s.nq),
                               stack(tr.qd, s.nq), stats, tr.interrupted);
       },

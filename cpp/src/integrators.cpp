@@ -121,6 +121,7 @@ class ExplicitRK {
         symplectic_(method == "symplectic_euler") {}
 
   int order() const { return tab_.order; }
+  double h_rho() const { return h_rho_; }  ///< dopri5: h ρ of the last step (0 otherwise)
 
   /// Fills y1, f1 = ẏ(t + h, y1) and returns the error norm (0 without an estimate).
   double step(double t, double h, const VecX& y0, const VecX& f0, VecX& y1, VecX& f1, const VecX& atol,
@@ -145,6 +146,7 @@ class ExplicitRK {
       for (int j = 0; j < i; ++j)
         if (tab_.a[i][j] != 0.0) yi += (h * tab_.a[i][j]) * k_[j];
       ode_.eval(t + tab_.c[i] * h, yi, k_[i]);
+      if (dopri_ && i == 5) y_stage6_ = yi;
     }
     // y1 = y0 + h Σ b_i k_i
     y1 = y0;
@@ -155,6 +157,11 @@ class ExplicitRK {
     else
       ode_.eval(t + h, y1, f1);
     y1_ = y1, f1_ = f1;
+    if (dopri_) {
+      // Hairer's estimate of h ρ (ρ the dominant eigenvalue) from stages 6 and 7, both at t + h.
+      const double den = (y1 - y_stage6_).squaredNorm();
+      h_rho_ = den > 0.0 ? h * std::sqrt((k_[6] - k_[5]).squaredNorm() / den) : 0.0;
+    }
     if (dopri_) {
       // Shampine's continuous extension of order 4 (as in Hairer's dopri5).
       static const double d[7] = {-12715105075.0 / 11282082432.0, 0.0, 87487479700.0 / 32700410799.0,
@@ -184,8 +191,8 @@ class ExplicitRK {
   const Tableau& tab_;
   std::vector<VecX> k_;
   bool dopri_, symplectic_;
-  double t0_ = 0, h_ = 1;
-  VecX y0_, y1_, f0_, f1_, rcont5_;
+  double t0_ = 0, h_ = 1, h_rho_ = 0;
+  VecX y0_, y1_, f0_, f1_, rcont5_, y_stage6_;
 };
 
 // ---------------------------------------------------------------------------------------
@@ -239,7 +246,10 @@ class NewmarkFamily {
       } else if (attempt == 1) {
         return false;
       }
-      s1.qdd = s.qdd;  // predictor
+      // Predictor: no displacement beyond q̇_n h (a_{n+1} = −(½ − β)/β a_n), so a stiff
+      // mode's large acceleration does not throw the first iterate far off.
+      const VecX a1 = (-(0.5 - beta_) / beta_) * s.a;
+      s1.qdd = ((1.0 - am_) * a1 - af_ * s.qdd + am_ * s.a) / (1.0 - af_);
       double previous = std::numeric_limits<double>::infinity();
       for (int it = 0; it < max_it_; ++it) {
         update(h, s, s1);
@@ -293,6 +303,7 @@ class NewmarkFamily {
     const MatX S = d_.A - (gp * h) * dfdqd - (bp * h * h) * dfdq;
     ++stats_.jacobians;
     ++stats_.factorizations;
+    stats_.rhs_evaluations += 4 * sys_.nq;  // the force evaluations of the central differences
     lu_.compute(S);
     if (!(std::abs(lu_.determinant()) > 0.0) || !std::isfinite(lu_.determinant()))
       throw SimulationError(t, "the Newton iteration matrix M + γh C + βh² K is singular (step size h = " + num(h) +
@@ -518,6 +529,7 @@ Trajectory run(const System& sys, double t0, double t_end, const VecX& q0, const
                                     : initial_step(ode, t0, y0, f0, atol, rtol, rk.order(), o.max_step, span))
                       : o.dt;
   bool rejected_last = false;
+  int stiff_steps = 0, nonstiff_steps = 0;  // Hairer's stiffness test (dopri5)
   while (t < t_end) {
     double hs = std::min({h, o.max_step, t_end - t});
     if (t + hs > t_end - 1e-12 * span) hs = t_end - t;
@@ -537,6 +549,12 @@ Trajectory run(const System& sys, double t0, double t_end, const VecX& q0, const
       }
       rejected_last = false;
       h = hs * factor;
+      if (rk.h_rho() > 3.25) {
+        nonstiff_steps = 0;
+        if (++stiff_steps == 15 && std::isnan(stats.stiff_at)) stats.stiff_at = t + hs;
+      } else if (++nonstiff_steps == 6) {
+        stiff_steps = 0;
+      }
     }
     y = y1;
     f0 = f1;
@@ -556,11 +574,12 @@ Trajectory integrate(const System& sys, double t0, double t_end, const VecX& q0,
   } catch (const SimulationError& e) {
     // What the last accepted state says about the failure: Euler angles near gimbal lock,
     // or a fixed step beyond the method's stability limit (the state grew by orders of magnitude).
-    std::string hint = gimbal_lock_hint(sys, last_q, 1e-3);
     const double growth = last_q.cwiseAbs().maxCoeff() / std::max(q0.cwiseAbs().maxCoeff(), 1e-300);
     if (!is_adaptive(o) && (growth > 1e3 || !last_q.allFinite()))
-      hint += "; the state grew " + num(growth) + " times over the run: the fixed step dt = " + num(o.dt) +
-              " s is probably beyond the stability limit of " + o.method + " for this problem";
+      throw SimulationError(e.time, "the fixed step dt = " + num(o.dt) + " s is probably beyond the stability limit of " +
+                                        o.method + " for this problem: the state grew " + num(growth) +
+                                        " times, then " + e.cause);
+    const std::string hint = gimbal_lock_hint(sys, last_q, 1e-3);
     if (hint.empty()) throw;
     throw SimulationError(e.time, e.cause + hint);
   }

@@ -36,6 +36,9 @@ struct IntegratorOptions {
 struct IntegratorStats {
   long steps = 0, rejected = 0, rhs_evaluations = 0, jacobians = 0, factorizations = 0, newton_iterations = 0;
   double wall_time = 0.0;  ///< s
+  /// dopri5 only: first time (s) Hairer's stiffness test fired (h ρ > 3.25 over 15 accepted
+  /// steps: the step is bounded by stability, not accuracy), NaN if never.
+  double stiff_at = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// States at the output times (every accepted step when no output times are given).
