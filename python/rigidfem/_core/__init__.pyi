@@ -7,7 +7,7 @@ import numpy
 import numpy.typing
 import typing
 from . import stages
-__all__: list[str] = ['Body', 'Data', 'JointSpec', 'Point', 'Profile', 'R1', 'R2', 'R3', 'SimulationError', 'callback_profile', 'constant_profile', 'euler_zyx', 'harmonic_profile', 'homogeneous', 'inverse', 'joint_transform', 'joint_transform_derivative', 'joint_transform_second_derivative', 'polynomial_profile', 'pseudo_inertia', 'skew', 'spin_up_profile', 'spline_profile', 'stages']
+__all__: list[str] = ['Body', 'Data', 'IntegratorOptions', 'JointSpec', 'Point', 'Profile', 'R1', 'R2', 'R3', 'SimulationError', 'callback_profile', 'constant_profile', 'euler_zyx', 'harmonic_profile', 'homogeneous', 'inverse', 'joint_transform', 'joint_transform_derivative', 'joint_transform_second_derivative', 'polynomial_profile', 'pseudo_inertia', 'skew', 'spin_up_profile', 'spline_profile', 'stages']
 class SimulationError(RuntimeError):
     pass
 class Profile:
@@ -334,6 +334,87 @@ class Data:
         """
         Driving forces (np,).
         """
+class IntegratorOptions:
+    """
+    Options of the C++ integrators (see rigidfem.simulate).
+    """
+    method: str
+    def __init__(self) -> None:
+        ...
+    @property
+    def adaptive(self) -> int:
+        """
+        -1: the method's default, 0: fixed dt, 1: adaptive
+        """
+    @adaptive.setter
+    def adaptive(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def alpha(self) -> float:
+        ...
+    @alpha.setter
+    def alpha(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def atol(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @atol.setter
+    def atol(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> None:
+        ...
+    @property
+    def beta(self) -> float:
+        ...
+    @beta.setter
+    def beta(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def dt(self) -> float:
+        ...
+    @dt.setter
+    def dt(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def gamma(self) -> float:
+        ...
+    @gamma.setter
+    def gamma(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def max_step(self) -> float:
+        ...
+    @max_step.setter
+    def max_step(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def max_steps(self) -> int:
+        ...
+    @max_steps.setter
+    def max_steps(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def newton_max_iterations(self) -> int:
+        ...
+    @newton_max_iterations.setter
+    def newton_max_iterations(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def newton_tol(self) -> float:
+        ...
+    @newton_tol.setter
+    def newton_tol(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def rho_inf(self) -> float:
+        ...
+    @rho_inf.setter
+    def rho_inf(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    @property
+    def rtol(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @rtol.setter
+    def rtol(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> None:
+        ...
 def R1(phi1: typing.SupportsFloat | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
     """
     Rotation matrix about x by phi1 (rad), (3, 3).
@@ -346,6 +427,12 @@ def R3(phi3: typing.SupportsFloat | typing.SupportsIndex) -> typing.Annotated[nu
     """
     Rotation matrix about z by phi3 (rad), (3, 3).
     """
+def _evaluate_outputs(system: _System, t: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"], qd: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]]:
+    ...
+def _integrate(system: _System, t0: typing.SupportsFloat | typing.SupportsIndex, t_end: typing.SupportsFloat | typing.SupportsIndex, q0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], qd0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], t_eval: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], options: IntegratorOptions, progress: typing.Any) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], dict, bool]:
+    ...
+def _point_positions(system: _System, body: typing.SupportsInt | typing.SupportsIndex, r: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], frame: typing.SupportsInt | typing.SupportsIndex, t: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+    ...
 def callback_profile(function: collections.abc.Callable[[float], tuple[typing.SupportsFloat | typing.SupportsIndex, typing.SupportsFloat | typing.SupportsIndex, typing.SupportsFloat | typing.SupportsIndex]]) -> Profile:
     ...
 def constant_profile(value: typing.SupportsFloat | typing.SupportsIndex) -> Profile:
