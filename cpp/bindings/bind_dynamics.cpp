@@ -29,8 +29,16 @@ void check_body(const System& s, int body) {
 void bind_dynamics(py::module_& m) {
   py::class_<System, std::shared_ptr<System>>(m, "_System")
       // The System is immutable: only const methods are bound.
-      .def(py::init([](const Model& model) { return std::const_pointer_cast<System>(model.compile()); }),
-           py::arg("model"))
+      .def(py::init([](const Model& model, const std::string& algorithm) {
+             if (algorithm != "recursive" && algorithm != "lagrange")
+               throw std::invalid_argument("algorithm: expected 'recursive' or 'lagrange', got '" + algorithm + "'");
+             const Algorithm a = algorithm == "recursive" ? Algorithm::Recursive : Algorithm::Lagrange;
+             return std::const_pointer_cast<System>(model.compile(a));
+           }),
+           py::arg("model"), py::arg("algorithm"))
+      .def_property_readonly(
+          "algorithm", [](const System& s) { return s.algorithm == Algorithm::Recursive ? "recursive" : "lagrange"; },
+          "'recursive' (O(n): RNEA, CRBA, ABA) or 'lagrange' (the book's formulation; always for linear joints).")
       .def_readonly("nq", &System::nq, "Number of free joint coordinates (the unknowns).")
       .def_readonly("np", &System::np, "Number of prescribed (driven) coordinates.")
       .def_readonly("nc", &System::nc, "Number of all joint coordinates, nq + np.")

@@ -5,6 +5,7 @@
 #include <string>
 
 #include "rigidfem/errors.hpp"
+#include "rigidfem/recursive.hpp"
 
 namespace rigidfem {
 
@@ -186,6 +187,7 @@ double passive_force(const System& sys, const Data& d, int i) {
 
 void generalized_forces(const System& sys, Data& d) {
   check_data(sys, d);
+  if (sys.algorithm == Algorithm::Recursive) return rnea_forces(sys, d);
   load_composites(sys, d);
   inertia_composites(sys, d);
   // f_i = Σ_{uses of q_i} tr(U_u (Z̄_b − W̄_b)) + Q_i^passive: loads minus the velocity (and drive) terms.
@@ -199,6 +201,7 @@ void generalized_forces(const System& sys, Data& d) {
 
 void mass_matrix(const System& sys, Data& d) {
   check_data(sys, d);
+  if (sys.algorithm == Algorithm::Recursive) return crba(sys, d);
   for (int p = 0; p < sys.nbodies; ++p) d.Hbar[p].noalias() = d.T[p] * sys.H[p] * d.T[p].transpose();
   accumulate_subtrees(sys, d.Hbar);
   // a_ij = Σ tr(U_u H̄_b U_vᵀ) over the pairs of uses u of q_i and v of q_j (on body b)
@@ -236,15 +239,19 @@ std::string gimbal_lock_hint(const System& sys, const VecX& q, double tol) {
   return hint;
 }
 
+void check_gimbal_lock(const System& sys, const Data& d) {
+  for (int i : sys.zyx_pitch)
+    if (std::abs(std::cos(d.qa(i))) < 1e-9)
+      throw SimulationError(d.t, "gimbal lock: the ZYX angles of " +
+                                     sys.coords[i].name.substr(0, sys.coords[i].name.size() - 3) +
+                                     " reached pitch phi2 = +-pi/2, where the mass matrix is singular; turn the joint "
+                                     "frame (placement) so the motion keeps away from it");
+}
+
 void accelerations(const System& sys, Data& d) {
   check_data(sys, d);
   if (sys.nq == 0) return;
-  // ZYX Euler angles at pitch ±π/2: the mass matrix is singular (gimbal lock).
-  for (int i : sys.zyx_pitch)
-    if (std::abs(std::cos(d.qa(i))) < 1e-9)
-      throw SimulationError(d.t, "gimbal lock: the ZYX angles of " + sys.coords[i].name.substr(0, sys.coords[i].name.size() - 3) +
-                                     " reached pitch phi2 = +-pi/2, where the mass matrix is singular; turn the joint "
-                                     "frame (placement) so the motion keeps away from it");
+  check_gimbal_lock(sys, d);
   d.llt.compute(d.A);
   if (d.llt.info() != Eigen::Success)
     throw SimulationError(d.t, "mass matrix is not positive definite (singular configuration or massless chain)");
@@ -255,6 +262,10 @@ void accelerations(const System& sys, Data& d) {
 void driving_forces(const System& sys, Data& d) {
   check_data(sys, d);
   if (sys.np == 0) return;
+  if (sys.algorithm == Algorithm::Recursive) {
+    for (int k = 0; k < sys.nq; ++k) d.qdda(sys.free_coords[k]) = d.qdd(k);
+    return rnea_driving_forces(sys, d);
+  }
   for (int k = 0; k < sys.nq; ++k) d.qdda(sys.free_coords[k]) = d.qdd(k);
   kinematics(sys, d);  // T̈ now holds the full accelerations
   inertia_composites(sys, d);
@@ -271,6 +282,10 @@ const VecX& forward_dynamics(const System& sys, Data& d, double t, const Eigen::
                              const Eigen::Ref<const VecX>& qd) {
   set_state(sys, d, t, q, qd);
   kinematics(sys, d);
+  if (sys.algorithm == Algorithm::Recursive) {
+    aba(sys, d);
+    return d.qdd;
+  }
   generalized_forces(sys, d);
   mass_matrix(sys, d);
   accelerations(sys, d);

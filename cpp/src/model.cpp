@@ -191,7 +191,7 @@ void Model::add_load(const Load& load) {
   loads_.push_back(load);
 }
 
-std::shared_ptr<const System> Model::compile() const {
+std::shared_ptr<const System> Model::compile(Algorithm algorithm) const {
   if (bodies_.empty()) bad("model", "at least one body before compile()", "an empty model");
   auto sys = std::make_shared<System>();
   System& s = *sys;
@@ -208,6 +208,8 @@ std::shared_ptr<const System> Model::compile() const {
     s.B.push_back(b.placement);
     s.H.push_back(pseudo_inertia(b.mass, b.com, b.inertia));
     s.mass.push_back(b.mass);
+    s.com.push_back(b.com);
+    s.inertia.push_back(b.inertia);
     s.joint.push_back(b.joint);
     for (int k = 0; k < b.joint.ncoords(); ++k) {
       Coordinate c;
@@ -256,6 +258,8 @@ std::shared_ptr<const System> Model::compile() const {
   s.nuses = static_cast<int>(s.use_coord.size());
   s.nc = static_cast<int>(s.coords.size());
   s.nq = static_cast<int>(s.free_coords.size());
+  const bool any_linear = std::any_of(s.joint.begin(), s.joint.end(), [](const Joint& j) { return j.linear; });
+  s.algorithm = any_linear ? Algorithm::Lagrange : algorithm;
   s.np = static_cast<int>(s.drive_coords.size());
   return sys;
 }
@@ -288,6 +292,18 @@ Data::Data(const System& s)
       f(VecX::Zero(s.nq)),
       qdd(VecX::Zero(s.nq)),
       tau(VecX::Zero(s.np)),
-      llt(s.nq) {}
+      llt(s.nq),
+      axes(s.nuses, Vec6::Zero()),
+      v(s.nbodies, Vec6::Zero()),
+      c(s.nbodies, Vec6::Zero()),
+      a(s.nbodies, Vec6::Zero()),
+      sf(s.nbodies, Vec6::Zero()),
+      pA(s.nbodies, Vec6::Zero()),
+      I(s.nbodies, Mat6::Zero()),
+      IA(s.nbodies, Mat6::Zero()),
+      fext(s.nbodies, Vec6::Zero()),
+      U6(s.nbodies),
+      Dinv(s.nbodies),
+      u(s.nbodies) {}
 
 }  // namespace rigidfem

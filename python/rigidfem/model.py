@@ -236,12 +236,21 @@ class Model(_core._Model):
         return add_beam(self, name, parent, length, material, section, elements, formulation, deform, linear,
                         joint, placement, tip_mass, tip_inertia, tip_offset)
 
-    def compile(self) -> System:
-        """Freeze the model into an immutable ``System``."""
-        return System(self)
+    def compile(self, algorithm: str = "recursive") -> System:
+        """Freeze the model into an immutable ``System``.
+
+        ``algorithm``: "recursive" (default; O(n) forward dynamics by the articulated-body
+        algorithm, RNEA and CRBA for the right-hand side and mass matrix) or "lagrange" (the
+        book's formulation, kept as the reference). Systems with linear joints (the linear
+        beam model) always use Lagrange.
+        """
+        return System(self, algorithm)
 
 
 class System(_core._System):
+    def __init__(self, model, algorithm: str = "recursive"):
+        super().__init__(model, algorithm)
+
     """A compiled multibody system: the book's A(q) q̈ = f(q, q̇, t).
 
     q holds the free joint coordinates (``coordinate_names``; m and rad), body by

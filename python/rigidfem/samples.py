@@ -115,3 +115,56 @@ def kane_beam(omega: float = 6.0, duration: float = 15.0, elements: int = 10, li
     beam = model.add_beam("beam", hub, p["L"], Material(E=p["E"], rho=p["rho"]), section, elements,
                           formulation=formulation, deform=deform, linear=linear)
     return model, {"hub": hub, "beam": beam}
+
+
+def random_tree(seed: int, nbodies: int = 6):
+    """A random tree for property tests: every joint type (fixed, revolute, prismatic,
+    cylindrical, universal, spherical, planar, free, custom subsets), random placements,
+    masses, centres of mass and inertias (positive definite, triangle inequality), joint
+    springs and dampers, a drive on some coordinates, point forces, torques and gravity.
+
+    Returns ``(model, handles, rng)``; the generator continues the same stream, for states.
+    """
+    import numpy as np
+
+    from .motion import harmonic, polynomial
+
+    rng = np.random.default_rng(seed)
+    model = Model(gravity=tuple(rng.normal(0.0, 5.0, 3)))
+    axes = ("x", "y", "z")
+    makers = [
+        lambda kw: Joint.fixed(),
+        lambda kw: Joint.revolute(rng.choice(axes), **kw),
+        lambda kw: Joint.prismatic(rng.choice(axes), **kw),
+        lambda kw: Joint.cylindrical(rng.choice(axes), **kw),
+        lambda kw: Joint.universal(tuple(rng.choice(axes, 2, replace=False)), **kw),
+        lambda kw: Joint.spherical(**kw),
+        lambda kw: Joint.planar(rng.choice(["xy", "yz", "zx"]), **kw),
+        lambda kw: Joint.free(**kw),
+        lambda kw: Joint.custom(list(rng.choice(["x", "y", "z", "rz", "ry", "rx"], int(rng.integers(1, 5)),
+                                                replace=False)), **kw),
+    ]
+    bodies = []
+    for p in range(nbodies):
+        parent = model.ground if p == 0 or rng.random() < 0.2 else bodies[int(rng.integers(0, p))]
+        springs = {"stiffness": float(rng.uniform(0, 50)), "damping": float(rng.uniform(0, 2))}
+        joint = makers[int(rng.integers(0, len(makers)))](springs)
+        moments = np.sort(rng.uniform(0.05, 1.0, 3))
+        moments[2] = min(moments[2], 0.99 * (moments[0] + moments[1]))  # triangle inequality
+        Rb = transform(euler_zyx=rng.uniform(-np.pi, np.pi, 3))[:3, :3]
+        body = model.add_body(
+            f"b{p}", parent, joint, mass=float(rng.uniform(0.5, 3.0)), com=rng.uniform(-0.5, 0.5, 3),
+            inertia=Rb @ np.diag(moments) @ Rb.T,
+            placement=transform(translation=rng.uniform(-1, 1, 3), euler_zyx=rng.uniform(-1, 1, 3)),
+        )
+        bodies.append(body)
+        if joint.ncoords and rng.random() < 0.3:
+            c = str(rng.choice(joint.coordinates))
+            drive = harmonic(float(rng.uniform(0.1, 0.5)), float(rng.uniform(0.5, 3)), float(rng.uniform(0, 3))) \
+                if rng.random() < 0.5 else polynomial(list(rng.uniform(-0.3, 0.3, 3)))
+            model.prescribe(body, drive, coordinate=c)
+        if rng.random() < 0.5:
+            model.add_force(body.point(rng.uniform(-1, 1, 3)), rng.normal(0, 3, 3), follower=bool(rng.random() < 0.5))
+        if rng.random() < 0.3:
+            model.add_torque(body, rng.normal(0, 2, 3), follower=bool(rng.random() < 0.5))
+    return model, {"bodies": bodies}, rng

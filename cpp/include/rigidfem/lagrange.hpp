@@ -35,6 +35,8 @@ double passive_force(const System& sys, const Data& d, int i);
 void generalized_forces(const System& sys, Data& d);
 /// => A (nq, nq): a_ij = tr(U_i H̄_b U_jᵀ). Needs kinematics.
 void mass_matrix(const System& sys, Data& d);
+/// SimulationError if a ZYX joint sits at pitch ±π/2, where its mass matrix is singular.
+void check_gimbal_lock(const System& sys, const Data& d);
 /// => q̈ (nq) solving A q̈ = f; SimulationError if A is singular.
 void accelerations(const System& sys, Data& d);
 /// => τ (np): driving forces of the prescribed coordinates from the full

@@ -13,6 +13,7 @@
 namespace rigidfem {
 
 class System;
+enum class Algorithm;
 
 /// A joint: the active elementary motions, in the book's order x, y, z, φ3, φ2, φ1,
 /// with a linear spring (stiffness, rest value) and a viscous damper on each.
@@ -118,7 +119,7 @@ class Model {
   int coordinate_index(int body, const std::string& coordinate) const;
 
   /// Freezes the description into an immutable System.
-  std::shared_ptr<const System> compile() const;
+  std::shared_ptr<const System> compile(Algorithm algorithm) const;
 
  private:
   void check_body(int body, const char* argument) const;

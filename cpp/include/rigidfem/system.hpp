@@ -27,8 +27,17 @@ struct Coordinate {
   std::string name;        ///< "body.rz"
 };
 
+/// How the equations of motion are evaluated.
+enum class Algorithm { Lagrange, Recursive };
+
+using Vec6 = Eigen::Matrix<double, 6, 1>;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
+
 class System {
  public:
+  /// Recursive (O(n), the default) or the book's Lagrange formulation; systems with linear
+  /// joints always use Lagrange.
+  Algorithm algorithm = Algorithm::Lagrange;
   int nbodies = 0;
   int nq = 0;  ///< free coordinates (the unknowns)
   int np = 0;  ///< prescribed coordinates
@@ -40,6 +49,8 @@ class System {
   std::vector<Mat4> B;                  // (nbodies) 4x4 joint placement in the parent frame
   std::vector<Mat4> H;                  // (nbodies) 4x4 pseudo-inertia, body frame
   std::vector<double> mass;             // (nbodies)
+  std::vector<Vec3> com;                // (nbodies) centre of mass, body frame
+  std::vector<Mat3> inertia;            // (nbodies) inertia tensor about the centre of mass, body axes
   std::vector<Joint> joint;             // (nbodies)
   std::vector<int> coord_start;         // (nbodies + 1) first coordinate of body p in `coords`
   std::vector<Coordinate> coords;       // (nc) in body order, within a joint in the book's order
@@ -78,6 +89,15 @@ struct Data {
   VecX qdd;                    // (nq)
   VecX tau;                    // (np) driving forces of the prescribed coordinates
   Eigen::LLT<MatX> llt;
+  // Recursive algorithms (ground coordinates, at the global origin):
+  std::vector<Vec6> axes;      // (nuses) coordinate axes s = (ω, v_O)
+  std::vector<Vec6> v, c, a;   // (nbodies) spatial velocity, joint bias acceleration, acceleration
+  std::vector<Vec6> sf, pA;    // (nbodies) spatial force (subtree sums after RNEA), articulated bias force
+  std::vector<Mat6> I, IA;     // (nbodies) spatial inertia, composite or articulated inertia
+  std::vector<Vec6> fext;      // (nbodies) external loads
+  std::vector<Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, 6>> U6;   // (nbodies) I^A S
+  std::vector<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>> Dinv;  // (nbodies) (Sᵀ I^A S)⁻¹
+  std::vector<Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>> u;    // (nbodies) τ − Sᵀ p^A
 };
 
 }  // namespace rigidfem

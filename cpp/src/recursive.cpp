@@ -1,0 +1,207 @@
+#include "rigidfem/recursive.hpp"
+
+#include <string>
+
+#include "rigidfem/errors.hpp"
+#include "rigidfem/lagrange.hpp"
+
+namespace rigidfem {
+
+namespace {
+
+// m1 ×m m2 (motion cross product) and v ×* f (force cross product), Featherstone's crm/crf.
+Vec6 crossm(const Vec6& v, const Vec6& m) {
+  Vec6 r;
+  r << v.head<3>().cross(m.head<3>()), v.head<3>().cross(m.tail<3>()) + v.tail<3>().cross(m.head<3>());
+  return r;
+}
+
+Vec6 crossf(const Vec6& v, const Vec6& f) {
+  Vec6 r;
+  r << v.head<3>().cross(f.head<3>()) + v.tail<3>().cross(f.tail<3>()), v.head<3>().cross(f.tail<3>());
+  return r;
+}
+
+// Spatial inertia at the global origin of mass m with centre c and inertia I_c about it
+// (global axes): [[I_c + m S(c) S(c)ᵀ, m S(c)], [m S(c)ᵀ, m 1]].
+Mat6 spatial_inertia(double m, const Vec3& c, const Mat3& Ic) {
+  const Mat3 C = skew(c);
+  Mat6 I;
+  I << Ic + m * C * C.transpose(), m * C, m * C.transpose(), m * Mat3::Identity();
+  return I;
+}
+
+Vec6 gravity_acceleration(const System& sys, const Data& d) {
+  Vec6 a0 = Vec6::Zero();
+  a0.tail<3>() = -d.load_factor * sys.gravity;  // the base accelerates upwards: a_0 = −g
+  return a0;
+}
+
+// (T, U, q̇) => axes s_u, velocities v_p, joint bias accelerations c_p = Σ ṡ_k q̇_k (+ known
+// q̈ of prescribed coordinates when `with_prescribed`), inertias I_p and external loads.
+void spatial_kinematics(const System& sys, Data& d) {
+  for (int p = 0; p < sys.nbodies; ++p) {
+    Vec6 v = sys.parent[p] >= 0 ? d.v[sys.parent[p]] : Vec6::Zero();
+    Vec6 c = Vec6::Zero();
+    for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) {
+      const Mat4& U = d.U[u];
+      Vec6& s = d.axes[u];
+      s << U(2, 1), U(0, 2), U(1, 0), U.block<3, 1>(0, 3);
+      const double qd = d.qda(sys.use_coord[u]);
+      c += crossm(v, s) * qd;  // ṡ = v_before × s: the axis moves with the frame carrying it
+      v += s * qd;
+    }
+    d.v[p] = v;
+    d.c[p] = c;
+    const Mat3 R = d.T[p].topLeftCorner<3, 3>();
+    d.I[p] = spatial_inertia(sys.mass[p], d.T[p].topLeftCorner<3, 3>() * sys.com[p] + d.T[p].topRightCorner<3, 1>(),
+                             R * sys.inertia[p] * R.transpose());
+    d.fext[p].setZero();
+  }
+  for (const Load& L : sys.loads) {
+    const double sc = d.load_factor * (L.scale ? L.scale->at(d.t).q : 1.0);
+    const Mat3 R = d.T[L.body].topLeftCorner<3, 3>();
+    const Vec3 F = sc * (L.follower ? Vec3(R * L.force) : L.force);
+    const Vec3 tau = sc * (L.follower ? Vec3(R * L.torque) : L.torque);
+    const Vec3 x = (d.T[L.body] * L.point.homogeneous()).head<3>();
+    d.fext[L.body].head<3>() += x.cross(F) + tau;
+    d.fext[L.body].tail<3>() += F;
+  }
+}
+
+// RNEA with the accelerations in d.qdda: a_p = a_λ + c_p + Σ s q̈, f_p = I a + v ×* I v − f_ext,
+// summed over subtrees; returns nothing, leaves the subtree forces in d.f.
+void rnea_pass(const System& sys, Data& d) {
+  const Vec6 a0 = gravity_acceleration(sys, d);
+  for (int p = 0; p < sys.nbodies; ++p) {
+    Vec6 a = (sys.parent[p] >= 0 ? d.a[sys.parent[p]] : a0) + d.c[p];
+    for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) a += d.axes[u] * d.qdda(sys.use_coord[u]);
+    d.a[p] = a;
+    d.sf[p] = d.I[p] * a + crossf(d.v[p], d.I[p] * d.v[p]) - d.fext[p];
+  }
+  for (int p = sys.nbodies - 1; p > 0; --p)
+    if (sys.parent[p] >= 0) d.sf[sys.parent[p]] += d.sf[p];
+}
+
+void require_tree(const System& sys) {
+  if (sys.algorithm != Algorithm::Recursive)
+    throw std::logic_error("recursive algorithms need a system compiled with algorithm=recursive");
+}
+
+}  // namespace
+
+void rnea_forces(const System& sys, Data& d) {
+  require_tree(sys);
+  spatial_kinematics(sys, d);
+  rnea_pass(sys, d);  // free q̈ are zero after set_state: the bias forces
+  // f = −(Sᵀ f̄)_free + passive: what drives the free coordinates besides A q̈.
+  for (int k = 0; k < sys.nq; ++k) {
+    const int i = sys.free_coords[k], u = sys.use_start[sys.coords[i].body] + sys.coords[i].slot;
+    d.f(k) = -d.axes[u].dot(d.sf[sys.coords[i].body]) + passive_force(sys, d, i);
+  }
+}
+
+void crba(const System& sys, Data& d) {
+  require_tree(sys);
+  spatial_kinematics(sys, d);
+  // Composite inertias I^c_p = Σ_subtree I_k (ground coordinates: plain sums).
+  for (int p = 0; p < sys.nbodies; ++p) d.IA[p] = d.I[p];
+  for (int p = sys.nbodies - 1; p > 0; --p)
+    if (sys.parent[p] >= 0) d.IA[sys.parent[p]] += d.IA[p];
+  // a_ij = s_iᵀ I^c_b s_j for coordinate i on the path from the root to j's body b.
+  for (int b = 0; b < sys.nbodies; ++b)
+    for (int v = sys.use_start[b]; v < sys.use_start[b + 1]; ++v) {
+      const int l = sys.coords[sys.use_coord[v]].free_index;
+      if (l < 0) continue;
+      const Vec6 F = d.IA[b] * d.axes[v];
+      for (int body = b; body >= 0; body = sys.parent[body]) {
+        const int last = body == b ? v : sys.use_start[body + 1] - 1;
+        for (int u = sys.use_start[body]; u <= last; ++u) {
+          const int k = sys.coords[sys.use_coord[u]].free_index;
+          if (k >= 0) d.A(k, l) = d.A(l, k) = d.axes[u].dot(F);
+        }
+      }
+    }
+}
+
+void aba(const System& sys, Data& d) {
+  require_tree(sys);
+  check_gimbal_lock(sys, d);
+  spatial_kinematics(sys, d);
+  // Pass 1: p^A = v ×* I v − f_ext; the joint bias c_p gains the prescribed q̈ (known).
+  for (int p = 0; p < sys.nbodies; ++p) {
+    d.IA[p] = d.I[p];
+    d.pA[p] = crossf(d.v[p], d.I[p] * d.v[p]) - d.fext[p];
+    for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u)
+      if (sys.coords[sys.use_coord[u]].drive_index >= 0) d.c[p] += d.axes[u] * d.qdda(sys.use_coord[u]);
+  }
+  // Pass 2 (leaves to root): U = I^A S, D = Sᵀ U, u = τ − Sᵀ p^A over the free coordinates;
+  // the parent gets I^a = I^A − U D⁻¹ Uᵀ and p^a = p^A + I^a c + U D⁻¹ u.
+  for (int p = sys.nbodies - 1; p >= 0; --p) {
+    int nf = 0;
+    for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) nf += sys.coords[sys.use_coord[u]].free_index >= 0;
+    Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, 6> S(6, nf);
+    Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1> tau(nf);
+    for (int u = sys.use_start[p], k = 0; u < sys.use_start[p + 1]; ++u) {
+      const int i = sys.use_coord[u];
+      if (sys.coords[i].free_index < 0) continue;
+      S.col(k) = d.axes[u];
+      tau(k++) = passive_force(sys, d, i);
+    }
+    Mat6 Ia = d.IA[p];
+    Vec6 pa = d.pA[p];
+    if (nf > 0) {
+      d.U6[p] = d.IA[p] * S;
+      const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6> D = S.transpose() * d.U6[p];
+      Eigen::LLT<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>> llt(D);
+      if (llt.info() != Eigen::Success)
+        throw SimulationError(d.t, "articulated inertia of body '" + sys.body_names[p] +
+                                       "' is singular (a massless chain or a singular configuration)");
+      d.Dinv[p] = llt.solve(Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>::Identity(nf, nf));
+      d.u[p] = tau - S.transpose() * d.pA[p];
+      Ia -= d.U6[p] * d.Dinv[p] * d.U6[p].transpose();
+      pa += Ia * d.c[p] + d.U6[p] * (d.Dinv[p] * d.u[p]);
+    } else {
+      pa += Ia * d.c[p];
+    }
+    if (sys.parent[p] >= 0) {
+      d.IA[sys.parent[p]] += Ia;
+      d.pA[sys.parent[p]] += pa;
+    }
+  }
+  // Pass 3 (root to leaves): a' = a_λ + c, q̈ = D⁻¹ (u − Uᵀ a'), a = a' + S q̈.
+  const Vec6 a0 = gravity_acceleration(sys, d);
+  for (int p = 0; p < sys.nbodies; ++p) {
+    Vec6 a = (sys.parent[p] >= 0 ? d.a[sys.parent[p]] : a0) + d.c[p];
+    if (d.U6[p].cols() > 0) {
+      const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1> qdd = d.Dinv[p] * (d.u[p] - d.U6[p].transpose() * a);
+      for (int u = sys.use_start[p], k = 0; u < sys.use_start[p + 1]; ++u) {
+        const int i = sys.use_coord[u];
+        if (sys.coords[i].free_index < 0) continue;
+        d.qdd(sys.coords[i].free_index) = qdd(k);
+        d.qdda(i) = qdd(k);
+        a += d.axes[u] * qdd(k++);
+      }
+    }
+    d.a[p] = a;
+  }
+  if (!d.qdd.allFinite()) throw SimulationError(d.t, "accelerations are NaN or inf");
+}
+
+}  // namespace rigidfem
+
+namespace rigidfem {
+
+void rnea_driving_forces(const System& sys, Data& d) {
+  require_tree(sys);
+  if (sys.np == 0) return;
+  spatial_kinematics(sys, d);  // fresh joint biases (aba folded the prescribed q̈ into them)
+  rnea_pass(sys, d);           // d.qdda holds every acceleration after aba
+  // Row i of the full equations: s_iᵀ f̄_p = Q_i^passive + τ_i.
+  for (int k = 0; k < sys.np; ++k) {
+    const int i = sys.drive_coords[k], u = sys.use_start[sys.coords[i].body] + sys.coords[i].slot;
+    d.tau(k) = d.axes[u].dot(d.sf[sys.coords[i].body]) - passive_force(sys, d, i);
+  }
+}
+
+}  // namespace rigidfem

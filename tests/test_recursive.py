@@ -1,0 +1,66 @@
+"""The recursive algorithms (RNEA, CRBA, ABA) against the book's Lagrange formulation on
+random trees (hypothesis): the same q̈, mass matrix, right-hand side and driving forces."""
+
+import threading
+
+import numpy as np
+import pytest
+from hypothesis import given, settings
+from hypothesis import strategies as st
+
+import rigidfem as rf
+
+
+def scale(x):
+    return max(1.0, np.max(np.abs(x), initial=0.0))
+
+
+@settings(max_examples=40, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), nbodies=st.integers(1, 9))
+def test_recursive_equals_lagrange_on_random_trees(seed, nbodies):
+    model, _, rng = rf.samples.random_tree(seed, nbodies)
+    lag, rec = model.compile("lagrange"), model.compile("recursive")
+    assert (lag.algorithm, rec.algorithm) == ("lagrange", "recursive")
+    if rec.nq == 0:
+        return
+    for _ in range(2):
+        # Angles within ±1 rad keep every ZYX joint far from gimbal lock.
+        q, qd, t = rng.uniform(-1, 1, rec.nq), rng.uniform(-2, 2, rec.nq), float(rng.uniform(0, 5))
+        A = lag.mass_matrix(q, t)
+        cond = np.linalg.cond(A)
+        np.testing.assert_allclose(rec.mass_matrix(q, t), A, rtol=0, atol=1e-12 * scale(A))
+        f = lag.generalized_forces(t, q, qd)
+        np.testing.assert_allclose(rec.generalized_forces(t, q, qd), f, rtol=0, atol=1e-12 * scale(f))
+        qdd = lag.forward_dynamics(t, q, qd)
+        # Both solve the same equations: agreement to round-off amplified by cond(A).
+        np.testing.assert_allclose(rec.forward_dynamics(t, q, qd), qdd, rtol=0,
+                                   atol=max(1e-10, 1e-14 * cond) * scale(qdd))
+        tau = lag.driving_forces(t, q, qd)
+        np.testing.assert_allclose(rec.driving_forces(t, q, qd), tau, rtol=0,
+                                   atol=max(1e-10, 1e-14 * cond) * scale(tau) * scale(qdd))
+
+
+def test_linear_beam_models_use_lagrange():
+    model, _ = rf.samples.kane_beam(elements=4, linear=True)
+    assert model.compile("recursive").algorithm == "lagrange"
+    with pytest.raises(ValueError, match="^algorithm"):
+        model.compile("featherstone")
+
+
+def test_one_system_shared_by_threads_gives_identical_results():
+    model, _, rng = rf.samples.random_tree(7, 8)
+    system = model.compile("recursive")
+    q, qd = rng.uniform(-1, 1, system.nq), rng.uniform(-1, 1, system.nq)
+    expected = rf.simulate(system, 1.0, method="dopri5", rtol=1e-9, q0=q, qd0=qd, stiffness_warning=False).q
+    results = [None] * 4
+
+    def job(k):
+        results[k] = rf.simulate(system, 1.0, method="dopri5", rtol=1e-9, q0=q, qd0=qd, stiffness_warning=False).q
+
+    threads = [threading.Thread(target=job, args=(k,)) for k in range(4)]
+    for th in threads:
+        th.start()
+    for th in threads:
+        th.join()
+    for r in results:
+        np.testing.assert_array_equal(r, expected)
