@@ -53,5 +53,13 @@ def test_bench_command_writes_the_table_and_plot(tmp_path, capsys):
     scenes = {r["scene"] for r in rows}
     assert any("cantilever modified" in s for s in scenes) and any("cantilever classical" in s for s in scenes)
     assert any("kane" in s for s in scenes) and any("whippy" in s for s in scenes)
-    assert (tmp_path / "discretisation.csv").exists()
+    assert (tmp_path / "discretisation.csv").exists() and (tmp_path / "dynamics_scaling.csv").exists()
     assert "machine:" in capsys.readouterr().out
+
+
+def test_dynamics_scaling_table():
+    """The scaling study's structure (its numbers are benchmarks, reported, not asserted)."""
+    table = rf.study.dynamics_scaling(elements=(20, 40, 80), lagrange_up_to=40)
+    assert [r["nq"] for r in table.rows] == [60, 120, 240] and "lagrange_s" not in table.rows[-1]
+    assert all(r["recursive_s"] > 0 for r in table.rows)
+    assert np.isfinite(table.rows[0]["recursive_exponent"]) and np.isfinite(table.rows[0]["lagrange_exponent"])

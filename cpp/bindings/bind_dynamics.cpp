@@ -1,4 +1,6 @@
 // System, Data and the named stages of the Lagrange formulation.
+#include <chrono>
+
 #include "bindings.hpp"
 #include "rigidfem/lagrange.hpp"
 
@@ -168,7 +170,19 @@ void bind_dynamics(py::module_& m) {
             return rigidfem::dissipated_power(s, at(s, t, q, qd));
           },
           py::arg("q"), py::arg("qd"), py::arg("t") = 0.0, "Power dissipated by the joint dampers, sum b qd^2 (W).")
-      .def("make_data", [](const System& s) { return Data(s); }, "A fresh workspace for the stage functions.");
+      .def("make_data", [](const System& s) { return Data(s); }, "A fresh workspace for the stage functions.")
+      .def(
+          "_time_forward_dynamics",
+          [](const System& s, double t, const RefV& q, const RefV& qd, int calls) {
+            // Benchmark helper: seconds per forward-dynamics call, one Data, timed in C++.
+            Data d(s);
+            rigidfem::forward_dynamics(s, d, t, q, qd);  // warm-up
+            py::gil_scoped_release release;
+            const auto start = std::chrono::steady_clock::now();
+            for (int k = 0; k < calls; ++k) rigidfem::forward_dynamics(s, d, t, q, qd);
+            return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() / calls;
+          },
+          py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("calls"));
 
   py::class_<Data>(m, "Data", "Workspace of the algorithms; after each stage it holds that stage's results.")
       .def_readonly("t", &Data::t)

@@ -268,6 +268,33 @@ def discretisation_error(elements=(5, 10, 20, 40, 80), modes: int = 3) -> Table:
     return Table(rows, columns)
 
 
+def dynamics_scaling(elements=(10, 20, 50, 100, 200, 500, 1000), lagrange_up_to: int = 200) -> Table:
+    """Time per forward-dynamics call (s, timed in C++, minimum of 3 batches) against the
+    number of coordinates for modified-RFEM 3D cantilevers (3 rotations per sde): recursive
+    (ABA) against the book's Lagrange formulation, with the fitted exponent of each."""
+    rows = []
+    for m in elements:
+        model, _ = samples.cantilever(elements=m, deform=("bend_z", "bend_y", "torsion"))
+        row = {"m": m}
+        for algorithm in ("recursive", "lagrange"):
+            if algorithm == "lagrange" and m > lagrange_up_to:
+                continue
+            system = model.compile(algorithm)
+            rng = np.random.default_rng(0)
+            q, qd = rng.uniform(-1e-3, 1e-3, system.nq), rng.uniform(-1e-2, 1e-2, system.nq)
+            calls = max(3, int(2e5 / system.nq)) if algorithm == "recursive" else max(3, int(2e6 / system.nq**2))
+            row[f"{algorithm}_s"] = min(system._time_forward_dynamics(0.0, q, qd, calls) for _ in range(3))
+            row["nq"] = system.nq
+        rows.append(row)
+    for algorithm in ("recursive", "lagrange"):
+        pts = [(r["nq"], r[f"{algorithm}_s"]) for r in rows if f"{algorithm}_s" in r and r["nq"] >= 60]
+        if len(pts) >= 2:
+            slope = np.polyfit(np.log([p[0] for p in pts]), np.log([p[1] for p in pts]), 1)[0]
+            for r in rows:
+                r[f"{algorithm}_exponent"] = float(slope)
+    return Table(rows, ("m", "nq", "recursive_s", "lagrange_s", "recursive_exponent", "lagrange_exponent"))
+
+
 def standard_methods(quick: bool = False):
     """The integrators and settings of the benchmark."""
     r = [1e-4, 1e-6, 1e-8] if quick else [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9]
@@ -276,8 +303,8 @@ def standard_methods(quick: bool = False):
 
 def bench(output_dir="bench", quick: bool = False) -> Table:
     """``python -m rigidfem bench``: the standard scenes under the standard integrators, plus
-    fixed-step sweeps; writes ``work_precision.csv``/``.png`` and ``discretisation.csv`` into
-    ``output_dir`` and prints the tables."""
+    fixed-step sweeps; writes ``work_precision.csv``/``.png``, ``discretisation.csv`` and
+    ``dynamics_scaling.csv`` into ``output_dir`` and prints the tables."""
     import platform
 
     import matplotlib
@@ -317,10 +344,14 @@ def bench(output_dir="bench", quick: bool = False) -> Table:
     plt.close(fig)
     disc = discretisation_error(elements=(5, 10, 20) if quick else (5, 10, 20, 40, 80))
     disc.to_csv(out / "discretisation.csv")
+    scaling = dynamics_scaling(elements=(10, 20, 50) if quick else (10, 20, 50, 100, 200, 500, 1000))
+    scaling.to_csv(out / "dynamics_scaling.csv")
     print(f"machine: {platform.machine()} {platform.processor() or ''}, {platform.python_implementation()} "
           f"{platform.python_version()}, {__import__('os').cpu_count()} cores")
     print(table)
     print("\nLeast wall time (s) to reach a tip RMS error (m):")
     print(table.summary().to_markdown())
     print(disc.to_markdown())
+    print("\nForward dynamics, time per call (s) against nq:")
+    print(scaling.to_markdown())
     return table
