@@ -205,7 +205,9 @@ void bind_dynamics(py::module_& m) {
   auto stages = m.def_submodule("stages", "The named stages of forward dynamics, each writing into a Data.");
   stages.def("set_state", &set_state, py::arg("system"), py::arg("data"), py::arg("t"), py::arg("q"), py::arg("qd"),
              "(t, q, qd) => data.qa, qda, qdda (drives evaluated).");
-  stages.def("kinematics", &kinematics, py::arg("system"), py::arg("data"), "(qa, qda, qdda) => data.T, Td, Tdd, U.");
+  stages.def(
+      "kinematics", [](const System& s, Data& d) { rigidfem::kinematics(s, d); }, py::arg("system"), py::arg("data"),
+      "(qa, qda, qdda) => data.T, Td, Tdd, U.");
   stages.def(
       "generalized_forces", [](const System& s, Data& d) { rigidfem::generalized_forces(s, d); return d.f; },
       py::arg("system"), py::arg("data"), "=> data.f (loads, velocity terms, springs, dampers); returns it.");

@@ -88,7 +88,7 @@ namespace {
 
 // Motion of body p's joint in its own frame ("jcalc", the one place that knows joint
 // types): T̃, Ṫ̃, T̃̈ and, per use u, the local twist X_u = (∂T̃/∂q_u) T̃⁻¹ (in d.X).
-void jcalc(const System& sys, int p, Data& d, Mat4& T, Mat4& Td, Mat4& Tdd) {
+void jcalc(const System& sys, int p, Data& d, Mat4& T, Mat4& Td, Mat4& Tdd, bool rates) {
   const int u0 = sys.use_start[p], n = sys.use_start[p + 1] - u0;
   if (sys.joint[p].linear) {
     // T̃ = 1 + Σ_u G_u q_u: Ṫ̃ = Σ G_u q̇_u, T̃̈ = Σ G_u q̈_u, ∂T̃/∂q_u = G_u.
@@ -113,11 +113,13 @@ void jcalc(const System& sys, int p, Data& d, Mat4& T, Mat4& Td, Mat4& Tdd) {
     const int i = sys.use_coord[u0 + k];
     const Mat4& Q = sys.use_G[u0 + k];
     const Mat4 E = elementary(sys.coords[i].axis, d.qa(i));
-    const Mat4 EQ = E * Q;
-    const double qd = d.qda(i);
-    const Mat4 Ed = EQ * qd, Edd = EQ * d.qdda(i) + EQ * Q * (qd * qd);
-    Pdd = Pdd * E + 2.0 * Pd * Ed + P * Edd;
-    Pd = Pd * E + P * Ed;
+    if (rates) {
+      const Mat4 EQ = E * Q;
+      const double qd = d.qda(i);
+      const Mat4 Ed = EQ * qd, Edd = EQ * d.qdda(i) + EQ * Q * (qd * qd);
+      Pdd = Pdd * E + 2.0 * Pd * Ed + P * Edd;
+      Pd = Pd * E + P * Ed;
+    }
     P = P * E;
     // ∂T̃/∂q_k = P_k Q_k (E_{k+1} ...) = (P_k Q_k P_k⁻¹) T̃ with P_k = E_1 ... E_k rigid.
     d.X[k].noalias() = P * Q * inverse(P);
@@ -129,20 +131,22 @@ void jcalc(const System& sys, int p, Data& d, Mat4& T, Mat4& Td, Mat4& Tdd) {
 
 }  // namespace
 
-void kinematics(const System& sys, Data& d) {
+void kinematics(const System& sys, Data& d, bool rates) {
   check_data(sys, d);
   static const Mat4 I4 = Mat4::Identity(), O4 = Mat4::Zero();
   Mat4 Tj, Tjd, Tjdd;
   for (int p = 0; p < sys.nbodies; ++p) {
-    // Joint frame F = T_parent B_p and its time derivatives.
+    // Joint frame F = T_parent B_p; T_p = F T̃.
     const Mat4 F = frame_of_parent(sys, d.T, p, I4) * sys.B[p];
-    const Mat4 Fd = frame_of_parent(sys, d.Td, p, O4) * sys.B[p];
-    const Mat4 Fdd = frame_of_parent(sys, d.Tdd, p, O4) * sys.B[p];
-    jcalc(sys, p, d, Tj, Tjd, Tjdd);
-    // T_p = F T̃, Ṫ_p = Ḟ T̃ + F Ṫ̃, T̈_p = F̈ T̃ + 2 Ḟ Ṫ̃ + F T̃̈.
+    jcalc(sys, p, d, Tj, Tjd, Tjdd, rates);
     d.T[p].noalias() = F * Tj;
-    d.Td[p].noalias() = Fd * Tj + F * Tjd;
-    d.Tdd[p].noalias() = Fdd * Tj + 2.0 * Fd * Tjd + F * Tjdd;
+    if (rates) {
+      // Ṫ_p = Ḟ T̃ + F Ṫ̃, T̈_p = F̈ T̃ + 2 Ḟ Ṫ̃ + F T̃̈ with Ḟ = Ṫ_parent B_p, F̈ = T̈_parent B_p.
+      const Mat4 Fd = frame_of_parent(sys, d.Td, p, O4) * sys.B[p];
+      const Mat4 Fdd = frame_of_parent(sys, d.Tdd, p, O4) * sys.B[p];
+      d.Td[p].noalias() = Fd * Tj + F * Tjd;
+      d.Tdd[p].noalias() = Fdd * Tj + 2.0 * Fd * Tjd + F * Tjdd;
+    }
     // ∂T_k/∂q = F X_u F⁻¹ T_k = U_u T_k for every body k at or below p. F is affine but
     // not always rigid (below a linear joint), hence the affine inverse.
     const int u0 = sys.use_start[p], n = sys.use_start[p + 1] - u0;
@@ -281,11 +285,12 @@ void driving_forces(const System& sys, Data& d) {
 const VecX& forward_dynamics(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
                              const Eigen::Ref<const VecX>& qd) {
   set_state(sys, d, t, q, qd);
-  kinematics(sys, d);
   if (sys.algorithm == Algorithm::Recursive) {
+    kinematics(sys, d, false);  // ABA needs only T_p and the axes U_i
     aba(sys, d);
     return d.qdd;
   }
+  kinematics(sys, d);
   generalized_forces(sys, d);
   mass_matrix(sys, d);
   accelerations(sys, d);
@@ -348,11 +353,13 @@ StateOutputs evaluate_outputs(const System& sys, const VecX& t, const MatX& Q, c
   StateOutputs out{MatX(N, sys.nq), MatX(N, sys.np), VecX(N), VecX(N), VecX(N)};
   Data d(sys);
   for (Eigen::Index k = 0; k < N; ++k) {
-    forward_dynamics(sys, d, t(k), Q.row(k).transpose(), QD.row(k).transpose());
-    out.qdd.row(k) = d.qdd.transpose();
+    set_state(sys, d, t(k), Q.row(k).transpose(), QD.row(k).transpose());
+    kinematics(sys, d);  // with rates: the kinetic energy needs Ṫ
     out.kinetic(k) = kinetic_energy(sys, d);
     out.gravity(k) = gravity_energy(sys, d);
     out.elastic(k) = elastic_energy(sys, d);
+    forward_dynamics(sys, d, t(k), Q.row(k).transpose(), QD.row(k).transpose());
+    out.qdd.row(k) = d.qdd.transpose();
     driving_forces(sys, d);
     out.tau.row(k) = d.tau.transpose();
   }

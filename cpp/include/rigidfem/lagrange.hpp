@@ -24,7 +24,8 @@ void set_state(const System& sys, Data& d, double t, const Eigen::Ref<const VecX
 void set_static_state(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q);
 /// (qa, qda, qdda) => T_p, Ṫ_p, T̈_p (nbodies) and U_i (nc): forward recursion
 /// T_p = T_parent B_p T̃_p(q_p) with the joint's elementary factors differentiated in time.
-void kinematics(const System& sys, Data& d);
+/// rates = false computes only T_p and U_i (all the recursive algorithms need).
+void kinematics(const System& sys, Data& d, bool rates = true);
 /// (T, T̈) => W̄_p = Σ_{k in subtree(p)} T_k H_k T̈_kᵀ.
 void inertia_composites(const System& sys, Data& d);
 /// (T) => Z̄_p = Σ_{k in subtree(p)} (T_k H_k e₄) g̃ᵀ + (T_k r) F̃ᵀ + [[−½ S(τ), 0], [0, 0]].
