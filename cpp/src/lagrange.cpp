@@ -169,17 +169,20 @@ void load_composites(const System& sys, Data& d) {
   // Gravity: V = −Σ m gᵀ r_C, so Q_i = g̃ᵀ U_i T_p H_p e₄ = tr(U_i (T_p H_p e₄) g̃ᵀ).
   for (int p = 0; p < sys.nbodies; ++p) d.Zbar[p].noalias() = (d.T[p] * sys.H[p].col(3)) * g.transpose();
   for (const Load& L : sys.loads) {
-    const double s = d.load_factor * (L.scale ? L.scale->at(d.t).q : 1.0);
-    const Mat3 R = d.T[L.body].topLeftCorner<3, 3>();
-    const Vec3 F = s * (L.follower ? Vec3(R * L.force) : L.force);
-    const Vec3 tau = s * (L.follower ? Vec3(R * L.torque) : L.torque);
     // Force F at point x: Q_i = F̃ᵀ U_i x = tr(U_i x F̃ᵀ); torque τ: tr(U_i [[−½S(τ), 0], [0, 0]]) = w_i · τ.
-    const Vec4 x = d.T[L.body] * L.point.homogeneous();
+    const AppliedLoad a = applied_load(d, L);
     Mat4& Z = d.Zbar[L.body];
-    Z.leftCols<3>() += x * F.transpose();
-    Z.topLeftCorner<3, 3>() -= 0.5 * skew(tau);
+    Z.leftCols<3>() += Vec4(a.x.homogeneous()) * a.F.transpose();
+    Z.topLeftCorner<3, 3>() -= 0.5 * skew(a.tau);
   }
   accumulate_subtrees(sys, d.Zbar);
+}
+
+AppliedLoad applied_load(const Data& d, const Load& L) {
+  const double s = d.load_factor * (L.scale ? L.scale->at(d.t).q : 1.0);
+  const Mat3 R = d.T[L.body].topLeftCorner<3, 3>();
+  return {(d.T[L.body] * L.point.homogeneous()).head<3>(), s * (L.follower ? Vec3(R * L.force) : L.force),
+          s * (L.follower ? Vec3(R * L.torque) : L.torque)};
 }
 
 double passive_force(const System& sys, const Data& d, int i) {

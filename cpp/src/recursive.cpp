@@ -37,8 +37,8 @@ Vec6 gravity_acceleration(const System& sys, const Data& d) {
   return a0;
 }
 
-// (T, U, q̇) => axes s_u, velocities v_p, joint bias accelerations c_p = Σ ṡ_k q̇_k (+ known
-// q̈ of prescribed coordinates when `with_prescribed`), inertias I_p and external loads.
+// (T, U, q̇) => axes s_u, velocities v_p, joint bias accelerations c_p = Σ ṡ_k q̇_k, spatial
+// inertias I_p and external loads f_ext,p, all in ground coordinates.
 void spatial_kinematics(const System& sys, Data& d) {
   for (int p = 0; p < sys.nbodies; ++p) {
     Vec6 v = sys.parent[p] >= 0 ? d.v[sys.parent[p]] : Vec6::Zero();
@@ -54,18 +54,15 @@ void spatial_kinematics(const System& sys, Data& d) {
     d.v[p] = v;
     d.c[p] = c;
     const Mat3 R = d.T[p].topLeftCorner<3, 3>();
-    d.I[p] = spatial_inertia(sys.mass[p], d.T[p].topLeftCorner<3, 3>() * sys.com[p] + d.T[p].topRightCorner<3, 1>(),
+    d.I[p] = spatial_inertia(sys.mass[p], R * sys.com[p] + d.T[p].topRightCorner<3, 1>(),
                              R * sys.inertia[p] * R.transpose());
     d.fext[p].setZero();
   }
   for (const Load& L : sys.loads) {
-    const double sc = d.load_factor * (L.scale ? L.scale->at(d.t).q : 1.0);
-    const Mat3 R = d.T[L.body].topLeftCorner<3, 3>();
-    const Vec3 F = sc * (L.follower ? Vec3(R * L.force) : L.force);
-    const Vec3 tau = sc * (L.follower ? Vec3(R * L.torque) : L.torque);
-    const Vec3 x = (d.T[L.body] * L.point.homogeneous()).head<3>();
-    d.fext[L.body].head<3>() += x.cross(F) + tau;
-    d.fext[L.body].tail<3>() += F;
+    // As a spatial force at the global origin: (x × F + τ, F).
+    const AppliedLoad a = applied_load(d, L);
+    d.fext[L.body].head<3>() += a.x.cross(a.F) + a.tau;
+    d.fext[L.body].tail<3>() += a.F;
   }
 }
 

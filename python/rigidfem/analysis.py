@@ -22,7 +22,7 @@ class Equilibrium:
     """Result of ``static_equilibrium``."""
 
     q: np.ndarray            #: (nq,) equilibrium coordinates, m and rad
-    converged: bool
+    converged: bool          #: always True: a load step that does not converge raises SimulationError
     iterations: int          #: Newton iterations over all load steps
     residual: float          #: max |f(q)| at the end, N or N·m
     load_steps: int

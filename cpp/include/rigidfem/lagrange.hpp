@@ -30,6 +30,12 @@ void kinematics(const System& sys, Data& d, bool rates = true);
 void inertia_composites(const System& sys, Data& d);
 /// (T) => Z̄_p = Σ_{k in subtree(p)} (T_k H_k e₄) g̃ᵀ + (T_k r) F̃ᵀ + [[−½ S(τ), 0], [0, 0]].
 void load_composites(const System& sys, Data& d);
+/// A load at the current state, global: point of application x (m), force F (N), torque τ
+/// (N·m), with its time scale and load factor applied and follower loads turned with the body.
+struct AppliedLoad {
+  Vec3 x, F, tau;
+};
+AppliedLoad applied_load(const Data& d, const Load& L);
 /// Q_i of springs, dampers and applied generalised forces on coordinate i (all coordinates).
 double passive_force(const System& sys, const Data& d, int i);
 /// => f (nq): loads, velocity terms and passive forces. Needs kinematics.
