@@ -2,6 +2,7 @@
 #include <chrono>
 
 #include "bindings.hpp"
+#include "rigidfem/derivatives.hpp"
 #include "rigidfem/lagrange.hpp"
 
 namespace rigidfem::bindings {
@@ -19,6 +20,16 @@ Data at(const System& s, double t, const RefV& q, const RefV& qd) {
 }
 
 Data at(const System& s, double t, const RefV& q) { return at(s, t, q, VecX::Zero(s.nq)); }
+
+// The workspace d at state (t, q, q̇) with the free accelerations q̈ and kinematics done.
+Data& at_accelerations(const System& s, Data& d, double t, const RefV& q, const RefV& qd, const RefV& qdd) {
+  set_state(s, d, t, q, qd);
+  if (qdd.size() != s.nq || !qdd.allFinite())
+    throw std::invalid_argument("qdd: expected " + std::to_string(s.nq) + " (nq) finite values");
+  set_accelerations(s, d, qdd);
+  kinematics(s, d);
+  return d;
+}
 
 void check_body(const System& s, int body) {
   if (body < 0 || body >= s.nbodies)
@@ -103,7 +114,8 @@ void bind_dynamics(py::module_& m) {
             return rigidfem::force_jacobians(s, d, t, q, qd, static_drives);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("load_factor") = 1.0, py::arg("static") = false,
-          "(df/dq, df/dqd), each (nq, nq), by central differences. -df/dq is the tangent stiffness K,\n"
+          "(df/dq, df/dqd), each (nq, nq): analytic for recursive systems, central differences for\n"
+          "algorithm='lagrange'. -df/dq is the tangent stiffness K,\n"
           "-df/dqd the damping and gyroscopic matrix C. static=True holds the prescribed coordinates at t.")
       .def(
           "driving_forces", [](const System& s, double t, const RefV& q, const RefV& qd) {
@@ -125,7 +137,35 @@ void bind_dynamics(py::module_& m) {
             Data d(s);
             return rhs_jacobian(s, d, t, y);
           },
-          py::arg("t"), py::arg("y"), "d(rhs)/dy (2 nq, 2 nq) by central finite differences, for solve_ivp(jac=...).")
+          py::arg("t"), py::arg("y"), "d(rhs)/dy (2 nq, 2 nq) for solve_ivp(jac=...): analytic for recursive systems (see\n"
+          "acceleration_derivatives), central differences for algorithm='lagrange'.")
+      .def(
+          "inverse_dynamics",
+          [](const System& s, double t, const RefV& q, const RefV& qd, const RefV& qdd) {
+            Data d(s);
+            return rigidfem::inverse_dynamics(s, at_accelerations(s, d, t, q, qd, qdd));
+          },
+          py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("qdd"),
+          "r = A(q) qdd - f(q, qd, t) (nq,): the generalised forces (N or N m) the free coordinates\n"
+          "need besides the loads, springs and dampers to move with qdd (the residual of the\n"
+          "equations of motion; zero at the forward-dynamics accelerations).")
+      .def(
+          "inverse_dynamics_derivatives",
+          [](const System& s, double t, const RefV& q, const RefV& qd, const RefV& qdd) {
+            Data d(s);
+            return rigidfem::inverse_dynamics_derivatives(s, at_accelerations(s, d, t, q, qd, qdd));
+          },
+          py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("qdd"),
+          "(dr/dq, dr/dqd), each (nq, nq), of r = A qdd - f: analytic through the RNEA for recursive\n"
+          "systems (O(n) per column), central differences for algorithm='lagrange'.")
+      .def(
+          "acceleration_derivatives",
+          [](const System& s, double t, const RefV& q, const RefV& qd) {
+            Data d(s);
+            return rigidfem::acceleration_derivatives(s, d, t, q, qd);
+          },
+          py::arg("t"), py::arg("q"), py::arg("qd"),
+          "(dqdd/dq, dqdd/dqd), each (nq, nq): -A^-1 (dr/dq, dr/dqd) at the forward-dynamics qdd.")
       .def(
           "transform", [](const System& s, int body, const RefV& q, double t) {
             check_body(s, body);

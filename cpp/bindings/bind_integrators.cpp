@@ -28,7 +28,8 @@ void bind_integrators(py::module_& m) {
       .def_readwrite("alpha", &IntegratorOptions::alpha)
       .def_readwrite("rho_inf", &IntegratorOptions::rho_inf)
       .def_readwrite("newton_tol", &IntegratorOptions::newton_tol)
-      .def_readwrite("newton_max_iterations", &IntegratorOptions::newton_max_iterations);
+      .def_readwrite("newton_max_iterations", &IntegratorOptions::newton_max_iterations)
+      .def_readwrite("iteration_matrix", &IntegratorOptions::iteration_matrix);
 
   m.def(
       "_integrate",

@@ -7,7 +7,9 @@
 #include <stdexcept>
 
 #include "rigidfem/errors.hpp"
+#include "rigidfem/derivatives.hpp"
 #include "rigidfem/lagrange.hpp"
+#include "rigidfem/recursive.hpp"
 
 namespace rigidfem {
 
@@ -211,7 +213,14 @@ struct NewmarkState {
 class NewmarkFamily {
  public:
   NewmarkFamily(const System& sys, IntegratorStats& stats, const IntegratorOptions& o)
-      : sys_(sys), d_(sys), stats_(stats), tol_(o.newton_tol), max_it_(o.newton_max_iterations) {
+      : sys_(sys),
+        d_(sys),
+        stats_(stats),
+        tol_(o.newton_tol),
+        max_it_(o.newton_max_iterations),
+        recursive_(sys.algorithm == Algorithm::Recursive),
+        spring_(o.iteration_matrix == "spring" || (o.iteration_matrix == "auto" && o.method == "implicit_spring")),
+        armature_(sys.nq) {
     if (o.method == "newmark") {
       am_ = af_ = 0.0;
       beta_ = o.beta;
@@ -221,7 +230,7 @@ class NewmarkFamily {
       af_ = -o.alpha;
       gamma_ = 0.5 - o.alpha;
       beta_ = 0.25 * (1.0 - o.alpha) * (1.0 - o.alpha);
-    } else {  // generalized_alpha
+    } else {  // generalized_alpha, implicit_spring
       const double r = o.rho_inf;
       am_ = (2.0 * r - 1.0) / (r + 1.0);
       af_ = r / (r + 1.0);
@@ -253,16 +262,8 @@ class NewmarkFamily {
       double previous = std::numeric_limits<double>::infinity();
       for (int it = 0; it < max_it_; ++it) {
         update(h, s, s1);
-        // r = M(q) q̈ − f(q, q̇, t) at t_{n+1}
-        set_state(sys_, d_, t + h, s1.q, s1.v);
-        kinematics(sys_, d_);
-        generalized_forces(sys_, d_);
-        mass_matrix(sys_, d_);
-        ++stats_.rhs_evaluations;
-        const VecX r = d_.A * s1.qdd - d_.f;
-        // The iteration matrix only steers Newton: keep it while h stays within 30 % of its own.
-        if (!valid_ || std::abs(h / h_ - 1.0) > 0.3) build(t + h, h, s1, bp, gp);
-        const VecX dx = -lu_.solve(r);
+        const VecX r = residual(t + h, s1);
+        const VecX dx = spring_ ? spring_correction(t + h, h, r, bp, gp) : tangent_correction(t + h, h, r, bp, gp);
         ++stats_.newton_iterations;
         if (!dx.allFinite()) break;
         s1.qdd += dx;
@@ -278,6 +279,7 @@ class NewmarkFamily {
         if (it >= 2 && size > 2.0 * previous) break;  // diverging
         previous = size;
       }
+      if (spring_) return false;  // its iteration matrix is always fresh
     }
     return false;
   }
@@ -294,23 +296,55 @@ class NewmarkFamily {
     s1.v = s.v + h * ((1.0 - gamma_) * s.a + gamma_ * s1.a);
   }
 
-  // Iteration matrix S = M + γ' h C + β' h² K with K = −∂f/∂q, C = −∂f/∂q̇ (central differences).
-  void build(double t, double h, const NewmarkState& s1, double bp, double gp) {
-    auto [dfdq, dfdqd] = force_jacobians(sys_, d_, t, s1.q, s1.v, false);
+  /// r = M(q) q̈ − f(q, q̇, t) at the iterate (inverse dynamics: O(n) for recursive systems).
+  VecX residual(double t, const NewmarkState& s1) {
     set_state(sys_, d_, t, s1.q, s1.v);
-    kinematics(sys_, d_);
-    mass_matrix(sys_, d_);
-    const MatX S = d_.A - (gp * h) * dfdqd - (bp * h * h) * dfdq;
-    ++stats_.jacobians;
+    set_accelerations(sys_, d_, s1.qdd);
+    kinematics(sys_, d_, !recursive_);  // the Lagrange forces need T̈; RNEA needs T and U only
+    ++stats_.rhs_evaluations;
+    return inverse_dynamics(sys_, d_);
+  }
+
+  /// Newton: −S⁻¹ r with the tangent S = M + γ' h ∂r/∂q̇ + β' h² ∂r/∂q, kept while h stays
+  /// within 30 % of its own (it only steers the iterations).
+  VecX tangent_correction(double t, double h, const VecX& r, double bp, double gp) {
+    if (!valid_ || std::abs(h / h_ - 1.0) > 0.3) {
+      auto [drdq, drdqd] = inverse_dynamics_derivatives(sys_, d_);  // at the iterate of residual()
+      mass_matrix(sys_, d_);
+      ++stats_.jacobians;
+      ++stats_.factorizations;
+      if (!recursive_) stats_.rhs_evaluations += 4 * sys_.nq;  // the central differences
+      lu_.compute(d_.A + (gp * h) * drdqd + (bp * h * h) * drdq);
+      if (!(std::abs(lu_.determinant()) > 0.0) || !std::isfinite(lu_.determinant()))
+        throw SimulationError(t, "the Newton iteration matrix M + γh C + βh² K is singular (step size h = " + num(h) +
+                                     " s)");
+      valid_ = true;
+      fresh_ = true;
+      h_ = h;
+    }
+    return -lu_.solve(r);
+  }
+
+  /// The O(n) step: −(M + diag(γ' h b + β' h² c))⁻¹ r, the springs c and dampers b of the
+  /// coordinates entering like joint armature in the articulated-body recursion (the rest
+  /// of the tangent, geometric and gyroscopic, is left to the iterations).
+  VecX spring_correction(double t, double h, const VecX& r, double bp, double gp) {
+    for (int k = 0; k < sys_.nq; ++k) {
+      const Coordinate& c = sys_.coords[sys_.free_coords[k]];
+      armature_(k) = gp * h * c.damping + bp * h * h * c.stiffness;
+    }
     ++stats_.factorizations;
-    stats_.rhs_evaluations += 4 * sys_.nq;  // the force evaluations of the central differences
-    lu_.compute(S);
-    if (!(std::abs(lu_.determinant()) > 0.0) || !std::isfinite(lu_.determinant()))
-      throw SimulationError(t, "the Newton iteration matrix M + γh C + βh² K is singular (step size h = " + num(h) +
-                                   " s)");
-    valid_ = true;
-    fresh_ = true;
-    h_ = h;
+    VecX dx(sys_.nq);
+    if (recursive_) {  // residual() left the spatial kinematics of the iterate in d_
+      aba_factor(sys_, d_, armature_);
+      aba_solve(sys_, d_, -r, dx);
+      return dx;
+    }
+    mass_matrix(sys_, d_);
+    d_.A.diagonal() += armature_;
+    d_.llt.compute(d_.A);
+    if (d_.llt.info() != Eigen::Success) throw SimulationError(t, "the mass matrix is not positive definite");
+    return -d_.llt.solve(r);
   }
 
   const System& sys_;
@@ -318,6 +352,8 @@ class NewmarkFamily {
   IntegratorStats& stats_;
   double tol_;
   int max_it_;
+  bool recursive_, spring_;
+  VecX armature_;
   double am_ = 0, af_ = 0, beta_ = 0.25, gamma_ = 0.5;
   Eigen::PartialPivLU<MatX> lu_;
   bool valid_ = false, fresh_ = false;
@@ -363,7 +399,7 @@ class Recorder {
 };
 
 bool is_newmark(const IntegratorOptions& o) {
-  return o.method == "newmark" || o.method == "hht" || o.method == "generalized_alpha";
+  return o.method == "newmark" || o.method == "hht" || o.method == "generalized_alpha" || o.method == "implicit_spring";
 }
 
 bool is_adaptive(const IntegratorOptions& o) {
@@ -374,10 +410,13 @@ bool is_adaptive(const IntegratorOptions& o) {
 void check_options(const System& sys, double t0, double t_end, const VecX& q0, const VecX& qd0, const VecX& t_eval,
                    const IntegratorOptions& o) {
   static const char* methods[] = {"euler", "symplectic_euler", "rk4", "dopri5", "rkf45", "newmark", "hht",
-                                  "generalized_alpha"};
+                                  "generalized_alpha", "implicit_spring"};
   if (std::find(std::begin(methods), std::end(methods), o.method) == std::end(methods))
     throw std::invalid_argument("method: expected one of euler, symplectic_euler, rk4, dopri5, rkf45, newmark, hht, "
-                                "generalized_alpha, got '" + o.method + "'");
+                                "generalized_alpha, implicit_spring, got '" + o.method + "'");
+  if (o.iteration_matrix != "auto" && o.iteration_matrix != "tangent" && o.iteration_matrix != "spring")
+    throw std::invalid_argument("iteration_matrix: expected 'auto', 'tangent' or 'spring', got '" + o.iteration_matrix +
+                                "'");
   if (!std::isfinite(t0) || !std::isfinite(t_end) || !(t_end > t0))
     throw std::invalid_argument("t_end: expected a finite end time after t0 = " + num(t0) + " s, got " + num(t_end));
   if (q0.size() != sys.nq || !q0.allFinite())
@@ -405,7 +444,7 @@ void check_options(const System& sys, double t0, double t_end, const VecX& q0, c
                                 "beta >= (gamma + 1/2)^2 / 4, got beta = " + num(o.beta) + ", gamma = " + num(o.gamma));
   if (o.method == "hht" && !(o.alpha >= -1.0 / 3.0 && o.alpha <= 0.0))
     throw std::invalid_argument("alpha: expected a value in [-1/3, 0], got " + num(o.alpha));
-  if (o.method == "generalized_alpha" && !(o.rho_inf >= 0.0 && o.rho_inf <= 1.0))
+  if ((o.method == "generalized_alpha" || o.method == "implicit_spring") && !(o.rho_inf >= 0.0 && o.rho_inf <= 1.0))
     throw std::invalid_argument("rho_inf: expected a value in [0, 1], got " + num(o.rho_inf));
   for (Eigen::Index k = 0; k < t_eval.size(); ++k)
     if (!(t_eval(k) >= t0 && t_eval(k) <= t_end) || (k > 0 && !(t_eval(k) > t_eval(k - 1))))

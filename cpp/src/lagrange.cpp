@@ -4,6 +4,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "rigidfem/derivatives.hpp"
 #include "rigidfem/errors.hpp"
 #include "rigidfem/recursive.hpp"
 
@@ -311,6 +312,12 @@ VecX rhs(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& y) 
 MatX rhs_jacobian(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& y) {
   const int n = 2 * sys.nq;
   MatX J(n, n);
+  if (sys.algorithm == Algorithm::Recursive) {
+    check_vector(y, n, "y", "2 nq");
+    auto [dq, dqd] = acceleration_derivatives(sys, d, t, y.head(sys.nq), y.tail(sys.nq));
+    J << MatX::Zero(sys.nq, sys.nq), MatX::Identity(sys.nq, sys.nq), dq, dqd;
+    return J;
+  }
   VecX yp = y;
   for (int j = 0; j < n; ++j) J.col(j) = central_difference([&] { return rhs(sys, d, t, yp); }, yp, j);
   return J;
@@ -318,6 +325,17 @@ MatX rhs_jacobian(const System& sys, Data& d, double t, const Eigen::Ref<const V
 
 std::pair<MatX, MatX> force_jacobians(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
                                       const Eigen::Ref<const VecX>& qd, bool static_drives) {
+  if (sys.algorithm == Algorithm::Recursive) {
+    // f = −r(q, q̇, q̈ = 0): the analytic derivatives of the recursive inverse dynamics.
+    if (static_drives)
+      set_static_state(sys, d, t, q);
+    else
+      set_state(sys, d, t, q, qd);
+    kinematics(sys, d, false);
+    auto [dq, dqd] = inverse_dynamics_derivatives(sys, d);
+    if (static_drives) dqd.setZero();
+    return {-dq, -dqd};
+  }
   // The springs and dampers, −c_i (q_i − q_i⁰) − b_i q̇_i, are differentiated exactly; only the
   // rest (loads, inertia, force laws) by central differences, so stiff sdes (EA/Δ ~ 1e10)
   // add no round-off to the soft terms.

@@ -7,8 +7,6 @@
 
 namespace rigidfem {
 
-namespace {
-
 // m1 ×m m2 (motion cross product) and v ×* f (force cross product), Featherstone's crm/crf.
 Vec6 crossm(const Vec6& v, const Vec6& m) {
   Vec6 r;
@@ -22,6 +20,8 @@ Vec6 crossf(const Vec6& v, const Vec6& f) {
   return r;
 }
 
+namespace {
+
 // Spatial inertia at the global origin of mass m with centre c and inertia I_c about it
 // (global axes): [[I_c + m S(c) S(c)ᵀ, m S(c)], [m S(c)ᵀ, m 1]].
 Mat6 spatial_inertia(double m, const Vec3& c, const Mat3& Ic) {
@@ -31,14 +31,14 @@ Mat6 spatial_inertia(double m, const Vec3& c, const Mat3& Ic) {
   return I;
 }
 
+}  // namespace
+
 Vec6 gravity_acceleration(const System& sys, const Data& d) {
   Vec6 a0 = Vec6::Zero();
   a0.tail<3>() = -d.load_factor * sys.gravity;  // the base accelerates upwards: a_0 = −g
   return a0;
 }
 
-// (T, U, q̇) => axes s_u, velocities v_p, joint bias accelerations c_p = Σ ṡ_k q̇_k, spatial
-// inertias I_p and external loads f_ext,p, all in ground coordinates.
 void spatial_kinematics(const System& sys, Data& d) {
   for (int p = 0; p < sys.nbodies; ++p) {
     Vec6 v = sys.parent[p] >= 0 ? d.v[sys.parent[p]] : Vec6::Zero();
@@ -66,8 +66,6 @@ void spatial_kinematics(const System& sys, Data& d) {
   }
 }
 
-// RNEA with the accelerations in d.qdda: a_p = a_λ + c_p + Σ s q̈, f_p = I a + v ×* I v − f_ext,
-// summed over subtrees; returns nothing, leaves the subtree forces in d.f.
 void rnea_pass(const System& sys, Data& d) {
   const Vec6 a0 = gravity_acceleration(sys, d);
   for (int p = 0; p < sys.nbodies; ++p) {
@@ -79,6 +77,8 @@ void rnea_pass(const System& sys, Data& d) {
   for (int p = sys.nbodies - 1; p > 0; --p)
     if (sys.parent[p] >= 0) d.sf[sys.parent[p]] += d.sf[p];
 }
+
+namespace {
 
 void require_tree(const System& sys) {
   if (sys.algorithm != Algorithm::Recursive)
@@ -121,68 +121,119 @@ void crba(const System& sys, Data& d) {
     }
 }
 
-void aba(const System& sys, Data& d) {
-  require_tree(sys);
-  check_gimbal_lock(sys, d);
-  spatial_kinematics(sys, d);
-  // Pass 1: p^A = v ×* I v − f_ext; the joint bias c_p gains the prescribed q̈ (known).
-  for (int p = 0; p < sys.nbodies; ++p) {
-    d.IA[p] = d.I[p];
-    d.pA[p] = crossf(d.v[p], d.I[p] * d.v[p]) - d.fext[p];
-    for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u)
-      if (sys.coords[sys.use_coord[u]].drive_index >= 0) d.c[p] += d.axes[u] * d.qdda(sys.use_coord[u]);
-  }
-  // Pass 2 (leaves to root): U = I^A S, D = Sᵀ U, u = τ − Sᵀ p^A over the free coordinates;
-  // the parent gets I^a = I^A − U D⁻¹ Uᵀ and p^a = p^A + I^a c + U D⁻¹ u.
+namespace {
+
+using Subspace = Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, 6>;
+using SmallVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
+using SmallMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
+
+// S (6, nf): the axes of body p's free coordinates.
+Subspace free_axes(const System& sys, const Data& d, int p) {
+  int nf = 0;
+  for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) nf += sys.coords[sys.use_coord[u]].free_index >= 0;
+  Subspace S(6, nf);
+  for (int u = sys.use_start[p], k = 0; u < sys.use_start[p + 1]; ++u)
+    if (sys.coords[sys.use_coord[u]].free_index >= 0) S.col(k++) = d.axes[u];
+  return S;
+}
+
+// ABA pass 2, inertia part (leaves to root): U = I^A S, D = Sᵀ U + diag(δ), and the parent
+// gets I^a = I^A − U D⁻¹ Uᵀ, kept in d.IA[p] for the bias pass. δ = 0 without an armature.
+void articulated_inertias(const System& sys, Data& d, const VecX* armature) {
+  for (int p = 0; p < sys.nbodies; ++p) d.IA[p] = d.I[p];
   for (int p = sys.nbodies - 1; p >= 0; --p) {
-    int nf = 0;
-    for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) nf += sys.coords[sys.use_coord[u]].free_index >= 0;
-    Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, 6> S(6, nf);
-    Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1> tau(nf);
-    for (int u = sys.use_start[p], k = 0; u < sys.use_start[p + 1]; ++u) {
-      const int i = sys.use_coord[u];
-      if (sys.coords[i].free_index < 0) continue;
-      S.col(k) = d.axes[u];
-      tau(k++) = passive_force(sys, d, i);
-    }
-    Mat6 Ia = d.IA[p];
-    Vec6 pa = d.pA[p];
-    if (nf > 0) {
+    const Subspace S = free_axes(sys, d, p);
+    if (S.cols() > 0) {
       d.U6[p] = d.IA[p] * S;
-      const Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6> D = S.transpose() * d.U6[p];
-      Eigen::LLT<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>> llt(D);
+      SmallMat D = S.transpose() * d.U6[p];
+      if (armature)
+        for (int u = sys.use_start[p], k = 0; u < sys.use_start[p + 1]; ++u) {
+          const int l = sys.coords[sys.use_coord[u]].free_index;
+          if (l >= 0) D(k, k) += (*armature)(l), ++k;
+        }
+      Eigen::LLT<SmallMat> llt(D);
       if (llt.info() != Eigen::Success)
         throw SimulationError(d.t, "articulated inertia of body '" + sys.body_names[p] +
                                        "' is singular (a massless chain or a singular configuration)");
-      d.Dinv[p] = llt.solve(Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>::Identity(nf, nf));
-      d.u[p] = tau - S.transpose() * d.pA[p];
-      Ia -= d.U6[p] * d.Dinv[p] * d.U6[p].transpose();
-      pa += Ia * d.c[p] + d.U6[p] * (d.Dinv[p] * d.u[p]);
+      d.Dinv[p] = llt.solve(SmallMat::Identity(S.cols(), S.cols()));
+      d.IA[p] -= d.U6[p] * d.Dinv[p] * d.U6[p].transpose();
     } else {
-      pa += Ia * d.c[p];
+      d.U6[p].resize(6, 0);
     }
-    if (sys.parent[p] >= 0) {
-      d.IA[sys.parent[p]] += Ia;
-      d.pA[sys.parent[p]] += pa;
-    }
+    if (sys.parent[p] >= 0) d.IA[sys.parent[p]] += d.IA[p];
   }
-  // Pass 3 (root to leaves): a' = a_λ + c, q̈ = D⁻¹ (u − Uᵀ a'), a = a' + S q̈.
-  const Vec6 a0 = gravity_acceleration(sys, d);
+}
+
+// ABA pass 2, bias part, and pass 3, given the bias forces p^A (d.pA), joint biases c (d.c),
+// the forces τ (nq) on the free coordinates and the base acceleration a_0:
+//   u = τ − Sᵀ p^A, the parent gets p^a = p^A + I^a c + U D⁻¹ u (leaves to root);
+//   a' = a_λ + c, q̈ = D⁻¹ (u − Uᵀ a'), a = a' + S q̈ (root to leaves), into x (nq).
+void articulated_accelerations(const System& sys, Data& d, const VecX& tau, const Vec6& a0, VecX& x) {
+  for (int p = sys.nbodies - 1; p >= 0; --p) {
+    Vec6 pa = d.pA[p] + d.IA[p] * d.c[p];
+    if (d.U6[p].cols() > 0) {
+      const Subspace S = free_axes(sys, d, p);
+      SmallVec t(S.cols());
+      for (int u = sys.use_start[p], k = 0; u < sys.use_start[p + 1]; ++u) {
+        const int l = sys.coords[sys.use_coord[u]].free_index;
+        if (l >= 0) t(k++) = tau(l);
+      }
+      d.u[p] = t - S.transpose() * d.pA[p];
+      pa += d.U6[p] * (d.Dinv[p] * d.u[p]);
+    }
+    if (sys.parent[p] >= 0) d.pA[sys.parent[p]] += pa;
+  }
   for (int p = 0; p < sys.nbodies; ++p) {
     Vec6 a = (sys.parent[p] >= 0 ? d.a[sys.parent[p]] : a0) + d.c[p];
     if (d.U6[p].cols() > 0) {
-      const Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1> qdd = d.Dinv[p] * (d.u[p] - d.U6[p].transpose() * a);
+      const SmallVec qdd = d.Dinv[p] * (d.u[p] - d.U6[p].transpose() * a);
       for (int u = sys.use_start[p], k = 0; u < sys.use_start[p + 1]; ++u) {
-        const int i = sys.use_coord[u];
-        if (sys.coords[i].free_index < 0) continue;
-        d.qdd(sys.coords[i].free_index) = qdd(k);
-        d.qdda(i) = qdd(k);
+        const int i = sys.use_coord[u], l = sys.coords[i].free_index;
+        if (l < 0) continue;
+        x(l) = qdd(k);
         a += d.axes[u] * qdd(k++);
       }
     }
     d.a[p] = a;
   }
+}
+
+}  // namespace
+
+void aba(const System& sys, Data& d) {
+  require_tree(sys);
+  check_gimbal_lock(sys, d);
+  spatial_kinematics(sys, d);
+  // Pass 1: p^A = v ×* I v − f_ext; the joint bias c_p gains the prescribed q̈ (known).
+  VecX tau(sys.nq);
+  for (int p = 0; p < sys.nbodies; ++p) {
+    d.pA[p] = crossf(d.v[p], d.I[p] * d.v[p]) - d.fext[p];
+    for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) {
+      const int i = sys.use_coord[u];
+      if (sys.coords[i].drive_index >= 0) d.c[p] += d.axes[u] * d.qdda(i);
+      if (sys.coords[i].free_index >= 0) tau(sys.coords[i].free_index) = passive_force(sys, d, i);
+    }
+  }
+  articulated_inertias(sys, d, nullptr);
+  articulated_accelerations(sys, d, tau, gravity_acceleration(sys, d), d.qdd);
+  for (int k = 0; k < sys.nq; ++k) d.qdda(sys.free_coords[k]) = d.qdd(k);
   if (!d.qdd.allFinite()) throw SimulationError(d.t, "accelerations are NaN or inf");
+}
+
+void aba_factor(const System& sys, Data& d, const VecX& armature) {
+  require_tree(sys);
+  articulated_inertias(sys, d, &armature);
+}
+
+void aba_solve(const System& sys, Data& d, const VecX& b, VecX& x) {
+  require_tree(sys);
+  // M x = b is the forward dynamics of a system at rest, without gravity or loads, under b.
+  for (int p = 0; p < sys.nbodies; ++p) {
+    d.pA[p].setZero();
+    d.c[p].setZero();
+  }
+  x.resize(sys.nq);
+  articulated_accelerations(sys, d, b, Vec6::Zero(), x);
 }
 
 }  // namespace rigidfem

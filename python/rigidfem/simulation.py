@@ -113,14 +113,18 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
              first_step: float | None = None, stiffness_warning: bool = True,
              max_steps: int = 1_000_000, max_step: float = np.inf, adaptive: bool | None = None, beta: float = 0.25,
              gamma: float = 0.5, alpha: float = -0.05, rho_inf: float = 0.8, newton_tol: float = 1e-10,
-             newton_max_iterations: int = 10) -> Result:
+             newton_max_iterations: int = 10, iteration_matrix: str = "auto") -> Result:
     """Integrate ``system`` from ``t0`` to ``t_end`` (s) in C++ (no Python per step).
 
     Parameters
     ----------
     method : str
         See the module docstring: "euler", "symplectic_euler", "rk4", "dopri5", "rkf45",
-        "newmark", "hht", "generalized_alpha", or "scipy:Radau", "scipy:BDF", "scipy:LSODA".
+        "newmark", "hht", "generalized_alpha", "implicit_spring", or "scipy:Radau", "scipy:BDF",
+        "scipy:LSODA". "implicit_spring" is generalised-α (``rho_inf``) whose Newton matrix
+        holds only the coordinates' springs and dampers, M + diag(γ'h b + β'h² c): the
+        articulated-body algorithm solves it in O(n), so a stiff beam takes steps far beyond
+        the explicit stability limit at O(n) per Newton iteration.
     dt : float
         Step (s) of the fixed-step methods.
     rtol, atol : float or (2 nq,) array
@@ -146,6 +150,12 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
         local error estimate).
     beta, gamma, alpha, rho_inf
         Newmark's β, γ; HHT's α ∈ [−1/3, 0]; generalised-α's spectral radius ρ∞ ∈ [0, 1].
+    newton_tol, newton_max_iterations
+        Newton stops when the increments of q and q̇ fall below newton_tol (1 + |q|).
+    iteration_matrix : str
+        Newton matrix of the Newmark family: "tangent" (the exact tangent
+        M + γ'h ∂r/∂q̇ + β'h² ∂r/∂q, analytic for recursive systems, dense LU), "spring" (the
+        O(n) matrix of "implicit_spring") or "auto" (spring for implicit_spring, else tangent).
 
     Returns
     -------
@@ -181,6 +191,7 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
     opt.beta, opt.gamma, opt.alpha, opt.rho_inf = float(beta), float(gamma), float(alpha), float(rho_inf)
     opt.newton_tol = _checks.scalar(newton_tol, "newton_tol", positive=True)
     opt.newton_max_iterations = int(newton_max_iterations)
+    opt.iteration_matrix = iteration_matrix
     bar = _ProgressBar(t0, t_end) if progress else None
     try:
         t, q, qd, stats, interrupted = _core._integrate(system, t0, t_end, q0, qd0, t_eval, opt, bar)

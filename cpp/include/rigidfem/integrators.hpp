@@ -16,7 +16,8 @@ namespace rigidfem {
 
 struct IntegratorOptions {
   /// "euler", "symplectic_euler", "rk4" (fixed step); "dopri5", "rkf45" (adaptive);
-  /// "newmark", "hht", "generalized_alpha" (implicit, fixed step or adaptive).
+  /// "newmark", "hht", "generalized_alpha" (implicit, fixed step or adaptive); "implicit_spring":
+  /// generalised-α whose Newton iteration matrix holds only the springs and dampers, O(n) per step.
   std::string method = "dopri5";
   double dt = 0.0;           ///< s: the step of fixed-step methods (first step of adaptive ones if > 0)
   /// Step-size control: dopri5/rkf45 by their embedded pair (default), the Newmark family by
@@ -31,6 +32,11 @@ struct IntegratorOptions {
   double rho_inf = 0.8;             ///< generalised-α: spectral radius at infinite frequency, in [0, 1]
   double newton_tol = 1e-10;        ///< Newton: increments below newton_tol (1 + |q|), relative for adaptive runs
   int newton_max_iterations = 10;
+  /// The Newmark family's Newton matrix: "tangent" (M + γ'h ∂r/∂q̇ + β'h² ∂r/∂q, analytic for
+  /// recursive systems, factorised densely), "spring" (M + diag(γ'h b + β'h² c), the sde
+  /// springs and dampers as armature of the articulated-body algorithm: O(n)), or "auto"
+  /// (spring for implicit_spring, tangent otherwise).
+  std::string iteration_matrix = "auto";
 };
 
 struct IntegratorStats {

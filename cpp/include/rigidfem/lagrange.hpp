@@ -55,10 +55,12 @@ const VecX& forward_dynamics(const System& sys, Data& d, double t, const Eigen::
                              const Eigen::Ref<const VecX>& qd);
 /// dy/dt = [q̇, q̈] for y = [q, q̇] (2 nq).
 VecX rhs(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& y);
-/// ∂(dy/dt)/∂y (2nq, 2nq) by central differences.
+/// ∂(dy/dt)/∂y (2nq, 2nq): analytic for recursive systems (derivatives.hpp), central
+/// differences for the Lagrange formulation.
 MatX rhs_jacobian(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& y);
 
-/// ∂f/∂q and ∂f/∂q̇ (nq, nq) at (t, q, q̇) by central differences, with the prescribed
+/// ∂f/∂q and ∂f/∂q̇ (nq, nq) at (t, q, q̇), analytic for recursive systems and by central
+/// differences for the Lagrange formulation, with the prescribed
 /// coordinates moving (static = false) or held at their values at t (static = true, q̇ ignored).
 /// −∂f/∂q is the tangent stiffness, −∂f/∂q̇ the damping and gyroscopic matrix.
 std::pair<MatX, MatX> force_jacobians(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,

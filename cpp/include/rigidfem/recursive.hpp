@@ -16,6 +16,20 @@
 
 namespace rigidfem {
 
+// Building blocks (also used by the derivatives):
+/// m ×m s, the motion cross product (Featherstone's crm).
+Vec6 crossm(const Vec6& m, const Vec6& s);
+/// v ×* f, the force cross product (Featherstone's crf).
+Vec6 crossf(const Vec6& v, const Vec6& f);
+/// a_0 = (0, −g): gravity as an upward acceleration of the base.
+Vec6 gravity_acceleration(const System& sys, const Data& d);
+/// (T, U, q̇) => axes s_u, velocities v_p, joint bias accelerations c_p = Σ ṡ_k q̇_k, spatial
+/// inertias I_p and external loads f_ext,p, all in ground coordinates. Needs kinematics.
+void spatial_kinematics(const System& sys, Data& d);
+/// RNEA with the accelerations in d.qdda: a_p = a_λ + c_p + Σ s q̈, f_p = I a + v ×* I v − f_ext,
+/// summed over subtrees into d.sf. Needs spatial_kinematics.
+void rnea_pass(const System& sys, Data& d);
+
 /// Needs set_state and kinematics: the generalised forces f (nq) of A q̈ = f by RNEA with the
 /// free accelerations zero, f = −τ_RNEA + passive.
 void rnea_forces(const System& sys, Data& d);
@@ -24,6 +38,12 @@ void crba(const System& sys, Data& d);
 /// Needs set_state and kinematics: q̈ (nq) by the articulated-body algorithm; with the
 /// driving forces τ (np) of the prescribed coordinates from a final RNEA pass.
 void aba(const System& sys, Data& d);
+/// Needs spatial_kinematics: the articulated-body factorisation of M + diag(δ), δ (nq) ≥ 0 added
+/// to the free coordinates the way joint armature is (D = Sᵀ I^A S + diag δ). O(n).
+void aba_factor(const System& sys, Data& d, const VecX& armature);
+/// After aba_factor: x = (M + diag δ)⁻¹ b (nq) by the bias passes of ABA for a system at rest
+/// with no gravity or loads under the forces b. O(n). Overwrites the ABA workspace (c, p^A, a).
+void aba_solve(const System& sys, Data& d, const VecX& b, VecX& x);
 /// After aba: the driving forces τ (np) of the prescribed coordinates by RNEA with the full accelerations.
 void rnea_driving_forces(const System& sys, Data& d);
 

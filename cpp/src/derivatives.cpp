@@ -1,0 +1,210 @@
+#include "rigidfem/derivatives.hpp"
+
+#include <vector>
+
+#include "rigidfem/errors.hpp"
+#include "rigidfem/lagrange.hpp"
+#include "rigidfem/recursive.hpp"
+
+namespace rigidfem {
+
+namespace {
+
+// δI x for δI = s ×* I − I s ×m (the inertia turned by the twist s), without forming δI.
+Vec6 turned_inertia_times(const Vec6& s, const Mat6& I, const Vec6& x) { return crossf(s, I * x) - I * crossm(s, x); }
+
+// ∂Q/∂x of a scalar force law Q(t, q_i, q̇_i) by a central difference in x (q or q̇).
+double law_derivative(const Coordinate& c, const Data& d, int i, bool rate) {
+  double q = d.qa(i), qd = d.qda(i);
+  double& x = rate ? qd : q;
+  const double x0 = x, h = 6e-6 * std::max(1.0, std::abs(x0));
+  x = x0 + h;
+  const double up = c.force_law(d.t, q, qd);
+  x = x0 - h;
+  const double down = c.force_law(d.t, q, qd);
+  return (up - down) / (2.0 * h);
+}
+
+// Tangents of the RNEA quantities along one direction (one coordinate's q or q̇).
+struct Tangent {
+  explicit Tangent(const System& sys) : inside(sys.nbodies), v(sys.nbodies), a(sys.nbodies), f(sys.nbodies) {}
+  std::vector<char> inside;  // body in the subtree carried by the coordinate
+  std::vector<Vec6> v, a, f;  // δv_p, δa_p, δf̄_p
+};
+
+// Marks the bodies carried by coordinate j (its body b and b's subtree); parent[p] < p.
+void mark_subtree(const System& sys, int b, Tangent& w) {
+  for (int p = 0; p < sys.nbodies; ++p) w.inside[p] = p == b || (p > b && sys.parent[p] >= 0 && w.inside[sys.parent[p]]);
+}
+
+// Backward pass of the tangent: δf̄_p = δf_p + Σ_children δf̄_c.
+void accumulate(const System& sys, Tangent& w) {
+  for (int p = sys.nbodies - 1; p > 0; --p)
+    if (sys.parent[p] >= 0) w.f[sys.parent[p]] += w.f[p];
+}
+
+// Column ∂r/∂q_j for the coordinate j with use uj on body bj, into col (nq).
+void position_column(const System& sys, const Data& d, const std::vector<AppliedLoad>& loads, int uj, int bj,
+                     Tangent& w, Eigen::Ref<VecX> col) {
+  const Vec6& s = d.axes[uj];
+  mark_subtree(sys, bj, w);
+  // Forward pass over the carried bodies: a later axis turns, δs_u = s ×m s_u; then
+  // δc = Σ (δv ×m s_u + v ×m δs_u) q̇_u, δv = Σ δs_u q̇_u, δa_p = δa_λ + δc + Σ δs_u q̈_u and
+  // δf_p = δI a + I δa + δv ×* I v + v ×* (δI v + I δv).
+  for (int p = 0; p < sys.nbodies; ++p) {
+    if (!w.inside[p]) {
+      w.v[p].setZero();
+      w.a[p].setZero();
+      w.f[p].setZero();
+      continue;
+    }
+    const int lam = sys.parent[p];
+    Vec6 v = lam >= 0 ? d.v[lam] : Vec6::Zero();
+    Vec6 dv = p == bj ? Vec6::Zero() : w.v[lam];
+    Vec6 da = p == bj ? Vec6::Zero() : w.a[lam];
+    for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) {
+      const int i = sys.use_coord[u];
+      const double qd = d.qda(i);
+      const Vec6 ds = p != bj || u > uj ? crossm(s, d.axes[u]) : Vec6::Zero();
+      da += (crossm(dv, d.axes[u]) + crossm(v, ds)) * qd + ds * d.qdda(i);
+      v += d.axes[u] * qd;
+      dv += ds * qd;
+    }
+    const Mat6& I = d.I[p];
+    w.v[p] = dv;
+    w.a[p] = da;
+    w.f[p] = turned_inertia_times(s, I, d.a[p]) + I * da + crossf(dv, I * d.v[p]) +
+             crossf(d.v[p], turned_inertia_times(s, I, d.v[p]) + I * dv);
+  }
+  // Loads on carried bodies: a point fixed in the body moves with velocity v_s + ω_s × x;
+  // a follower load turns with the body, δf = s ×* f.
+  for (std::size_t k = 0; k < loads.size(); ++k) {
+    const Load& L = sys.loads[k];
+    if (!w.inside[L.body]) continue;
+    const AppliedLoad& l = loads[k];
+    Vec6 fl;
+    fl << l.x.cross(l.F) + l.tau, l.F;
+    if (L.follower) {
+      w.f[L.body] -= crossf(s, fl);
+    } else {
+      const Vec3 dx = s.tail<3>() + s.head<3>().cross(l.x);
+      w.f[L.body].head<3>() -= dx.cross(l.F);
+    }
+  }
+  accumulate(sys, w);
+  // r_i = s_iᵀ f̄_b − Q_i: δr_i = δs_iᵀ f̄_b + s_iᵀ δf̄_b.
+  for (int k = 0; k < sys.nq; ++k) {
+    const int i = sys.free_coords[k], b = sys.coords[i].body, u = sys.use_start[b] + sys.coords[i].slot;
+    double r = d.axes[u].dot(w.f[b]);
+    if (w.inside[b] && (b != bj || u > uj)) r += crossm(s, d.axes[u]).dot(d.sf[b]);
+    col(k) = r;
+  }
+}
+
+// Column ∂r/∂q̇_j: δv = s_j from the use uj on, δc = Σ δv ×m s_u q̇_u + v ×m s_j.
+void rate_column(const System& sys, const Data& d, int uj, int bj, Tangent& w, Eigen::Ref<VecX> col) {
+  mark_subtree(sys, bj, w);
+  for (int p = 0; p < sys.nbodies; ++p) {
+    if (!w.inside[p]) {
+      w.f[p].setZero();
+      continue;
+    }
+    const int lam = sys.parent[p];
+    Vec6 v = lam >= 0 ? d.v[lam] : Vec6::Zero();
+    Vec6 dv = p == bj ? Vec6::Zero() : w.v[lam];
+    Vec6 da = p == bj ? Vec6::Zero() : w.a[lam];
+    for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) {
+      da += crossm(dv, d.axes[u]) * d.qda(sys.use_coord[u]);
+      if (u == uj) {
+        da += crossm(v, d.axes[u]);
+        dv += d.axes[u];
+      }
+      v += d.axes[u] * d.qda(sys.use_coord[u]);
+    }
+    const Mat6& I = d.I[p];
+    w.v[p] = dv;
+    w.a[p] = da;
+    w.f[p] = I * da + crossf(dv, I * d.v[p]) + crossf(d.v[p], I * dv);
+  }
+  accumulate(sys, w);
+  for (int k = 0; k < sys.nq; ++k) {
+    const int i = sys.free_coords[k], b = sys.coords[i].body;
+    col(k) = d.axes[sys.use_start[b] + sys.coords[i].slot].dot(w.f[b]);
+  }
+}
+
+// Columns of ∂r/∂(q, q̇) by central differences of r (Lagrange systems, the reference).
+std::pair<MatX, MatX> differenced(const System& sys, Data& d) {
+  const double t = d.t;
+  const VecX q0 = d.qa(sys.free_coords), qd0 = d.qda(sys.free_coords), qdd = d.qdda(sys.free_coords);
+  VecX q = q0, qd = qd0;
+  auto r = [&] {
+    set_state(sys, d, t, q, qd);
+    set_accelerations(sys, d, qdd);
+    kinematics(sys, d);
+    return inverse_dynamics(sys, d);
+  };
+  MatX dq(sys.nq, sys.nq), dqd(sys.nq, sys.nq);
+  for (int j = 0; j < sys.nq; ++j)
+    for (auto [x, J] : {std::pair<VecX*, MatX*>{&q, &dq}, {&qd, &dqd}}) {
+      const double xj = (*x)(j), h = 6e-6 * std::max(1.0, std::abs(xj));
+      (*x)(j) = xj + h;
+      const VecX up = r();
+      (*x)(j) = xj - h;
+      const VecX down = r();
+      (*x)(j) = xj;
+      J->col(j) = (up - down) / (2.0 * h);
+    }
+  r();  // leave d at the state it came with
+  return {dq, dqd};
+}
+
+}  // namespace
+
+void set_accelerations(const System& sys, Data& d, const Eigen::Ref<const VecX>& qdd) {
+  for (int k = 0; k < sys.nq; ++k) d.qdda(sys.free_coords[k]) = qdd(k);
+}
+
+VecX inverse_dynamics(const System& sys, Data& d) {
+  generalized_forces(sys, d);  // with q̈ in d.qdda both formulations give f − A q̈
+  return -d.f;
+}
+
+std::pair<MatX, MatX> inverse_dynamics_derivatives(const System& sys, Data& d) {
+  if (sys.algorithm != Algorithm::Recursive) return differenced(sys, d);
+  spatial_kinematics(sys, d);
+  rnea_pass(sys, d);
+  std::vector<AppliedLoad> loads;
+  for (const Load& L : sys.loads) loads.push_back(applied_load(d, L));
+  MatX dq(sys.nq, sys.nq), dqd(sys.nq, sys.nq);
+  Tangent w(sys);
+  for (int j = 0; j < sys.nq; ++j) {
+    const int i = sys.free_coords[j], b = sys.coords[i].body, u = sys.use_start[b] + sys.coords[i].slot;
+    position_column(sys, d, loads, u, b, w, dq.col(j));
+    rate_column(sys, d, u, b, w, dqd.col(j));
+    // −∂Q_j/∂(q_j, q̇_j) of the coordinate's own spring, damper and force law.
+    const Coordinate& c = sys.coords[i];
+    dq(j, j) += c.stiffness;
+    dqd(j, j) += c.damping;
+    if (c.force_law) {
+      dq(j, j) -= d.load_factor * law_derivative(c, d, i, false);
+      dqd(j, j) -= d.load_factor * law_derivative(c, d, i, true);
+    }
+  }
+  return {dq, dqd};
+}
+
+std::pair<MatX, MatX> acceleration_derivatives(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                                               const Eigen::Ref<const VecX>& qd) {
+  const VecX qdd = forward_dynamics(sys, d, t, q, qd);
+  set_state(sys, d, t, q, qd);
+  set_accelerations(sys, d, qdd);
+  kinematics(sys, d);
+  auto [dq, dqd] = inverse_dynamics_derivatives(sys, d);
+  mass_matrix(sys, d);
+  d.llt.compute(d.A);
+  if (d.llt.info() != Eigen::Success) throw SimulationError(t, "the mass matrix is not positive definite");
+  return {-d.llt.solve(dq), -d.llt.solve(dqd)};
+}
+
+}  // namespace rigidfem
