@@ -22,8 +22,8 @@ def rot(axis, a):
 
 
 @functools.lru_cache
-def sympy_equations(spatial):
-    """Returns numeric functions M(q) and f(q, qd) of M q̈ = f from the Lagrangian."""
+def sympy_lagrange(spatial):
+    """Symbols q, q̇ and the symbolic M(q), f(q, q̇) of M q̈ = f from the Lagrangian."""
     n = 3 if spatial else 1
     q = sp.symbols(f"q0:{2 * n}")
     qd = sp.symbols(f"qd0:{2 * n}")
@@ -52,9 +52,27 @@ def sympy_equations(spatial):
     Mm = sp.hessian(T, qd)
     # M q̈ = ∂L/∂q − (∂²L/∂q̇∂q) q̇
     f = sp.Matrix([Lag.diff(qi) for qi in q]) - sp.Matrix([Lag.diff(qdi) for qdi in qd]).jacobian(qv) * qdv
+    return q, qd, Mm, f
+
+
+@functools.lru_cache
+def sympy_equations(spatial):
+    """Returns numeric functions M(q) and f(q, qd) of M q̈ = f from the Lagrangian."""
+    q, qd, Mm, f = sympy_lagrange(spatial)
     Mf = sp.lambdify([q], Mm, cse=True)
     ff = sp.lambdify([q, qd], f, cse=True)
     return (lambda x: np.array(Mf(x), float)), (lambda x, xd: np.array(ff(x, xd), float).ravel())
+
+
+@functools.lru_cache
+def sympy_residual_derivatives(spatial):
+    """Numeric ∂r/∂q and ∂r/∂q̇ of the residual r = M(q) q̈ − f(q, q̇), differentiated symbolically."""
+    q, qd, Mm, f = sympy_lagrange(spatial)
+    qdd = sp.symbols(f"qdd0:{len(q)}")
+    r = Mm * sp.Matrix(qdd) - f
+    drdq = sp.lambdify([q, qd, qdd], r.jacobian(sp.Matrix(q)), cse=True)
+    drdqd = sp.lambdify([q, qd, qdd], r.jacobian(sp.Matrix(qd)), cse=True)
+    return (lambda *x: np.array(drdq(*x), float)), (lambda *x: np.array(drdqd(*x), float))
 
 
 @pytest.mark.parametrize("algorithm", ["lagrange", "recursive"])
@@ -74,6 +92,30 @@ def test_mass_matrix_and_accelerations_against_sympy(spatial, algorithm, rng):
         qdd_ref = np.linalg.solve(M_ref(q), f_ref(q, qd))
         tol = max(1e-10, 1e-14 * np.linalg.cond(M)) * np.max(np.abs(qdd_ref))
         np.testing.assert_allclose(system.forward_dynamics(0.0, q, qd), qdd_ref, rtol=0, atol=tol)
+
+
+@pytest.mark.parametrize("spatial", [False])  # the spatial derivation takes SymPy minutes: see test_derivatives
+def test_analytic_derivatives_against_sympy(spatial, rng):
+    """The recursive engine's ∂r/∂q, ∂r/∂q̇ (tangent RNEA) and ∂q̈/∂(q, q̇) = −A⁻¹ ∂r against
+    SymPy's derivatives of the Lagrangian equations (planar)."""
+    model, _ = rf.samples.double_pendulum(lengths=(L1, L2), masses=(M1, M2), spatial=spatial, gravity=G)
+    system = model.compile("recursive")
+    M_ref, f_ref = sympy_equations(spatial)
+    drdq_ref, drdqd_ref = sympy_residual_derivatives(spatial)
+    for _ in range(3):
+        q, qd, qdd = rng.uniform(-1.2, 1.2, system.nq), rng.uniform(-3, 3, system.nq), rng.normal(0, 5, system.nq)
+        drdq, drdqd = system.inverse_dynamics_derivatives(0.0, q, qd, qdd)
+        Kref, Cref = drdq_ref(q, qd, qdd), drdqd_ref(q, qd, qdd)
+        np.testing.assert_allclose(drdq, Kref, rtol=0, atol=1e-11 * np.abs(Kref).max())
+        np.testing.assert_allclose(drdqd, Cref, rtol=0, atol=1e-11 * np.abs(Cref).max())
+        # At the forward-dynamics accelerations: ∂q̈/∂x = −M⁻¹ ∂r/∂x.
+        qdd0 = np.linalg.solve(M_ref(q), f_ref(q, qd))
+        Mref = M_ref(q)
+        dq, dqd = system.acceleration_derivatives(0.0, q, qd)
+        for got, ref in ((dq, -np.linalg.solve(Mref, drdq_ref(q, qd, qdd0))),
+                         (dqd, -np.linalg.solve(Mref, drdqd_ref(q, qd, qdd0)))):
+            tol = max(1e-10, 1e-14 * np.linalg.cond(Mref)) * np.abs(ref).max()
+            np.testing.assert_allclose(got, ref, rtol=0, atol=tol)
 
 
 def test_planar_mass_matrix_closed_form():

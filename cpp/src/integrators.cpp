@@ -277,6 +277,9 @@ class NewmarkFamily {
         }
         const double size = dx.cwiseAbs().maxCoeff();
         if (it >= 2 && size > 2.0 * previous) break;  // diverging
+        // A tangent from another state (an earlier step or the predictor) converging slowly:
+        // rebuild it at the next iterate (Newton proper).
+        if (!spring_ && it >= 1 && size > 0.2 * previous) valid_ = false;
         previous = size;
       }
       if (spring_) return false;  // its iteration matrix is always fresh

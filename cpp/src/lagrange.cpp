@@ -333,7 +333,6 @@ std::pair<MatX, MatX> force_jacobians(const System& sys, Data& d, double t, cons
       set_state(sys, d, t, q, qd);
     kinematics(sys, d, false);
     auto [dq, dqd] = inverse_dynamics_derivatives(sys, d);
-    if (static_drives) dqd.setZero();
     return {-dq, -dqd};
   }
   // The springs and dampers, −c_i (q_i − q_i⁰) − b_i q̇_i, are differentiated exactly; only the

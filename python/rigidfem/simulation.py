@@ -217,7 +217,7 @@ def _tolerance(x, name, n) -> np.ndarray:
 
 
 def _simulate_scipy(system, name, t0, t_end, q0, qd0, t_eval, rtol, atol, max_step) -> Result:
-    """SciPy's solve_ivp with the C++ rhs and finite-difference Jacobian (slow path)."""
+    """SciPy's solve_ivp with the C++ rhs and Jacobian (analytic for recursive systems; slow path)."""
     import time
 
     from scipy.integrate import solve_ivp

@@ -61,7 +61,7 @@ MatX rhs_jacobian(const System& sys, Data& d, double t, const Eigen::Ref<const V
 
 /// ∂f/∂q and ∂f/∂q̇ (nq, nq) at (t, q, q̇), analytic for recursive systems and by central
 /// differences for the Lagrange formulation, with the prescribed
-/// coordinates moving (static = false) or held at their values at t (static = true, q̇ ignored).
+/// coordinates moving (static = false) or held at their values at t (static = true: at rest, q̇ ignored).
 /// −∂f/∂q is the tangent stiffness, −∂f/∂q̇ the damping and gyroscopic matrix.
 std::pair<MatX, MatX> force_jacobians(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
                                       const Eigen::Ref<const VecX>& qd, bool static_drives);
