@@ -63,6 +63,21 @@ class scenes:
         return Scene(f"cantilever {formulation} m={elements}", model.compile(), periods * T1, h["beam"].tip, q0=q0)
 
     @staticmethod
+    def stiff_cantilever(elements: int = 10, periods: float = 2.0) -> Scene:
+        """The steel cantilever in 3D (both bendings and torsion, modified formulation) released
+        from rest at its static deflection under a skew tip load (0, 20, 10) N and a 1 N·m
+        torque: the torsion of the short end elements puts ω_max near 10⁶ rad/s, ~10⁴ times the
+        first frequency (105 rad/s), the stiff beam of the implicit-step study."""
+        deform = ("torsion", "bend_y", "bend_z")
+        loaded, hl = samples.cantilever(elements=elements, deform=deform)
+        loaded.add_force(hl["beam"].tip, (0.0, 20.0, 10.0))
+        loaded.add_torque(hl["beam"].tip, (1.0, 0.0, 0.0))
+        q0 = static_equilibrium(loaded.compile(), load_steps=2).q
+        model, h = samples.cantilever(elements=elements, deform=deform)
+        T1 = 2 * np.pi / 105.0
+        return Scene(f"stiff 3D cantilever m={elements}", model.compile(), periods * T1, h["beam"].tip, q0=q0)
+
+    @staticmethod
     def kane(omega: float = 6.0, elements: int = 10, t_end: float = 20.0, linear: bool = False) -> Scene:
         """Kane's spin-up beam, tip observed in the hub frame."""
         model, h = samples.kane_beam(omega=omega, elements=elements, linear=linear)
@@ -295,6 +310,46 @@ def dynamics_scaling(elements=(10, 20, 50, 100, 200, 500, 1000), lagrange_up_to:
     return Table(rows, ("m", "nq", "recursive_s", "lagrange_s", "recursive_exponent", "lagrange_exponent"))
 
 
+def implicit_step_scaling(elements=(10, 20, 50, 100, 200, 500, 1000), tangent_up_to: int = 200,
+                          steps: int = 50) -> Table:
+    """Cost per step (s, timed in C++) of the implicit methods against the number of coordinates
+    for modified-RFEM 3D cantilevers (steel, 1 m, 20 × 5 mm, 3 rotations per sde) set vibrating
+    by a 20 N tip load, at the step h = T₁/50 (T₁ = 2π/105 s its first period, far beyond the
+    explicit stability limit of the sdes): ``implicit_spring`` (O(n) Newton matrix) against
+    generalised-α with the exact tangent (analytic derivatives, dense LU), and the cost of
+    one rk4 step (four ABA calls) for scale. Also the Newton iterations per step and the
+    fitted exponent of the implicit_spring cost."""
+    h = 2 * np.pi / 105.0 / 50
+    rows = []
+    for m in elements:
+        model, hd = samples.cantilever(elements=m, deform=("bend_z", "bend_y", "torsion"))
+        model.add_force(hd["beam"].tip, (0.0, 20.0, 10.0))
+        system = model.compile()
+        row = {"m": m, "nq": system.nq}
+        runs = [("implicit_spring", {}), ("generalized_alpha", {"iteration_matrix": "tangent"})]
+        for name, kw in runs:
+            if name == "generalized_alpha" and m > tangent_up_to:
+                continue
+            best = min((simulate(system, steps * h, method=name, dt=h, **kw) for _ in range(2)),
+                       key=lambda r: r.stats["wall_time"])
+            key = "spring" if name == "implicit_spring" else "tangent"
+            row[f"{key}_s_per_step"] = best.stats["wall_time"] / best.stats["steps"]
+            row[f"{key}_iterations_per_step"] = best.stats["newton_iterations"] / best.stats["steps"]
+            if key == "tangent":
+                row["tangent_jacobians"] = best.stats["jacobians"]
+        q = np.zeros(system.nq)
+        calls = max(3, int(2e5 / system.nq))
+        row["rk4_s_per_step"] = 4 * min(system._time_forward_dynamics(0.0, q, q, calls) for _ in range(3))
+        rows.append(row)
+    pts = [(r["nq"], r["spring_s_per_step"]) for r in rows if r["nq"] >= 60]
+    if len(pts) >= 2:
+        slope = float(np.polyfit(np.log([p[0] for p in pts]), np.log([p[1] for p in pts]), 1)[0])
+        for r in rows:
+            r["spring_exponent"] = slope
+    return Table(rows, ("m", "nq", "spring_s_per_step", "spring_iterations_per_step", "tangent_s_per_step",
+                        "tangent_iterations_per_step", "tangent_jacobians", "rk4_s_per_step", "spring_exponent"))
+
+
 def standard_methods(quick: bool = False):
     """The integrators and settings of the benchmark."""
     r = [1e-4, 1e-6, 1e-8] if quick else [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9]
@@ -304,7 +359,7 @@ def standard_methods(quick: bool = False):
 def bench(output_dir="bench", quick: bool = False) -> Table:
     """``python -m rigidfem bench``: the standard scenes under the standard integrators, plus
     fixed-step sweeps; writes ``work_precision.csv``/``.png``, ``discretisation.csv`` and
-    ``dynamics_scaling.csv`` into ``output_dir`` and prints the tables."""
+    ``dynamics_scaling.csv``, ``implicit_step_scaling.csv`` into ``output_dir`` and prints the tables."""
     import platform
 
     import matplotlib
@@ -318,15 +373,23 @@ def bench(output_dir="bench", quick: bool = False) -> Table:
         (scenes.cantilever("modified", m), standard_methods(quick) + [
             ("rk4", "dt", [2e-5, 1e-5] if quick else [4e-5, 2e-5, 1e-5]),
             ("newmark", "dt", [1e-3, 5e-4] if quick else [1e-3, 5e-4, 2.5e-4, 1.25e-4]),
-            ("generalized_alpha", "dt", [1e-3, 5e-4] if quick else [1e-3, 5e-4, 2.5e-4, 1.25e-4])]),
+            ("generalized_alpha", "dt", [1e-3, 5e-4] if quick else [1e-3, 5e-4, 2.5e-4, 1.25e-4]),
+            ("implicit_spring", "dt", [1e-3, 5e-4] if quick else [1e-3, 5e-4, 2.5e-4, 1.25e-4])]),
+        (scenes.stiff_cantilever(4 if quick else m), [
+            ("dopri5", "rtol", [1e-4, 1e-6] if quick else [1e-4, 1e-6, 1e-8]),
+            ("rk4", "dt", [1e-6] if quick else [2e-6, 1e-6, 5e-7]),
+            ("generalized_alpha", "dt", [1e-3, 5e-4] if quick else [2e-3, 1e-3, 5e-4, 2.5e-4, 1.25e-4]),
+            ("implicit_spring", "dt", [1e-3, 5e-4] if quick else [2e-3, 1e-3, 5e-4, 2.5e-4, 1.25e-4])]),
         (scenes.cantilever("classical", m), [
             ("dopri5", "rtol", [1e-4, 1e-6] if quick else [1e-4, 1e-6, 1e-8]),
             ("newmark", "dt", [1e-3, 5e-4] if quick else [1e-3, 5e-4, 2.5e-4, 1.25e-4]),
             ("generalized_alpha", "dt", [1e-3, 5e-4] if quick else [1e-3, 5e-4, 2.5e-4, 1.25e-4])]),
         (scenes.kane(6.0, m, t_end=10.0 if quick else 20.0), standard_methods(quick) + [
-            ("generalized_alpha", "dt", [0.01, 0.005] if quick else [0.02, 0.01, 0.005, 0.0025])]),
+            ("generalized_alpha", "dt", [0.01, 0.005] if quick else [0.02, 0.01, 0.005, 0.0025]),
+            ("implicit_spring", "dt", [0.01, 0.005] if quick else [0.02, 0.01, 0.005, 0.0025])]),
         (scenes.whippy(m, t_end=0.5 if quick else 1.0), standard_methods(quick) + [
-            ("generalized_alpha", "dt", [2e-3, 1e-3] if quick else [2e-3, 1e-3, 5e-4, 2.5e-4])]),
+            ("generalized_alpha", "dt", [2e-3, 1e-3] if quick else [2e-3, 1e-3, 5e-4, 2.5e-4]),
+            ("implicit_spring", "dt", [2e-3, 1e-3] if quick else [2e-3, 1e-3, 5e-4, 2.5e-4])]),
     ]
     rows = []
     for scene, methods in todo:
@@ -346,6 +409,8 @@ def bench(output_dir="bench", quick: bool = False) -> Table:
     disc.to_csv(out / "discretisation.csv")
     scaling = dynamics_scaling(elements=(10, 20, 50) if quick else (10, 20, 50, 100, 200, 500, 1000))
     scaling.to_csv(out / "dynamics_scaling.csv")
+    implicit = implicit_step_scaling(elements=(10, 20, 50) if quick else (10, 20, 50, 100, 200, 500, 1000))
+    implicit.to_csv(out / "implicit_step_scaling.csv")
     print(f"machine: {platform.machine()} {platform.processor() or ''}, {platform.python_implementation()} "
           f"{platform.python_version()}, {__import__('os').cpu_count()} cores")
     print(table)
@@ -354,4 +419,6 @@ def bench(output_dir="bench", quick: bool = False) -> Table:
     print(disc.to_markdown())
     print("\nForward dynamics, time per call (s) against nq:")
     print(scaling.to_markdown())
+    print("\nImplicit step, time per step (s) against nq (h = T1/50):")
+    print(implicit.to_markdown())
     return table
