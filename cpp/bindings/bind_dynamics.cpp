@@ -31,6 +31,13 @@ Data& at_accelerations(const System& s, Data& d, double t, const RefV& q, const 
   return d;
 }
 
+// One field of every free coordinate, in q order.
+VecX free_coordinate_values(const System& s, double Coordinate::*field) {
+  VecX v(s.nq);
+  for (int k = 0; k < s.nq; ++k) v(k) = s.coords[s.free_coords[k]].*field;
+  return v;
+}
+
 void check_body(const System& s, int body) {
   if (body < 0 || body >= s.nbodies)
     throw std::invalid_argument("body: expected a body of this system (index 0.." + std::to_string(s.nbodies - 1) +
@@ -63,6 +70,19 @@ void bind_dynamics(py::module_& m) {
                              "Names 'body.axis' of the free coordinates, in the order of q.")
       .def_property_readonly("prescribed_names", &System::prescribed_names,
                              "Names of the prescribed coordinates, in the order of driving_forces().")
+      .def_property_readonly(
+          "stiffness", [](const System& s) { return free_coordinate_values(s, &Coordinate::stiffness); },
+          "Spring stiffness c_i of each free coordinate (nq,), N/m or N m/rad.")
+      .def_property_readonly(
+          "damping", [](const System& s) { return free_coordinate_values(s, &Coordinate::damping); },
+          "Damping coefficient b_i of each free coordinate (nq,), N s/m or N m s/rad.")
+      .def_property_readonly(
+          "rest", [](const System& s) { return free_coordinate_values(s, &Coordinate::rest); },
+          "Spring rest value q_i^0 of each free coordinate (nq,), m or rad.")
+      .def_readonly("masses", &System::mass, "Mass of every body (nbodies), kg.")
+      .def_readonly("centres_of_mass", &System::com, "Centre of mass of every body in its own frame (m).")
+      .def_readonly("inertias", &System::inertia,
+                    "Inertia tensor (3, 3) of every body about its centre of mass, body axes (kg m^2).")
       .def_property_readonly("pseudo_inertias", [](const System& s) { return s.H; },
                              "Pseudo-inertia H_p = int r r^T dm (4, 4) of every body, body frame (kg, kg m, kg m^2).")
       .def_property_readonly("placements", [](const System& s) { return s.B; },

@@ -21,7 +21,7 @@ void check_vector(const Eigen::Ref<const VecX>& v, int n, const char* name, cons
 
 // Every stage checks its workspace: a Data made for another system would be written out of bounds.
 void check_data(const System& sys, const Data& d) {
-  if (static_cast<int>(d.T.size()) != sys.nbodies || d.qa.size() != sys.nc || d.A.rows() != sys.nq ||
+  if (static_cast<int>(d.T.size()) != sys.nbodies || d.qa.size() != sys.nc ||
       d.f.size() != sys.nq || d.qdd.size() != sys.nq || d.tau.size() != sys.np)
     throw std::invalid_argument("data: expected a workspace made by this system's make_data(), got one of another system");
 }
@@ -214,7 +214,7 @@ void mass_matrix(const System& sys, Data& d) {
   accumulate_subtrees(sys, d.Hbar);
   // a_ij = Σ tr(U_u H̄_b U_vᵀ) over the pairs of uses u of q_i and v of q_j (on body b)
   // with u on the path from the root to b: each pair once, mirrored.
-  d.A.setZero();
+  d.A.setZero(sys.nq, sys.nq);
   for (int b = 0; b < sys.nbodies; ++b) {
     for (int v = sys.use_start[b]; v < sys.use_start[b + 1]; ++v) {
       const int l = sys.coords[sys.use_coord[v]].free_index;

@@ -105,7 +105,9 @@ void crba(const System& sys, Data& d) {
   for (int p = 0; p < sys.nbodies; ++p) d.IA[p] = d.I[p];
   for (int p = sys.nbodies - 1; p > 0; --p)
     if (sys.parent[p] >= 0) d.IA[sys.parent[p]] += d.IA[p];
-  // a_ij = s_iᵀ I^c_b s_j for coordinate i on the path from the root to j's body b.
+  // a_ij = s_iᵀ I^c_b s_j for coordinate i on the path from the root to j's body b; the other
+  // entries (coordinates on different branches) stay zero from the first allocation.
+  if (d.A.rows() != sys.nq) d.A.setZero(sys.nq, sys.nq);
   for (int b = 0; b < sys.nbodies; ++b)
     for (int v = sys.use_start[b]; v < sys.use_start[b + 1]; ++v) {
       const int l = sys.coords[sys.use_coord[v]].free_index;

@@ -84,7 +84,7 @@ struct Data {
   std::vector<Mat4> Hbar;      // (nbodies) Σ_{k in subtree(p)} T_k H_k T_kᵀ
   std::vector<Mat4> Wbar;      // (nbodies) Σ_{k in subtree(p)} T_k H_k T̈_kᵀ  (inertia)
   std::vector<Mat4> Zbar;      // (nbodies) Σ_{k in subtree(p)} load moments   (gravity, forces)
-  MatX A;                      // (nq, nq) mass matrix
+  MatX A;                      // (nq, nq) mass matrix, allocated by the first mass_matrix (ABA needs none)
   VecX f;                      // (nq) right-hand side: loads − velocity terms − springs − dampers
   VecX qdd;                    // (nq)
   VecX tau;                    // (np) driving forces of the prescribed coordinates

@@ -141,12 +141,18 @@ class _Model:
     def nbodies(self) -> int:
         ...
 class _System:
-    def __init__(self, model: _Model) -> None:
+    def __init__(self, model: _Model, algorithm: str) -> None:
         ...
     def _position(self, point: Point, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], t: typing.SupportsFloat | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
         ...
+    def _time_forward_dynamics(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], calls: typing.SupportsInt | typing.SupportsIndex) -> float:
+        ...
     def _velocity(self, point: Point, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], t: typing.SupportsFloat | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
         ...
+    def acceleration_derivatives(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]]:
+        """
+        (dqdd/dq, dqdd/dqd), each (nq, nq): -A^-1 (dr/dq, dr/dqd) at the forward-dynamics qdd.
+        """
     def dissipated_power(self, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], t: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> float:
         """
         Power dissipated by the joint dampers, sum b qd^2 (W).
@@ -161,7 +167,8 @@ class _System:
         """
     def force_jacobians(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], load_factor: typing.SupportsFloat | typing.SupportsIndex = 1.0, static: bool = False) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]]:
         """
-        (df/dq, df/dqd), each (nq, nq), by central differences. -df/dq is the tangent stiffness K,
+        (df/dq, df/dqd), each (nq, nq): analytic for recursive systems, central differences for
+        algorithm='lagrange'. -df/dq is the tangent stiffness K,
         -df/dqd the damping and gyroscopic matrix C. static=True holds the prescribed coordinates at t.
         """
     def forward_dynamics(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
@@ -177,9 +184,21 @@ class _System:
         """
         Potential energy of gravity -sum m g^T r_C (J).
         """
+    def inverse_dynamics(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qdd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        r = A(q) qdd - f(q, qd, t) (nq,): the generalised forces (N or N m) the free coordinates
+        need besides the loads, springs and dampers to move with qdd (the residual of the
+        equations of motion; zero at the forward-dynamics accelerations).
+        """
+    def inverse_dynamics_derivatives(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qdd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]]:
+        """
+        (dr/dq, dr/dqd), each (nq, nq), of r = A qdd - f: analytic through the RNEA for recursive
+        systems (O(n) per column), central differences for algorithm='lagrange'.
+        """
     def jacobian(self, t: typing.SupportsFloat | typing.SupportsIndex, y: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
         """
-        d(rhs)/dy (2 nq, 2 nq) by central finite differences, for solve_ivp(jac=...).
+        d(rhs)/dy (2 nq, 2 nq) for solve_ivp(jac=...): analytic for recursive systems (see
+        acceleration_derivatives), central differences for algorithm='lagrange'.
         """
     def kinetic_energy(self, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], t: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> float:
         """
@@ -208,6 +227,11 @@ class _System:
     def transform(self, body: typing.SupportsInt | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], t: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
         """
         Pose T_p (4, 4) of a body (by index) in the global frame.
+        """
+    @property
+    def algorithm(self) -> str:
+        """
+        'recursive' (O(n): RNEA, CRBA, ABA) or 'lagrange' (the book's formulation; always for linear joints).
         """
     @property
     def body_names(self) -> list[str]:
@@ -338,6 +362,7 @@ class IntegratorOptions:
     """
     Options of the C++ integrators (see rigidfem.simulate).
     """
+    iteration_matrix: str
     method: str
     def __init__(self) -> None:
         ...
