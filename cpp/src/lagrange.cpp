@@ -130,10 +130,48 @@ void jcalc(const System& sys, int p, Data& d, Mat4& T, Mat4& Td, Mat4& Tdd, bool
   Tdd = Pdd;
 }
 
+// G ← G E_a(q), the elementary factor applied to the columns of G: a translation moves the
+// origin along column a; a rotation turns the two other columns (right-handed pair).
+void apply_elementary(Mat4& G, Axis a, double q) {
+  if (!is_rotation(a)) {
+    const int k = static_cast<int>(a);
+    G.col(3).head<3>() += q * G.col(k).head<3>();
+    return;
+  }
+  static const int pair[3][2] = {{1, 2}, {2, 0}, {0, 1}};  // about x, y, z
+  const int j = 5 - static_cast<int>(a);                   // RX → 0, RY → 1, RZ → 2
+  const double c = std::cos(q), s = std::sin(q);
+  const Vec4 c1 = G.col(pair[j][0]), c2 = G.col(pair[j][1]);
+  G.col(pair[j][0]) = c * c1 + s * c2;
+  G.col(pair[j][1]) = -s * c1 + c * c2;
+}
+
+// The recursive engine's kinematics: T_p and the axes s_u of its coordinates, from the frame
+// G after each elementary factor: (e, o × e) for a rotation about the unit vector e through
+// the origin o of G, (0, e) for a translation along e (e a column of G), without 4x4 twists.
+void frames_and_axes(const System& sys, Data& d) {
+  for (int p = 0; p < sys.nbodies; ++p) {
+    Mat4 G = sys.parent[p] >= 0 ? Mat4(d.T[sys.parent[p]] * sys.B[p]) : sys.B[p];
+    for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) {
+      const int i = sys.use_coord[u];
+      const Axis a = sys.coords[i].axis;
+      apply_elementary(G, a, d.qa(i));
+      if (is_rotation(a)) {
+        const Vec3 e = G.col(5 - static_cast<int>(a)).head<3>(), o = G.col(3).head<3>();
+        d.axes[u] << e, o.cross(e);
+      } else {
+        d.axes[u] << Vec3::Zero(), G.col(static_cast<int>(a)).head<3>();
+      }
+    }
+    d.T[p] = G;
+  }
+}
+
 }  // namespace
 
 void kinematics(const System& sys, Data& d, bool rates) {
   check_data(sys, d);
+  if (!rates && sys.algorithm == Algorithm::Recursive) return frames_and_axes(sys, d);
   static const Mat4 I4 = Mat4::Identity(), O4 = Mat4::Zero();
   Mat4 Tj, Tjd, Tjdd;
   for (int p = 0; p < sys.nbodies; ++p) {
@@ -153,7 +191,10 @@ void kinematics(const System& sys, Data& d, bool rates) {
     const int u0 = sys.use_start[p], n = sys.use_start[p + 1] - u0;
     if (n == 0) continue;
     const Mat4 Fi = affine_inverse(F);
-    for (int k = 0; k < n; ++k) d.U[u0 + k].noalias() = F * d.X[k] * Fi;
+    for (int k = 0; k < n; ++k) {
+      const Mat4& U = d.U[u0 + k] = F * d.X[k] * Fi;
+      d.axes[u0 + k] << U(2, 1), U(0, 2), U(1, 0), U.block<3, 1>(0, 3);  // s = (ω, v_O) of U
+    }
   }
 }
 

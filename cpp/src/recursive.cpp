@@ -7,19 +7,6 @@
 
 namespace rigidfem {
 
-// m1 ×m m2 (motion cross product) and v ×* f (force cross product), Featherstone's crm/crf.
-Vec6 crossm(const Vec6& v, const Vec6& m) {
-  Vec6 r;
-  r << v.head<3>().cross(m.head<3>()), v.head<3>().cross(m.tail<3>()) + v.tail<3>().cross(m.head<3>());
-  return r;
-}
-
-Vec6 crossf(const Vec6& v, const Vec6& f) {
-  Vec6 r;
-  r << v.head<3>().cross(f.head<3>()) + v.tail<3>().cross(f.tail<3>()), v.head<3>().cross(f.tail<3>());
-  return r;
-}
-
 namespace {
 
 // Spatial inertia at the global origin of mass m with centre c and inertia I_c about it
@@ -44,9 +31,7 @@ void spatial_kinematics(const System& sys, Data& d) {
     Vec6 v = sys.parent[p] >= 0 ? d.v[sys.parent[p]] : Vec6::Zero();
     Vec6 c = Vec6::Zero();
     for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) {
-      const Mat4& U = d.U[u];
-      Vec6& s = d.axes[u];
-      s << U(2, 1), U(0, 2), U(1, 0), U.block<3, 1>(0, 3);
+      const Vec6& s = d.axes[u];
       const double qd = d.qda(sys.use_coord[u]);
       c += crossm(v, s) * qd;  // ṡ = v_before × s: the axis moves with the frame carrying it
       v += s * qd;
@@ -139,6 +124,21 @@ Subspace free_axes(const System& sys, const Data& d, int p) {
   return S;
 }
 
+// D⁻¹ of a symmetric positive definite D (nf ≤ 6) by Cholesky; fixed-size code for the
+// common three rotations of an sde. False if D is not positive definite.
+bool invert_spd(const SmallMat& D, SmallMat& Dinv) {
+  if (D.rows() == 3) {
+    const Eigen::LLT<Mat3> llt{Mat3(D)};
+    if (llt.info() != Eigen::Success) return false;
+    Dinv = llt.solve(Mat3::Identity());
+    return true;
+  }
+  const Eigen::LLT<SmallMat> llt(D);
+  if (llt.info() != Eigen::Success) return false;
+  Dinv = llt.solve(SmallMat::Identity(D.rows(), D.cols()));
+  return true;
+}
+
 // ABA pass 2, inertia part (leaves to root): U = I^A S, D = Sᵀ U + diag(δ), and the parent
 // gets I^a = I^A − U D⁻¹ Uᵀ, kept in d.IA[p] for the bias pass. δ = 0 without an armature.
 void articulated_inertias(const System& sys, Data& d, const VecX* armature) {
@@ -153,11 +153,9 @@ void articulated_inertias(const System& sys, Data& d, const VecX* armature) {
           const int l = sys.coords[sys.use_coord[u]].free_index;
           if (l >= 0) D(k, k) += (*armature)(l), ++k;
         }
-      Eigen::LLT<SmallMat> llt(D);
-      if (llt.info() != Eigen::Success)
+      if (!invert_spd(D, d.Dinv[p]))
         throw SimulationError(d.t, "articulated inertia of body '" + sys.body_names[p] +
                                        "' is singular (a massless chain or a singular configuration)");
-      d.Dinv[p] = llt.solve(SmallMat::Identity(S.cols(), S.cols()));
       d.IA[p] -= d.U6[p] * d.Dinv[p] * d.U6[p].transpose();
     } else {
       d.U6[p].resize(6, 0);

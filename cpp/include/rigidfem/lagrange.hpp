@@ -24,7 +24,8 @@ void set_state(const System& sys, Data& d, double t, const Eigen::Ref<const VecX
 void set_static_state(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q);
 /// (qa, qda, qdda) => T_p, Ṫ_p, T̈_p (nbodies) and U_i (nc): forward recursion
 /// T_p = T_parent B_p T̃_p(q_p) with the joint's elementary factors differentiated in time.
-/// rates = false computes only T_p and U_i (all the recursive algorithms need).
+/// Also the axes s_u = (ω, v_O) of U_u. rates = false computes only T_p and the axes for
+/// recursive systems (all their algorithms need; U_u is then not computed), T_p and U_u otherwise.
 void kinematics(const System& sys, Data& d, bool rates = true);
 /// (T, T̈) => W̄_p = Σ_{k in subtree(p)} T_k H_k T̈_kᵀ.
 void inertia_composites(const System& sys, Data& d);

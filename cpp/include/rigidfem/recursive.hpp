@@ -18,12 +18,20 @@ namespace rigidfem {
 
 // Building blocks (also used by the derivatives):
 /// m ×m s, the motion cross product (Featherstone's crm).
-Vec6 crossm(const Vec6& m, const Vec6& s);
+inline Vec6 crossm(const Vec6& m, const Vec6& s) {
+  Vec6 r;
+  r << m.head<3>().cross(s.head<3>()), m.head<3>().cross(s.tail<3>()) + m.tail<3>().cross(s.head<3>());
+  return r;
+}
 /// v ×* f, the force cross product (Featherstone's crf).
-Vec6 crossf(const Vec6& v, const Vec6& f);
+inline Vec6 crossf(const Vec6& v, const Vec6& f) {
+  Vec6 r;
+  r << v.head<3>().cross(f.head<3>()) + v.tail<3>().cross(f.tail<3>()), v.head<3>().cross(f.tail<3>());
+  return r;
+}
 /// a_0 = (0, −g): gravity as an upward acceleration of the base.
 Vec6 gravity_acceleration(const System& sys, const Data& d);
-/// (T, U, q̇) => axes s_u, velocities v_p, joint bias accelerations c_p = Σ ṡ_k q̇_k, spatial
+/// (T, axes, q̇) => velocities v_p, joint bias accelerations c_p = Σ ṡ_k q̇_k, spatial
 /// inertias I_p and external loads f_ext,p, all in ground coordinates. Needs kinematics.
 void spatial_kinematics(const System& sys, Data& d);
 /// RNEA with the accelerations in d.qdda: a_p = a_λ + c_p + Σ s q̈, f_p = I a + v ×* I v − f_ext,
