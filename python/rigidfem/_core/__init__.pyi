@@ -237,14 +237,34 @@ class _System:
     def body_names(self) -> list[str]:
         ...
     @property
+    def centres_of_mass(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]]:
+        """
+        Centre of mass of every body in its own frame (m).
+        """
+    @property
     def coordinate_names(self) -> list[str]:
         """
         Names 'body.axis' of the free coordinates, in the order of q.
         """
     @property
+    def damping(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        Damping coefficient b_i of each free coordinate (nq,), N s/m or N m s/rad.
+        """
+    @property
     def gravity(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
         """
         Gravitational acceleration (m/s^2), global.
+        """
+    @property
+    def inertias(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]]:
+        """
+        Inertia tensor (3, 3) of every body about its centre of mass, body axes (kg m^2).
+        """
+    @property
+    def masses(self) -> list[float]:
+        """
+        Mass of every body (nbodies), kg.
         """
     @property
     def nbodies(self) -> int:
@@ -283,6 +303,16 @@ class _System:
     def pseudo_inertias(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
         """
         Pseudo-inertia H_p = int r r^T dm (4, 4) of every body, body frame (kg, kg m, kg m^2).
+        """
+    @property
+    def rest(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        Spring rest value q_i^0 of each free coordinate (nq,), m or rad.
+        """
+    @property
+    def stiffness(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        Spring stiffness c_i of each free coordinate (nq,), N/m or N m/rad.
         """
 class Data:
     """
