@@ -1,5 +1,7 @@
 #include "rigidfem/derivatives.hpp"
 
+#include <algorithm>
+#include <cmath>
 #include <vector>
 
 #include "rigidfem/errors.hpp"
