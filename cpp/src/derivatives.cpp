@@ -19,7 +19,7 @@ Vec6 turned_inertia_times(const Vec6& s, const Mat6& I, const Vec6& x) { return 
 double law_derivative(const Coordinate& c, const Data& d, int i, bool rate) {
   double q = d.qa(i), qd = d.qda(i);
   double& x = rate ? qd : q;
-  const double x0 = x, h = 6e-6 * std::max(1.0, std::abs(x0));
+  const double x0 = x, h = difference_step(x0);
   x = x0 + h;
   const double up = c.force_law(d.t, q, qd);
   x = x0 - h;
@@ -34,29 +34,20 @@ struct Tangent {
   std::vector<Vec6> v, a, f;  // δv_p, δa_p, δf̄_p
 };
 
-// Marks the bodies carried by coordinate j (its body b and b's subtree); parent[p] < p.
-void mark_subtree(const System& sys, int b, Tangent& w) {
-  for (int p = 0; p < sys.nbodies; ++p) w.inside[p] = p == b || (p > b && sys.parent[p] >= 0 && w.inside[sys.parent[p]]);
-}
-
-// Backward pass of the tangent: δf̄_p = δf_p + Σ_children δf̄_c.
-void accumulate(const System& sys, Tangent& w) {
-  for (int p = sys.nbodies - 1; p > 0; --p)
-    if (sys.parent[p] >= 0) w.f[sys.parent[p]] += w.f[p];
-}
-
-// Column ∂r/∂q_j for the coordinate j with use uj on body bj, into col (nq).
-void position_column(const System& sys, const Data& d, const std::vector<AppliedLoad>& loads, int uj, int bj,
-                     Tangent& w, Eigen::Ref<VecX> col) {
+// Column ∂r/∂q_j (position) or ∂r/∂q̇_j (rate) for the coordinate j with use uj on body bj,
+// into col (nq). Only the bodies carried by q_j (bj and its subtree) have tangents:
+//   position: the later axes turn, δs_u = s_j ×m s_u, and so do inertias and follower loads;
+//   rate:     δq̇_j = 1, so δv gains s_j from the use uj on and δc gains v ×m s_j there.
+// Then δc = Σ (δv ×m s_u + v ×m δs_u) q̇_u, δv = Σ δs_u q̇_u, δa_p = δa_λ + δc + Σ δs_u q̈_u,
+// δf_p = δI a + I δa + δv ×* I v + v ×* (δI v + I δv) − δf_ext, summed over subtrees, and
+// δr_i = δs_iᵀ f̄_b + s_iᵀ δf̄_b.
+void tangent_column(const System& sys, const Data& d, const std::vector<AppliedLoad>& loads, int uj, int bj,
+                    bool position, Tangent& w, Eigen::Ref<VecX> col) {
   const Vec6& s = d.axes[uj];
-  mark_subtree(sys, bj, w);
-  // Forward pass over the carried bodies: a later axis turns, δs_u = s ×m s_u; then
-  // δc = Σ (δv ×m s_u + v ×m δs_u) q̇_u, δv = Σ δs_u q̇_u, δa_p = δa_λ + δc + Σ δs_u q̈_u and
-  // δf_p = δI a + I δa + δv ×* I v + v ×* (δI v + I δv).
+  auto turned = [&](int p, int u) { return position && w.inside[p] && (p != bj || u > uj); };
   for (int p = 0; p < sys.nbodies; ++p) {
+    w.inside[p] = p == bj || (p > bj && sys.parent[p] >= 0 && w.inside[sys.parent[p]]);  // parent[p] < p
     if (!w.inside[p]) {
-      w.v[p].setZero();
-      w.a[p].setZero();
       w.f[p].setZero();
       continue;
     }
@@ -67,79 +58,49 @@ void position_column(const System& sys, const Data& d, const std::vector<Applied
     for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) {
       const int i = sys.use_coord[u];
       const double qd = d.qda(i);
-      const Vec6 ds = p != bj || u > uj ? crossm(s, d.axes[u]) : Vec6::Zero();
+      const Vec6 ds = turned(p, u) ? crossm(s, d.axes[u]) : Vec6::Zero();
       da += (crossm(dv, d.axes[u]) + crossm(v, ds)) * qd + ds * d.qdda(i);
-      v += d.axes[u] * qd;
       dv += ds * qd;
+      if (!position && u == uj) {
+        da += crossm(v, d.axes[u]);
+        dv += d.axes[u];
+      }
+      v += d.axes[u] * qd;
     }
     const Mat6& I = d.I[p];
     w.v[p] = dv;
     w.a[p] = da;
-    w.f[p] = turned_inertia_times(s, I, d.a[p]) + I * da + crossf(dv, I * d.v[p]) +
-             crossf(d.v[p], turned_inertia_times(s, I, d.v[p]) + I * dv);
+    w.f[p] = I * da + crossf(dv, I * d.v[p]) + crossf(d.v[p], I * dv);
+    if (position) w.f[p] += turned_inertia_times(s, I, d.a[p]) + crossf(d.v[p], turned_inertia_times(s, I, d.v[p]));
   }
   // Loads on carried bodies: a point fixed in the body moves with velocity v_s + ω_s × x;
   // a follower load turns with the body, δf = s ×* f.
-  for (std::size_t k = 0; k < loads.size(); ++k) {
+  for (std::size_t k = 0; position && k < loads.size(); ++k) {
     const Load& L = sys.loads[k];
     if (!w.inside[L.body]) continue;
     const AppliedLoad& l = loads[k];
-    Vec6 fl;
-    fl << l.x.cross(l.F) + l.tau, l.F;
     if (L.follower) {
+      Vec6 fl;
+      fl << l.x.cross(l.F) + l.tau, l.F;
       w.f[L.body] -= crossf(s, fl);
     } else {
       const Vec3 dx = s.tail<3>() + s.head<3>().cross(l.x);
       w.f[L.body].head<3>() -= dx.cross(l.F);
     }
   }
-  accumulate(sys, w);
-  // r_i = s_iᵀ f̄_b − Q_i: δr_i = δs_iᵀ f̄_b + s_iᵀ δf̄_b.
+  for (int p = sys.nbodies - 1; p > 0; --p)
+    if (sys.parent[p] >= 0) w.f[sys.parent[p]] += w.f[p];
   for (int k = 0; k < sys.nq; ++k) {
-    const int i = sys.free_coords[k], b = sys.coords[i].body, u = sys.use_start[b] + sys.coords[i].slot;
-    double r = d.axes[u].dot(w.f[b]);
-    if (w.inside[b] && (b != bj || u > uj)) r += crossm(s, d.axes[u]).dot(d.sf[b]);
-    col(k) = r;
-  }
-}
-
-// Column ∂r/∂q̇_j: δv = s_j from the use uj on, δc = Σ δv ×m s_u q̇_u + v ×m s_j.
-void rate_column(const System& sys, const Data& d, int uj, int bj, Tangent& w, Eigen::Ref<VecX> col) {
-  mark_subtree(sys, bj, w);
-  for (int p = 0; p < sys.nbodies; ++p) {
-    if (!w.inside[p]) {
-      w.f[p].setZero();
-      continue;
-    }
-    const int lam = sys.parent[p];
-    Vec6 v = lam >= 0 ? d.v[lam] : Vec6::Zero();
-    Vec6 dv = p == bj ? Vec6::Zero() : w.v[lam];
-    Vec6 da = p == bj ? Vec6::Zero() : w.a[lam];
-    for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) {
-      da += crossm(dv, d.axes[u]) * d.qda(sys.use_coord[u]);
-      if (u == uj) {
-        da += crossm(v, d.axes[u]);
-        dv += d.axes[u];
-      }
-      v += d.axes[u] * d.qda(sys.use_coord[u]);
-    }
-    const Mat6& I = d.I[p];
-    w.v[p] = dv;
-    w.a[p] = da;
-    w.f[p] = I * da + crossf(dv, I * d.v[p]) + crossf(d.v[p], I * dv);
-  }
-  accumulate(sys, w);
-  for (int k = 0; k < sys.nq; ++k) {
-    const int i = sys.free_coords[k], b = sys.coords[i].body;
-    col(k) = d.axes[sys.use_start[b] + sys.coords[i].slot].dot(w.f[b]);
+    const int b = sys.coords[sys.free_coords[k]].body, u = own_use(sys, sys.free_coords[k]);
+    col(k) = d.axes[u].dot(w.f[b]) + (turned(b, u) ? crossm(s, d.axes[u]).dot(d.sf[b]) : 0.0);
   }
 }
 
 // Columns of ∂r/∂(q, q̇) by central differences of r (Lagrange systems, the reference).
 std::pair<MatX, MatX> differenced(const System& sys, Data& d) {
   const double t = d.t;
-  const VecX q0 = d.qa(sys.free_coords), qd0 = d.qda(sys.free_coords), qdd = d.qdda(sys.free_coords);
-  VecX q = q0, qd = qd0;
+  const VecX qdd = d.qdda(sys.free_coords);
+  VecX q = d.qa(sys.free_coords), qd = d.qda(sys.free_coords);
   auto r = [&] {
     set_state(sys, d, t, q, qd);
     set_accelerations(sys, d, qdd);
@@ -147,16 +108,10 @@ std::pair<MatX, MatX> differenced(const System& sys, Data& d) {
     return inverse_dynamics(sys, d);
   };
   MatX dq(sys.nq, sys.nq), dqd(sys.nq, sys.nq);
-  for (int j = 0; j < sys.nq; ++j)
-    for (auto [x, J] : {std::pair<VecX*, MatX*>{&q, &dq}, {&qd, &dqd}}) {
-      const double xj = (*x)(j), h = 6e-6 * std::max(1.0, std::abs(xj));
-      (*x)(j) = xj + h;
-      const VecX up = r();
-      (*x)(j) = xj - h;
-      const VecX down = r();
-      (*x)(j) = xj;
-      J->col(j) = (up - down) / (2.0 * h);
-    }
+  for (int j = 0; j < sys.nq; ++j) {
+    dq.col(j) = central_difference(r, q, j);
+    dqd.col(j) = central_difference(r, qd, j);
+  }
   r();  // leave d at the state it came with
   return {dq, dqd};
 }
@@ -181,9 +136,9 @@ std::pair<MatX, MatX> inverse_dynamics_derivatives(const System& sys, Data& d) {
   MatX dq(sys.nq, sys.nq), dqd(sys.nq, sys.nq);
   Tangent w(sys);
   for (int j = 0; j < sys.nq; ++j) {
-    const int i = sys.free_coords[j], b = sys.coords[i].body, u = sys.use_start[b] + sys.coords[i].slot;
-    position_column(sys, d, loads, u, b, w, dq.col(j));
-    rate_column(sys, d, u, b, w, dqd.col(j));
+    const int i = sys.free_coords[j], b = sys.coords[i].body, u = own_use(sys, i);
+    tangent_column(sys, d, loads, u, b, true, w, dq.col(j));
+    tangent_column(sys, d, loads, u, b, false, w, dqd.col(j));
     // −∂Q_j/∂(q_j, q̇_j) of the coordinate's own spring, damper and force law.
     const Coordinate& c = sys.coords[i];
     dq(j, j) += c.stiffness;
@@ -201,7 +156,7 @@ std::pair<MatX, MatX> acceleration_derivatives(const System& sys, Data& d, doubl
   const VecX qdd = forward_dynamics(sys, d, t, q, qd);
   set_state(sys, d, t, q, qd);
   set_accelerations(sys, d, qdd);
-  kinematics(sys, d);
+  kinematics(sys, d, false);  // T and the axes (recursive); the Lagrange differences redo it
   auto [dq, dqd] = inverse_dynamics_derivatives(sys, d);
   mass_matrix(sys, d);
   d.llt.compute(d.A);

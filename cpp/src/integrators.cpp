@@ -347,10 +347,10 @@ class NewmarkFamily {
       armature_(k) = gp * h * c.damping + bp * h * h * c.stiffness;
     }
     ++stats_.factorizations;
-    VecX dx(sys_.nq);
     if (recursive_) {  // residual() left the spatial kinematics of the iterate in d_
       aba_factor(sys_, d_, armature_);
-      aba_solve(sys_, d_, -r, dx);
+      VecX dx = -r;
+      aba_solve(sys_, d_, dx, dx);
       return dx;
     }
     mass_matrix(sys_, d_);

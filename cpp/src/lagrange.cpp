@@ -37,19 +37,6 @@ void accumulate_subtrees(const System& sys, std::vector<Mat4>& X) {
     if (sys.parent[p] >= 0) X[sys.parent[p]] += X[p];
 }
 
-// Column j of ∂g/∂x by central differences, g reading x by reference; step ∝ ε^(1/3)
-// for an error O(ε^(2/3)). x is restored.
-template <class G>
-VecX central_difference(G&& g, VecX& x, int j) {
-  const double xj = x(j), h = 6e-6 * std::max(1.0, std::abs(xj));
-  x(j) = xj + h;
-  const VecX gp = g();
-  x(j) = xj - h;
-  const VecX gm = g();
-  x(j) = xj;
-  return (gp - gm) / (2.0 * h);
-}
-
 const Mat4& frame_of_parent(const System& sys, const std::vector<Mat4>& X, int p, const Mat4& ground) {
   return sys.parent[p] >= 0 ? X[sys.parent[p]] : ground;
 }
@@ -133,35 +120,34 @@ void jcalc(const System& sys, int p, Data& d, Mat4& T, Mat4& Td, Mat4& Tdd, bool
 // G ← G E_a(q), the elementary factor applied to the columns of G: a translation moves the
 // origin along column a; a rotation turns the two other columns (right-handed pair).
 void apply_elementary(Mat4& G, Axis a, double q) {
+  const int k = axis_index(a);
   if (!is_rotation(a)) {
-    const int k = static_cast<int>(a);
     G.col(3).head<3>() += q * G.col(k).head<3>();
     return;
   }
-  static const int pair[3][2] = {{1, 2}, {2, 0}, {0, 1}};  // about x, y, z
-  const int j = 5 - static_cast<int>(a);                   // RX → 0, RY → 1, RZ → 2
+  const int k1 = (k + 1) % 3, k2 = (k + 2) % 3;  // (y, z) about x, (z, x) about y, (x, y) about z
   const double c = std::cos(q), s = std::sin(q);
-  const Vec4 c1 = G.col(pair[j][0]), c2 = G.col(pair[j][1]);
-  G.col(pair[j][0]) = c * c1 + s * c2;
-  G.col(pair[j][1]) = -s * c1 + c * c2;
+  const Vec4 c1 = G.col(k1), c2 = G.col(k2);
+  G.col(k1) = c * c1 + s * c2;
+  G.col(k2) = -s * c1 + c * c2;
 }
 
 // The recursive engine's kinematics: T_p and the axes s_u of its coordinates, from the frame
 // G after each elementary factor: (e, o × e) for a rotation about the unit vector e through
 // the origin o of G, (0, e) for a translation along e (e a column of G), without 4x4 twists.
 void frames_and_axes(const System& sys, Data& d) {
+  static const Mat4 I4 = Mat4::Identity();
   for (int p = 0; p < sys.nbodies; ++p) {
-    Mat4 G = sys.parent[p] >= 0 ? Mat4(d.T[sys.parent[p]] * sys.B[p]) : sys.B[p];
+    Mat4 G = frame_of_parent(sys, d.T, p, I4) * sys.B[p];
     for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) {
       const int i = sys.use_coord[u];
       const Axis a = sys.coords[i].axis;
       apply_elementary(G, a, d.qa(i));
-      if (is_rotation(a)) {
-        const Vec3 e = G.col(5 - static_cast<int>(a)).head<3>(), o = G.col(3).head<3>();
-        d.axes[u] << e, o.cross(e);
-      } else {
-        d.axes[u] << Vec3::Zero(), G.col(static_cast<int>(a)).head<3>();
-      }
+      const Vec3 e = G.col(axis_index(a)).head<3>();
+      if (is_rotation(a))
+        d.axes[u] << e, G.col(3).head<3>().cross(e);
+      else
+        d.axes[u] << Vec3::Zero(), e;
     }
     d.T[p] = G;
   }

@@ -78,7 +78,7 @@ void rnea_forces(const System& sys, Data& d) {
   rnea_pass(sys, d);  // free q̈ are zero after set_state: the bias forces
   // f = −(Sᵀ f̄)_free + passive: what drives the free coordinates besides A q̈.
   for (int k = 0; k < sys.nq; ++k) {
-    const int i = sys.free_coords[k], u = sys.use_start[sys.coords[i].body] + sys.coords[i].slot;
+    const int i = sys.free_coords[k], u = own_use(sys, i);
     d.f(k) = -d.axes[u].dot(d.sf[sys.coords[i].body]) + passive_force(sys, d, i);
   }
 }
@@ -168,6 +168,7 @@ void articulated_inertias(const System& sys, Data& d, const VecX* armature) {
 // the forces τ (nq) on the free coordinates and the base acceleration a_0:
 //   u = τ − Sᵀ p^A, the parent gets p^a = p^A + I^a c + U D⁻¹ u (leaves to root);
 //   a' = a_λ + c, q̈ = D⁻¹ (u − Uᵀ a'), a = a' + S q̈ (root to leaves), into x (nq).
+// τ is read only before x is written: they may be the same vector.
 void articulated_accelerations(const System& sys, Data& d, const VecX& tau, const Vec6& a0, VecX& x) {
   for (int p = sys.nbodies - 1; p >= 0; --p) {
     Vec6 pa = d.pA[p] + d.IA[p] * d.c[p];
@@ -204,18 +205,18 @@ void aba(const System& sys, Data& d) {
   require_tree(sys);
   check_gimbal_lock(sys, d);
   spatial_kinematics(sys, d);
-  // Pass 1: p^A = v ×* I v − f_ext; the joint bias c_p gains the prescribed q̈ (known).
-  VecX tau(sys.nq);
+  // Pass 1: p^A = v ×* I v − f_ext; the joint bias c_p gains the prescribed q̈ (known); the
+  // passive forces τ of the free coordinates go into d.qdd, which pass 3 overwrites with q̈.
   for (int p = 0; p < sys.nbodies; ++p) {
     d.pA[p] = crossf(d.v[p], d.I[p] * d.v[p]) - d.fext[p];
     for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) {
       const int i = sys.use_coord[u];
       if (sys.coords[i].drive_index >= 0) d.c[p] += d.axes[u] * d.qdda(i);
-      if (sys.coords[i].free_index >= 0) tau(sys.coords[i].free_index) = passive_force(sys, d, i);
+      if (sys.coords[i].free_index >= 0) d.qdd(sys.coords[i].free_index) = passive_force(sys, d, i);
     }
   }
   articulated_inertias(sys, d, nullptr);
-  articulated_accelerations(sys, d, tau, gravity_acceleration(sys, d), d.qdd);
+  articulated_accelerations(sys, d, d.qdd, gravity_acceleration(sys, d), d.qdd);
   for (int k = 0; k < sys.nq; ++k) d.qdda(sys.free_coords[k]) = d.qdd(k);
   if (!d.qdd.allFinite()) throw SimulationError(d.t, "accelerations are NaN or inf");
 }
@@ -232,7 +233,7 @@ void aba_solve(const System& sys, Data& d, const VecX& b, VecX& x) {
     d.pA[p].setZero();
     d.c[p].setZero();
   }
-  x.resize(sys.nq);
+  if (&x != &b) x.resize(sys.nq);
   articulated_accelerations(sys, d, b, Vec6::Zero(), x);
 }
 
@@ -247,7 +248,7 @@ void rnea_driving_forces(const System& sys, Data& d) {
   rnea_pass(sys, d);           // d.qdda holds every acceleration after aba
   // Row i of the full equations: s_iᵀ f̄_p = Q_i^passive + τ_i.
   for (int k = 0; k < sys.np; ++k) {
-    const int i = sys.drive_coords[k], u = sys.use_start[sys.coords[i].body] + sys.coords[i].slot;
+    const int i = sys.drive_coords[k], u = own_use(sys, i);
     d.tau(k) = d.axes[u].dot(d.sf[sys.coords[i].body]) - passive_force(sys, d, i);
   }
 }

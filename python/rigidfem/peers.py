@@ -39,7 +39,7 @@ from ._core import Point, SimulationError
 from .analysis import static_equilibrium
 from .materials import Material
 from .simulation import simulate
-from .study import Table
+from .study import Table, cheapest
 
 INSTALL_HINT = 'pip install "rigidfem[bench]"'
 
@@ -656,8 +656,7 @@ def equal_accuracy(table: Table, thresholds=(1e-4, 1e-6)) -> Table:
     for (scene, code, method), runs in groups.items():
         row = {"scene": scene, "code": code, "method": method}
         for tol in thresholds:
-            ok = [r for r in runs if r["rel_error"] <= tol]
-            best = min(ok, key=lambda r: r["wall_s_per_s"]) if ok else None
+            best = cheapest(runs, "rel_error", "wall_s_per_s", tol)
             row[f"wall_s_per_s_to_{tol:g}"] = best["wall_s_per_s"] if best else "-"
             row[f"setting_to_{tol:g}"] = f"{best['setting']}={best['value']:g}" if best else "-"
         row["smallest_error"] = min(r["rel_error"] for r in runs)

@@ -140,8 +140,8 @@ class Table:
         for (scene, method, setting), runs in groups.items():
             row = {"scene": scene, "method": f"{method} ({setting})"}
             for tol in thresholds:
-                ok = [r["wall_time_s"] for r in runs if r[error] <= tol]
-                row[f"time_s_to_{tol:g}"] = min(ok) if ok else "-"
+                best = cheapest(runs, error, "wall_time_s", tol)
+                row[f"time_s_to_{tol:g}"] = best["wall_time_s"] if best else "-"
             row["smallest_error"] = min(r[error] for r in runs)
             rows.append(row)
         return Table(rows, ("scene", "method", *(f"time_s_to_{t:g}" for t in thresholds), "smallest_error"))
@@ -167,6 +167,12 @@ class Table:
         ax.legend(fontsize=7)
         ax.grid(True, which="both", alpha=0.3)
         return ax
+
+
+def cheapest(runs, error: str, cost: str, tol: float):
+    """The run (a row) of least ``cost`` among those whose ``error`` is at most ``tol``, or None."""
+    ok = [r for r in runs if r[error] <= tol]
+    return min(ok, key=lambda r: r[cost]) if ok else None
 
 
 def _fmt(v) -> str:
@@ -283,6 +289,16 @@ def discretisation_error(elements=(5, 10, 20, 40, 80), modes: int = 3) -> Table:
     return Table(rows, columns)
 
 
+def _fit_exponent(rows, cost: str, exponent: str, smallest_nq: int = 60) -> None:
+    """Writes into every row the slope of log(cost) against log(nq), fitted over the rows with
+    nq ≥ smallest_nq that have the cost (at least two)."""
+    pts = [(r["nq"], r[cost]) for r in rows if cost in r and r["nq"] >= smallest_nq]
+    if len(pts) >= 2:
+        slope = float(np.polyfit(np.log([p[0] for p in pts]), np.log([p[1] for p in pts]), 1)[0])
+        for r in rows:
+            r[exponent] = slope
+
+
 def dynamics_scaling(elements=(10, 20, 50, 100, 200, 500, 1000), lagrange_up_to: int = 200) -> Table:
     """Time per forward-dynamics call (s, timed in C++, minimum of 3 batches) against the
     number of coordinates for modified-RFEM 3D cantilevers (3 rotations per sde): recursive
@@ -302,11 +318,7 @@ def dynamics_scaling(elements=(10, 20, 50, 100, 200, 500, 1000), lagrange_up_to:
             row["nq"] = system.nq
         rows.append(row)
     for algorithm in ("recursive", "lagrange"):
-        pts = [(r["nq"], r[f"{algorithm}_s"]) for r in rows if f"{algorithm}_s" in r and r["nq"] >= 60]
-        if len(pts) >= 2:
-            slope = np.polyfit(np.log([p[0] for p in pts]), np.log([p[1] for p in pts]), 1)[0]
-            for r in rows:
-                r[f"{algorithm}_exponent"] = float(slope)
+        _fit_exponent(rows, f"{algorithm}_s", f"{algorithm}_exponent")
     return Table(rows, ("m", "nq", "recursive_s", "lagrange_s", "recursive_exponent", "lagrange_exponent"))
 
 
@@ -341,11 +353,7 @@ def implicit_step_scaling(elements=(10, 20, 50, 100, 200, 500, 1000), tangent_up
         calls = max(3, int(2e5 / system.nq))
         row["rk4_s_per_step"] = 4 * min(system._time_forward_dynamics(0.0, q, q, calls) for _ in range(3))
         rows.append(row)
-    pts = [(r["nq"], r["spring_s_per_step"]) for r in rows if r["nq"] >= 60]
-    if len(pts) >= 2:
-        slope = float(np.polyfit(np.log([p[0] for p in pts]), np.log([p[1] for p in pts]), 1)[0])
-        for r in rows:
-            r["spring_exponent"] = slope
+    _fit_exponent(rows, "spring_s_per_step", "spring_exponent")
     return Table(rows, ("m", "nq", "spring_s_per_step", "spring_iterations_per_step", "tangent_s_per_step",
                         "tangent_iterations_per_step", "tangent_jacobians", "rk4_s_per_step", "spring_exponent"))
 

@@ -11,11 +11,28 @@
 /// The accelerations follow from  ∂q̈/∂x = −A⁻¹ ∂r/∂x  (x = q, q̇) at the actual q̈.
 #pragma once
 
+#include <algorithm>
+#include <cmath>
 #include <utility>
 
 #include "rigidfem/system.hpp"
 
 namespace rigidfem {
+
+/// Step of the central differences at x: ∝ ε^(1/3) for an error O(ε^(2/3)).
+inline double difference_step(double x) { return 6e-6 * std::max(1.0, std::abs(x)); }
+
+/// Column j of ∂g/∂x by central differences, g() reading x by reference; x is restored.
+template <class G>
+VecX central_difference(G&& g, VecX& x, int j) {
+  const double xj = x(j), h = difference_step(xj);
+  x(j) = xj + h;
+  const VecX gp = g();
+  x(j) = xj - h;
+  const VecX gm = g();
+  x(j) = xj;
+  return (gp - gm) / (2.0 * h);
+}
 
 /// Needs set_state, the free accelerations in d.qdda and kinematics: r = A q̈ − f (nq).
 VecX inverse_dynamics(const System& sys, Data& d);

@@ -50,7 +50,7 @@ void aba(const System& sys, Data& d);
 /// to the free coordinates the way joint armature is (D = Sᵀ I^A S + diag δ). O(n).
 void aba_factor(const System& sys, Data& d, const VecX& armature);
 /// After aba_factor: x = (M + diag δ)⁻¹ b (nq) by the bias passes of ABA for a system at rest
-/// with no gravity or loads under the forces b. O(n). Overwrites the ABA workspace (c, p^A, a).
+/// with no gravity or loads under the forces b (x may be b). O(n). Overwrites the ABA workspace (c, p^A, a).
 void aba_solve(const System& sys, Data& d, const VecX& b, VecX& x);
 /// After aba: the driving forces τ (np) of the prescribed coordinates by RNEA with the full accelerations.
 void rnea_driving_forces(const System& sys, Data& d);

@@ -71,6 +71,9 @@ class System {
   std::vector<std::string> prescribed_names() const;  ///< (np)
 };
 
+/// The use of coordinate i (index in coords) on its own body: its axis in Data::axes and U.
+inline int own_use(const System& sys, int i) { return sys.use_start[sys.coords[i].body] + sys.coords[i].slot; }
+
 /// Workspace of the algorithms. "(nbodies) 4x4" are global quantities.
 struct Data {
   explicit Data(const System& sys);

@@ -22,6 +22,8 @@ using MatX = Eigen::MatrixXd;
 enum class Axis : int { X = 0, Y = 1, Z = 2, RZ = 3, RY = 4, RX = 5 };
 
 inline bool is_rotation(Axis a) { return static_cast<int>(a) >= 3; }
+/// 0, 1, 2 for the axis x, y, z a motion translates along or turns about.
+inline int axis_index(Axis a) { return is_rotation(a) ? 5 - static_cast<int>(a) : static_cast<int>(a); }
 /// Unit vector of the axis an elementary motion translates along or turns about.
 Vec3 axis_direction(Axis a);
 /// "x", "y", "z", "rz", "ry", "rx".
