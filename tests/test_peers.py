@@ -1,15 +1,21 @@
-"""Peer codes (the optional bench extra): equivalent chains in Pinocchio and MuJoCo."""
+"""Peer codes (benchmarks/peers.py of the checkout; pip install pin mujoco): equivalent chains
+in Pinocchio and MuJoCo. Moved here from the package (formerly ``rigidfem.peers``)."""
 
 import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
 
 import rigidfem as rf
-from rigidfem import Joint, peers, transform
+from rigidfem import Joint, transform
 
 pinocchio = pytest.importorskip("pinocchio")
 mujoco = pytest.importorskip("mujoco")
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from benchmarks import peers  # noqa: E402
 
 
 @pytest.fixture(scope="module")
@@ -91,7 +97,7 @@ def test_mjcf_joints_in_order(beam):
     assert 'springref="0.0"' in xml and 'angle="radian"' in xml and '<site name="tip"' in xml
 
 
-def test_missing_peer_names_the_extra(monkeypatch, beam):
+def test_missing_peer_names_the_install_command(monkeypatch, beam):
     monkeypatch.setitem(sys.modules, "mujoco", None)
-    with pytest.raises(ImportError, match=r'pip install "rigidfem\[bench\]"'):
+    with pytest.raises(ImportError, match=r"pip install pin mujoco"):
         peers.MujocoChain(peers.describe(beam[0]))

@@ -1,9 +1,8 @@
-// System, Data and the named stages of the Lagrange formulation.
-#include <chrono>
-
+// System, Data and the named stages of the equations of motion: each binding calls one C++ function.
 #include "bindings.hpp"
-#include "rigidfem/derivatives.hpp"
-#include "rigidfem/lagrange.hpp"
+#include "rigidfem/dynamics.hpp"
+#include "rigidfem/kinematics.hpp"
+#include "rigidfem/outputs.hpp"
 
 namespace rigidfem::bindings {
 
@@ -11,37 +10,11 @@ namespace {
 
 using RefV = Eigen::Ref<const VecX>;
 
-// A fresh workspace at state (t, q, q̇) with kinematics done (calls from Python are not per-step).
-Data at(const System& s, double t, const RefV& q, const RefV& qd) {
-  Data d(s);
-  set_state(s, d, t, q, qd);
-  kinematics(s, d);
-  return d;
-}
-
-Data at(const System& s, double t, const RefV& q) { return at(s, t, q, VecX::Zero(s.nq)); }
-
-// The workspace d at state (t, q, q̇) with the free accelerations q̈ and kinematics done.
-Data& at_accelerations(const System& s, Data& d, double t, const RefV& q, const RefV& qd, const RefV& qdd) {
-  set_state(s, d, t, q, qd);
-  if (qdd.size() != s.nq || !qdd.allFinite())
-    throw std::invalid_argument("qdd: expected " + std::to_string(s.nq) + " (nq) finite values");
-  set_accelerations(s, d, qdd);
-  kinematics(s, d);
-  return d;
-}
-
 // One field of every free coordinate, in q order.
 VecX free_coordinate_values(const System& s, double Coordinate::*field) {
   VecX v(s.nq);
   for (int k = 0; k < s.nq; ++k) v(k) = s.coords[s.free_coords[k]].*field;
   return v;
-}
-
-void check_body(const System& s, int body) {
-  if (body < 0 || body >= s.nbodies)
-    throw std::invalid_argument("body: expected a body of this system (index 0.." + std::to_string(s.nbodies - 1) +
-                                "), got index " + std::to_string(body));
 }
 
 }  // namespace
@@ -96,20 +69,15 @@ void bind_dynamics(py::module_& m) {
           "Accelerations qdd (nq,) solving A(q) qdd = f(q, qd, t); t in s, q in m/rad, qd in m/s, rad/s.")
       .def(
           "mass_matrix", [](const System& s, const RefV& q, double t) {
-            Data d = at(s, t, q);
-            rigidfem::mass_matrix(s, d);
-            return d.A;
+            Data d(s);
+            return rigidfem::mass_matrix(s, d, t, q);
           },
           py::arg("q"), py::arg("t") = 0.0, "Mass matrix A(q) (nq, nq), a_ij = sum_p tr(T_p,i H_p T_p,j^T).")
       .def(
           "generalized_forces",
           [](const System& s, double t, const RefV& q, const RefV& qd, double load_factor) {
             Data d(s);
-            d.load_factor = load_factor;
-            set_state(s, d, t, q, qd);
-            kinematics(s, d);
-            rigidfem::generalized_forces(s, d);
-            return d.f;
+            return rigidfem::generalized_forces(s, d, t, q, qd, load_factor);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("load_factor") = 1.0,
           "Right-hand side f (nq,) of A qdd = f: loads, gravity, springs, dampers minus velocity terms (N, N m).\n"
@@ -118,11 +86,7 @@ void bind_dynamics(py::module_& m) {
           "static_forces",
           [](const System& s, double t, const RefV& q, double load_factor) {
             Data d(s);
-            d.load_factor = load_factor;
-            set_static_state(s, d, t, q);
-            kinematics(s, d);
-            rigidfem::generalized_forces(s, d);
-            return d.f;
+            return rigidfem::static_forces(s, d, t, q, load_factor);
           },
           py::arg("t"), py::arg("q"), py::arg("load_factor") = 1.0,
           "Static residual f(q) (nq,): generalised forces at rest, prescribed coordinates held at their values at t.")
@@ -130,8 +94,7 @@ void bind_dynamics(py::module_& m) {
           "force_jacobians",
           [](const System& s, double t, const RefV& q, const RefV& qd, double load_factor, bool static_drives) {
             Data d(s);
-            d.load_factor = load_factor;
-            return rigidfem::force_jacobians(s, d, t, q, qd, static_drives);
+            return rigidfem::force_jacobians(s, d, t, q, qd, load_factor, static_drives);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("load_factor") = 1.0, py::arg("static") = false,
           "(df/dq, df/dqd), each (nq, nq): analytic for recursive systems, central differences for\n"
@@ -140,9 +103,7 @@ void bind_dynamics(py::module_& m) {
       .def(
           "driving_forces", [](const System& s, double t, const RefV& q, const RefV& qd) {
             Data d(s);
-            rigidfem::forward_dynamics(s, d, t, q, qd);
-            rigidfem::driving_forces(s, d);
-            return d.tau;
+            return rigidfem::driving_forces(s, d, t, q, qd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"),
           "Forces/torques (np,) the drives exert on the prescribed coordinates (N or N m).")
@@ -163,7 +124,7 @@ void bind_dynamics(py::module_& m) {
           "inverse_dynamics",
           [](const System& s, double t, const RefV& q, const RefV& qd, const RefV& qdd) {
             Data d(s);
-            return rigidfem::inverse_dynamics(s, at_accelerations(s, d, t, q, qd, qdd));
+            return rigidfem::inverse_dynamics(s, d, t, q, qd, qdd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("qdd"),
           "r = A(q) qdd - f(q, qd, t) (nq,): the generalised forces (N or N m) the free coordinates\n"
@@ -173,7 +134,7 @@ void bind_dynamics(py::module_& m) {
           "inverse_dynamics_derivatives",
           [](const System& s, double t, const RefV& q, const RefV& qd, const RefV& qdd) {
             Data d(s);
-            return rigidfem::inverse_dynamics_derivatives(s, at_accelerations(s, d, t, q, qd, qdd));
+            return rigidfem::inverse_dynamics_derivatives(s, d, t, q, qd, qdd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("qdd"),
           "(dr/dq, dr/dqd), each (nq, nq), of r = A qdd - f: analytic through the RNEA for recursive\n"
@@ -188,61 +149,53 @@ void bind_dynamics(py::module_& m) {
           "(dqdd/dq, dqdd/dqd), each (nq, nq): -A^-1 (dr/dq, dr/dqd) at the forward-dynamics qdd.")
       .def(
           "transform", [](const System& s, int body, const RefV& q, double t) {
-            check_body(s, body);
-            return at(s, t, q).T[body];
+            Data d(s);
+            return body_pose(s, d, body, t, q);
           },
           py::arg("body"), py::arg("q"), py::arg("t") = 0.0, "Pose T_p (4, 4) of a body (by index) in the global frame.")
       .def(
           "_position", [](const System& s, const Point& p, const RefV& q, double t) {
-            check_body(s, p.body);
-            return Vec3((at(s, t, q).T[p.body] * p.r.homogeneous()).head<3>());
+            Data d(s);
+            return point_position(s, d, p, t, q);
           },
           py::arg("point"), py::arg("q"), py::arg("t"))
       .def(
           "_velocity", [](const System& s, const Point& p, const RefV& q, const RefV& qd, double t) {
-            check_body(s, p.body);
-            return Vec3((at(s, t, q, qd).Td[p.body] * p.r.homogeneous()).head<3>());
+            Data d(s);
+            return point_velocity(s, d, p, t, q, qd);
           },
           py::arg("point"), py::arg("q"), py::arg("qd"), py::arg("t"))
       .def(
           "kinetic_energy", [](const System& s, const RefV& q, const RefV& qd, double t) {
-            return rigidfem::kinetic_energy(s, at(s, t, q, qd));
+            Data d(s);
+            return energies(s, d, t, q, qd).kinetic;
           },
           py::arg("q"), py::arg("qd"), py::arg("t") = 0.0, "Kinetic energy 1/2 sum tr(dT H dT^T) (J).")
       .def(
           "gravity_energy", [](const System& s, const RefV& q, double t) {
-            return rigidfem::gravity_energy(s, at(s, t, q));
+            Data d(s);
+            return energies(s, d, t, q, VecX::Zero(s.nq)).gravity;
           },
           py::arg("q"), py::arg("t") = 0.0, "Potential energy of gravity -sum m g^T r_C (J).")
       .def(
           "elastic_energy", [](const System& s, const RefV& q, double t) {
-            return rigidfem::elastic_energy(s, at(s, t, q));
+            Data d(s);
+            return energies(s, d, t, q, VecX::Zero(s.nq)).elastic;
           },
           py::arg("q"), py::arg("t") = 0.0, "Energy of the joint springs 1/2 sum c (q - q_rest)^2 (J).")
       .def(
           "potential_energy", [](const System& s, const RefV& q, double t) {
-            const Data d = at(s, t, q);
-            return rigidfem::gravity_energy(s, d) + rigidfem::elastic_energy(s, d);
+            Data d(s);
+            return energies(s, d, t, q, VecX::Zero(s.nq)).potential();
           },
           py::arg("q"), py::arg("t") = 0.0, "Gravity plus elastic energy (J).")
       .def(
           "dissipated_power", [](const System& s, const RefV& q, const RefV& qd, double t) {
-            return rigidfem::dissipated_power(s, at(s, t, q, qd));
+            Data d(s);
+            return energies(s, d, t, q, qd).dissipated;
           },
           py::arg("q"), py::arg("qd"), py::arg("t") = 0.0, "Power dissipated by the joint dampers, sum b qd^2 (W).")
-      .def("make_data", [](const System& s) { return Data(s); }, "A fresh workspace for the stage functions.")
-      .def(
-          "_time_forward_dynamics",
-          [](const System& s, double t, const RefV& q, const RefV& qd, int calls) {
-            // Benchmark helper: seconds per forward-dynamics call, one Data, timed in C++.
-            Data d(s);
-            rigidfem::forward_dynamics(s, d, t, q, qd);  // warm-up
-            py::gil_scoped_release release;
-            const auto start = std::chrono::steady_clock::now();
-            for (int k = 0; k < calls; ++k) rigidfem::forward_dynamics(s, d, t, q, qd);
-            return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count() / calls;
-          },
-          py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("calls"));
+      .def("make_data", [](const System& s) { return Data(s); }, "A fresh workspace for the stage functions.");
 
   py::class_<Data>(m, "Data", "Workspace of the algorithms; after each stage it holds that stage's results.")
       .def_readonly("t", &Data::t)

@@ -1,13 +1,14 @@
 // The C++ integrators: options, the run (GIL released), and batch outputs for results.
 #include "bindings.hpp"
 #include "rigidfem/integrators.hpp"
-#include "rigidfem/lagrange.hpp"
+#include "rigidfem/outputs.hpp"
 
 namespace rigidfem::bindings {
 
 namespace {
-MatX stack(const std::vector<VecX>& rows, int n) {
-  MatX M(rows.size(), n);
+// The states of a trajectory as the rows of a (len t, n) array.
+RowMatX stack(const std::vector<VecX>& rows, int n) {
+  RowMatX M(rows.size(), n);
   for (size_t k = 0; k < rows.size(); ++k) M.row(k) = rows[k].transpose();
   return M;
 }
@@ -16,7 +17,9 @@ MatX stack(const std::vector<VecX>& rows, int n) {
 void bind_integrators(py::module_& m) {
   py::class_<IntegratorOptions>(m, "IntegratorOptions", "Options of the C++ integrators (see rigidfem.simulate).")
       .def(py::init<>())
-      .def_readwrite("method", &IntegratorOptions::method)
+      .def_property(
+          "method", [](const IntegratorOptions& o) { return method_name(o.method); },
+          [](IntegratorOptions& o, const std::string& name) { o.method = parse_method(name); })
       .def_readwrite("dt", &IntegratorOptions::dt)
       .def_readwrite("adaptive", &IntegratorOptions::adaptive, "-1: the method's default, 0: fixed dt, 1: adaptive")
       .def_readwrite("rtol", &IntegratorOptions::rtol)
@@ -29,12 +32,14 @@ void bind_integrators(py::module_& m) {
       .def_readwrite("rho_inf", &IntegratorOptions::rho_inf)
       .def_readwrite("newton_tol", &IntegratorOptions::newton_tol)
       .def_readwrite("newton_max_iterations", &IntegratorOptions::newton_max_iterations)
-      .def_readwrite("iteration_matrix", &IntegratorOptions::iteration_matrix);
+      .def_property(
+          "iteration_matrix", [](const IntegratorOptions& o) { return iteration_matrix_name(o.iteration_matrix); },
+          [](IntegratorOptions& o, const std::string& name) { o.iteration_matrix = parse_iteration_matrix(name); });
 
   m.def(
       "_integrate",
-      [](const System& s, double t0, double t_end, const VecX& q0, const VecX& qd0, const VecX& t_eval,
-         const IntegratorOptions& o, py::object progress) {
+      [](const System& s, double t0, double t_end, const VecX& q0, const VecX& qd0,
+         const Eigen::Ref<const VecX>& t_eval, const IntegratorOptions& o, py::object progress) {
         // Runs with the GIL released; every ~0.05 s the monitor takes it back to look for
         // Ctrl-C (PyErr_CheckSignals) and to call the progress callback.
         Monitor monitor = [&progress](double t) {
@@ -69,7 +74,8 @@ void bind_integrators(py::module_& m) {
 
   m.def(
       "_evaluate_outputs",
-      [](const System& s, const VecX& t, const MatX& Q, const MatX& QD) {
+      [](const System& s, const Eigen::Ref<const VecX>& t, const Eigen::Ref<const RowMatX>& Q,
+         const Eigen::Ref<const RowMatX>& QD) {
         StateOutputs o = evaluate_outputs(s, t, Q, QD);
         return py::make_tuple(o.qdd, o.tau, o.kinetic, o.gravity, o.elastic);
       },

@@ -4,7 +4,8 @@
 #include "rigidfem/errors.hpp"
 #include "rigidfem/model.hpp"
 #include "rigidfem/profiles.hpp"
-#include "rigidfem/transforms.hpp"
+#include "rigidfem/timing.hpp"
+#include "rigidfem/joint_motion.hpp"
 
 namespace rigidfem::bindings {
 
@@ -76,11 +77,25 @@ void bind_profiles(py::module_& m) {
 PYBIND11_MODULE(_core, m) {
   namespace py = pybind11;
   using namespace rigidfem::bindings;
-  m.doc() = "rigidfem C++ core: homogeneous transforms, models, the book's Lagrange formulation.";
-  py::register_exception<rigidfem::SimulationError>(m, "SimulationError", PyExc_RuntimeError);
+  m.doc() = "rigidfem C++ core: transforms, models, kinematics, the Lagrange and recursive formulations, integrators.";
+  py::register_exception<rigidfem::SimulationError>(m, "SimulationError", PyExc_RuntimeError)
+      .attr("__doc__") =
+      "A numerical failure, a RuntimeError whose message names the time (s) and the cause: a singular mass or "
+      "iteration matrix, a step size below the minimum, a NaN or inf state, Newton divergence in a step or a load "
+      "step of the statics, max_steps, gimbal lock of ZYX Euler angles.";
   bind_transforms(m);
   bind_profiles(m);
   bind_model(m);
   bind_dynamics(m);
   bind_integrators(m);
+  auto bench = m.def_submodule("_bench", "Maintainers' timing helpers for benchmarks/ (not public API).");
+  bench.def(
+      "forward_dynamics_seconds",
+      [](const rigidfem::System& s, double t, const Eigen::Ref<const rigidfem::VecX>& q,
+         const Eigen::Ref<const rigidfem::VecX>& qd, int calls) {
+        py::gil_scoped_release release;
+        return rigidfem::forward_dynamics_seconds(s, t, q, qd, calls);
+      },
+      py::arg("system"), py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("calls"),
+      "Seconds per forward-dynamics call, timed in C++ on one workspace after a warm-up call.");
 }

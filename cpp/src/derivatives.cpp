@@ -4,10 +4,6 @@
 #include <cmath>
 #include <vector>
 
-#include "rigidfem/errors.hpp"
-#include "rigidfem/lagrange.hpp"
-#include "rigidfem/recursive.hpp"
-
 namespace rigidfem {
 
 namespace {
@@ -88,47 +84,16 @@ void tangent_column(const System& sys, const Data& d, const std::vector<AppliedL
       w.f[L.body].head<3>() -= dx.cross(l.F);
     }
   }
-  for (int p = sys.nbodies - 1; p > 0; --p)
-    if (sys.parent[p] >= 0) w.f[sys.parent[p]] += w.f[p];
+  accumulate_subtrees(sys, w.f);
   for (int k = 0; k < sys.nq; ++k) {
-    const int b = sys.coords[sys.free_coords[k]].body, u = own_use(sys, sys.free_coords[k]);
+    const int b = sys.coords[sys.free_coords[k]].body, u = sys.q_use[k];
     col(k) = d.axes[u].dot(w.f[b]) + (turned(b, u) ? crossm(s, d.axes[u]).dot(d.sf[b]) : 0.0);
   }
 }
 
-// Columns of ∂r/∂(q, q̇) by central differences of r (Lagrange systems, the reference).
-std::pair<MatX, MatX> differenced(const System& sys, Data& d) {
-  const double t = d.t;
-  const VecX qdd = d.qdda(sys.free_coords);
-  VecX q = d.qa(sys.free_coords), qd = d.qda(sys.free_coords);
-  auto r = [&] {
-    set_state(sys, d, t, q, qd);
-    set_accelerations(sys, d, qdd);
-    kinematics(sys, d);
-    return inverse_dynamics(sys, d);
-  };
-  MatX dq(sys.nq, sys.nq), dqd(sys.nq, sys.nq);
-  for (int j = 0; j < sys.nq; ++j) {
-    dq.col(j) = central_difference(r, q, j);
-    dqd.col(j) = central_difference(r, qd, j);
-  }
-  r();  // leave d at the state it came with
-  return {dq, dqd};
-}
-
 }  // namespace
 
-void set_accelerations(const System& sys, Data& d, const Eigen::Ref<const VecX>& qdd) {
-  for (int k = 0; k < sys.nq; ++k) d.qdda(sys.free_coords[k]) = qdd(k);
-}
-
-VecX inverse_dynamics(const System& sys, Data& d) {
-  generalized_forces(sys, d);  // with q̈ in d.qdda both formulations give f − A q̈
-  return -d.f;
-}
-
-std::pair<MatX, MatX> inverse_dynamics_derivatives(const System& sys, Data& d) {
-  if (sys.algorithm != Algorithm::Recursive) return differenced(sys, d);
+std::pair<MatX, MatX> rnea_derivatives(const System& sys, Data& d) {
   spatial_kinematics(sys, d);
   rnea_pass(sys, d);
   std::vector<AppliedLoad> loads;
@@ -136,7 +101,7 @@ std::pair<MatX, MatX> inverse_dynamics_derivatives(const System& sys, Data& d) {
   MatX dq(sys.nq, sys.nq), dqd(sys.nq, sys.nq);
   Tangent w(sys);
   for (int j = 0; j < sys.nq; ++j) {
-    const int i = sys.free_coords[j], b = sys.coords[i].body, u = own_use(sys, i);
+    const int i = sys.free_coords[j], b = sys.coords[i].body, u = sys.q_use[j];
     tangent_column(sys, d, loads, u, b, true, w, dq.col(j));
     tangent_column(sys, d, loads, u, b, false, w, dqd.col(j));
     // −∂Q_j/∂(q_j, q̇_j) of the coordinate's own spring, damper and force law.
@@ -149,19 +114,6 @@ std::pair<MatX, MatX> inverse_dynamics_derivatives(const System& sys, Data& d) {
     }
   }
   return {dq, dqd};
-}
-
-std::pair<MatX, MatX> acceleration_derivatives(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
-                                               const Eigen::Ref<const VecX>& qd) {
-  const VecX qdd = forward_dynamics(sys, d, t, q, qd);
-  set_state(sys, d, t, q, qd);
-  set_accelerations(sys, d, qdd);
-  kinematics(sys, d, false);  // T and the axes (recursive); the Lagrange differences redo it
-  auto [dq, dqd] = inverse_dynamics_derivatives(sys, d);
-  mass_matrix(sys, d);
-  d.llt.compute(d.A);
-  if (d.llt.info() != Eigen::Success) throw SimulationError(t, "the mass matrix is not positive definite");
-  return {-d.llt.solve(dq), -d.llt.solve(dqd)};
 }
 
 }  // namespace rigidfem

@@ -1,9 +1,9 @@
 #include "rigidfem/recursive.hpp"
 
+#include <stdexcept>
 #include <string>
 
 #include "rigidfem/errors.hpp"
-#include "rigidfem/lagrange.hpp"
 
 namespace rigidfem {
 
@@ -18,6 +18,11 @@ Mat6 spatial_inertia(double m, const Vec3& c, const Mat3& Ic) {
   return I;
 }
 
+void require_tree(const System& sys) {
+  if (sys.algorithm != Algorithm::Recursive)
+    throw std::logic_error("recursive algorithms need a system compiled with algorithm=recursive");
+}
+
 }  // namespace
 
 Vec6 gravity_acceleration(const System& sys, const Data& d) {
@@ -27,8 +32,9 @@ Vec6 gravity_acceleration(const System& sys, const Data& d) {
 }
 
 void spatial_kinematics(const System& sys, Data& d) {
+  static const Vec6 O6 = Vec6::Zero();
   for (int p = 0; p < sys.nbodies; ++p) {
-    Vec6 v = sys.parent[p] >= 0 ? d.v[sys.parent[p]] : Vec6::Zero();
+    Vec6 v = parent_value(sys, d.v, p, O6);
     Vec6 c = Vec6::Zero();
     for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) {
       const Vec6& s = d.axes[u];
@@ -54,32 +60,22 @@ void spatial_kinematics(const System& sys, Data& d) {
 void rnea_pass(const System& sys, Data& d) {
   const Vec6 a0 = gravity_acceleration(sys, d);
   for (int p = 0; p < sys.nbodies; ++p) {
-    Vec6 a = (sys.parent[p] >= 0 ? d.a[sys.parent[p]] : a0) + d.c[p];
+    Vec6 a = parent_value(sys, d.a, p, a0) + d.c[p];
     for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) a += d.axes[u] * d.qdda(sys.use_coord[u]);
     d.a[p] = a;
     d.sf[p] = d.I[p] * a + crossf(d.v[p], d.I[p] * d.v[p]) - d.fext[p];
   }
-  for (int p = sys.nbodies - 1; p > 0; --p)
-    if (sys.parent[p] >= 0) d.sf[sys.parent[p]] += d.sf[p];
+  accumulate_subtrees(sys, d.sf);
 }
-
-namespace {
-
-void require_tree(const System& sys) {
-  if (sys.algorithm != Algorithm::Recursive)
-    throw std::logic_error("recursive algorithms need a system compiled with algorithm=recursive");
-}
-
-}  // namespace
 
 void rnea_forces(const System& sys, Data& d) {
   require_tree(sys);
   spatial_kinematics(sys, d);
-  rnea_pass(sys, d);  // free q̈ are zero after set_state: the bias forces
+  rnea_pass(sys, d);
   // f = −(Sᵀ f̄)_free + passive: what drives the free coordinates besides A q̈.
   for (int k = 0; k < sys.nq; ++k) {
-    const int i = sys.free_coords[k], u = own_use(sys, i);
-    d.f(k) = -d.axes[u].dot(d.sf[sys.coords[i].body]) + passive_force(sys, d, i);
+    const int i = sys.free_coords[k];
+    d.f(k) = -d.axes[sys.q_use[k]].dot(d.sf[sys.coords[i].body]) + passive_force(sys, d, i);
   }
 }
 
@@ -87,21 +83,20 @@ void crba(const System& sys, Data& d) {
   require_tree(sys);
   spatial_kinematics(sys, d);
   // Composite inertias I^c_p = Σ_subtree I_k (ground coordinates: plain sums).
-  for (int p = 0; p < sys.nbodies; ++p) d.IA[p] = d.I[p];
-  for (int p = sys.nbodies - 1; p > 0; --p)
-    if (sys.parent[p] >= 0) d.IA[sys.parent[p]] += d.IA[p];
+  d.IA = d.I;
+  accumulate_subtrees(sys, d.IA);
   // a_ij = s_iᵀ I^c_b s_j for coordinate i on the path from the root to j's body b; the other
   // entries (coordinates on different branches) stay zero from the first allocation.
   if (d.A.rows() != sys.nq) d.A.setZero(sys.nq, sys.nq);
   for (int b = 0; b < sys.nbodies; ++b)
     for (int v = sys.use_start[b]; v < sys.use_start[b + 1]; ++v) {
-      const int l = sys.coords[sys.use_coord[v]].free_index;
+      const int l = sys.use_q[v];
       if (l < 0) continue;
       const Vec6 F = d.IA[b] * d.axes[v];
       for (int body = b; body >= 0; body = sys.parent[body]) {
         const int last = body == b ? v : sys.use_start[body + 1] - 1;
         for (int u = sys.use_start[body]; u <= last; ++u) {
-          const int k = sys.coords[sys.use_coord[u]].free_index;
+          const int k = sys.use_q[u];
           if (k >= 0) d.A(k, l) = d.A(l, k) = d.axes[u].dot(F);
         }
       }
@@ -110,19 +105,8 @@ void crba(const System& sys, Data& d) {
 
 namespace {
 
-using Subspace = Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, 6>;
 using SmallVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
 using SmallMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
-
-// S (6, nf): the axes of body p's free coordinates.
-Subspace free_axes(const System& sys, const Data& d, int p) {
-  int nf = 0;
-  for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) nf += sys.coords[sys.use_coord[u]].free_index >= 0;
-  Subspace S(6, nf);
-  for (int u = sys.use_start[p], k = 0; u < sys.use_start[p + 1]; ++u)
-    if (sys.coords[sys.use_coord[u]].free_index >= 0) S.col(k++) = d.axes[u];
-  return S;
-}
 
 // D⁻¹ of a symmetric positive definite D (nf ≤ 6) by Cholesky; fixed-size code for the
 // common three rotations of an sde. False if D is not positive definite.
@@ -139,26 +123,23 @@ bool invert_spd(const SmallMat& D, SmallMat& Dinv) {
   return true;
 }
 
-// ABA pass 2, inertia part (leaves to root): U = I^A S, D = Sᵀ U + diag(δ), and the parent
-// gets I^a = I^A − U D⁻¹ Uᵀ, kept in d.IA[p] for the bias pass. δ = 0 without an armature.
+// ABA pass 2, inertia part (leaves to root): S the free axes, U = I^A S, D = Sᵀ U + diag(δ), and
+// the parent gets I^a = I^A − U D⁻¹ Uᵀ, kept in d.IA[p] for the bias pass. δ = 0 without an armature.
 void articulated_inertias(const System& sys, Data& d, const VecX* armature) {
-  for (int p = 0; p < sys.nbodies; ++p) d.IA[p] = d.I[p];
+  d.IA = d.I;
   for (int p = sys.nbodies - 1; p >= 0; --p) {
-    const Subspace S = free_axes(sys, d, p);
-    if (S.cols() > 0) {
-      d.U6[p] = d.IA[p] * S;
+    const int k0 = sys.q_index[p], nf = sys.nq_of[p];
+    Subspace& S = d.S[p];
+    S.resize(6, nf);
+    for (int k = 0; k < nf; ++k) S.col(k) = d.axes[sys.q_use[k0 + k]];
+    d.U6[p].noalias() = d.IA[p] * S;
+    if (nf > 0) {
       SmallMat D = S.transpose() * d.U6[p];
-      if (armature)
-        for (int u = sys.use_start[p], k = 0; u < sys.use_start[p + 1]; ++u) {
-          const int l = sys.coords[sys.use_coord[u]].free_index;
-          if (l >= 0) D(k, k) += (*armature)(l), ++k;
-        }
+      if (armature) D.diagonal() += armature->segment(k0, nf);
       if (!invert_spd(D, d.Dinv[p]))
         throw SimulationError(d.t, "articulated inertia of body '" + sys.body_names[p] +
                                        "' is singular (a massless chain or a singular configuration)");
       d.IA[p] -= d.U6[p] * d.Dinv[p] * d.U6[p].transpose();
-    } else {
-      d.U6[p].resize(6, 0);
     }
     if (sys.parent[p] >= 0) d.IA[sys.parent[p]] += d.IA[p];
   }
@@ -172,28 +153,18 @@ void articulated_inertias(const System& sys, Data& d, const VecX* armature) {
 void articulated_accelerations(const System& sys, Data& d, const VecX& tau, const Vec6& a0, VecX& x) {
   for (int p = sys.nbodies - 1; p >= 0; --p) {
     Vec6 pa = d.pA[p] + d.IA[p] * d.c[p];
-    if (d.U6[p].cols() > 0) {
-      const Subspace S = free_axes(sys, d, p);
-      SmallVec t(S.cols());
-      for (int u = sys.use_start[p], k = 0; u < sys.use_start[p + 1]; ++u) {
-        const int l = sys.coords[sys.use_coord[u]].free_index;
-        if (l >= 0) t(k++) = tau(l);
-      }
-      d.u[p] = t - S.transpose() * d.pA[p];
+    if (sys.nq_of[p] > 0) {
+      d.u[p] = tau.segment(sys.q_index[p], sys.nq_of[p]) - d.S[p].transpose() * d.pA[p];
       pa += d.U6[p] * (d.Dinv[p] * d.u[p]);
     }
     if (sys.parent[p] >= 0) d.pA[sys.parent[p]] += pa;
   }
   for (int p = 0; p < sys.nbodies; ++p) {
-    Vec6 a = (sys.parent[p] >= 0 ? d.a[sys.parent[p]] : a0) + d.c[p];
-    if (d.U6[p].cols() > 0) {
+    Vec6 a = parent_value(sys, d.a, p, a0) + d.c[p];
+    if (sys.nq_of[p] > 0) {
       const SmallVec qdd = d.Dinv[p] * (d.u[p] - d.U6[p].transpose() * a);
-      for (int u = sys.use_start[p], k = 0; u < sys.use_start[p + 1]; ++u) {
-        const int i = sys.use_coord[u], l = sys.coords[i].free_index;
-        if (l < 0) continue;
-        x(l) = qdd(k);
-        a += d.axes[u] * qdd(k++);
-      }
+      x.segment(sys.q_index[p], sys.nq_of[p]) = qdd;
+      for (int k = 0; k < sys.nq_of[p]; ++k) a += d.S[p].col(k) * qdd(k);
     }
     d.a[p] = a;
   }
@@ -211,13 +182,13 @@ void aba(const System& sys, Data& d) {
     d.pA[p] = crossf(d.v[p], d.I[p] * d.v[p]) - d.fext[p];
     for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) {
       const int i = sys.use_coord[u];
-      if (sys.coords[i].drive_index >= 0) d.c[p] += d.axes[u] * d.qdda(i);
-      if (sys.coords[i].free_index >= 0) d.qdd(sys.coords[i].free_index) = passive_force(sys, d, i);
+      if (sys.use_drive[u] >= 0) d.c[p] += d.axes[u] * d.qdda(i);
+      if (sys.use_q[u] >= 0) d.qdd(sys.use_q[u]) = passive_force(sys, d, i);
     }
   }
   articulated_inertias(sys, d, nullptr);
   articulated_accelerations(sys, d, d.qdd, gravity_acceleration(sys, d), d.qdd);
-  for (int k = 0; k < sys.nq; ++k) d.qdda(sys.free_coords[k]) = d.qdd(k);
+  set_accelerations(sys, d, d.qdd);
   if (!d.qdd.allFinite()) throw SimulationError(d.t, "accelerations are NaN or inf");
 }
 
@@ -237,10 +208,6 @@ void aba_solve(const System& sys, Data& d, const VecX& b, VecX& x) {
   articulated_accelerations(sys, d, b, Vec6::Zero(), x);
 }
 
-}  // namespace rigidfem
-
-namespace rigidfem {
-
 void rnea_driving_forces(const System& sys, Data& d) {
   require_tree(sys);
   if (sys.np == 0) return;
@@ -248,8 +215,8 @@ void rnea_driving_forces(const System& sys, Data& d) {
   rnea_pass(sys, d);           // d.qdda holds every acceleration after aba
   // Row i of the full equations: s_iᵀ f̄_p = Q_i^passive + τ_i.
   for (int k = 0; k < sys.np; ++k) {
-    const int i = sys.drive_coords[k], u = own_use(sys, i);
-    d.tau(k) = d.axes[u].dot(d.sf[sys.coords[i].body]) - passive_force(sys, d, i);
+    const int i = sys.drive_coords[k];
+    d.tau(k) = d.axes[own_use(sys, i)].dot(d.sf[sys.coords[i].body]) - passive_force(sys, d, i);
   }
 }
 

@@ -289,75 +289,6 @@ def discretisation_error(elements=(5, 10, 20, 40, 80), modes: int = 3) -> Table:
     return Table(rows, columns)
 
 
-def _fit_exponent(rows, cost: str, exponent: str, smallest_nq: int = 60) -> None:
-    """Writes into every row the slope of log(cost) against log(nq), fitted over the rows with
-    nq ≥ smallest_nq that have the cost (at least two)."""
-    pts = [(r["nq"], r[cost]) for r in rows if cost in r and r["nq"] >= smallest_nq]
-    if len(pts) >= 2:
-        slope = float(np.polyfit(np.log([p[0] for p in pts]), np.log([p[1] for p in pts]), 1)[0])
-        for r in rows:
-            r[exponent] = slope
-
-
-def dynamics_scaling(elements=(10, 20, 50, 100, 200, 500, 1000), lagrange_up_to: int = 200) -> Table:
-    """Time per forward-dynamics call (s, timed in C++, minimum of 3 batches) against the
-    number of coordinates for modified-RFEM 3D cantilevers (3 rotations per sde): recursive
-    (ABA) against the book's Lagrange formulation, with the fitted exponent of each."""
-    rows = []
-    for m in elements:
-        model, _ = samples.cantilever(elements=m, deform=("bend_z", "bend_y", "torsion"))
-        row = {"m": m}
-        for algorithm in ("recursive", "lagrange"):
-            if algorithm == "lagrange" and m > lagrange_up_to:
-                continue
-            system = model.compile(algorithm)
-            rng = np.random.default_rng(0)
-            q, qd = rng.uniform(-1e-3, 1e-3, system.nq), rng.uniform(-1e-2, 1e-2, system.nq)
-            calls = max(3, int(2e5 / system.nq)) if algorithm == "recursive" else max(3, int(2e6 / system.nq**2))
-            row[f"{algorithm}_s"] = min(system._time_forward_dynamics(0.0, q, qd, calls) for _ in range(3))
-            row["nq"] = system.nq
-        rows.append(row)
-    for algorithm in ("recursive", "lagrange"):
-        _fit_exponent(rows, f"{algorithm}_s", f"{algorithm}_exponent")
-    return Table(rows, ("m", "nq", "recursive_s", "lagrange_s", "recursive_exponent", "lagrange_exponent"))
-
-
-def implicit_step_scaling(elements=(10, 20, 50, 100, 200, 500, 1000), tangent_up_to: int = 200,
-                          steps: int = 50) -> Table:
-    """Cost per step (s, timed in C++) of the implicit methods against the number of coordinates
-    for modified-RFEM 3D cantilevers (steel, 1 m, 20 × 5 mm, 3 rotations per sde) set vibrating
-    by a 20 N tip load, at the step h = T₁/50 (T₁ = 2π/105 s its first period, far beyond the
-    explicit stability limit of the sdes): ``implicit_spring`` (O(n) Newton matrix) against
-    generalised-α with the exact tangent (analytic derivatives, dense LU), and the cost of
-    one rk4 step (four ABA calls) for scale. Also the Newton iterations per step and the
-    fitted exponent of the implicit_spring cost."""
-    h = 2 * np.pi / 105.0 / 50
-    rows = []
-    for m in elements:
-        model, hd = samples.cantilever(elements=m, deform=("bend_z", "bend_y", "torsion"))
-        model.add_force(hd["beam"].tip, (0.0, 20.0, 10.0))
-        system = model.compile()
-        row = {"m": m, "nq": system.nq}
-        runs = [("implicit_spring", {}), ("generalized_alpha", {"iteration_matrix": "tangent"})]
-        for name, kw in runs:
-            if name == "generalized_alpha" and m > tangent_up_to:
-                continue
-            best = min((simulate(system, steps * h, method=name, dt=h, **kw) for _ in range(2)),
-                       key=lambda r: r.stats["wall_time"])
-            key = "spring" if name == "implicit_spring" else "tangent"
-            row[f"{key}_s_per_step"] = best.stats["wall_time"] / best.stats["steps"]
-            row[f"{key}_iterations_per_step"] = best.stats["newton_iterations"] / best.stats["steps"]
-            if key == "tangent":
-                row["tangent_jacobians"] = best.stats["jacobians"]
-        q = np.zeros(system.nq)
-        calls = max(3, int(2e5 / system.nq))
-        row["rk4_s_per_step"] = 4 * min(system._time_forward_dynamics(0.0, q, q, calls) for _ in range(3))
-        rows.append(row)
-    _fit_exponent(rows, "spring_s_per_step", "spring_exponent")
-    return Table(rows, ("m", "nq", "spring_s_per_step", "spring_iterations_per_step", "tangent_s_per_step",
-                        "tangent_iterations_per_step", "tangent_jacobians", "rk4_s_per_step", "spring_exponent"))
-
-
 def standard_methods(quick: bool = False):
     """The integrators and settings of the benchmark."""
     r = [1e-4, 1e-6, 1e-8] if quick else [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9]
@@ -366,8 +297,9 @@ def standard_methods(quick: bool = False):
 
 def bench(output_dir="bench", quick: bool = False) -> Table:
     """``python -m rigidfem bench``: the standard scenes under the standard integrators, plus
-    fixed-step sweeps; writes ``work_precision.csv``/``.png``, ``discretisation.csv`` and
-    ``dynamics_scaling.csv``, ``implicit_step_scaling.csv`` into ``output_dir`` and prints the tables."""
+    fixed-step sweeps; writes ``work_precision.csv``/``.png`` and ``discretisation.csv`` into
+    ``output_dir`` and prints the tables. (The maintainers' scaling and peer benchmarks are in
+    the checkout's ``benchmarks/``: ``python -m benchmarks scaling``.)"""
     import platform
 
     import matplotlib
@@ -415,18 +347,10 @@ def bench(output_dir="bench", quick: bool = False) -> Table:
     plt.close(fig)
     disc = discretisation_error(elements=(5, 10, 20) if quick else (5, 10, 20, 40, 80))
     disc.to_csv(out / "discretisation.csv")
-    scaling = dynamics_scaling(elements=(10, 20, 50) if quick else (10, 20, 50, 100, 200, 500, 1000))
-    scaling.to_csv(out / "dynamics_scaling.csv")
-    implicit = implicit_step_scaling(elements=(10, 20, 50) if quick else (10, 20, 50, 100, 200, 500, 1000))
-    implicit.to_csv(out / "implicit_step_scaling.csv")
     print(f"machine: {platform.machine()} {platform.processor() or ''}, {platform.python_implementation()} "
           f"{platform.python_version()}, {__import__('os').cpu_count()} cores")
     print(table)
     print("\nLeast wall time (s) to reach a tip RMS error (m):")
     print(table.summary().to_markdown())
     print(disc.to_markdown())
-    print("\nForward dynamics, time per call (s) against nq:")
-    print(scaling.to_markdown())
-    print("\nImplicit step, time per step (s) against nq (h = T1/50):")
-    print(implicit.to_markdown())
     return table

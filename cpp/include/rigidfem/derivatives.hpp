@@ -1,5 +1,5 @@
 /// Analytic derivatives of the recursive equations of motion (systems compiled with
-/// algorithm=recursive).
+/// algorithm=recursive), and the central differences used where no analytic form exists.
 ///
 /// The residual of the equations of motion, r(q, q̇, q̈) = A(q) q̈ − f(q, q̇, t) = Sᵀ f̄ − Q^passive
 /// (inverse dynamics of the free coordinates), is differentiated through the RNEA in ground
@@ -8,14 +8,13 @@
 ///   ∂s_u/∂q_j = s_j ×m s_u,   ∂I_p/∂q_j = s_j ×* I_p − I_p s_j ×m,   ∂f_ext/∂q_j = s_j ×* f (follower)
 /// for every use u and body p below q_j; the tangents of v, c, a and f follow by the product
 /// rule through the three RNEA passes, one pass per direction: O(n) per column, O(n²) in all.
-/// The accelerations follow from  ∂q̈/∂x = −A⁻¹ ∂r/∂x  (x = q, q̇) at the actual q̈.
 #pragma once
 
 #include <algorithm>
 #include <cmath>
 #include <utility>
 
-#include "rigidfem/system.hpp"
+#include "rigidfem/recursive.hpp"
 
 namespace rigidfem {
 
@@ -34,16 +33,9 @@ VecX central_difference(G&& g, VecX& x, int j) {
   return (gp - gm) / (2.0 * h);
 }
 
-/// Needs set_state, the free accelerations in d.qdda and kinematics: r = A q̈ − f (nq).
-VecX inverse_dynamics(const System& sys, Data& d);
-/// Needs set_state, the free accelerations in d.qdda and kinematics: (∂r/∂q, ∂r/∂q̇), each
-/// (nq, nq), analytic for the rigid-body terms, springs and dampers; force laws by central
-/// differences of their scalar functions.
-std::pair<MatX, MatX> inverse_dynamics_derivatives(const System& sys, Data& d);
-/// ∂q̈/∂q and ∂q̈/∂q̇ (nq, nq) at (t, q, q̇): −A⁻¹ (∂r/∂q, ∂r/∂q̇) at the forward-dynamics q̈.
-std::pair<MatX, MatX> acceleration_derivatives(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
-                                               const Eigen::Ref<const VecX>& qd);
-/// Writes the free accelerations q̈ (nq) into d.qdda (after set_state).
-void set_accelerations(const System& sys, Data& d, const Eigen::Ref<const VecX>& qdd);
+/// Needs set_state, the free accelerations in d.qdda and the axes (frames_and_axes): (∂r/∂q,
+/// ∂r/∂q̇), each (nq, nq), analytic for the rigid-body terms, springs and dampers; force laws by
+/// central differences of their scalar functions.
+std::pair<MatX, MatX> rnea_derivatives(const System& sys, Data& d);
 
 }  // namespace rigidfem

@@ -3,6 +3,7 @@
 /// Explicit methods integrate the first-order form y = [q, q̇], ẏ = [q̇, q̈]; the Newmark
 /// family integrates the second-order form directly with Newton iterations on
 /// M(q) q̈ − f(q, q̇, t) = 0. Every failure raises SimulationError with t, h and the cause.
+/// The methods are listed once, in the table of integrate.cpp (stepper.hpp says how to add one).
 #pragma once
 
 #include <functional>
@@ -14,11 +15,30 @@
 
 namespace rigidfem {
 
+enum class Method {
+  Euler,             ///< explicit Euler, order 1, fixed step
+  SymplecticEuler,   ///< semi-implicit Euler (q̇ first, then q), order 1, fixed step
+  RK4,               ///< classical Runge–Kutta, order 4, fixed step
+  Dopri5,            ///< Dormand–Prince 5(4), adaptive
+  RKF45,             ///< Runge–Kutta–Fehlberg 4(5), adaptive
+  Newmark,           ///< Newmark β, γ, Newton
+  HHT,               ///< Hilber–Hughes–Taylor α
+  GeneralizedAlpha,  ///< Chung–Hulbert generalised-α with ρ∞
+  ImplicitSpring,    ///< generalised-α with the O(n) Newton matrix M + diag(γ'h b + β'h² c)
+};
+/// The method called `name` ("dopri5", ...); std::invalid_argument listing the methods otherwise.
+Method parse_method(const std::string& name);
+const char* method_name(Method method);
+
+/// The Newmark family's Newton matrix: Tangent, M + γ'h ∂r/∂q̇ + β'h² ∂r/∂q (analytic for recursive
+/// systems, factorised densely); Spring, M + diag(γ'h b + β'h² c) (the sde springs and dampers as
+/// armature of the articulated-body algorithm: O(n)); Auto, Spring for implicit_spring, else Tangent.
+enum class IterationMatrix { Auto, Tangent, Spring };
+IterationMatrix parse_iteration_matrix(const std::string& name);
+const char* iteration_matrix_name(IterationMatrix matrix);
+
 struct IntegratorOptions {
-  /// "euler", "symplectic_euler", "rk4" (fixed step); "dopri5", "rkf45" (adaptive);
-  /// "newmark", "hht", "generalized_alpha" (implicit, fixed step or adaptive); "implicit_spring":
-  /// generalised-α whose Newton iteration matrix holds only the springs and dampers, O(n) per step.
-  std::string method = "dopri5";
+  Method method = Method::Dopri5;
   double dt = 0.0;           ///< s: the step of fixed-step methods (first step of adaptive ones if > 0)
   /// Step-size control: dopri5/rkf45 by their embedded pair (default), the Newmark family by
   /// a local error estimate (off by default); false runs every method at the fixed step dt.
@@ -32,11 +52,7 @@ struct IntegratorOptions {
   double rho_inf = 0.8;             ///< generalised-α: spectral radius at infinite frequency, in [0, 1]
   double newton_tol = 1e-10;        ///< Newton: increments below newton_tol (1 + |q|), relative for adaptive runs
   int newton_max_iterations = 10;
-  /// The Newmark family's Newton matrix: "tangent" (M + γ'h ∂r/∂q̇ + β'h² ∂r/∂q, analytic for
-  /// recursive systems, factorised densely), "spring" (M + diag(γ'h b + β'h² c), the sde
-  /// springs and dampers as armature of the articulated-body algorithm: O(n)), or "auto"
-  /// (spring for implicit_spring, tangent otherwise).
-  std::string iteration_matrix = "auto";
+  IterationMatrix iteration_matrix = IterationMatrix::Auto;
 };
 
 struct IntegratorStats {
@@ -63,6 +79,6 @@ using Monitor = std::function<bool(double)>;
 /// [t0, t_end]) by each method's dense output — Dormand–Prince's own continuous extension,
 /// cubic Hermite interpolation of y and ẏ otherwise — or at every step if it is empty.
 Trajectory integrate(const System& sys, double t0, double t_end, const VecX& q0, const VecX& qd0,
-                     const VecX& t_eval, const IntegratorOptions& options, const Monitor& monitor);
+                     const Eigen::Ref<const VecX>& t_eval, const IntegratorOptions& options, const Monitor& monitor);
 
 }  // namespace rigidfem

@@ -7,8 +7,8 @@
 #include <string>
 #include <vector>
 
+#include "rigidfem/joint_motion.hpp"
 #include "rigidfem/profiles.hpp"
-#include "rigidfem/transforms.hpp"
 
 namespace rigidfem {
 
@@ -40,11 +40,6 @@ struct Joint {
   static Joint make(const std::string& kind, std::vector<Axis> axes);
   int ncoords() const { return static_cast<int>(axes.size()); }
 };
-
-/// Parses "x", "y", "z" (a translation or, for rotations, the axis) into an Axis.
-Axis parse_axis(const std::string& name, bool rotation, const std::string& argument);
-/// Parses "x", "y", "z", "rz", "ry", "rx" (also "phi3", "phi2", "phi1").
-Axis parse_coordinate(const std::string& name, const std::string& argument);
 
 /// A handle to a body; index −1 is the ground.
 struct Body {

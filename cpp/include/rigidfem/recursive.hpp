@@ -1,7 +1,7 @@
 /// Recursive O(n) algorithms (Featherstone) over the same System, in ground coordinates:
 /// spatial vectors are expressed in the global frame at its origin — motion m = (ω, v_O),
 /// force f = (n_O, F) — so composite and articulated inertias add without transforms.
-/// Coordinate axes s_i = (w_i, v_i) are the global twists U_i of the kinematics stage.
+/// Coordinate axes s_i = (w_i, v_i) come from the kinematics (frames_and_axes).
 ///
 ///   RNEA  (inverse dynamics):  v_p = v_λ + S q̇, a_p = a_λ + S q̈ + Ṡ q̇ (a_0 = −g),
 ///                              f_p = I_p a_p + v_p ×* I_p v_p − f_ext,p, τ = Sᵀ f̄_p (subtree sums)
@@ -12,39 +12,25 @@
 /// Lagrange formulation.
 #pragma once
 
-#include "rigidfem/system.hpp"
+#include "rigidfem/kinematics.hpp"
 
 namespace rigidfem {
 
-// Building blocks (also used by the derivatives):
-/// m ×m s, the motion cross product (Featherstone's crm).
-inline Vec6 crossm(const Vec6& m, const Vec6& s) {
-  Vec6 r;
-  r << m.head<3>().cross(s.head<3>()), m.head<3>().cross(s.tail<3>()) + m.tail<3>().cross(s.head<3>());
-  return r;
-}
-/// v ×* f, the force cross product (Featherstone's crf).
-inline Vec6 crossf(const Vec6& v, const Vec6& f) {
-  Vec6 r;
-  r << v.head<3>().cross(f.head<3>()) + v.tail<3>().cross(f.tail<3>()), v.head<3>().cross(f.tail<3>());
-  return r;
-}
 /// a_0 = (0, −g): gravity as an upward acceleration of the base.
 Vec6 gravity_acceleration(const System& sys, const Data& d);
 /// (T, axes, q̇) => velocities v_p, joint bias accelerations c_p = Σ ṡ_k q̇_k, spatial
-/// inertias I_p and external loads f_ext,p, all in ground coordinates. Needs kinematics.
+/// inertias I_p and external loads f_ext,p, all in ground coordinates. Needs the axes.
 void spatial_kinematics(const System& sys, Data& d);
 /// RNEA with the accelerations in d.qdda: a_p = a_λ + c_p + Σ s q̈, f_p = I a + v ×* I v − f_ext,
 /// summed over subtrees into d.sf. Needs spatial_kinematics.
 void rnea_pass(const System& sys, Data& d);
 
-/// Needs set_state and kinematics: the generalised forces f (nq) of A q̈ = f by RNEA with the
-/// free accelerations zero, f = −τ_RNEA + passive.
+/// Needs set_state and the axes: the generalised forces f (nq) of A q̈ = f by RNEA with the
+/// free accelerations of d.qdda, f = −τ_RNEA + passive (= f − A q̈ when q̈ ≠ 0).
 void rnea_forces(const System& sys, Data& d);
-/// Needs kinematics: the mass matrix A (nq, nq) by the composite-rigid-body algorithm.
+/// Needs the axes: the mass matrix A (nq, nq) by the composite-rigid-body algorithm.
 void crba(const System& sys, Data& d);
-/// Needs set_state and kinematics: q̈ (nq) by the articulated-body algorithm; with the
-/// driving forces τ (np) of the prescribed coordinates from a final RNEA pass.
+/// Needs set_state and the axes: q̈ (nq) by the articulated-body algorithm.
 void aba(const System& sys, Data& d);
 /// Needs spatial_kinematics: the articulated-body factorisation of M + diag(δ), δ (nq) ≥ 0 added
 /// to the free coordinates the way joint armature is (D = Sᵀ I^A S + diag δ). O(n).

@@ -1,4 +1,4 @@
-/// The compiled, immutable multibody system and its workspace.
+/// The compiled, immutable multibody system, its workspace and the tree helpers every engine uses.
 ///
 /// System holds topology (bodies in order parent[p] < p), constant placements B_p,
 /// pseudo-inertias H_p and flat coordinate tables. Every scratch array lives in
@@ -30,9 +30,6 @@ struct Coordinate {
 /// How the equations of motion are evaluated.
 enum class Algorithm { Lagrange, Recursive };
 
-using Vec6 = Eigen::Matrix<double, 6, 1>;
-using Mat6 = Eigen::Matrix<double, 6, 6>;
-
 class System {
  public:
   /// Recursive (O(n), the default) or the book's Lagrange formulation; systems with linear
@@ -45,7 +42,6 @@ class System {
 
   std::vector<std::string> body_names;  // (nbodies)
   std::vector<int> parent;              // (nbodies), −1 = ground, parent[p] < p
-  std::vector<std::vector<int>> children;  // (nbodies)
   std::vector<Mat4> B;                  // (nbodies) 4x4 joint placement in the parent frame
   std::vector<Mat4> H;                  // (nbodies) 4x4 pseudo-inertia, body frame
   std::vector<double> mass;             // (nbodies)
@@ -56,12 +52,19 @@ class System {
   std::vector<Coordinate> coords;       // (nc) in body order, within a joint in the book's order
   std::vector<int> free_coords;         // (nq) -> index in coords
   std::vector<int> drive_coords;        // (np) -> index in coords
+  // The free coordinates of body p are contiguous in q (Pinocchio's idx_v, nv):
+  std::vector<int> q_index;             // (nbodies) first free coordinate of body p in q
+  std::vector<int> nq_of;               // (nbodies) number of free coordinates of body p
+  std::vector<int> q_use;               // (nq) the use (axis) of free coordinate k on its own body
   // Coordinate uses: the coordinates that move each body's joint, its own ones first
   // (so without couplings use u is coordinate u), then coupled ones (linear model).
   int nuses = 0;
   std::vector<int> use_start;           // (nbodies + 1) first use of body p
   std::vector<int> use_coord;           // (nuses) -> index in coords
-  std::vector<Mat4> use_G;              // (nuses) generator in the joint frame (linear joints)
+  std::vector<Axis> use_axis;           // (nuses) its elementary motion
+  std::vector<Mat4> use_G;              // (nuses) its generator in the joint frame
+  std::vector<int> use_q;               // (nuses) index in q of its coordinate, −1 if prescribed
+  std::vector<int> use_drive;           // (nuses) index among the prescribed coordinates, −1 if free
   int max_uses = 0;                     // largest number of uses of one body
   std::vector<int> zyx_pitch;           // coordinate index of φ2 in every exact joint with φ3, φ2 and φ1
   Vec3 gravity = Vec3::Zero();          // m/s², global
@@ -73,6 +76,31 @@ class System {
 
 /// The use of coordinate i (index in coords) on its own body: its axis in Data::axes and U.
 inline int own_use(const System& sys, int i) { return sys.use_start[sys.coords[i].body] + sys.coords[i].slot; }
+
+/// The uses that move body p's joint, for joint_motion and joint_frames.
+inline JointUses joint_uses(const System& sys, int p) {
+  const int u0 = sys.use_start[p];
+  return {sys.use_start[p + 1] - u0, &sys.use_coord[u0], &sys.use_axis[u0], &sys.use_G[u0], sys.joint[p].linear};
+}
+
+/// X_parent(p), or `root` for a body on the ground.
+template <class T>
+const T& parent_value(const System& sys, const std::vector<T>& X, int p, const T& root) {
+  return sys.parent[p] >= 0 ? X[sys.parent[p]] : root;
+}
+
+/// X̄_p = X_p + Σ_children X̄_c: sums a per-body quantity over subtrees, children before parents.
+template <class T>
+void accumulate_subtrees(const System& sys, std::vector<T>& X) {
+  for (int p = sys.nbodies - 1; p >= 0; --p)
+    if (sys.parent[p] >= 0) X[sys.parent[p]] += X[p];
+}
+
+/// Throws std::invalid_argument unless `body` indexes a body of sys (−1, the ground, if allowed).
+void check_body(const System& sys, int body, const std::string& argument, bool ground_allowed = false);
+
+/// The motion subspace S (6, ≤ 6) of a body's free coordinates.
+using Subspace = Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, 6>;
 
 /// Workspace of the algorithms. "(nbodies) 4x4" are global quantities.
 struct Data {
@@ -98,9 +126,14 @@ struct Data {
   std::vector<Vec6> sf, pA;    // (nbodies) spatial force (subtree sums after RNEA), articulated bias force
   std::vector<Mat6> I, IA;     // (nbodies) spatial inertia, composite or articulated inertia
   std::vector<Vec6> fext;      // (nbodies) external loads
-  std::vector<Eigen::Matrix<double, 6, Eigen::Dynamic, 0, 6, 6>> U6;   // (nbodies) I^A S
+  std::vector<Subspace> S;     // (nbodies) axes of the free coordinates
+  std::vector<Subspace> U6;    // (nbodies) I^A S
   std::vector<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>> Dinv;  // (nbodies) (Sᵀ I^A S)⁻¹
   std::vector<Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>> u;    // (nbodies) τ − Sᵀ p^A
 };
+
+/// Throws std::invalid_argument unless d is a workspace made for sys (a Data of another system
+/// would be written out of bounds).
+void check_data(const System& sys, const Data& d);
 
 }  // namespace rigidfem

@@ -1,33 +1,25 @@
-/// Homogeneous transformations (book ch. 2.1).
+/// Homogeneous transformations (book ch. 2.1) and the spatial-vector algebra of the recursive engine.
 ///
 /// A pose is T = [[R, r], [0 0 0 1]]. Rotations about x, y, z are R1(φ1), R2(φ2),
 /// R3(φ3); Euler angles ZYX give R = R3(φ3) R2(φ2) R1(φ1) (book eq. 2.7).
-/// A joint's motion is T̃(q) = Trans(x, y, z) R3(φ3) R2(φ2) R1(φ1) restricted to
-/// its active coordinates, always in this (the book's) order.
+/// Spatial vectors are expressed in ground coordinates at the global origin: motion
+/// m = (ω, v_O), force f = (n_O, F) (Featherstone's notation).
 #pragma once
 
 #include <Eigen/Dense>
-#include <vector>
 
 namespace rigidfem {
 
 using Vec3 = Eigen::Vector3d;
 using Vec4 = Eigen::Vector4d;
+using Vec6 = Eigen::Matrix<double, 6, 1>;
 using Mat3 = Eigen::Matrix3d;
 using Mat4 = Eigen::Matrix4d;
+using Mat6 = Eigen::Matrix<double, 6, 6>;
 using VecX = Eigen::VectorXd;
 using MatX = Eigen::MatrixXd;
-
-/// The six elementary motions of a joint, in the book's order x, y, z, φ3, φ2, φ1.
-enum class Axis : int { X = 0, Y = 1, Z = 2, RZ = 3, RY = 4, RX = 5 };
-
-inline bool is_rotation(Axis a) { return static_cast<int>(a) >= 3; }
-/// 0, 1, 2 for the axis x, y, z a motion translates along or turns about.
-inline int axis_index(Axis a) { return is_rotation(a) ? 5 - static_cast<int>(a) : static_cast<int>(a); }
-/// Unit vector of the axis an elementary motion translates along or turns about.
-Vec3 axis_direction(Axis a);
-/// "x", "y", "z", "rz", "ry", "rx".
-const char* axis_name(Axis a);
+/// Row-major (N, n) arrays: one state per row, as numpy stores a trajectory.
+using RowMatX = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
 Mat3 R1(double phi1);  ///< rotation about x
 Mat3 R2(double phi2);  ///< rotation about y
@@ -47,16 +39,17 @@ Mat4 inverse(const Mat4& T);
 /// [[M⁻¹, −M⁻¹ r], [0, 1]].
 Mat4 affine_inverse(const Mat4& T);
 
-/// Elementary transform E_a(q): Trans(q e_a) for a translation, the rotation R_a(q) otherwise.
-Mat4 elementary(Axis a, double q);
-/// Its generator Q_a, constant: dE_a/dq = E_a Q_a.
-Mat4 generator(Axis a);
-
-/// Joint transform T̃(q) = Π_k E_{axes[k]}(q_k) (4x4); axes must be in the book's order.
-Mat4 joint_transform(const std::vector<Axis>& axes, const VecX& q);
-/// ∂T̃/∂q_i (4x4): the i-th factor E_i replaced by E_i Q_i.
-Mat4 joint_transform_derivative(const std::vector<Axis>& axes, const VecX& q, int i);
-/// ∂²T̃/∂q_i∂q_j (4x4): factors i and j replaced (E_i Q_i Q_i when i == j).
-Mat4 joint_transform_second_derivative(const std::vector<Axis>& axes, const VecX& q, int i, int j);
+/// m ×m s, the motion cross product (Featherstone's crm).
+inline Vec6 crossm(const Vec6& m, const Vec6& s) {
+  Vec6 r;
+  r << m.head<3>().cross(s.head<3>()), m.head<3>().cross(s.tail<3>()) + m.tail<3>().cross(s.head<3>());
+  return r;
+}
+/// v ×* f, the force cross product (Featherstone's crf).
+inline Vec6 crossf(const Vec6& v, const Vec6& f) {
+  Vec6 r;
+  r << v.head<3>().cross(f.head<3>()) + v.tail<3>().cross(f.tail<3>()), v.head<3>().cross(f.tail<3>());
+  return r;
+}
 
 }  // namespace rigidfem

@@ -15,12 +15,12 @@ spring (c, rest value) and a viscous damper (b) on each coordinate.
   ``stiff_beam_accuracy`` and ``equal_accuracy`` compare the cost of simulating a steel
   cantilever to a given accuracy with each code's integrators (``RIGIDFEM_METHODS``,
   ``MUJOCO_METHODS``);
-- ``bench`` runs it all and prints markdown tables::
+- ``run`` runs it all, writes the tables as CSV and prints them as markdown::
 
-    python -m rigidfem.peers [--quick]
+    python -m benchmarks peers [--quick] [--output DIR]
 
-Needs the optional extra ``pip install "rigidfem[bench]"`` (the ``pin`` and ``mujoco``
-packages). SI units throughout: m, rad, kg, s, N, N·m.
+Needs the peer codes: ``pip install pin mujoco`` (Pinocchio's PyPI name is ``pin``). SI
+units throughout: m, rad, kg, s, N, N·m.
 """
 
 from __future__ import annotations
@@ -34,14 +34,13 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import samples
-from ._core import Point, SimulationError
-from .analysis import static_equilibrium
-from .materials import Material
-from .simulation import simulate
-from .study import Table, cheapest
+import rigidfem
+from rigidfem import Material, Point, SimulationError, samples, simulate, static_equilibrium
+from rigidfem.study import Table, cheapest
 
-INSTALL_HINT = 'pip install "rigidfem[bench]"'
+from ._common import cpp_seconds_per_call, machine, report
+
+INSTALL_HINT = "pip install pin mujoco"
 
 #: rigidfem's integrators in the accuracy study: (method, setting, values[, extra keyword arguments]).
 #: A method this build does not know yet is skipped with a note, so a new one is one line here.
@@ -65,11 +64,11 @@ MUJOCO_METHODS = [
 
 
 def _require(module: str, package: str):
-    """Import an optional peer code, or raise an ImportError naming the extra."""
+    """Import a peer code, or raise an ImportError saying how to install it."""
     try:
         return importlib.import_module(module)
     except ImportError as e:
-        raise ImportError(f"rigidfem.peers needs the '{package}' package ({module}): {INSTALL_HINT}") from e
+        raise ImportError(f"benchmarks.peers needs the '{package}' package ({module}): {INSTALL_HINT}") from e
 
 
 # ---------------------------------------------------------------------------------------------
@@ -486,7 +485,7 @@ def forward_dynamics_timing(elements=(10, 30, 100, 200, 300, 1000), mujoco_up_to
             eq["eps_cond_A"] = agreement(system, q, qd, system.forward_dynamics(0.0, q, qd))["tolerance"]
             eq["cond_A"] = eq["eps_cond_A"] / np.finfo(float).eps
         batches = {"rigidfem_us": _batch(lambda: system.forward_dynamics(0.0, q, qd)),
-                   "rigidfem_cpp_us": lambda: system._time_forward_dynamics(0.0, q, qd, max(3, int(2e5 / system.nq)))}
+                   "rigidfem_cpp_us": lambda: cpp_seconds_per_call(system, q, qd)}
         if with_pinocchio:
             # SphericalZYX first and on its own: two Pinocchio Data may not fit in memory together.
             zyx = PinocchioChain(chain, spherical=True)
@@ -669,8 +668,6 @@ def equal_accuracy(table: Table, thresholds=(1e-4, 1e-6)) -> Table:
 
 def versions() -> dict:
     """Versions of the compared codes (and numpy)."""
-    import rigidfem
-
     pin = _require("pinocchio", "pin")
     mujoco = _require("mujoco", "mujoco")
     return {"rigidfem": rigidfem.__version__, "pinocchio": pin.__version__, "mujoco": mujoco.__version__,
@@ -682,24 +679,24 @@ def _fewer(methods, keep: slice):
     return [(method, setting, values[keep], *extra) for method, setting, values, *extra in methods]
 
 
-def bench(quick: bool = False) -> dict:
-    """``python -m rigidfem.peers``: print as markdown and return (as ``study.Table``s, keys
-    "forward_dynamics", "equivalence", "accuracy", "equal_accuracy") the forward-dynamics
-    timing against nq, the equivalence errors behind it, the stiff-beam accuracy and cost
-    of every code and integrator (m = 10 and 30 rfes over 0.2 s), and the cheapest run of
-    each reaching a tip error of 1e-4 and 1e-6 of the tip deflection. ``quick``: small
+def run(output_dir="bench", quick: bool = False) -> dict:
+    """``python -m benchmarks peers``: the forward-dynamics timing against nq, the
+    equivalence errors behind it, the stiff-beam accuracy and cost of every code and
+    integrator (m = 10 and 30 rfes over 0.2 s), and the cheapest run of each reaching a tip
+    error of 1e-4 and 1e-6 of the tip deflection; each written to ``output_dir`` as
+    ``peers_<name>.csv`` and printed as markdown. Returns name -> Table (names
+    "forward_dynamics", "equivalence", "accuracy", "equal_accuracy"). ``quick``: small
     chains, few settings, a 0.05 s span (a smoke run of about half a minute)."""
-    import platform
-
     info = versions()
     print(f"rigidfem {info['rigidfem']}, Pinocchio {info['pinocchio']}, MuJoCo {info['mujoco']}, numpy "
-          f"{info['numpy']}; {platform.machine()}, {os.cpu_count()} cores, Python {platform.python_version()}\n",
-          flush=True)
+          f"{info['numpy']}; {machine()}", flush=True)
     timing, equivalence = forward_dynamics_timing(elements=(4, 10) if quick else (10, 30, 100, 200, 300, 1000))
-    print("Forward dynamics, µs per call from Python (3D steel cantilever, gravity on, random state):\n")
-    print(timing.to_markdown(), "\n")
-    print("Equivalence at that state: relative q̈ error (*_fwd) and backward error in rigidfem's equations (*_bwd):\n")
-    print(equivalence.to_markdown(), "\n", flush=True)
+    tables = report({
+        "peers_forward_dynamics": ("Forward dynamics, µs per call from Python (3D steel cantilever, gravity on, "
+                                   "random state)", timing),
+        "peers_equivalence": ("Equivalence at that state: relative q̈ error (*_fwd) and backward error in "
+                              "rigidfem's equations (*_bwd)", equivalence),
+    }, output_dir)
     rows = []
     for m in (4,) if quick else (10, 30):
         start = time.perf_counter()
@@ -713,17 +710,10 @@ def bench(quick: bool = False) -> dict:
         rows += table.rows
         print(f"[{time.perf_counter() - start:6.1f} s] {scene.name}", flush=True)
     accuracy = Table(rows, ACCURACY_COLUMNS)
-    print("\nStiff beam: largest tip error relative to the largest tip deflection, wall time per simulated second:\n")
-    print(accuracy.to_markdown(), "\n")
-    summary = equal_accuracy(accuracy)
-    print("Equal accuracy: the cheapest run of each code and method reaching each relative tip error:\n")
-    print(summary.to_markdown())
-    return {"forward_dynamics": timing, "equivalence": equivalence, "accuracy": accuracy, "equal_accuracy": summary}
-
-
-if __name__ == "__main__":
-    import argparse
-
-    parser = argparse.ArgumentParser(prog="python -m rigidfem.peers", description=__doc__.split("\n\n")[0])
-    parser.add_argument("--quick", action="store_true", help="small chains and few settings (a smoke run)")
-    bench(quick=parser.parse_args().quick)
+    tables.update(report({
+        "peers_accuracy": ("Stiff beam: largest tip error relative to the largest tip deflection, wall time per "
+                           "simulated second", accuracy),
+        "peers_equal_accuracy": ("Equal accuracy: the cheapest run of each code and method reaching each relative "
+                                 "tip error", equal_accuracy(accuracy)),
+    }, output_dir))
+    return {name[len("peers_"):]: table for name, table in tables.items()}

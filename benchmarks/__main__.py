@@ -1,0 +1,33 @@
+"""``python -m benchmarks {scaling,peers} [--quick] [--output DIR]``, from the root of a checkout."""
+
+from __future__ import annotations
+
+import argparse
+import importlib
+import sys
+
+#: Command -> its help; each command is a module of this package with ``run(output_dir, quick)``.
+COMMANDS = {
+    "scaling": "forward-dynamics and implicit-step cost against the number of coordinates",
+    "peers": "rigidfem against Pinocchio and MuJoCo (needs: pip install pin mujoco)",
+}
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(prog="python -m benchmarks", description=__doc__)
+    sub = parser.add_subparsers(dest="command", required=True)
+    for name, text in COMMANDS.items():
+        p = sub.add_parser(name, help=text, description=text)
+        p.add_argument("--output", default="bench", help="folder for the CSV tables (default bench)")
+        p.add_argument("--quick", action="store_true", help="a few small sizes and settings (a smoke run)")
+    args = parser.parse_args(argv)
+    try:
+        module = importlib.import_module(f"{__package__ or 'benchmarks'}.{args.command}")
+        module.run(args.output, quick=args.quick)
+    except ImportError as e:  # a peer code (or rigidfem) not installed: say what to install
+        parser.exit(1, f"{parser.prog} {args.command}: {e}\n")
+    return 0
+
+
+if __name__ == "__main__":
+    sys.exit(main())

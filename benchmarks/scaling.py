@@ -1,0 +1,115 @@
+"""Scaling benchmarks: cost against the number of coordinates nq of modified-RFEM 3D
+cantilevers (``samples.cantilever`` with bend_z, bend_y and torsion: 3 rotations per sde).
+
+- ``dynamics_scaling``: time per forward-dynamics call, recursive (ABA) against the book's
+  Lagrange formulation;
+- ``implicit_step_scaling``: time per step of ``implicit_spring`` (O(n) Newton matrix)
+  against generalised-α with the exact tangent, and one rk4 step for scale;
+- ``run``: both, written to ``dynamics_scaling.csv`` and ``implicit_step_scaling.csv``::
+
+    python -m benchmarks scaling [--quick] [--output DIR]
+
+Times in s, timed in C++ where marked; the fitted exponents are slopes of log(time)
+against log(nq).
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from rigidfem import samples
+from rigidfem.simulation import simulate
+from rigidfem.study import Table
+
+from ._common import cpp_seconds_per_call, machine, report
+
+ELEMENTS = (10, 20, 50, 100, 200, 500, 1000)
+QUICK_ELEMENTS = (10, 20, 40)
+DEFORM = ("bend_z", "bend_y", "torsion")
+
+
+def _fit_exponent(rows, cost: str, exponent: str, smallest_nq: int = 60) -> None:
+    """Writes into every row the slope of log(cost) against log(nq), fitted over the rows with
+    nq ≥ smallest_nq that have the cost (at least two)."""
+    pts = [(r["nq"], r[cost]) for r in rows if cost in r and r["nq"] >= smallest_nq]
+    if len(pts) >= 2:
+        slope = float(np.polyfit(np.log([p[0] for p in pts]), np.log([p[1] for p in pts]), 1)[0])
+        for r in rows:
+            r[exponent] = slope
+
+
+def _least_cpp_seconds(system, q, qd, calls: int | None = None) -> float:
+    """Least of 3 batches of ``cpp_seconds_per_call`` (s per call)."""
+    return min(cpp_seconds_per_call(system, q, qd, calls) for _ in range(3))
+
+
+def dynamics_scaling(elements=ELEMENTS, lagrange_up_to: int = 200) -> Table:
+    """Time per forward-dynamics call (s, timed in C++, minimum of 3 batches) against the
+    number of coordinates for modified-RFEM 3D cantilevers (3 rotations per sde): recursive
+    (ABA) against the book's Lagrange formulation (for m ≤ ``lagrange_up_to``), with the
+    fitted exponent of each (nq ≥ 60)."""
+    rows = []
+    for m in elements:
+        model, _ = samples.cantilever(elements=m, deform=DEFORM)
+        row = {"m": m}
+        for algorithm in ("recursive", "lagrange"):
+            if algorithm == "lagrange" and m > lagrange_up_to:
+                continue
+            system = model.compile(algorithm)
+            rng = np.random.default_rng(0)
+            q, qd = rng.uniform(-1e-3, 1e-3, system.nq), rng.uniform(-1e-2, 1e-2, system.nq)
+            calls = None if algorithm == "recursive" else max(3, int(2e6 / system.nq**2))
+            row[f"{algorithm}_s"] = _least_cpp_seconds(system, q, qd, calls)
+            row["nq"] = system.nq
+        rows.append(row)
+    for algorithm in ("recursive", "lagrange"):
+        _fit_exponent(rows, f"{algorithm}_s", f"{algorithm}_exponent")
+    return Table(rows, ("m", "nq", "recursive_s", "lagrange_s", "recursive_exponent", "lagrange_exponent"))
+
+
+def implicit_step_scaling(elements=ELEMENTS, tangent_up_to: int = 200, steps: int = 50) -> Table:
+    """Cost per step (s, timed in C++) of the implicit methods against the number of coordinates
+    for modified-RFEM 3D cantilevers (steel, 1 m, 20 × 5 mm, 3 rotations per sde) set vibrating
+    by a 20 N tip load, at the step h = T₁/50 (T₁ = 2π/105 s its first period, far beyond the
+    explicit stability limit of the sdes), over ``steps`` steps: ``implicit_spring`` (O(n)
+    Newton matrix) against generalised-α with the exact tangent (analytic derivatives, dense
+    LU; m ≤ ``tangent_up_to``), and the cost of one rk4 step (four ABA calls) for scale. Also
+    the Newton iterations per step and the fitted exponent of the implicit_spring cost."""
+    h = 2 * np.pi / 105.0 / 50
+    rows = []
+    for m in elements:
+        model, hd = samples.cantilever(elements=m, deform=DEFORM)
+        model.add_force(hd["beam"].tip, (0.0, 20.0, 10.0))
+        system = model.compile()
+        row = {"m": m, "nq": system.nq}
+        runs = [("implicit_spring", {}), ("generalized_alpha", {"iteration_matrix": "tangent"})]
+        for name, kw in runs:
+            if name == "generalized_alpha" and m > tangent_up_to:
+                continue
+            best = min((simulate(system, steps * h, method=name, dt=h, **kw) for _ in range(2)),
+                       key=lambda r: r.stats["wall_time"])
+            key = "spring" if name == "implicit_spring" else "tangent"
+            row[f"{key}_s_per_step"] = best.stats["wall_time"] / best.stats["steps"]
+            row[f"{key}_iterations_per_step"] = best.stats["newton_iterations"] / best.stats["steps"]
+            if key == "tangent":
+                row["tangent_jacobians"] = best.stats["jacobians"]
+        q = np.zeros(system.nq)
+        row["rk4_s_per_step"] = 4 * _least_cpp_seconds(system, q, q)
+        rows.append(row)
+    _fit_exponent(rows, "spring_s_per_step", "spring_exponent")
+    return Table(rows, ("m", "nq", "spring_s_per_step", "spring_iterations_per_step", "tangent_s_per_step",
+                        "tangent_iterations_per_step", "tangent_jacobians", "rk4_s_per_step", "spring_exponent"))
+
+
+def run(output_dir="bench", quick: bool = False) -> dict:
+    """``python -m benchmarks scaling``: both studies (m = 10 … 1000 rfes; ``quick``: m = 10,
+    20, 40 and 20 implicit steps), written to ``output_dir`` as ``dynamics_scaling.csv`` and
+    ``implicit_step_scaling.csv`` and printed as markdown. Returns name -> Table."""
+    elements = QUICK_ELEMENTS if quick else ELEMENTS
+    print(machine(), flush=True)
+    return report({
+        "dynamics_scaling": ("Forward dynamics, time per call (s, timed in C++) against nq",
+                             dynamics_scaling(elements)),
+        "implicit_step_scaling": ("Implicit step, time per step (s) against nq (h = T1/50)",
+                                  implicit_step_scaling(elements, steps=20 if quick else 50)),
+    }, output_dir)

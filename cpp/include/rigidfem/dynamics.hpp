@@ -1,0 +1,80 @@
+/// The equations of motion A(q) q̈ = f(q, q̇, t) of a System: the only place that chooses a
+/// formulation (recursive: RNEA, CRBA, ABA and their analytic derivatives; Lagrange: the book's
+/// equations, derivatives by central differences).
+///
+/// Stages (set_state and dynamics_kinematics first) write into Data; the functions taking a
+/// state (t, q, q̇) run the whole pipeline on the workspace d given.
+#pragma once
+
+#include <utility>
+
+#include "rigidfem/system.hpp"
+
+namespace rigidfem {
+
+/// The kinematics the system's formulation needs: T_p and the axes (recursive), or T_p, Ṫ_p, T̈_p
+/// and the twists U_u (Lagrange).
+void dynamics_kinematics(const System& sys, Data& d);
+/// Whether ∂r/∂(q, q̇) is analytic (recursive) rather than differenced (4 nq residuals, Lagrange).
+inline bool analytic_derivatives(const System& sys) { return sys.algorithm == Algorithm::Recursive; }
+
+// Stages, after set_state and a kinematics pass.
+/// => f (nq): loads, velocity terms and passive forces (f − A q̈ if d.qdda holds free accelerations).
+void generalized_forces(const System& sys, Data& d);
+/// => A (nq, nq).
+void mass_matrix(const System& sys, Data& d);
+/// => q̈ (nq) solving A q̈ = f by Cholesky; SimulationError if A is singular.
+void accelerations(const System& sys, Data& d);
+/// => τ (np): driving forces of the prescribed coordinates from the full accelerations (their
+/// rows of the equations). Needs q̈ in d.qdd (accelerations or forward_dynamics).
+void driving_forces(const System& sys, Data& d);
+/// r = A q̈ − f (nq) with the free accelerations of d.qdda: the inverse dynamics.
+VecX inverse_dynamics(const System& sys, Data& d);
+/// (∂r/∂q, ∂r/∂q̇), each (nq, nq), at the state and accelerations of d: analytic (recursive),
+/// central differences of r (Lagrange).
+std::pair<MatX, MatX> inverse_dynamics_derivatives(const System& sys, Data& d);
+
+// The pipeline at a state (t in s, q in m and rad, q̇ per s).
+/// q̈ (nq): ABA (recursive) or A q̈ = f (Lagrange).
+const VecX& forward_dynamics(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                             const Eigen::Ref<const VecX>& qd);
+/// A(q) (nq, nq), the prescribed coordinates at their values at t.
+const MatX& mass_matrix(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q);
+/// f (nq) with gravity, loads and applied generalised forces scaled by load_factor.
+const VecX& generalized_forces(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                               const Eigen::Ref<const VecX>& qd, double load_factor);
+/// The static residual f(q) (nq): at rest, the prescribed coordinates held at their values at t.
+const VecX& static_forces(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                          double load_factor);
+/// τ (np) at the forward-dynamics accelerations.
+const VecX& driving_forces(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                           const Eigen::Ref<const VecX>& qd);
+/// r = A q̈ − f (nq) at (t, q, q̇, q̈).
+VecX inverse_dynamics(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                      const Eigen::Ref<const VecX>& qd, const Eigen::Ref<const VecX>& qdd);
+/// (∂r/∂q, ∂r/∂q̇) at (t, q, q̇, q̈).
+std::pair<MatX, MatX> inverse_dynamics_derivatives(const System& sys, Data& d, double t,
+                                                   const Eigen::Ref<const VecX>& q, const Eigen::Ref<const VecX>& qd,
+                                                   const Eigen::Ref<const VecX>& qdd);
+/// ∂q̈/∂q and ∂q̈/∂q̇ (nq, nq) at (t, q, q̇): −A⁻¹ (∂r/∂q, ∂r/∂q̇) at the forward-dynamics q̈.
+std::pair<MatX, MatX> acceleration_derivatives(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                                               const Eigen::Ref<const VecX>& qd);
+/// dy/dt = [q̇, q̈] for y = [q, q̇] (2 nq).
+VecX rhs(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& y);
+/// ∂(dy/dt)/∂y (2nq, 2nq): from acceleration_derivatives (recursive), central differences of rhs
+/// (Lagrange).
+MatX rhs_jacobian(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& y);
+/// ∂f/∂q and ∂f/∂q̇ (nq, nq) at (t, q, q̇) with the loads scaled by load_factor, the prescribed
+/// coordinates moving (static_drives = false) or held at their values at t (true: at rest, q̇
+/// ignored). −∂f/∂q is the tangent stiffness, −∂f/∂q̇ the damping and gyroscopic matrix.
+std::pair<MatX, MatX> force_jacobians(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                                      const Eigen::Ref<const VecX>& qd, double load_factor, bool static_drives);
+
+// The operator of the implicit methods.
+/// Factorises M + diag(δ) (δ (nq) ≥ 0) at the state of the last inverse_dynamics: O(n) by the
+/// articulated-body algorithm with δ as armature (recursive), dense Cholesky (Lagrange).
+void factor_armature(const System& sys, Data& d, const VecX& armature);
+/// After factor_armature: x = (M + diag δ)⁻¹ b (x may be b).
+void solve_armature(const System& sys, Data& d, const VecX& b, VecX& x);
+
+}  // namespace rigidfem

@@ -1,0 +1,49 @@
+/// Kinematics: the state, the poses and coordinate axes of the bodies, the loads applied to
+/// them and the passive forces of the coordinates (the layer under both formulations).
+///
+/// T_p = T_parent B_p T̃_p(q_p): the joint's motion T̃_p comes from joint_motion (jcalc), the
+/// forward recursion from here. With ∂T_k/∂q_i = U_i T_k for every body k below coordinate i,
+/// U_i is the coordinate's global twist, with the axis s_i = (ω, v_O).
+#pragma once
+
+#include <string>
+
+#include "rigidfem/system.hpp"
+
+namespace rigidfem {
+
+/// (t, q, q̇) => qa, qda, qdda: the free coordinates from q, q̇ (q̈ = 0), the
+/// prescribed ones from their drives. Checks sizes and finiteness.
+void set_state(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q, const Eigen::Ref<const VecX>& qd);
+/// (t, q) => qa, with q̇ = q̈ = 0 for every coordinate, the prescribed ones held at
+/// their values at t (statics).
+void set_static_state(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q);
+/// Writes the free accelerations q̈ (nq) into d.qdda (after set_state).
+void set_accelerations(const System& sys, Data& d, const Eigen::Ref<const VecX>& qdd);
+
+/// (qa, qda, qdda) => T_p, and if `rates` Ṫ_p, T̈_p (nbodies), U_u and the axes s_u (nuses):
+/// the forward recursion T_p = T_parent B_p T̃_p(q_p) with the joint's factors differentiated in
+/// time (every joint, linear ones included: the Lagrange formulation's kinematics).
+void kinematics(const System& sys, Data& d, bool rates = true);
+/// (qa) => T_p and the axes s_u, read off the frame after each elementary factor, without 4x4
+/// twists or rates: all the recursive algorithms need. Exact joints only.
+void frames_and_axes(const System& sys, Data& d);
+
+/// A load at the current state, global: point of application x (m), force F (N), torque τ
+/// (N·m), with its time scale and load factor applied and follower loads turned with the body.
+struct AppliedLoad {
+  Vec3 x, F, tau;
+};
+/// Needs T_p of the load's body.
+AppliedLoad applied_load(const Data& d, const Load& L);
+/// Q_i of springs, dampers and applied generalised forces on coordinate i (all coordinates):
+/// −c_i (q_i − q_i⁰) − b_i q̇_i + λ (Q_i + Q_i(t, q_i, q̇_i)).
+double passive_force(const System& sys, const Data& d, int i);
+
+/// SimulationError if a ZYX joint sits at pitch ±π/2, where its mass matrix is singular.
+void check_gimbal_lock(const System& sys, const Data& d);
+/// "" or a sentence naming the ZYX joints whose pitch φ2 (free coordinates q) is within
+/// `tol` of ±π/2 in cos φ2, where Euler angles are singular (gimbal lock).
+std::string gimbal_lock_hint(const System& sys, const VecX& q, double tol);
+
+}  // namespace rigidfem

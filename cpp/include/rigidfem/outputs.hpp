@@ -1,0 +1,45 @@
+/// What a user reads off a state or a trajectory: energies, poses and points, and the batch
+/// outputs of a simulation result.
+#pragma once
+
+#include "rigidfem/system.hpp"
+
+namespace rigidfem {
+
+/// Energies after kinematics with rates (J): ½ Σ tr(Ṫ_p H_p Ṫ_pᵀ); −Σ m_p gᵀ r_Cp; ½ Σ c_i (q_i − q_i⁰)².
+double kinetic_energy(const System& sys, const Data& d);
+double gravity_energy(const System& sys, const Data& d);
+double elastic_energy(const System& sys, const Data& d);
+/// Power dissipated by the dampers, Σ b_i q̇_i² (W).
+double dissipated_power(const System& sys, const Data& d);
+
+/// The energies (J) and the dissipated power (W) at (t, q, q̇).
+struct Energies {
+  double kinetic, gravity, elastic, dissipated;
+  double potential() const { return gravity + elastic; }
+};
+Energies energies(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                  const Eigen::Ref<const VecX>& qd);
+
+/// Global pose T_p (4, 4) of a body at (t, q).
+const Mat4& body_pose(const System& sys, Data& d, int body, double t, const Eigen::Ref<const VecX>& q);
+/// Global position (3) in m of the point r (body frame) of a body at (t, q).
+Vec3 point_position(const System& sys, Data& d, const Point& point, double t, const Eigen::Ref<const VecX>& q);
+/// Global velocity (3) in m/s of the point r of a body at (t, q, q̇).
+Vec3 point_velocity(const System& sys, Data& d, const Point& point, double t, const Eigen::Ref<const VecX>& q,
+                    const Eigen::Ref<const VecX>& qd);
+
+/// Quantities at a batch of states (t_k, q_k, q̇_k), rows k: accelerations, driving
+/// forces and energies (J). Used for simulation results.
+struct StateOutputs {
+  MatX qdd, tau;                   // (N, nq), (N, np)
+  VecX kinetic, gravity, elastic;  // (N)
+};
+StateOutputs evaluate_outputs(const System& sys, const Eigen::Ref<const VecX>& t, const Eigen::Ref<const RowMatX>& Q,
+                              const Eigen::Ref<const RowMatX>& QD);
+/// Global positions (N, 3) of the point r (body frame) of `body` at (t_k, q_k), expressed in
+/// the frame of body `frame` (−1: global).
+MatX point_positions(const System& sys, int body, const Vec3& r, int frame, const Eigen::Ref<const VecX>& t,
+                     const Eigen::Ref<const RowMatX>& Q);
+
+}  // namespace rigidfem

@@ -1,0 +1,73 @@
+/// The one interface of every integration method, and the table that lists them.
+///
+/// integrate() runs one loop for every method, fixed or adaptive: it asks a Stepper to attempt a
+/// step, controls the step size from the error estimate, records outputs by the stepper's dense
+/// output and lands on t_end once. To add a method: write its Stepper (one file per family:
+/// runge_kutta.cpp, newmark.cpp), add its Method and a row in the table of integrate.cpp.
+#pragma once
+
+#include <memory>
+#include <string>
+
+#include "rigidfem/integrators.hpp"
+
+namespace rigidfem {
+
+/// Error weights per component of y = [q, q̇] (2 nq each): sc_i = atol_i + rtol_i max(|y0_i|, |y1_i|).
+struct Tolerances {
+  VecX atol, rtol;
+};
+/// Scaled RMS norm of an error e against the weights atol + rtol max(|y0|, |y1|), per component.
+double error_norm(const VecX& e, const VecX& y0, const VecX& y1, const VecX& atol, const VecX& rtol);
+/// Cubic Hermite interpolation of y on [t0, t0 + h] at θ = (t − t0)/h from y and ẏ at both ends.
+VecX hermite(double theta, double h, const VecX& y0, const VecX& f0, const VecX& y1, const VecX& f1);
+/// SimulationError naming the time, the step size and the cause.
+[[noreturn]] void step_failure(double t, double h, const std::string& cause);
+
+/// Step-size control of a method whose local error estimate is O(h^k):
+/// h_new = h · min(growth, max(0.2, 0.9 err^(−1/k))).
+struct StepControl {
+  int k;
+  double growth;           ///< largest growth after an accepted step
+  bool hold_after_reject;  ///< no growth on the step after a rejection
+  double keep_below;       ///< factors in [1, keep_below) keep h (and an iteration matrix with it)
+};
+
+class Stepper {
+ public:
+  virtual ~Stepper() = default;
+  /// Takes the initial state (t0, q0, q̇0) and evaluates what the method needs there.
+  virtual void start(double t0, const VecX& q0, const VecX& qd0) = 0;
+  /// A first step (s) for an adaptive run given no dt.
+  virtual double initial_step(double span, const Tolerances& tol, double max_step) = 0;
+  /// Attempts the step t → t + h from the current state; false if it could not be computed (Newton
+  /// did not converge). err: the scaled norm of its error estimate against `tol`, 0 without one or
+  /// when tol is null (a fixed-step run).
+  virtual bool attempt(double t, double h, const Tolerances* tol, double& err) = 0;
+  /// Makes the attempted step the current state.
+  virtual void accept() = 0;
+  /// The current state y = [q, q̇] (2 nq).
+  virtual const VecX& state() const = 0;
+  /// y at a time t within the last accepted step (dense output).
+  virtual VecX dense(double t) const = 0;
+  /// h ρ of the last attempted step (ρ the dominant eigenvalue) where the method estimates it, else 0.
+  virtual double h_rho() const { return 0.0; }
+  virtual StepControl control() const = 0;
+};
+
+/// The explicit Runge–Kutta family (runge_kutta.cpp) and the Newmark family (newmark.cpp).
+std::unique_ptr<Stepper> make_runge_kutta(const System& sys, const IntegratorOptions& o, IntegratorStats& stats);
+std::unique_ptr<Stepper> make_newmark(const System& sys, const IntegratorOptions& o, IntegratorStats& stats);
+
+/// A row of the method table.
+struct MethodInfo {
+  Method method;
+  const char* name;
+  int order;            ///< order of the propagated solution
+  bool error_estimate;  ///< an embedded error estimate: may run adaptive
+  bool adaptive;        ///< adaptive by default
+  std::unique_ptr<Stepper> (*make)(const System&, const IntegratorOptions&, IntegratorStats&);
+};
+const MethodInfo& method_info(Method method);
+
+}  // namespace rigidfem

@@ -1,0 +1,254 @@
+#include "rigidfem/dynamics.hpp"
+
+#include "rigidfem/derivatives.hpp"
+#include "rigidfem/errors.hpp"
+#include "rigidfem/lagrange.hpp"
+#include "rigidfem/recursive.hpp"
+
+namespace rigidfem {
+
+namespace {
+
+bool recursive(const System& sys) { return sys.algorithm == Algorithm::Recursive; }
+
+// Columns of ∂r/∂(q, q̇) by central differences of r at the state and accelerations of d,
+// which is left at that state (the Lagrange formulation, the reference).
+std::pair<MatX, MatX> differenced(const System& sys, Data& d) {
+  const double t = d.t;
+  const VecX qdd = d.qdda(sys.free_coords);
+  VecX q = d.qa(sys.free_coords), qd = d.qda(sys.free_coords);
+  auto r = [&] {
+    set_state(sys, d, t, q, qd);
+    set_accelerations(sys, d, qdd);
+    kinematics(sys, d);
+    return inverse_dynamics(sys, d);
+  };
+  MatX dq(sys.nq, sys.nq), dqd(sys.nq, sys.nq);
+  for (int j = 0; j < sys.nq; ++j) {
+    dq.col(j) = central_difference(r, q, j);
+    dqd.col(j) = central_difference(r, qd, j);
+  }
+  r();
+  return {dq, dqd};
+}
+
+// The state (t, q, q̇) with every kinematic quantity (rates and twists) computed.
+void full_state(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                const Eigen::Ref<const VecX>& qd) {
+  set_state(sys, d, t, q, qd);
+  kinematics(sys, d);
+}
+
+// ... and the free accelerations q̈.
+void full_state(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                const Eigen::Ref<const VecX>& qd, const Eigen::Ref<const VecX>& qdd) {
+  set_state(sys, d, t, q, qd);
+  check_vector(qdd, sys.nq, "qdd", "nq");
+  set_accelerations(sys, d, qdd);
+  kinematics(sys, d);
+}
+
+}  // namespace
+
+void dynamics_kinematics(const System& sys, Data& d) {
+  if (recursive(sys))
+    frames_and_axes(sys, d);
+  else
+    kinematics(sys, d);
+}
+
+void generalized_forces(const System& sys, Data& d) {
+  check_data(sys, d);
+  if (recursive(sys))
+    rnea_forces(sys, d);
+  else
+    lagrange_forces(sys, d);
+}
+
+void mass_matrix(const System& sys, Data& d) {
+  check_data(sys, d);
+  if (recursive(sys))
+    crba(sys, d);
+  else
+    lagrange_mass_matrix(sys, d);
+}
+
+void accelerations(const System& sys, Data& d) {
+  check_data(sys, d);
+  if (sys.nq == 0) return;
+  check_gimbal_lock(sys, d);
+  d.llt.compute(d.A);
+  if (d.llt.info() != Eigen::Success)
+    throw SimulationError(d.t, "mass matrix is not positive definite (singular configuration or massless chain)");
+  d.qdd = d.llt.solve(d.f);
+  if (!d.qdd.allFinite()) throw SimulationError(d.t, "accelerations are NaN or inf");
+}
+
+void driving_forces(const System& sys, Data& d) {
+  check_data(sys, d);
+  if (sys.np == 0) return;
+  set_accelerations(sys, d, d.qdd);
+  if (recursive(sys)) return rnea_driving_forces(sys, d);
+  kinematics(sys, d);  // T̈ now holds the full accelerations
+  lagrange_driving_forces(sys, d);
+}
+
+VecX inverse_dynamics(const System& sys, Data& d) {
+  generalized_forces(sys, d);  // with q̈ in d.qdda both formulations give f − A q̈
+  return -d.f;
+}
+
+std::pair<MatX, MatX> inverse_dynamics_derivatives(const System& sys, Data& d) {
+  return recursive(sys) ? rnea_derivatives(sys, d) : differenced(sys, d);
+}
+
+const VecX& forward_dynamics(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                             const Eigen::Ref<const VecX>& qd) {
+  set_state(sys, d, t, q, qd);
+  dynamics_kinematics(sys, d);
+  if (recursive(sys)) {
+    aba(sys, d);
+    return d.qdd;
+  }
+  lagrange_forces(sys, d);
+  lagrange_mass_matrix(sys, d);
+  accelerations(sys, d);
+  return d.qdd;
+}
+
+const MatX& mass_matrix(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q) {
+  full_state(sys, d, t, q, VecX::Zero(sys.nq));
+  mass_matrix(sys, d);
+  return d.A;
+}
+
+const VecX& generalized_forces(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                               const Eigen::Ref<const VecX>& qd, double load_factor) {
+  d.load_factor = load_factor;
+  full_state(sys, d, t, q, qd);
+  generalized_forces(sys, d);
+  return d.f;
+}
+
+const VecX& static_forces(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                          double load_factor) {
+  d.load_factor = load_factor;
+  set_static_state(sys, d, t, q);
+  kinematics(sys, d);
+  generalized_forces(sys, d);
+  return d.f;
+}
+
+const VecX& driving_forces(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                           const Eigen::Ref<const VecX>& qd) {
+  forward_dynamics(sys, d, t, q, qd);
+  driving_forces(sys, d);
+  return d.tau;
+}
+
+VecX inverse_dynamics(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                      const Eigen::Ref<const VecX>& qd, const Eigen::Ref<const VecX>& qdd) {
+  full_state(sys, d, t, q, qd, qdd);
+  return inverse_dynamics(sys, d);
+}
+
+std::pair<MatX, MatX> inverse_dynamics_derivatives(const System& sys, Data& d, double t,
+                                                   const Eigen::Ref<const VecX>& q, const Eigen::Ref<const VecX>& qd,
+                                                   const Eigen::Ref<const VecX>& qdd) {
+  full_state(sys, d, t, q, qd, qdd);
+  return inverse_dynamics_derivatives(sys, d);
+}
+
+std::pair<MatX, MatX> acceleration_derivatives(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                                               const Eigen::Ref<const VecX>& qd) {
+  const VecX qdd = forward_dynamics(sys, d, t, q, qd);
+  set_state(sys, d, t, q, qd);
+  set_accelerations(sys, d, qdd);
+  dynamics_kinematics(sys, d);
+  auto [dq, dqd] = inverse_dynamics_derivatives(sys, d);
+  mass_matrix(sys, d);
+  d.llt.compute(d.A);
+  if (d.llt.info() != Eigen::Success) throw SimulationError(t, "the mass matrix is not positive definite");
+  return {-d.llt.solve(dq), -d.llt.solve(dqd)};
+}
+
+VecX rhs(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& y) {
+  check_vector(y, 2 * sys.nq, "y", "2 nq");
+  VecX ydot(2 * sys.nq);
+  ydot.head(sys.nq) = y.tail(sys.nq);
+  ydot.tail(sys.nq) = forward_dynamics(sys, d, t, y.head(sys.nq), y.tail(sys.nq));
+  return ydot;
+}
+
+MatX rhs_jacobian(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& y) {
+  const int n = 2 * sys.nq;
+  MatX J(n, n);
+  if (analytic_derivatives(sys)) {
+    check_vector(y, n, "y", "2 nq");
+    auto [dq, dqd] = acceleration_derivatives(sys, d, t, y.head(sys.nq), y.tail(sys.nq));
+    J << MatX::Zero(sys.nq, sys.nq), MatX::Identity(sys.nq, sys.nq), dq, dqd;
+    return J;
+  }
+  VecX yp = y;
+  for (int j = 0; j < n; ++j) J.col(j) = central_difference([&] { return rhs(sys, d, t, yp); }, yp, j);
+  return J;
+}
+
+std::pair<MatX, MatX> force_jacobians(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                                      const Eigen::Ref<const VecX>& qd, double load_factor, bool static_drives) {
+  d.load_factor = load_factor;
+  if (analytic_derivatives(sys)) {
+    // f = −r(q, q̇, q̈ = 0): the analytic derivatives of the recursive inverse dynamics.
+    if (static_drives)
+      set_static_state(sys, d, t, q);
+    else
+      set_state(sys, d, t, q, qd);
+    dynamics_kinematics(sys, d);
+    auto [dq, dqd] = rnea_derivatives(sys, d);
+    return {-dq, -dqd};
+  }
+  // The springs and dampers, −c_i (q_i − q_i⁰) − b_i q̇_i, are differentiated exactly; only the
+  // rest (loads, inertia, force laws) by central differences, so stiff sdes (EA/Δ ~ 1e10)
+  // add no round-off to the soft terms.
+  VecX x = q, xd = static_drives ? VecX::Zero(sys.nq) : VecX(qd);
+  auto f = [&]() -> VecX {
+    if (static_drives)
+      set_static_state(sys, d, t, x);
+    else
+      set_state(sys, d, t, x, xd);
+    kinematics(sys, d);
+    lagrange_forces(sys, d);
+    VecX g = d.f;
+    for (int k = 0; k < sys.nq; ++k) {
+      const Coordinate& c = sys.coords[sys.free_coords[k]];
+      g(k) += c.stiffness * (x(k) - c.rest) + c.damping * xd(k);
+    }
+    return g;
+  };
+  MatX dq(sys.nq, sys.nq), dqd = MatX::Zero(sys.nq, sys.nq);
+  for (int j = 0; j < sys.nq; ++j) {
+    dq.col(j) = central_difference(f, x, j);
+    if (!static_drives) dqd.col(j) = central_difference(f, xd, j);
+  }
+  for (int k = 0; k < sys.nq; ++k) {
+    const Coordinate& c = sys.coords[sys.free_coords[k]];
+    dq(k, k) -= c.stiffness;
+    dqd(k, k) -= c.damping;
+  }
+  return {dq, dqd};
+}
+
+void factor_armature(const System& sys, Data& d, const VecX& armature) {
+  if (recursive(sys)) return aba_factor(sys, d, armature);  // needs the spatial kinematics of the residual
+  mass_matrix(sys, d);
+  d.A.diagonal() += armature;
+  d.llt.compute(d.A);
+  if (d.llt.info() != Eigen::Success) throw SimulationError(d.t, "the mass matrix is not positive definite");
+}
+
+void solve_armature(const System& sys, Data& d, const VecX& b, VecX& x) {
+  if (recursive(sys)) return aba_solve(sys, d, b, x);
+  x = d.llt.solve(b);
+}
+
+}  // namespace rigidfem

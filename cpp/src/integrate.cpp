@@ -1,0 +1,254 @@
+// The integration loop shared by every method, the method table and the checks of the options.
+#include <algorithm>
+#include <chrono>
+#include <cmath>
+#include <limits>
+#include <memory>
+#include <stdexcept>
+
+#include "rigidfem/errors.hpp"
+#include "rigidfem/kinematics.hpp"
+#include "rigidfem/stepper.hpp"
+
+namespace rigidfem {
+
+namespace {
+
+// The methods: name, order, error estimate, adaptive by default, stepper.
+const MethodInfo methods[] = {
+    {Method::Euler, "euler", 1, false, false, make_runge_kutta},
+    {Method::SymplecticEuler, "symplectic_euler", 1, false, false, make_runge_kutta},
+    {Method::RK4, "rk4", 4, false, false, make_runge_kutta},
+    {Method::Dopri5, "dopri5", 5, true, true, make_runge_kutta},
+    {Method::RKF45, "rkf45", 4, true, true, make_runge_kutta},
+    {Method::Newmark, "newmark", 2, true, false, make_newmark},
+    {Method::HHT, "hht", 2, true, false, make_newmark},
+    {Method::GeneralizedAlpha, "generalized_alpha", 2, true, false, make_newmark},
+    {Method::ImplicitSpring, "implicit_spring", 2, true, false, make_newmark},
+};
+
+const char* iteration_matrices[] = {"auto", "tangent", "spring"};
+
+using Clock = std::chrono::steady_clock;
+
+}  // namespace
+
+const MethodInfo& method_info(Method method) {
+  for (const MethodInfo& m : methods)
+    if (m.method == method) return m;
+  throw std::logic_error("method_info: a method without a row in the table");
+}
+
+Method parse_method(const std::string& name) {
+  std::string names;
+  for (const MethodInfo& m : methods) {
+    if (name == m.name) return m.method;
+    names += std::string(names.empty() ? "" : ", ") + m.name;
+  }
+  bad("method", "one of " + names, "'" + name + "'");
+}
+
+const char* method_name(Method method) { return method_info(method).name; }
+
+IterationMatrix parse_iteration_matrix(const std::string& name) {
+  for (int k = 0; k < 3; ++k)
+    if (name == iteration_matrices[k]) return static_cast<IterationMatrix>(k);
+  bad("iteration_matrix", "'auto', 'tangent' or 'spring'", "'" + name + "'");
+}
+
+const char* iteration_matrix_name(IterationMatrix matrix) { return iteration_matrices[static_cast<int>(matrix)]; }
+
+double error_norm(const VecX& e, const VecX& y0, const VecX& y1, const VecX& atol, const VecX& rtol) {
+  const VecX sc = atol.array() + rtol.array() * y0.cwiseAbs().cwiseMax(y1.cwiseAbs()).array();
+  return std::sqrt((e.array() / sc.array()).square().mean());
+}
+
+VecX hermite(double theta, double h, const VecX& y0, const VecX& f0, const VecX& y1, const VecX& f1) {
+  const double t2 = theta * theta, t3 = t2 * theta;
+  return (2 * t3 - 3 * t2 + 1) * y0 + (t3 - 2 * t2 + theta) * h * f0 + (-2 * t3 + 3 * t2) * y1 +
+         (t3 - t2) * h * f1;
+}
+
+void step_failure(double t, double h, const std::string& cause) {
+  throw SimulationError(t, cause + " (step size h = " + num(h) + " s)");
+}
+
+namespace {
+
+/// Output at requested times (or every step).
+class Recorder {
+ public:
+  Recorder(Trajectory& traj, const Eigen::Ref<const VecX>& t_eval, int nq) : traj_(traj), t_eval_(t_eval), nq_(nq) {}
+  void push(double t, const VecX& y) {
+    traj_.t.push_back(t);
+    traj_.q.push_back(y.head(nq_));
+    traj_.qd.push_back(y.tail(nq_));
+  }
+  void start(double t0, const VecX& y0) {
+    if (t_eval_.size() == 0) {
+      push(t0, y0);
+      return;
+    }
+    while (next_ < t_eval_.size() && t_eval_(next_) <= t0) push(t_eval_(next_++), y0);
+  }
+  /// After an accepted step ending at t1: the requested times in (t0, t1] by dense output.
+  void step(double t1, const VecX& y1, const Stepper& stepper) {
+    if (t_eval_.size() == 0) {
+      push(t1, y1);
+      return;
+    }
+    while (next_ < t_eval_.size() && t_eval_(next_) <= t1) {
+      const double t = t_eval_(next_++);
+      push(t, t == t1 ? y1 : stepper.dense(t));
+    }
+  }
+
+ private:
+  Trajectory& traj_;
+  const Eigen::Ref<const VecX>& t_eval_;
+  int nq_;
+  Eigen::Index next_ = 0;
+};
+
+bool is_adaptive(const IntegratorOptions& o) {
+  return o.adaptive >= 0 ? o.adaptive == 1 : method_info(o.method).adaptive;
+}
+
+void check_options(const System& sys, double t0, double t_end, const VecX& q0, const VecX& qd0,
+                   const Eigen::Ref<const VecX>& t_eval, const IntegratorOptions& o) {
+  const MethodInfo& m = method_info(o.method);
+  if (!std::isfinite(t0) || !std::isfinite(t_end) || !(t_end > t0))
+    throw std::invalid_argument("t_end: expected a finite end time after t0 = " + num(t0) + " s, got " + num(t_end));
+  check_vector(q0, sys.nq, "q0", "nq");
+  check_vector(qd0, sys.nq, "qd0", "nq");
+  if (!m.error_estimate && o.adaptive == 1)
+    throw std::invalid_argument(std::string("adaptive: the method '") + m.name +
+                                "' has no error estimate; use dopri5, rkf45 or the Newmark family");
+  if (!is_adaptive(o) && !(o.dt > 0.0 && std::isfinite(o.dt)))
+    throw std::invalid_argument(std::string("dt: expected a positive step in s for the fixed-step method '") + m.name +
+                                "', got " + num(o.dt));
+  for (const auto& [tol, name] : {std::pair<const VecX*, const char*>{&o.rtol, "rtol"}, {&o.atol, "atol"}})
+    if (tol->size() == 0 || (tol->size() != 1 && tol->size() != 2 * sys.nq) || !(tol->minCoeff() >= 0.0) ||
+        !tol->allFinite())
+      throw std::invalid_argument(std::string(name) + ": expected non-negative tolerances, one or 2 nq = " +
+                                  std::to_string(2 * sys.nq) + " of them");
+  if (o.rtol.maxCoeff() == 0.0 && o.atol.minCoeff() == 0.0)
+    throw std::invalid_argument("atol: expected positive values when rtol is zero");
+  if (!(o.max_step > 0.0)) throw std::invalid_argument("max_step: expected a positive step in s");
+  if (o.max_steps < 1) throw std::invalid_argument("max_steps: expected a positive number of steps");
+  if (o.method == Method::Newmark && !(o.gamma >= 0.5 && o.beta >= 0.25 * (0.5 + o.gamma) * (0.5 + o.gamma) - 1e-15))
+    throw std::invalid_argument("beta, gamma: expected the unconditionally stable range gamma >= 1/2, "
+                                "beta >= (gamma + 1/2)^2 / 4, got beta = " + num(o.beta) + ", gamma = " + num(o.gamma));
+  if (o.method == Method::HHT && !(o.alpha >= -1.0 / 3.0 && o.alpha <= 0.0))
+    throw std::invalid_argument("alpha: expected a value in [-1/3, 0], got " + num(o.alpha));
+  if ((o.method == Method::GeneralizedAlpha || o.method == Method::ImplicitSpring) &&
+      !(o.rho_inf >= 0.0 && o.rho_inf <= 1.0))
+    throw std::invalid_argument("rho_inf: expected a value in [0, 1], got " + num(o.rho_inf));
+  for (Eigen::Index k = 0; k < t_eval.size(); ++k)
+    if (!(t_eval(k) >= t0 && t_eval(k) <= t_end) || (k > 0 && !(t_eval(k) > t_eval(k - 1))))
+      throw std::invalid_argument("t_eval: expected increasing times within [t0, t_end]");
+}
+
+/// The one loop: attempt a step, control its size by the error estimate (adaptive runs), record
+/// the outputs it covers, ask the monitor; the last step lands on t_end exactly.
+Trajectory run(const System& sys, double t0, double t_end, const VecX& q0, const VecX& qd0,
+               const Eigen::Ref<const VecX>& t_eval, const IntegratorOptions& o, const Monitor& monitor,
+               VecX& last_q) {
+  const auto start_clock = Clock::now();
+  auto last_check = start_clock;
+  Trajectory traj;
+  IntegratorStats& stats = traj.stats;
+  Recorder out(traj, t_eval, sys.nq);
+  const int n = sys.nq;
+  const Tolerances tol{o.atol.size() == 1 ? VecX::Constant(2 * n, o.atol(0)) : o.atol,
+                       o.rtol.size() == 1 ? VecX::Constant(2 * n, o.rtol(0)) : o.rtol};
+  const bool adaptive = is_adaptive(o);
+  const double span = t_end - t0;
+
+  const std::unique_ptr<Stepper> stepper = method_info(o.method).make(sys, o, stats);
+  const StepControl control = stepper->control();
+  stepper->start(t0, q0, qd0);
+  out.start(t0, stepper->state());
+  double h = o.dt > 0.0 ? std::min(o.dt, span) : stepper->initial_step(span, tol, o.max_step);
+
+  double t = t0;
+  bool rejected_last = false;
+  int stiff_steps = 0, nonstiff_steps = 0;  // Hairer's stiffness test (h ρ, dopri5)
+  while (t < t_end) {
+    double hs = std::min({h, o.max_step, t_end - t});
+    if (t + hs > t_end - 1e-12 * span) hs = t_end - t;  // land on t_end exactly
+    if (stats.steps + stats.rejected >= o.max_steps)
+      step_failure(t, hs, "max_steps = " + std::to_string(o.max_steps) + " reached");
+    if (hs < 16.0 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t)))
+      step_failure(t, hs, "the step size fell below the minimum: the problem is too stiff or singular for this method");
+    double err = 0.0;
+    if (!stepper->attempt(t, hs, adaptive ? &tol : nullptr, err)) {
+      if (!adaptive) step_failure(t, hs, "Newton iterations did not converge; reduce dt");
+      ++stats.rejected;
+      h = 0.25 * hs;
+      continue;
+    }
+    if (adaptive) {
+      // h_new = h · min(growth, max(0.2, 0.9 err^(−1/k))); no growth right after a rejection
+      // where the method asks so, and h kept for small gains where it reuses a matrix.
+      const double growth = control.hold_after_reject && rejected_last ? 1.0 : control.growth;
+      double factor = std::min(growth, std::max(0.2, 0.9 * std::pow(std::max(err, 1e-10), -1.0 / control.k)));
+      if (factor >= 1.0 && factor < control.keep_below) factor = 1.0;
+      if (!(err <= 1.0)) {
+        if (!std::isfinite(err) && hs < 1e-300) step_failure(t, hs, "the error estimate is NaN or inf");
+        ++stats.rejected;
+        rejected_last = true;
+        h = hs * (std::isfinite(err) ? factor : 0.2);
+        continue;
+      }
+      rejected_last = false;
+      h = hs * factor;
+      if (stepper->h_rho() > 3.25) {
+        nonstiff_steps = 0;
+        if (++stiff_steps == 15 && std::isnan(stats.stiff_at)) stats.stiff_at = t + hs;
+      } else if (++nonstiff_steps == 6) {
+        stiff_steps = 0;
+      }
+    }
+    stepper->accept();
+    t = (t + hs >= t_end - 1e-12 * span) ? t_end : t + hs;
+    ++stats.steps;
+    const VecX& y = stepper->state();
+    out.step(t, y, *stepper);
+    last_q = y.head(n);
+    // Ask the monitor about every 0.05 s; false means stop (e.g. Ctrl-C).
+    if (monitor && Clock::now() - last_check >= std::chrono::milliseconds(50)) {
+      last_check = Clock::now();
+      if (!monitor(t)) {
+        traj.interrupted = true;
+        break;
+      }
+    }
+  }
+  stats.wall_time = std::chrono::duration<double>(Clock::now() - start_clock).count();
+  return traj;
+}
+
+}  // namespace
+
+Trajectory integrate(const System& sys, double t0, double t_end, const VecX& q0, const VecX& qd0,
+                     const Eigen::Ref<const VecX>& t_eval, const IntegratorOptions& o, const Monitor& monitor) {
+  check_options(sys, t0, t_end, q0, qd0, t_eval, o);
+  VecX last_q = q0;
+  try {
+    return run(sys, t0, t_end, q0, qd0, t_eval, o, monitor, last_q);
+  } catch (const SimulationError& e) {
+    // What the last accepted state says about the failure: Euler angles near gimbal lock,
+    // or a fixed step beyond the method's stability limit (the state grew by orders of magnitude).
+    const double growth = last_q.cwiseAbs().maxCoeff() / std::max(q0.cwiseAbs().maxCoeff(), 1e-300);
+    if (!is_adaptive(o) && (growth > 1e3 || !last_q.allFinite()))
+      throw SimulationError(e.time, "the fixed step dt = " + num(o.dt) + " s is probably beyond the stability limit of " +
+                                        std::string(method_name(o.method)) + " for this problem: the state grew " +
+                                        num(growth) + " times, then " + e.cause);
+    const std::string hint = gimbal_lock_hint(sys, last_q, 1e-3);
+    if (hint.empty()) throw;
+    throw SimulationError(e.time, e.cause + hint);
+  }
+}
+
+}  // namespace rigidfem

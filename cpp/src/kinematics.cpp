@@ -1,0 +1,121 @@
+#include "rigidfem/kinematics.hpp"
+
+#include <cmath>
+
+#include "rigidfem/errors.hpp"
+
+namespace rigidfem {
+
+void set_state(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+               const Eigen::Ref<const VecX>& qd) {
+  check_data(sys, d);
+  if (!std::isfinite(t)) throw std::invalid_argument("t: expected a finite time in s, got NaN or inf");
+  check_vector(q, sys.nq, "q", "nq");
+  check_vector(qd, sys.nq, "qd", "nq");
+  d.t = t;
+  for (int k = 0; k < sys.nq; ++k) {
+    const int i = sys.free_coords[k];
+    d.qa(i) = q(k);
+    d.qda(i) = qd(k);
+    d.qdda(i) = 0.0;
+  }
+  for (int k = 0; k < sys.np; ++k) {
+    const int i = sys.drive_coords[k];
+    const MotionState m = sys.coords[i].drive->at(t);
+    if (!std::isfinite(m.q) || !std::isfinite(m.qd) || !std::isfinite(m.qdd))
+      throw SimulationError(t, "drive of " + sys.coords[i].name + " returned NaN or inf");
+    d.qa(i) = m.q;
+    d.qda(i) = m.qd;
+    d.qdda(i) = m.qdd;
+  }
+}
+
+void set_static_state(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q) {
+  set_state(sys, d, t, q, VecX::Zero(sys.nq));
+  for (int i : sys.drive_coords) d.qda(i) = d.qdda(i) = 0.0;
+}
+
+void set_accelerations(const System& sys, Data& d, const Eigen::Ref<const VecX>& qdd) {
+  for (int k = 0; k < sys.nq; ++k) d.qdda(sys.free_coords[k]) = qdd(k);
+}
+
+void kinematics(const System& sys, Data& d, bool rates) {
+  check_data(sys, d);
+  static const Mat4 I4 = Mat4::Identity(), O4 = Mat4::Zero();
+  Mat4 Tj, Tjd, Tjdd;
+  for (int p = 0; p < sys.nbodies; ++p) {
+    // Joint frame F = T_parent B_p; T_p = F T̃.
+    const Mat4 F = parent_value(sys, d.T, p, I4) * sys.B[p];
+    const JointUses j = joint_uses(sys, p);
+    joint_motion(j, d.qa, d.qda, d.qdda, rates, Tj, Tjd, Tjdd, d.X.data());
+    d.T[p].noalias() = F * Tj;
+    if (rates) {
+      // Ṫ_p = Ḟ T̃ + F Ṫ̃, T̈_p = F̈ T̃ + 2 Ḟ Ṫ̃ + F T̃̈ with Ḟ = Ṫ_parent B_p, F̈ = T̈_parent B_p.
+      const Mat4 Fd = parent_value(sys, d.Td, p, O4) * sys.B[p];
+      const Mat4 Fdd = parent_value(sys, d.Tdd, p, O4) * sys.B[p];
+      d.Td[p].noalias() = Fd * Tj + F * Tjd;
+      d.Tdd[p].noalias() = Fdd * Tj + 2.0 * Fd * Tjd + F * Tjdd;
+    }
+    // ∂T_k/∂q = F X_u F⁻¹ T_k = U_u T_k for every body k at or below p. F is affine but
+    // not always rigid (below a linear joint), hence the affine inverse.
+    if (j.n == 0) continue;
+    const Mat4 Fi = affine_inverse(F);
+    const int u0 = sys.use_start[p];
+    for (int k = 0; k < j.n; ++k) {
+      const Mat4& U = d.U[u0 + k] = F * d.X[k] * Fi;
+      d.axes[u0 + k] << U(2, 1), U(0, 2), U(1, 0), U.block<3, 1>(0, 3);  // s = (ω, v_O) of U
+    }
+  }
+}
+
+void frames_and_axes(const System& sys, Data& d) {
+  static const Mat4 I4 = Mat4::Identity();
+  for (int p = 0; p < sys.nbodies; ++p) {
+    Mat4 G = parent_value(sys, d.T, p, I4) * sys.B[p];
+    joint_frames(joint_uses(sys, p), d.qa, G, &d.axes[sys.use_start[p]]);
+    d.T[p] = G;
+  }
+}
+
+AppliedLoad applied_load(const Data& d, const Load& L) {
+  const double s = d.load_factor * (L.scale ? L.scale->at(d.t).q : 1.0);
+  const Mat3 R = d.T[L.body].topLeftCorner<3, 3>();
+  return {(d.T[L.body] * L.point.homogeneous()).head<3>(), s * (L.follower ? Vec3(R * L.force) : L.force),
+          s * (L.follower ? Vec3(R * L.torque) : L.torque)};
+}
+
+double passive_force(const System& sys, const Data& d, int i) {
+  const Coordinate& c = sys.coords[i];
+  double applied = c.force;
+  if (c.force_law) applied += c.force_law(d.t, d.qa(i), d.qda(i));
+  return -c.stiffness * (d.qa(i) - c.rest) - c.damping * d.qda(i) + d.load_factor * applied;
+}
+
+namespace {
+
+// "body" of the coordinate name "body.ry".
+std::string joint_name(const Coordinate& c) { return c.name.substr(0, c.name.size() - 3); }
+
+}  // namespace
+
+std::string gimbal_lock_hint(const System& sys, const VecX& q, double tol) {
+  std::string hint;
+  for (int i : sys.zyx_pitch) {
+    const int k = sys.coords[i].free_index;
+    if (k < 0 || k >= q.size() || std::abs(std::cos(q(k))) >= tol) continue;
+    hint += "; the ZYX angles of " + joint_name(sys.coords[i]) + " are at pitch phi2 = " + std::to_string(q(k)) +
+            " rad, near +-pi/2 where they are singular (gimbal lock): turn the joint frame (placement) so "
+            "the motion keeps away from it";
+  }
+  return hint;
+}
+
+void check_gimbal_lock(const System& sys, const Data& d) {
+  for (int i : sys.zyx_pitch)
+    if (std::abs(std::cos(d.qa(i))) < 1e-9)
+      throw SimulationError(d.t, "gimbal lock: the ZYX angles of " + joint_name(sys.coords[i]) +
+                                     " reached pitch phi2 = +-pi/2, where the mass matrix is singular; turn the joint "
+                                     "frame (placement) so the motion keeps away from it");
+}
+
+}  // namespace rigidfem

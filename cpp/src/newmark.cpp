@@ -1,0 +1,219 @@
+// The Newmark family in the generalised-α form of Arnold & Brüls (2007): the equations
+// of motion hold at t_{n+1}, M(q_{n+1}) q̈_{n+1} = f(q_{n+1}, q̇_{n+1}, t_{n+1}), and a
+// pseudo-acceleration a carries the method:
+//   (1 − α_m) a_{n+1} + α_m a_n = (1 − α_f) q̈_{n+1} + α_f q̈_n,
+//   q_{n+1} = q_n + h q̇_n + h² [(½ − β) a_n + β a_{n+1}],
+//   q̇_{n+1} = q̇_n + h [(1 − γ) a_n + γ a_{n+1}].
+// Newmark: α_m = α_f = 0; HHT-α: α_m = 0, α_f = −α; generalised-α from ρ∞ (Chung & Hulbert).
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "rigidfem/dynamics.hpp"
+#include "rigidfem/errors.hpp"
+#include "rigidfem/kinematics.hpp"
+#include "rigidfem/stepper.hpp"
+
+namespace rigidfem {
+
+namespace {
+
+struct NewmarkState {
+  VecX q, v, qdd, a;
+};
+
+class NewmarkFamily final : public Stepper {
+ public:
+  NewmarkFamily(const System& sys, const IntegratorOptions& o, IntegratorStats& stats)
+      : sys_(sys),
+        d_(sys),
+        stats_(stats),
+        tol_(o.newton_tol),
+        max_it_(o.newton_max_iterations),
+        spring_(o.iteration_matrix == IterationMatrix::Spring ||
+                (o.iteration_matrix == IterationMatrix::Auto && o.method == Method::ImplicitSpring)),
+        armature_(sys.nq) {
+    if (o.method == Method::Newmark) {
+      am_ = af_ = 0.0;
+      beta_ = o.beta;
+      gamma_ = o.gamma;
+    } else if (o.method == Method::HHT) {
+      am_ = 0.0;
+      af_ = -o.alpha;
+      gamma_ = 0.5 - o.alpha;
+      beta_ = 0.25 * (1.0 - o.alpha) * (1.0 - o.alpha);
+    } else {  // generalized_alpha, implicit_spring
+      const double r = o.rho_inf;
+      am_ = (2.0 * r - 1.0) / (r + 1.0);
+      af_ = r / (r + 1.0);
+      gamma_ = 0.5 - am_ + af_;
+      beta_ = 0.25 * (gamma_ + 0.5) * (gamma_ + 0.5);
+    }
+  }
+
+  /// M q̈ = f at (t, q, q̇): the initial state's acceleration, a_0 = q̈_0.
+  void start(double t0, const VecX& q0, const VecX& qd0) override {
+    ++stats_.rhs_evaluations;
+    const VecX qdd = forward_dynamics(sys_, d_, t0, q0, qd0);
+    s_ = {q0, qd0, qdd, qdd};
+    y_.resize(2 * sys_.nq);
+    y_ << q0, qd0;
+  }
+
+  double initial_step(double span, const Tolerances&, double max_step) override {
+    return std::min(1e-3 * span, max_step);
+  }
+
+  bool attempt(double t, double h, const Tolerances* tol, double& err) override {
+    t_ = t, h_step_ = h;
+    err = 0.0;
+    if (!newton(t, h)) return false;
+    if (!s1_.q.allFinite() || !s1_.v.allFinite()) step_failure(t, h, "the state became NaN or inf");
+    if (!tol) return true;
+    // Local error estimate of q over the step, h² (β − 1/6)(a_{n+1} − a_n).
+    const int n = sys_.nq;
+    err = error_norm((h * h * (beta_ - 1.0 / 6.0)) * (s1_.a - s_.a), s_.q, s1_.q, tol->atol.head(n), tol->rtol.head(n));
+    return true;
+  }
+
+  void accept() override {
+    const int n = sys_.nq;
+    ya_.resize(2 * n), fa_.resize(2 * n), fb_.resize(2 * n);
+    ya_ << s_.q, s_.v;
+    fa_ << s_.v, s_.qdd;
+    y_ << s1_.q, s1_.v;
+    fb_ << s1_.v, s1_.qdd;
+    s_ = s1_;
+  }
+
+  const VecX& state() const override { return y_; }
+  VecX dense(double t) const override { return hermite((t - t_) / h_step_, h_step_, ya_, fa_, y_, fb_); }
+  StepControl control() const override { return {3, 5.0, false, 1.25}; }
+
+ private:
+  /// Newton iterations for q̈_{n+1} into s1_; false when they do not converge.
+  bool newton(double t, double h) {
+    const NewmarkState& s = s_;
+    NewmarkState& s1 = s1_;
+    const double bp = beta_ * (1.0 - af_) / (1.0 - am_), gp = gamma_ * (1.0 - af_) / (1.0 - am_);
+    // Attempts: the kept iteration matrix; a fresh one (if it was old); Newton proper, the
+    // tangent rebuilt at every iterate (spring: its matrix is always fresh, one attempt).
+    for (int attempt = 0; attempt < 3; ++attempt) {
+      if (attempt > 0 && spring_) return false;
+      if (attempt == 1 && fresh_) continue;
+      valid_ = valid_ && attempt == 0;
+      full_newton_ = attempt == 2;
+      // Predictor: no displacement beyond q̇_n h (a_{n+1} = −(½ − β)/β a_n), so a stiff
+      // mode's large acceleration does not throw the first iterate far off.
+      const VecX a1 = (-(0.5 - beta_) / beta_) * s.a;
+      s1.qdd = ((1.0 - am_) * a1 - af_ * s.qdd + am_ * s.a) / (1.0 - af_);
+      double previous = std::numeric_limits<double>::infinity();
+      for (int it = 0; it < max_it_; ++it) {
+        update(h, s, s1);
+        const VecX r = residual(t + h, s1);
+        const VecX dx =
+            spring_ ? spring_correction(h, r, bp, gp) : tangent_correction(t + h, h, r, bp, gp, it == 0);
+        ++stats_.newton_iterations;
+        if (!dx.allFinite()) break;
+        s1.qdd += dx;
+        // Converged when the position and velocity errors left are negligible: the increments
+        // times η = θ/(1 − θ) once a contraction rate θ < 1 is seen (the sum of the remaining
+        // increments of a contraction; Hairer & Wanner IV.8), the increments themselves before.
+        const double size = dx.cwiseAbs().maxCoeff();
+        const double eta = it >= 1 && size < previous ? (size / previous) / (1.0 - size / previous) : 1.0;
+        const double dq = eta * bp * h * h * size, dv = eta * gp * h * size;
+        if (dq <= tol_ * (1.0 + s1.q.cwiseAbs().maxCoeff()) && dv <= tol_ * (1.0 + s1.v.cwiseAbs().maxCoeff())) {
+          update(h, s, s1);
+          if (it > 4) valid_ = false;  // slow convergence: refresh the iteration matrix next step
+          fresh_ = false;
+          return true;
+        }
+        if (it >= 2 && size > 2.0 * previous) break;  // diverging
+        // A tangent from another state (an earlier step or the predictor) converging slowly:
+        // rebuild it at the next iterate (Newton proper).
+        if (!spring_ && ((it >= 1 && size > 0.5 * previous) || full_newton_)) valid_ = false;
+        previous = size;
+      }
+    }
+    return false;
+  }
+
+  void update(double h, const NewmarkState& s, NewmarkState& s1) const {
+    s1.a = ((1.0 - af_) * s1.qdd + af_ * s.qdd - am_ * s.a) / (1.0 - am_);
+    s1.q = s.q + h * s.v + (h * h) * ((0.5 - beta_) * s.a + beta_ * s1.a);
+    s1.v = s.v + h * ((1.0 - gamma_) * s.a + gamma_ * s1.a);
+  }
+
+  /// r = M(q) q̈ − f(q, q̇, t) at the iterate (inverse dynamics: O(n) for recursive systems).
+  VecX residual(double t, const NewmarkState& s1) {
+    set_state(sys_, d_, t, s1.q, s1.v);
+    set_accelerations(sys_, d_, s1.qdd);
+    dynamics_kinematics(sys_, d_);
+    ++stats_.rhs_evaluations;
+    return inverse_dynamics(sys_, d_);
+  }
+
+  /// Newton: −S⁻¹ r with the tangent S = M + γ' h ∂r/∂q̇ + β' h² ∂r/∂q, kept while h stays
+  /// within 30 % of its own (it only steers the iterations).
+  VecX tangent_correction(double t, double h, const VecX& r, double bp, double gp, bool predictor) {
+    if (!valid_ || std::abs(h / h_ - 1.0) > 0.3) {
+      // At the iterate of residual(); at the predictor with q̈ = 0: there the inertia term
+      // ∂(M q̈)/∂q of a stiff mode's far-off q̈ steers worse than leaving it to the iterations
+      // (measured on a stiff 3D beam at h = 2e-3 s), while near the solution it makes Newton's
+      // convergence quadratic.
+      if (predictor) set_accelerations(sys_, d_, VecX::Zero(sys_.nq));
+      auto [drdq, drdqd] = inverse_dynamics_derivatives(sys_, d_);
+      mass_matrix(sys_, d_);
+      ++stats_.jacobians;
+      ++stats_.factorizations;
+      if (!analytic_derivatives(sys_)) stats_.rhs_evaluations += 4 * sys_.nq;  // the central differences
+      lu_.compute(d_.A + (gp * h) * drdqd + (bp * h * h) * drdq);
+      // The reciprocal condition number, not the determinant, which under- or overflows for large n.
+      if (!(lu_.rcond() > 1e-15))
+        throw SimulationError(t, "the Newton iteration matrix M + γh C + βh² K is singular (step size h = " + num(h) +
+                                     " s)");
+      valid_ = true;
+      fresh_ = true;
+      h_ = h;
+    }
+    return -lu_.solve(r);
+  }
+
+  /// The O(n) step: −(M + diag(γ' h b + β' h² c))⁻¹ r, the springs c and dampers b of the
+  /// coordinates entering like joint armature in the articulated-body recursion (the rest
+  /// of the tangent, geometric and gyroscopic, is left to the iterations).
+  VecX spring_correction(double h, const VecX& r, double bp, double gp) {
+    for (int k = 0; k < sys_.nq; ++k) {
+      const Coordinate& c = sys_.coords[sys_.free_coords[k]];
+      armature_(k) = gp * h * c.damping + bp * h * h * c.stiffness;
+    }
+    ++stats_.factorizations;
+    factor_armature(sys_, d_, armature_);  // residual() left the state of the iterate in d_
+    VecX dx = -r;
+    solve_armature(sys_, d_, dx, dx);
+    return dx;
+  }
+
+  const System& sys_;
+  Data d_;
+  IntegratorStats& stats_;
+  double tol_;
+  int max_it_;
+  bool spring_;
+  VecX armature_;
+  double am_ = 0, af_ = 0, beta_ = 0.25, gamma_ = 0.5;
+  Eigen::PartialPivLU<MatX> lu_;
+  bool valid_ = false, fresh_ = false, full_newton_ = false;
+  double h_ = 0.0;                   // step of the kept tangent
+  NewmarkState s_, s1_;              // the current state and the attempted step
+  double t_ = 0.0, h_step_ = 1.0;    // the last attempted step
+  VecX y_, ya_, fa_, fb_;            // [q, q̇] after and before it, and [q̇, q̈] before and after
+};
+
+}  // namespace
+
+std::unique_ptr<Stepper> make_newmark(const System& sys, const IntegratorOptions& o, IntegratorStats& stats) {
+  return std::make_unique<NewmarkFamily>(sys, o, stats);
+}
+
+}  // namespace rigidfem

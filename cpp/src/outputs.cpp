@@ -1,0 +1,104 @@
+#include "rigidfem/outputs.hpp"
+
+#include <cmath>
+#include <stdexcept>
+
+#include "rigidfem/dynamics.hpp"
+#include "rigidfem/kinematics.hpp"
+
+namespace rigidfem {
+
+double kinetic_energy(const System& sys, const Data& d) {
+  check_data(sys, d);
+  double E = 0.0;
+  for (int p = 0; p < sys.nbodies; ++p) E += 0.5 * (d.Td[p] * sys.H[p] * d.Td[p].transpose()).trace();
+  return E;
+}
+
+double gravity_energy(const System& sys, const Data& d) {
+  check_data(sys, d);
+  double V = 0.0;
+  for (int p = 0; p < sys.nbodies; ++p) V -= sys.gravity.dot((d.T[p] * sys.H[p].col(3)).head<3>());
+  return V;
+}
+
+double elastic_energy(const System& sys, const Data& d) {
+  check_data(sys, d);
+  double V = 0.0;
+  for (int i = 0; i < sys.nc; ++i) V += 0.5 * sys.coords[i].stiffness * std::pow(d.qa(i) - sys.coords[i].rest, 2);
+  return V;
+}
+
+double dissipated_power(const System& sys, const Data& d) {
+  check_data(sys, d);
+  double P = 0.0;
+  for (int i = 0; i < sys.nc; ++i) P += sys.coords[i].damping * d.qda(i) * d.qda(i);
+  return P;
+}
+
+Energies energies(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                  const Eigen::Ref<const VecX>& qd) {
+  set_state(sys, d, t, q, qd);
+  kinematics(sys, d);
+  return {kinetic_energy(sys, d), gravity_energy(sys, d), elastic_energy(sys, d), dissipated_power(sys, d)};
+}
+
+const Mat4& body_pose(const System& sys, Data& d, int body, double t, const Eigen::Ref<const VecX>& q) {
+  check_body(sys, body, "body");
+  set_state(sys, d, t, q, VecX::Zero(sys.nq));
+  kinematics(sys, d);
+  return d.T[body];
+}
+
+Vec3 point_position(const System& sys, Data& d, const Point& point, double t, const Eigen::Ref<const VecX>& q) {
+  return (body_pose(sys, d, point.body, t, q) * point.r.homogeneous()).head<3>();
+}
+
+Vec3 point_velocity(const System& sys, Data& d, const Point& point, double t, const Eigen::Ref<const VecX>& q,
+                    const Eigen::Ref<const VecX>& qd) {
+  check_body(sys, point.body, "body");
+  set_state(sys, d, t, q, qd);
+  kinematics(sys, d);
+  return (d.Td[point.body] * point.r.homogeneous()).head<3>();
+}
+
+StateOutputs evaluate_outputs(const System& sys, const Eigen::Ref<const VecX>& t, const Eigen::Ref<const RowMatX>& Q,
+                              const Eigen::Ref<const RowMatX>& QD) {
+  const Eigen::Index N = t.size();
+  if (Q.rows() != N || QD.rows() != N || Q.cols() != sys.nq || QD.cols() != sys.nq)
+    throw std::invalid_argument("q, qd: expected (len(t), nq) arrays");
+  StateOutputs out{MatX(N, sys.nq), MatX(N, sys.np), VecX(N), VecX(N), VecX(N)};
+  Data d(sys);
+  for (Eigen::Index k = 0; k < N; ++k) {
+    set_state(sys, d, t(k), Q.row(k).transpose(), QD.row(k).transpose());
+    kinematics(sys, d);  // with rates: the kinetic energy needs Ṫ
+    out.kinetic(k) = kinetic_energy(sys, d);
+    out.gravity(k) = gravity_energy(sys, d);
+    out.elastic(k) = elastic_energy(sys, d);
+    forward_dynamics(sys, d, t(k), Q.row(k).transpose(), QD.row(k).transpose());
+    out.qdd.row(k) = d.qdd.transpose();
+    driving_forces(sys, d);
+    out.tau.row(k) = d.tau.transpose();
+  }
+  return out;
+}
+
+MatX point_positions(const System& sys, int body, const Vec3& r, int frame, const Eigen::Ref<const VecX>& t,
+                     const Eigen::Ref<const RowMatX>& Q) {
+  if (body < 0 || body >= sys.nbodies || frame < -1 || frame >= sys.nbodies)
+    throw std::invalid_argument("point, frame: expected bodies of this system");
+  if (Q.rows() != t.size() || Q.cols() != sys.nq) throw std::invalid_argument("q: expected a (len(t), nq) array");
+  MatX P(t.size(), 3);
+  Data d(sys);
+  const VecX zero = VecX::Zero(sys.nq);
+  for (Eigen::Index k = 0; k < t.size(); ++k) {
+    set_state(sys, d, t(k), Q.row(k).transpose(), zero);
+    kinematics(sys, d);
+    Vec4 x = d.T[body] * r.homogeneous();
+    if (frame >= 0) x = affine_inverse(d.T[frame]) * x;
+    P.row(k) = x.head<3>().transpose();
+  }
+  return P;
+}
+
+}  // namespace rigidfem

@@ -1,0 +1,203 @@
+// The explicit Runge–Kutta family from Butcher tableaus, and the symplectic Euler rule.
+#include <algorithm>
+#include <cmath>
+#include <vector>
+
+#include "rigidfem/dynamics.hpp"
+#include "rigidfem/errors.hpp"
+#include "rigidfem/stepper.hpp"
+
+namespace rigidfem {
+
+namespace {
+
+/// y = [q, q̇] as a first-order system ẏ = [q̇, q̈(t, q, q̇)], counting evaluations.
+class FirstOrder {
+ public:
+  FirstOrder(const System& sys, IntegratorStats& stats) : sys_(sys), d_(sys), stats_(stats) {}
+  void eval(double t, const VecX& y, VecX& ydot) {
+    if (!y.allFinite()) throw SimulationError(t, "the state became NaN or inf: the step was unstable");
+    ++stats_.rhs_evaluations;
+    const int n = sys_.nq;
+    ydot.resize(2 * n);
+    ydot.head(n) = y.tail(n);
+    ydot.tail(n) = forward_dynamics(sys_, d_, t, y.head(n), y.tail(n));
+  }
+
+ private:
+  const System& sys_;
+  Data d_;
+  IntegratorStats& stats_;
+};
+
+struct Tableau {
+  std::vector<double> c;
+  std::vector<std::vector<double>> a;  // a[i][j], j < i
+  std::vector<double> b;               // propagated solution
+  std::vector<double> e;               // error estimate b − b̂ (empty: fixed step only)
+  int order;                           // order of the propagated solution
+  bool fsal;                           // last stage is f(t + h, y1)
+};
+
+const Tableau& tableau(Method method) {
+  static const Tableau euler{{0.0}, {{}}, {1.0}, {}, 1, false};
+  static const Tableau rk4{{0.0, 0.5, 0.5, 1.0},
+                           {{}, {0.5}, {0.0, 0.5}, {0.0, 0.0, 1.0}},
+                           {1.0 / 6, 1.0 / 3, 1.0 / 3, 1.0 / 6},
+                           {},
+                           4,
+                           false};
+  // Dormand & Prince (1980) 5(4), FSAL; error coefficients e = b − b̂.
+  static const Tableau dopri5{
+      {0.0, 0.2, 0.3, 0.8, 8.0 / 9.0, 1.0, 1.0},
+      {{},
+       {0.2},
+       {3.0 / 40, 9.0 / 40},
+       {44.0 / 45, -56.0 / 15, 32.0 / 9},
+       {19372.0 / 6561, -25360.0 / 2187, 64448.0 / 6561, -212.0 / 729},
+       {9017.0 / 3168, -355.0 / 33, 46732.0 / 5247, 49.0 / 176, -5103.0 / 18656},
+       {35.0 / 384, 0.0, 500.0 / 1113, 125.0 / 192, -2187.0 / 6784, 11.0 / 84}},
+      {35.0 / 384, 0.0, 500.0 / 1113, 125.0 / 192, -2187.0 / 6784, 11.0 / 84, 0.0},
+      {71.0 / 57600, 0.0, -71.0 / 16695, 71.0 / 1920, -17253.0 / 339200, 22.0 / 525, -1.0 / 40},
+      5,
+      true};
+  // Runge–Kutta–Fehlberg 4(5) as in the book: the 4th-order solution is propagated.
+  static const Tableau rkf45{
+      {0.0, 0.25, 3.0 / 8, 12.0 / 13, 1.0, 0.5},
+      {{},
+       {0.25},
+       {3.0 / 32, 9.0 / 32},
+       {1932.0 / 2197, -7200.0 / 2197, 7296.0 / 2197},
+       {439.0 / 216, -8.0, 3680.0 / 513, -845.0 / 4104},
+       {-8.0 / 27, 2.0, -3544.0 / 2565, 1859.0 / 4104, -11.0 / 40}},
+      {25.0 / 216, 0.0, 1408.0 / 2565, 2197.0 / 4104, -0.2, 0.0},
+      {25.0 / 216 - 16.0 / 135, 0.0, 1408.0 / 2565 - 6656.0 / 12825, 2197.0 / 4104 - 28561.0 / 56430, -0.2 + 9.0 / 50,
+       -2.0 / 55},
+      4,
+      false};
+  switch (method) {
+    case Method::Euler:
+    case Method::SymplecticEuler: return euler;
+    case Method::RK4: return rk4;
+    case Method::Dopri5: return dopri5;
+    case Method::RKF45: return rkf45;
+    default: throw std::logic_error("tableau: not an explicit Runge-Kutta method");
+  }
+}
+
+/// One explicit step y0 -> y1 with its dense output: a Runge–Kutta tableau, or the
+/// semi-implicit (symplectic) Euler rule.
+class RungeKutta final : public Stepper {
+ public:
+  RungeKutta(const System& sys, Method method, IntegratorStats& stats)
+      : ode_(sys, stats), tab_(tableau(method)), k_(tab_.b.size()), dopri_(method == Method::Dopri5),
+        symplectic_(method == Method::SymplecticEuler) {}
+
+  void start(double t0, const VecX& q0, const VecX& qd0) override {
+    t_start_ = t0;
+    y_.resize(q0.size() + qd0.size());
+    y_ << q0, qd0;
+    ode_.eval(t0, y_, f_);
+  }
+
+  /// Hairer's starting step for a method of order p.
+  double initial_step(double span, const Tolerances& tol, double max_step) override {
+    const int p = tab_.order;
+    const VecX sc = tol.atol.array() + tol.rtol.array() * y_.cwiseAbs().array();
+    const double d0 = std::sqrt((y_.array() / sc.array()).square().mean());
+    const double d1 = std::sqrt((f_.array() / sc.array()).square().mean());
+    double h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
+    h0 = std::min({h0, max_step, span});
+    VecX f1;
+    ode_.eval(t_start_ + h0, y_ + h0 * f_, f1);
+    const double d2 = std::sqrt((((f1 - f_).array() / sc.array())).square().mean()) / h0;
+    const double dm = std::max(d1, d2);
+    const double h1 = dm <= 1e-15 ? std::max(1e-6, 1e-3 * h0) : std::pow(0.01 / dm, 1.0 / (p + 1));
+    return std::min({100.0 * h0, h1, max_step, span});
+  }
+
+  bool attempt(double t, double h, const Tolerances* tol, double& err) override {
+    t0_ = t, h_ = h, y0_ = y_, f0_ = f_;
+    err = 0.0;
+    if (symplectic_) {
+      // q̇_{n+1} = q̇_n + h q̈(t_n, q_n, q̇_n), then q_{n+1} = q_n + h q̇_{n+1}.
+      const int n = static_cast<int>(y0_.size()) / 2;
+      y1_ = y0_;
+      y1_.tail(n) += h * f0_.tail(n);
+      y1_.head(n) += h * y1_.tail(n);
+      ode_.eval(t + h, y1_, f1_);
+      return true;
+    }
+    const int s = static_cast<int>(tab_.b.size());
+    k_[0] = f0_;
+    VecX yi;
+    // k_i = f(t + c_i h, y0 + h Σ_j a_ij k_j)
+    for (int i = 1; i < s; ++i) {
+      yi = y0_;
+      for (int j = 0; j < i; ++j)
+        if (tab_.a[i][j] != 0.0) yi += (h * tab_.a[i][j]) * k_[j];
+      ode_.eval(t + tab_.c[i] * h, yi, k_[i]);
+      if (dopri_ && i == 5) y_stage6_ = yi;
+    }
+    // y1 = y0 + h Σ b_i k_i
+    y1_ = y0_;
+    for (int i = 0; i < s; ++i)
+      if (tab_.b[i] != 0.0) y1_ += (h * tab_.b[i]) * k_[i];
+    if (tab_.fsal)
+      f1_ = k_[s - 1];
+    else
+      ode_.eval(t + h, y1_, f1_);
+    if (dopri_) {
+      // Hairer's estimate of h ρ (ρ the dominant eigenvalue) from stages 6 and 7, both at t + h.
+      const double den = (y1_ - y_stage6_).squaredNorm();
+      h_rho_ = den > 0.0 ? h * std::sqrt((k_[6] - k_[5]).squaredNorm() / den) : 0.0;
+      // Shampine's continuous extension of order 4 (as in Hairer's dopri5).
+      static const double d[7] = {-12715105075.0 / 11282082432.0, 0.0, 87487479700.0 / 32700410799.0,
+                                  -10690763975.0 / 1880347072.0, 701980252875.0 / 199316789632.0,
+                                  -1453857185.0 / 822651844.0, 69997945.0 / 29380423.0};
+      rcont5_ = VecX::Zero(y0_.size());
+      for (int i = 0; i < 7; ++i)
+        if (d[i] != 0.0) rcont5_ += (h * d[i]) * k_[i];
+    }
+    if (tab_.e.empty() || !tol) return true;
+    VecX e = VecX::Zero(y0_.size());
+    for (int i = 0; i < s; ++i)
+      if (tab_.e[i] != 0.0) e += (h * tab_.e[i]) * k_[i];
+    err = error_norm(e, y0_, y1_, tol->atol, tol->rtol);
+    return true;
+  }
+
+  void accept() override {
+    y_ = y1_;
+    f_ = f1_;
+  }
+
+  const VecX& state() const override { return y_; }
+
+  VecX dense(double t) const override {
+    const double theta = (t - t0_) / h_;
+    if (!dopri_) return hermite(theta, h_, y0_, f0_, y1_, f1_);
+    const VecX dy = y1_ - y0_, r3 = h_ * f0_ - dy, r4 = dy - h_ * f1_ - r3;
+    return y0_ + theta * (dy + (1.0 - theta) * (r3 + theta * (r4 + (1.0 - theta) * rcont5_)));
+  }
+
+  double h_rho() const override { return h_rho_; }
+  StepControl control() const override { return {std::min(tab_.order, 5), 10.0, true, 1.0}; }
+
+ private:
+  FirstOrder ode_;
+  const Tableau& tab_;
+  std::vector<VecX> k_;
+  bool dopri_, symplectic_;
+  double t_start_ = 0, t0_ = 0, h_ = 1, h_rho_ = 0;
+  VecX y_, f_;                             // the current state and ẏ there
+  VecX y0_, y1_, f0_, f1_, rcont5_, y_stage6_;  // the last attempted step
+};
+
+}  // namespace
+
+std::unique_ptr<Stepper> make_runge_kutta(const System& sys, const IntegratorOptions& o, IntegratorStats& stats) {
+  return std::make_unique<RungeKutta>(sys, o.method, stats);
+}
+
+}  // namespace rigidfem

@@ -1,0 +1,40 @@
+"""The maintainers' benchmarks in the checkout's benchmarks/ (not part of the package): the
+scaling studies' tables and the ``python -m benchmarks`` runner. Moved here from
+test_study.py with the studies (formerly ``rigidfem.study.dynamics_scaling`` and
+``rigidfem.study.implicit_step_scaling``)."""
+
+import csv
+import sys
+from pathlib import Path
+
+import numpy as np
+
+sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+
+from benchmarks import scaling  # noqa: E402
+from benchmarks.__main__ import main  # noqa: E402
+
+
+def test_dynamics_scaling_table():
+    """The scaling study's structure (its numbers are benchmarks, reported, not asserted)."""
+    table = scaling.dynamics_scaling(elements=(20, 40, 80), lagrange_up_to=40)
+    assert [r["nq"] for r in table.rows] == [60, 120, 240] and "lagrange_s" not in table.rows[-1]
+    assert all(r["recursive_s"] > 0 for r in table.rows)
+    assert np.isfinite(table.rows[0]["recursive_exponent"]) and np.isfinite(table.rows[0]["lagrange_exponent"])
+
+
+def test_implicit_step_scaling_table():
+    """The implicit-step study's structure; its Newton iterations per step stay few at h = T1/50."""
+    table = scaling.implicit_step_scaling(elements=(20, 40), tangent_up_to=20, steps=10)
+    assert [r["nq"] for r in table.rows] == [60, 120] and "tangent_s_per_step" not in table.rows[-1]
+    assert all(r["spring_s_per_step"] > 0 and 1 <= r["spring_iterations_per_step"] <= 10 for r in table.rows)
+    assert np.isfinite(table.rows[0]["spring_exponent"])
+
+
+def test_runner_writes_and_prints_the_scaling_tables(tmp_path, capsys):
+    assert main(["scaling", "--quick", "--output", str(tmp_path)]) == 0
+    for name in ("dynamics_scaling", "implicit_step_scaling"):
+        with open(tmp_path / f"{name}.csv") as f:
+            assert [int(r["m"]) for r in csv.DictReader(f)] == list(scaling.QUICK_ELEMENTS)
+    out = capsys.readouterr().out
+    assert "machine:" in out and "| m | nq | recursive_s |" in out and "| m | nq | spring_s_per_step |" in out
