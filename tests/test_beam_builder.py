@@ -1,4 +1,4 @@
-"""The beam builder (RFEM_METHOD.md §2–5): division of a link into rfes and sdes, their
+"""The beam builder (book ch. 3.1–3.6, 4.5): division of a link into rfes and sdes, their
 parameters, sections and materials, the Beam handles, deformation options, the linear
 model, the tip body, small/large static deflections and bad input.
 
@@ -54,7 +54,7 @@ def cantilever(L=2.0, m=5, material=None, section=None, gravity=None, **kw):
 
 
 def seg_pieces(L, m):
-    """(start, end, frame) of rfe 0..m, written from RFEM_METHOD §2."""
+    """(start, end, frame) of rfe 0..m, written from the book's ch. 3.1."""
     d = L / m
     out = [(0.0, d / 2, 0.0)]
     for i in range(1, m + 1):

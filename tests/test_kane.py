@@ -1,4 +1,4 @@
-"""Kane's spin-up beam (Kane, Ryan & Banerjee 1987; RFEM_METHOD.md §6), Ω_s = 6 rad/s:
+"""Kane's spin-up beam (Kane, Ryan & Banerjee 1987), Ω_s = 6 rad/s:
 the nonlinear model stays bounded, the linear one grows without bound at the rate the
 loss of geometric stiffening predicts; steady-spin modal analysis against a rotating
 Hermite-beam reference with centrifugal tension computed here."""

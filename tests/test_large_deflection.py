@@ -8,7 +8,7 @@ against continuum references computed here:
 - the Euler–Bernoulli sag q L⁴/(8 EI) under a small self weight.
 
 With sdes at segment middles and half-length end rfes, deflections converge as O(m⁻²)
-(RFEM_METHOD.md §2): the tip deflection is the midpoint rule applied to the
+(book ch. 3.1): the tip deflection is the midpoint rule applied to the
 continuum's ∫ M(s)(L − s)/EI ds, so the errors quarter when m doubles.
 """
 

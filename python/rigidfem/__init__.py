@@ -30,7 +30,8 @@ from .analysis import Equilibrium, Modes, modal_analysis, static_equilibrium
 from .beams import Beam, rfe_parameters, sde_parameters
 from .joints import Joint
 from .materials import Material, Section
-from .model import Model, System, transform
+from .frames import transform
+from .model import Model, System
 from .simulation import Result, simulate
 
 __version__ = "0.1.0"

@@ -1,7 +1,8 @@
 """Statics and modal analysis of a compiled System.
 
 Both linearise the book's equations A(q) q̈ = f(q, q̇, t) about a configuration with
-the force Jacobians of ``System.force_jacobians`` (central differences in C++):
+the force Jacobians of ``System.force_jacobians`` (in C++: analytic for the default
+recursive engine, central differences for ``compile(algorithm="lagrange")``):
 K = −∂f/∂q (tangent stiffness: springs, gravity and preload, centrifugal terms of a
 prescribed spin) and C = −∂f/∂q̇ (dampers, gyroscopic terms).
 """
@@ -115,8 +116,9 @@ def modal_analysis(system, q=None, qd=None, t: float = 0.0) -> Modes:
     dfdq, dfdqd = system.force_jacobians(t, q, qd)
     K, C = -dfdq, -dfdqd
     scale = max(np.max(np.abs(K)), 1e-300)
-    # C counts as absent below 1e-9 of its natural unit sqrt(|K| |M|) (finite-difference noise is
-    # ~1e-12 of it); the symmetric solver is then far more accurate for the low modes of stiff beams.
+    # C counts as absent below 1e-9 of its natural unit sqrt(|K| |M|) (the Lagrange engine's central
+    # differences leave noise ~1e-12 of it); the symmetric solver is then far more accurate for the
+    # low modes of stiff beams.
     if np.max(np.abs(C)) <= 1e-9 * np.sqrt(scale * np.max(np.abs(M))) and \
             np.max(np.abs(K - K.T)) <= 1e-6 * scale:
         w2, X = scipy.linalg.eigh(0.5 * (K + K.T), M)

@@ -22,7 +22,7 @@ from . import _checks, _core
 from ._core import Body, Point
 from .joints import Joint
 from .materials import Material, Section
-from .model import transform
+from .frames import transform
 
 #: Deformation name -> joint coordinate of the sde (book order x, y, z, φ3, φ2, φ1).
 DEFORMATIONS = {"axial": "x", "shear_y": "y", "shear_z": "z", "torsion": "rx", "bend_y": "ry", "bend_z": "rz"}

@@ -1,7 +1,7 @@
 """Joint types. A joint's motion is Trans(x, y, z) R3(φ3) R2(φ2) R1(φ1) restricted to
-its active coordinates (RFEM_METHOD.md §1); coordinate names are ``"x"``, ``"y"``,
-``"z"`` (translations, m) and ``"rz"``, ``"ry"``, ``"rx"`` (rotations φ3, φ2, φ1, rad),
-always ordered as the book orders them: x, y, z, rz, ry, rx.
+its active coordinates (Wittbrodt, Adamiec-Wójcik & Wojciech 2006, ch. 2.1); coordinate
+names are ``"x"``, ``"y"``, ``"z"`` (translations, m) and ``"rz"``, ``"ry"``, ``"rx"``
+(rotations φ3, φ2, φ1, rad), always ordered as the book orders them: x, y, z, rz, ry, rx.
 
 Every constructor takes optional ``stiffness`` (N/m or N·m/rad), ``damping``
 (N·s/m or N·m·s/rad) and ``rest`` (m or rad): a linear spring and viscous damper

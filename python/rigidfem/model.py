@@ -12,16 +12,8 @@ import numpy as np
 
 from . import _checks, _core
 from ._core import Body, JointSpec, Point, Profile
-
-
-def transform(translation=(0.0, 0.0, 0.0), euler_zyx=(0.0, 0.0, 0.0)) -> np.ndarray:
-    """Homogeneous transform Trans(translation) · R3(φ3) R2(φ2) R1(φ1) (4, 4).
-
-    ``translation`` in m, ``euler_zyx = (φ3, φ2, φ1)`` in rad (yaw, pitch, roll).
-    """
-    r = _checks.vec3(translation, "translation")
-    phi = _checks.vec3(euler_zyx, "euler_zyx")
-    return _core.homogeneous(_core.euler_zyx(*phi), r)
+from .beams import add_beam
+from .frames import transform  # noqa: F401 (re-exported: rigidfem.model.transform)
 
 
 def _inertia(inertia) -> np.ndarray:
@@ -231,8 +223,6 @@ class Model(_core._Model):
             Handle with ``tip``, ``point(s)``, ``rfes``, ``centerline(system, q)``, and
             the rfe/sde parameters ``rfe`` and ``sde``.
         """
-        from .beams import add_beam
-
         return add_beam(self, name, parent, length, material, section, elements, formulation, deform, linear,
                         joint, placement, tip_mass, tip_inertia, tip_offset)
 
@@ -248,9 +238,6 @@ class Model(_core._Model):
 
 
 class System(_core._System):
-    def __init__(self, model, algorithm: str = "recursive"):
-        super().__init__(model, algorithm)
-
     """A compiled multibody system: the book's A(q) q̈ = f(q, q̇, t).
 
     q holds the free joint coordinates (``coordinate_names``; m and rad), body by
@@ -258,6 +245,9 @@ class System(_core._System):
     rz, ry, rx. Prescribed coordinates are not part of q; their drives are
     evaluated at time t (s), which is why some methods take ``t``.
     """
+
+    def __init__(self, model, algorithm: str = "recursive"):
+        super().__init__(model, algorithm)
 
     def position(self, point, q, t: float = 0.0) -> np.ndarray:
         """Global position (3,) in m of a ``Point`` (or a ``Body``'s origin)."""

@@ -13,14 +13,19 @@ name                   scheme                                                   
 ``"newmark"``          Newmark β, γ (average acceleration ¼, ½), Newton           ``dt`` or adaptive
 ``"hht"``              Hilber–Hughes–Taylor α ∈ [−⅓, 0], Newton                   ``dt`` or adaptive
 ``"generalized_alpha"`` Chung–Hulbert generalised-α with ρ∞, Newton                ``dt`` or adaptive
+``"implicit_spring"``  generalised-α whose Newton matrix is                       ``dt`` or adaptive
+                       M + diag(γ′h b + β′h² c), O(n) per iteration (ABA)
 ``"scipy:Radau"`` …    SciPy's ``solve_ivp`` (Radau, BDF, LSODA) with the C++      ``rtol``/``atol``
                        ``rhs`` and ``jacobian`` (Python per step: the slow path)
 =====================  =========================================================  ===========
 
 The implicit methods solve M(q) q̈ = f(q, q̇, t) at the end of each step by Newton's
-method with the iteration matrix M + γh C + βh² K (K = −∂f/∂q, C = −∂f/∂q̇ by central
-differences), reused while it converges. ``adaptive=True`` controls their step by the
-local error estimate h²(β − 1/6)(a_{n+1} − a_n).
+method with the iteration matrix M + γ′h ∂r/∂q̇ + β′h² ∂r/∂q of the residual
+r = M q̈ − f (∂r/∂q holds K = −∂f/∂q, ∂r/∂q̇ is C = −∂f/∂q̇), reused while it converges:
+analytic for the default recursive engine, by central differences for
+``compile(algorithm="lagrange")``. ``implicit_spring`` keeps only its diagonal
+springs c and dampers b. ``adaptive=True`` controls their step by the local error
+estimate h²(β − 1/6)(a_{n+1} − a_n).
 """
 
 from __future__ import annotations
