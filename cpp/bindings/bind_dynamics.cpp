@@ -1,4 +1,8 @@
 // System, Data and the named stages of the equations of motion: each binding calls one C++ function.
+#include <algorithm>
+#include <memory>
+#include <vector>
+
 #include "bindings.hpp"
 #include "rigidfem/dynamics.hpp"
 #include "rigidfem/kinematics.hpp"
@@ -16,6 +20,59 @@ VecX free_coordinate_values(const System& s, double Coordinate::*field) {
   for (int k = 0; k < s.nq; ++k) v(k) = s.coords[s.free_coords[k]].*field;
   return v;
 }
+
+// The workspace of a call from Python: each thread keeps one Data per System for its four most
+// recently called systems, so calls allocate nothing (a fresh Data costs as much as the dynamics
+// from ~800 elements on). A call re-entered from a Python callback (a force law calling the
+// system) gets a fresh Data while the outer call holds the kept one.
+class Workspace {
+ public:
+  explicit Workspace(const System& s) {
+    std::vector<Entry>& cache = entries();
+    const std::weak_ptr<const System> me = s.weak_from_this();
+    const auto same = [&me](const Entry& e) { return !e.system.owner_before(me) && !me.owner_before(e.system); };
+    auto it = std::find_if(cache.begin(), cache.end(), same);
+    if (it != cache.end() && it->busy) {
+      fresh_ = std::make_unique<Data>(s);
+      data_ = fresh_.get();
+      return;
+    }
+    if (it == cache.end()) {
+      cache.erase(std::remove_if(cache.begin(), cache.end(), [](const Entry& e) { return e.system.expired(); }),
+                  cache.end());
+      if (cache.size() >= 4) cache.pop_back();
+      cache.insert(cache.begin(), Entry{me, std::make_unique<Data>(s), false});
+      it = cache.begin();
+    } else {
+      std::rotate(cache.begin(), it, it + 1);  // most recent first
+      it = cache.begin();
+    }
+    it->busy = true;
+    data_ = it->data.get();
+    data_->load_factor = 1.0;
+  }
+  ~Workspace() {
+    if (fresh_) return;
+    for (Entry& e : entries())
+      if (e.data.get() == data_) e.busy = false;
+  }
+  Workspace(const Workspace&) = delete;
+  Workspace& operator=(const Workspace&) = delete;
+  Data& operator*() { return *data_; }
+
+ private:
+  struct Entry {
+    std::weak_ptr<const System> system;
+    std::unique_ptr<Data> data;
+    bool busy;
+  };
+  static std::vector<Entry>& entries() {
+    thread_local std::vector<Entry> cache;
+    return cache;
+  }
+  Data* data_ = nullptr;
+  std::unique_ptr<Data> fresh_;
+};
 
 }  // namespace
 
@@ -62,22 +119,22 @@ void bind_dynamics(py::module_& m) {
                              "Constant joint placements B_p (4, 4) in the parent frame.")
       .def(
           "forward_dynamics", [](const System& s, double t, const RefV& q, const RefV& qd) {
-            Data d(s);
-            return VecX(rigidfem::forward_dynamics(s, d, t, q, qd));
+            Workspace d(s);
+            return VecX(rigidfem::forward_dynamics(s, *d, t, q, qd));
           },
           py::arg("t"), py::arg("q"), py::arg("qd"),
           "Accelerations qdd (nq,) solving A(q) qdd = f(q, qd, t); t in s, q in m/rad, qd in m/s, rad/s.")
       .def(
           "mass_matrix", [](const System& s, const RefV& q, double t) {
-            Data d(s);
-            return rigidfem::mass_matrix(s, d, t, q);
+            Workspace d(s);
+            return rigidfem::mass_matrix(s, *d, t, q);
           },
           py::arg("q"), py::arg("t") = 0.0, "Mass matrix A(q) (nq, nq), a_ij = sum_p tr(T_p,i H_p T_p,j^T).")
       .def(
           "generalized_forces",
           [](const System& s, double t, const RefV& q, const RefV& qd, double load_factor) {
-            Data d(s);
-            return rigidfem::generalized_forces(s, d, t, q, qd, load_factor);
+            Workspace d(s);
+            return rigidfem::generalized_forces(s, *d, t, q, qd, load_factor);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("load_factor") = 1.0,
           "Right-hand side f (nq,) of A qdd = f: loads, gravity, springs, dampers minus velocity terms (N, N m).\n"
@@ -85,16 +142,16 @@ void bind_dynamics(py::module_& m) {
       .def(
           "static_forces",
           [](const System& s, double t, const RefV& q, double load_factor) {
-            Data d(s);
-            return rigidfem::static_forces(s, d, t, q, load_factor);
+            Workspace d(s);
+            return rigidfem::static_forces(s, *d, t, q, load_factor);
           },
           py::arg("t"), py::arg("q"), py::arg("load_factor") = 1.0,
           "Static residual f(q) (nq,): generalised forces at rest, prescribed coordinates held at their values at t.")
       .def(
           "force_jacobians",
           [](const System& s, double t, const RefV& q, const RefV& qd, double load_factor, bool static_drives) {
-            Data d(s);
-            return rigidfem::force_jacobians(s, d, t, q, qd, load_factor, static_drives);
+            Workspace d(s);
+            return rigidfem::force_jacobians(s, *d, t, q, qd, load_factor, static_drives);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("load_factor") = 1.0, py::arg("static") = false,
           "(df/dq, df/dqd), each (nq, nq): analytic for recursive systems, central differences for\n"
@@ -102,29 +159,29 @@ void bind_dynamics(py::module_& m) {
           "-df/dqd the damping and gyroscopic matrix C. static=True holds the prescribed coordinates at t.")
       .def(
           "driving_forces", [](const System& s, double t, const RefV& q, const RefV& qd) {
-            Data d(s);
-            return rigidfem::driving_forces(s, d, t, q, qd);
+            Workspace d(s);
+            return rigidfem::driving_forces(s, *d, t, q, qd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"),
           "Forces/torques (np,) the drives exert on the prescribed coordinates (N or N m).")
       .def(
           "rhs", [](const System& s, double t, const RefV& y) {
-            Data d(s);
-            return rigidfem::rhs(s, d, t, y);
+            Workspace d(s);
+            return rigidfem::rhs(s, *d, t, y);
           },
           py::arg("t"), py::arg("y"), "dy/dt = [qd, qdd] for y = [q, qd] (2 nq,): the signature of scipy's solve_ivp.")
       .def(
           "jacobian", [](const System& s, double t, const RefV& y) {
-            Data d(s);
-            return rhs_jacobian(s, d, t, y);
+            Workspace d(s);
+            return rhs_jacobian(s, *d, t, y);
           },
           py::arg("t"), py::arg("y"), "d(rhs)/dy (2 nq, 2 nq) for solve_ivp(jac=...): analytic for recursive systems (see\n"
           "acceleration_derivatives), central differences for algorithm='lagrange'.")
       .def(
           "inverse_dynamics",
           [](const System& s, double t, const RefV& q, const RefV& qd, const RefV& qdd) {
-            Data d(s);
-            return rigidfem::inverse_dynamics(s, d, t, q, qd, qdd);
+            Workspace d(s);
+            return rigidfem::inverse_dynamics(s, *d, t, q, qd, qdd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("qdd"),
           "r = A(q) qdd - f(q, qd, t) (nq,): the generalised forces (N or N m) the free coordinates\n"
@@ -133,8 +190,8 @@ void bind_dynamics(py::module_& m) {
       .def(
           "inverse_dynamics_derivatives",
           [](const System& s, double t, const RefV& q, const RefV& qd, const RefV& qdd) {
-            Data d(s);
-            return rigidfem::inverse_dynamics_derivatives(s, d, t, q, qd, qdd);
+            Workspace d(s);
+            return rigidfem::inverse_dynamics_derivatives(s, *d, t, q, qd, qdd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("qdd"),
           "(dr/dq, dr/dqd), each (nq, nq), of r = A qdd - f: analytic through the RNEA for recursive\n"
@@ -142,60 +199,69 @@ void bind_dynamics(py::module_& m) {
       .def(
           "acceleration_derivatives",
           [](const System& s, double t, const RefV& q, const RefV& qd) {
-            Data d(s);
-            return rigidfem::acceleration_derivatives(s, d, t, q, qd);
+            Workspace d(s);
+            return rigidfem::acceleration_derivatives(s, *d, t, q, qd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"),
           "(dqdd/dq, dqdd/dqd), each (nq, nq): -A^-1 (dr/dq, dr/dqd) at the forward-dynamics qdd.")
       .def(
           "transform", [](const System& s, int body, const RefV& q, double t) {
-            Data d(s);
-            return body_pose(s, d, body, t, q);
+            Workspace d(s);
+            return body_pose(s, *d, body, t, q);
           },
           py::arg("body"), py::arg("q"), py::arg("t") = 0.0, "Pose T_p (4, 4) of a body (by index) in the global frame.")
       .def(
           "_position", [](const System& s, const Point& p, const RefV& q, double t) {
-            Data d(s);
-            return point_position(s, d, p, t, q);
+            Workspace d(s);
+            return point_position(s, *d, p, t, q);
           },
           py::arg("point"), py::arg("q"), py::arg("t"))
       .def(
+          "_positions",
+          [](const System& s, const std::vector<Point>& points, const RefV& q, double t) {
+            Workspace d(s);
+            return point_positions(s, *d, points, t, q);
+          },
+          py::arg("points"), py::arg("q"), py::arg("t"))
+      .def(
           "_velocity", [](const System& s, const Point& p, const RefV& q, const RefV& qd, double t) {
-            Data d(s);
-            return point_velocity(s, d, p, t, q, qd);
+            Workspace d(s);
+            return point_velocity(s, *d, p, t, q, qd);
           },
           py::arg("point"), py::arg("q"), py::arg("qd"), py::arg("t"))
       .def(
           "kinetic_energy", [](const System& s, const RefV& q, const RefV& qd, double t) {
-            Data d(s);
-            return energies(s, d, t, q, qd).kinetic;
+            Workspace d(s);
+            return energies(s, *d, t, q, qd).kinetic;
           },
           py::arg("q"), py::arg("qd"), py::arg("t") = 0.0, "Kinetic energy 1/2 sum tr(dT H dT^T) (J).")
       .def(
           "gravity_energy", [](const System& s, const RefV& q, double t) {
-            Data d(s);
-            return energies(s, d, t, q, VecX::Zero(s.nq)).gravity;
+            Workspace d(s);
+            return energies(s, *d, t, q, VecX::Zero(s.nq)).gravity;
           },
           py::arg("q"), py::arg("t") = 0.0, "Potential energy of gravity -sum m g^T r_C (J).")
       .def(
           "elastic_energy", [](const System& s, const RefV& q, double t) {
-            Data d(s);
-            return energies(s, d, t, q, VecX::Zero(s.nq)).elastic;
+            Workspace d(s);
+            return energies(s, *d, t, q, VecX::Zero(s.nq)).elastic;
           },
           py::arg("q"), py::arg("t") = 0.0, "Energy of the joint springs 1/2 sum c (q - q_rest)^2 (J).")
       .def(
           "potential_energy", [](const System& s, const RefV& q, double t) {
-            Data d(s);
-            return energies(s, d, t, q, VecX::Zero(s.nq)).potential();
+            Workspace d(s);
+            return energies(s, *d, t, q, VecX::Zero(s.nq)).potential();
           },
           py::arg("q"), py::arg("t") = 0.0, "Gravity plus elastic energy (J).")
       .def(
           "dissipated_power", [](const System& s, const RefV& q, const RefV& qd, double t) {
-            Data d(s);
-            return energies(s, d, t, q, qd).dissipated;
+            Workspace d(s);
+            return energies(s, *d, t, q, qd).dissipated;
           },
           py::arg("q"), py::arg("qd"), py::arg("t") = 0.0, "Power dissipated by the joint dampers, sum b qd^2 (W).")
-      .def("make_data", [](const System& s) { return Data(s); }, "A fresh workspace for the stage functions.");
+      .def(
+          "make_data", [](const System& s) { return std::make_unique<Data>(s); },
+          "A fresh workspace for the stage functions (allocated in place: a Data is never copied or moved).");
 
   py::class_<Data>(m, "Data", "Workspace of the algorithms; after each stage it holds that stage's results.")
       .def_readonly("t", &Data::t)

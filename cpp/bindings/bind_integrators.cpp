@@ -1,5 +1,6 @@
 // The C++ integrators: options, the run (GIL released), and batch outputs for results.
 #include "bindings.hpp"
+#include "rigidfem/errors.hpp"
 #include "rigidfem/integrators.hpp"
 #include "rigidfem/outputs.hpp"
 
@@ -39,22 +40,35 @@ void bind_integrators(py::module_& m) {
   m.def(
       "_integrate",
       [](const System& s, double t0, double t_end, const VecX& q0, const VecX& qd0,
-         const Eigen::Ref<const VecX>& t_eval, const IntegratorOptions& o, py::object progress) {
+         const Eigen::Ref<const VecX>& t_eval, const IntegratorOptions& o, py::object keep_going) {
         // Runs with the GIL released; every ~0.05 s the monitor takes it back to look for
-        // Ctrl-C (PyErr_CheckSignals) and to call the progress callback.
-        Monitor monitor = [&progress](double t) {
+        // Ctrl-C (PyErr_CheckSignals, main thread) and to ask keep_going(t) (progress, stop event).
+        Monitor monitor = [&keep_going](double t) {
           py::gil_scoped_acquire gil;
           if (PyErr_CheckSignals() != 0) {
             PyErr_Clear();
             return false;
           }
-          if (!progress.is_none()) progress(t);
-          return true;
+          return keep_going.is_none() || keep_going(t).cast<bool>();
         };
         Trajectory tr;
         {
           py::gil_scoped_release release;
           tr = integrate(s, t0, t_end, q0, qd0, t_eval, o, monitor);
+        }
+        // A run ended early: Ctrl-C in a Python callback returns the partial result; a numerical
+        // failure returns it with the error's message (Python raises SimulationError carrying it);
+        // any other exception propagates.
+        py::object failure = py::none();
+        if (tr.error) {
+          try {
+            std::rethrow_exception(tr.error);
+          } catch (py::error_already_set& e) {
+            if (!e.matches(PyExc_KeyboardInterrupt)) throw;
+            tr.interrupted = true;
+          } catch (const SimulationError& e) {
+            failure = py::make_tuple(e.what(), e.time, e.cause);
+          }
         }
         const auto& st = tr.stats;
         py::dict stats;
@@ -67,10 +81,10 @@ void bind_integrators(py::module_& m) {
         stats["wall_time"] = st.wall_time;
         stats["stiff_at"] = st.stiff_at;
         return py::make_tuple(VecX(Eigen::Map<const VecX>(tr.t.data(), tr.t.size())), stack(tr.q, s.nq),
-                              stack(tr.qd, s.nq), stats, tr.interrupted);
+                              stack(tr.qd, s.nq), stats, tr.interrupted, failure);
       },
       py::arg("system"), py::arg("t0"), py::arg("t_end"), py::arg("q0"), py::arg("qd0"), py::arg("t_eval"),
-      py::arg("options"), py::arg("progress"));
+      py::arg("options"), py::arg("keep_going"));
 
   m.def(
       "_evaluate_outputs",
@@ -80,8 +94,11 @@ void bind_integrators(py::module_& m) {
         return py::make_tuple(o.qdd, o.tau, o.kinetic, o.gravity, o.elastic);
       },
       py::arg("system"), py::arg("t"), py::arg("q"), py::arg("qd"));
-  m.def("_point_positions", &point_positions, py::arg("system"), py::arg("body"), py::arg("r"), py::arg("frame"),
-        py::arg("t"), py::arg("q"));
+  m.def(
+      "_point_positions",
+      [](const System& s, int body, const Vec3& r, int frame, const Eigen::Ref<const VecX>& t,
+         const Eigen::Ref<const RowMatX>& Q) { return point_positions(s, body, r, frame, t, Q); },
+      py::arg("system"), py::arg("body"), py::arg("r"), py::arg("frame"), py::arg("t"), py::arg("q"));
 }
 
 }  // namespace rigidfem::bindings

@@ -1,5 +1,7 @@
 // rigidfem._core: the C++ core. Errors: std::invalid_argument -> ValueError,
 // rigidfem::SimulationError -> rigidfem.SimulationError (a RuntimeError).
+#include <cmath>
+
 #include "bindings.hpp"
 #include "rigidfem/errors.hpp"
 #include "rigidfem/model.hpp"
@@ -49,6 +51,7 @@ void bind_profiles(py::module_& m) {
       .def(
           "__call__",
           [](const Profile& p, double t) {
+            if (!std::isfinite(t)) bad("t", "a finite time in s", num(t));
             const MotionState s = p.at(t);
             return py::make_tuple(s.q, s.qd, s.qdd);
           },

@@ -1,5 +1,7 @@
 #include "rigidfem/dynamics.hpp"
 
+#include <cmath>
+
 #include "rigidfem/derivatives.hpp"
 #include "rigidfem/errors.hpp"
 #include "rigidfem/lagrange.hpp"
@@ -46,6 +48,12 @@ void full_state(const System& sys, Data& d, double t, const Eigen::Ref<const Vec
   check_vector(qdd, sys.nq, "qdd", "nq");
   set_accelerations(sys, d, qdd);
   kinematics(sys, d);
+}
+
+// d.load_factor = λ, which scales gravity, loads and applied generalised forces.
+void set_load_factor(Data& d, double load_factor) {
+  if (!std::isfinite(load_factor)) bad("load_factor", "a finite factor", num(load_factor));
+  d.load_factor = load_factor;
 }
 
 }  // namespace
@@ -124,7 +132,7 @@ const MatX& mass_matrix(const System& sys, Data& d, double t, const Eigen::Ref<c
 
 const VecX& generalized_forces(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
                                const Eigen::Ref<const VecX>& qd, double load_factor) {
-  d.load_factor = load_factor;
+  set_load_factor(d, load_factor);
   full_state(sys, d, t, q, qd);
   generalized_forces(sys, d);
   return d.f;
@@ -132,7 +140,7 @@ const VecX& generalized_forces(const System& sys, Data& d, double t, const Eigen
 
 const VecX& static_forces(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
                           double load_factor) {
-  d.load_factor = load_factor;
+  set_load_factor(d, load_factor);
   set_static_state(sys, d, t, q);
   kinematics(sys, d);
   generalized_forces(sys, d);
@@ -196,7 +204,7 @@ MatX rhs_jacobian(const System& sys, Data& d, double t, const Eigen::Ref<const V
 
 std::pair<MatX, MatX> force_jacobians(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
                                       const Eigen::Ref<const VecX>& qd, double load_factor, bool static_drives) {
-  d.load_factor = load_factor;
+  set_load_factor(d, load_factor);
   if (analytic_derivatives(sys)) {
     // f = −r(q, q̇, q̈ = 0): the analytic derivatives of the recursive inverse dynamics.
     if (static_drives)

@@ -58,9 +58,17 @@ IterationMatrix parse_iteration_matrix(const std::string& name) {
 
 const char* iteration_matrix_name(IterationMatrix matrix) { return iteration_matrices[static_cast<int>(matrix)]; }
 
+double scaled_rms(const VecX& v, const VecX& sc) {
+  if (v.size() == 0) return 0.0;
+  if ((sc.array() > 0.0).all()) return std::sqrt((v.array() / sc.array()).square().mean());
+  double sum = 0.0;
+  for (Eigen::Index i = 0; i < v.size(); ++i)
+    if (v(i) != 0.0) sum += (v(i) / sc(i)) * (v(i) / sc(i));
+  return std::sqrt(sum / static_cast<double>(v.size()));
+}
+
 double error_norm(const VecX& e, const VecX& y0, const VecX& y1, const VecX& atol, const VecX& rtol) {
-  const VecX sc = atol.array() + rtol.array() * y0.cwiseAbs().cwiseMax(y1.cwiseAbs()).array();
-  return std::sqrt((e.array() / sc.array()).square().mean());
+  return scaled_rms(e, atol.array() + rtol.array() * y0.cwiseAbs().cwiseMax(y1.cwiseAbs()).array());
 }
 
 VecX hermite(double theta, double h, const VecX& y0, const VecX& f0, const VecX& y1, const VecX& f1) {
@@ -149,21 +157,20 @@ void check_options(const System& sys, double t0, double t_end, const VecX& q0, c
       throw std::invalid_argument("t_eval: expected increasing times within [t0, t_end]");
 }
 
-/// The one loop: attempt a step, control its size by the error estimate (adaptive runs), record
-/// the outputs it covers, ask the monitor; the last step lands on t_end exactly.
-Trajectory run(const System& sys, double t0, double t_end, const VecX& q0, const VecX& qd0,
-               const Eigen::Ref<const VecX>& t_eval, const IntegratorOptions& o, const Monitor& monitor,
-               VecX& last_q) {
-  const auto start_clock = Clock::now();
-  auto last_check = start_clock;
-  Trajectory traj;
+/// The one loop, into traj: attempt a step, control its size by the error estimate (adaptive runs)
+/// or keep to the grid t0 + k·dt (fixed steps), record the outputs it covers, ask the monitor; the
+/// last step lands on t_end exactly. last_q: the last accepted coordinates.
+void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX& qd0,
+         const Eigen::Ref<const VecX>& t_eval, const IntegratorOptions& o, const Monitor& monitor, Trajectory& traj,
+         VecX& last_q) {
+  auto last_check = Clock::now();
   IntegratorStats& stats = traj.stats;
   Recorder out(traj, t_eval, sys.nq);
   const int n = sys.nq;
   const Tolerances tol{o.atol.size() == 1 ? VecX::Constant(2 * n, o.atol(0)) : o.atol,
                        o.rtol.size() == 1 ? VecX::Constant(2 * n, o.rtol(0)) : o.rtol};
   const bool adaptive = is_adaptive(o);
-  const double span = t_end - t0;
+  const double span = t_end - t0, grid = std::min(o.dt, o.max_step), near_end = t_end - 1e-12 * span;
 
   const std::unique_ptr<Stepper> stepper = method_info(o.method).make(sys, o, stats);
   const StepControl control = stepper->control();
@@ -175,8 +182,17 @@ Trajectory run(const System& sys, double t0, double t_end, const VecX& q0, const
   bool rejected_last = false;
   int stiff_steps = 0, nonstiff_steps = 0;  // Hairer's stiffness test (h ρ, dopri5)
   while (t < t_end) {
-    double hs = std::min({h, o.max_step, t_end - t});
-    if (t + hs > t_end - 1e-12 * span) hs = t_end - t;  // land on t_end exactly
+    // The step: to the grid point t0 + k·dt (fixed) or by h (adaptive), to t_end for the last one.
+    double hs, t1;
+    if (adaptive) {
+      hs = std::min({h, o.max_step, t_end - t});
+      if (t + hs > near_end) hs = t_end - t;
+      t1 = t + hs >= near_end ? t_end : t + hs;
+    } else {
+      t1 = t0 + static_cast<double>(stats.steps + 1) * grid;
+      if (t1 > near_end) t1 = t_end;
+      hs = t1 - t;
+    }
     if (stats.steps + stats.rejected >= o.max_steps)
       step_failure(t, hs, "max_steps = " + std::to_string(o.max_steps) + " reached");
     if (hs < 16.0 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t)))
@@ -205,13 +221,13 @@ Trajectory run(const System& sys, double t0, double t_end, const VecX& q0, const
       h = hs * factor;
       if (stepper->h_rho() > 3.25) {
         nonstiff_steps = 0;
-        if (++stiff_steps == 15 && std::isnan(stats.stiff_at)) stats.stiff_at = t + hs;
+        if (++stiff_steps == 15 && std::isnan(stats.stiff_at)) stats.stiff_at = t1;
       } else if (++nonstiff_steps == 6) {
         stiff_steps = 0;
       }
     }
     stepper->accept();
-    t = (t + hs >= t_end - 1e-12 * span) ? t_end : t + hs;
+    t = t1;
     ++stats.steps;
     const VecX& y = stepper->state();
     out.step(t, y, *stepper);
@@ -221,12 +237,22 @@ Trajectory run(const System& sys, double t0, double t_end, const VecX& q0, const
       last_check = Clock::now();
       if (!monitor(t)) {
         traj.interrupted = true;
-        break;
+        return;
       }
     }
   }
-  stats.wall_time = std::chrono::duration<double>(Clock::now() - start_clock).count();
-  return traj;
+}
+
+/// What the last accepted state says about a failure: a fixed step beyond the method's stability
+/// limit (the state grew by orders of magnitude), or Euler angles near gimbal lock.
+SimulationError explained(const SimulationError& e, const System& sys, const VecX& q0, const VecX& last_q,
+                          const IntegratorOptions& o) {
+  const double growth = max_abs(last_q) / std::max(max_abs(q0), 1e-300);
+  if (!is_adaptive(o) && (growth > 1e3 || !last_q.allFinite()))
+    return SimulationError(e.time, "the fixed step dt = " + num(o.dt) + " s is probably beyond the stability limit of " +
+                                       std::string(method_name(o.method)) + " for this problem: the state grew " +
+                                       num(growth) + " times, then " + e.cause);
+  return SimulationError(e.time, e.cause + gimbal_lock_hint(sys, last_q, 1e-3));
 }
 
 }  // namespace
@@ -234,21 +260,18 @@ Trajectory run(const System& sys, double t0, double t_end, const VecX& q0, const
 Trajectory integrate(const System& sys, double t0, double t_end, const VecX& q0, const VecX& qd0,
                      const Eigen::Ref<const VecX>& t_eval, const IntegratorOptions& o, const Monitor& monitor) {
   check_options(sys, t0, t_end, q0, qd0, t_eval, o);
+  const auto start = Clock::now();
+  Trajectory traj;
   VecX last_q = q0;
   try {
-    return run(sys, t0, t_end, q0, qd0, t_eval, o, monitor, last_q);
+    run(sys, t0, t_end, q0, qd0, t_eval, o, monitor, traj, last_q);
   } catch (const SimulationError& e) {
-    // What the last accepted state says about the failure: Euler angles near gimbal lock,
-    // or a fixed step beyond the method's stability limit (the state grew by orders of magnitude).
-    const double growth = last_q.cwiseAbs().maxCoeff() / std::max(q0.cwiseAbs().maxCoeff(), 1e-300);
-    if (!is_adaptive(o) && (growth > 1e3 || !last_q.allFinite()))
-      throw SimulationError(e.time, "the fixed step dt = " + num(o.dt) + " s is probably beyond the stability limit of " +
-                                        std::string(method_name(o.method)) + " for this problem: the state grew " +
-                                        num(growth) + " times, then " + e.cause);
-    const std::string hint = gimbal_lock_hint(sys, last_q, 1e-3);
-    if (hint.empty()) throw;
-    throw SimulationError(e.time, e.cause + hint);
+    traj.error = std::make_exception_ptr(explained(e, sys, q0, last_q, o));
+  } catch (...) {
+    traj.error = std::current_exception();  // from a callback: the caller decides (Ctrl-C: partial result)
   }
+  traj.stats.wall_time = std::chrono::duration<double>(Clock::now() - start).count();
+  return traj;
 }
 
 }  // namespace rigidfem

@@ -77,6 +77,22 @@ void frames_and_axes(const System& sys, Data& d) {
   }
 }
 
+void frames(const System& sys, Data& d) {
+  static const Mat4 I4 = Mat4::Identity();
+  Mat4 Tj, unused;
+  for (int p = 0; p < sys.nbodies; ++p) {
+    Mat4 G = parent_value(sys, d.T, p, I4) * sys.B[p];
+    const JointUses j = joint_uses(sys, p);
+    if (j.linear) {
+      joint_motion(j, d.qa, d.qda, d.qdda, false, Tj, unused, unused, d.X.data());
+      d.T[p].noalias() = G * Tj;
+      continue;
+    }
+    for (int k = 0; k < j.n; ++k) apply_elementary(G, j.axis[k], d.qa(j.coord[k]));
+    d.T[p] = G;
+  }
+}
+
 AppliedLoad applied_load(const Data& d, const Load& L) {
   const double s = d.load_factor * (L.scale ? L.scale->at(d.t).q : 1.0);
   const Mat3 R = d.T[L.body].topLeftCorner<3, 3>();

@@ -67,6 +67,10 @@ class NewmarkFamily final : public Stepper {
   bool attempt(double t, double h, const Tolerances* tol, double& err) override {
     t_ = t, h_step_ = h;
     err = 0.0;
+    if (sys_.nq == 0) {  // nothing to solve: the state is empty
+      s1_ = s_;
+      return true;
+    }
     if (!newton(t, h)) return false;
     if (!s1_.q.allFinite() || !s1_.v.allFinite()) step_failure(t, h, "the state became NaN or inf");
     if (!tol) return true;
@@ -119,10 +123,10 @@ class NewmarkFamily final : public Stepper {
         // Converged when the position and velocity errors left are negligible: the increments
         // times η = θ/(1 − θ) once a contraction rate θ < 1 is seen (the sum of the remaining
         // increments of a contraction; Hairer & Wanner IV.8), the increments themselves before.
-        const double size = dx.cwiseAbs().maxCoeff();
+        const double size = max_abs(dx);
         const double eta = it >= 1 && size < previous ? (size / previous) / (1.0 - size / previous) : 1.0;
         const double dq = eta * bp * h * h * size, dv = eta * gp * h * size;
-        if (dq <= tol_ * (1.0 + s1.q.cwiseAbs().maxCoeff()) && dv <= tol_ * (1.0 + s1.v.cwiseAbs().maxCoeff())) {
+        if (dq <= tol_ * (1.0 + max_abs(s1.q)) && dv <= tol_ * (1.0 + max_abs(s1.v))) {
           update(h, s, s1);
           if (it > 4) valid_ = false;  // slow convergence: refresh the iteration matrix next step
           fresh_ = false;

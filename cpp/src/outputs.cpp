@@ -46,12 +46,23 @@ Energies energies(const System& sys, Data& d, double t, const Eigen::Ref<const V
 const Mat4& body_pose(const System& sys, Data& d, int body, double t, const Eigen::Ref<const VecX>& q) {
   check_body(sys, body, "body");
   set_state(sys, d, t, q, VecX::Zero(sys.nq));
-  kinematics(sys, d);
+  frames(sys, d);
   return d.T[body];
 }
 
 Vec3 point_position(const System& sys, Data& d, const Point& point, double t, const Eigen::Ref<const VecX>& q) {
   return (body_pose(sys, d, point.body, t, q) * point.r.homogeneous()).head<3>();
+}
+
+MatX point_positions(const System& sys, Data& d, const std::vector<Point>& points, double t,
+                     const Eigen::Ref<const VecX>& q) {
+  for (const Point& p : points) check_body(sys, p.body, "points");
+  set_state(sys, d, t, q, VecX::Zero(sys.nq));
+  frames(sys, d);
+  MatX X(points.size(), 3);
+  for (std::size_t k = 0; k < points.size(); ++k)
+    X.row(k) = (d.T[points[k].body] * points[k].r.homogeneous()).head<3>().transpose();
+  return X;
 }
 
 Vec3 point_velocity(const System& sys, Data& d, const Point& point, double t, const Eigen::Ref<const VecX>& q,
@@ -93,7 +104,7 @@ MatX point_positions(const System& sys, int body, const Vec3& r, int frame, cons
   const VecX zero = VecX::Zero(sys.nq);
   for (Eigen::Index k = 0; k < t.size(); ++k) {
     set_state(sys, d, t(k), Q.row(k).transpose(), zero);
-    kinematics(sys, d);
+    frames(sys, d);
     Vec4 x = d.T[body] * r.homogeneous();
     if (frame >= 0) x = affine_inverse(d.T[frame]) * x;
     P.row(k) = x.head<3>().transpose();

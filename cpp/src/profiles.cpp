@@ -110,8 +110,9 @@ class Spline final : public Profile {
       const double slope = segment(k, te).qd;
       return {(left ? q_.front() : q_.back()) + slope * (t - te), slope, 0.0};
     }
-    const size_t k = static_cast<size_t>(std::upper_bound(t_.begin(), t_.end(), t) - t_.begin()) - 1;
-    return segment(k, t);
+    // The knot interval [t_k, t_k+1) holding t; clamped, so a NaN t reads no knot beyond the table.
+    const size_t after = static_cast<size_t>(std::upper_bound(t_.begin(), t_.end(), t) - t_.begin());
+    return segment(std::min(std::max(after, size_t{1}), n - 1) - 1, t);
   }
   std::string describe() const override { return "spline(" + std::to_string(t_.size()) + " points)"; }
 

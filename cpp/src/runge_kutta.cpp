@@ -100,19 +100,22 @@ class RungeKutta final : public Stepper {
     ode_.eval(t0, y_, f_);
   }
 
-  /// Hairer's starting step for a method of order p.
+  /// Hairer's starting step for a method of order p (the whole span when nothing moves, nq = 0).
   double initial_step(double span, const Tolerances& tol, double max_step) override {
+    if (y_.size() == 0) return std::min(span, max_step);
     const int p = tab_.order;
     const VecX sc = tol.atol.array() + tol.rtol.array() * y_.cwiseAbs().array();
-    const double d0 = std::sqrt((y_.array() / sc.array()).square().mean());
-    const double d1 = std::sqrt((f_.array() / sc.array()).square().mean());
+    const double d0 = scaled_rms(y_, sc), d1 = scaled_rms(f_, sc);
     double h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
     h0 = std::min({h0, max_step, span});
     VecX f1;
     ode_.eval(t_start_ + h0, y_ + h0 * f_, f1);
-    const double d2 = std::sqrt((((f1 - f_).array() / sc.array())).square().mean()) / h0;
+    const double d2 = scaled_rms(f1 - f_, sc) / h0;
     const double dm = std::max(d1, d2);
-    const double h1 = dm <= 1e-15 ? std::max(1e-6, 1e-3 * h0) : std::pow(0.01 / dm, 1.0 / (p + 1));
+    // dm is infinite when a component with zero weight (atol = 0, starting at zero) moves: start small.
+    const double h1 = dm <= 1e-15         ? std::max(1e-6, 1e-3 * h0)
+                      : std::isfinite(dm) ? std::pow(0.01 / dm, 1.0 / (p + 1))
+                                          : 1e-3 * h0;
     return std::min({100.0 * h0, h1, max_step, span});
   }
 

@@ -125,9 +125,9 @@ Data::Data(const System& s)
       I(s.nbodies, Mat6::Zero()),
       IA(s.nbodies, Mat6::Zero()),
       fext(s.nbodies, Vec6::Zero()),
+      S(s.nbodies),
       U6(s.nbodies),
       Dinv(s.nbodies),
-      S(s.nbodies),
       u(s.nbodies) {}
 
 void check_body(const System& sys, int body, const std::string& argument, bool ground_allowed) {

@@ -61,3 +61,32 @@ def per_coordinate(x, n: int, name: str, *, nonnegative: bool = False) -> list[f
     if len(values) != n:
         raise ValueError(f"{name}: expected a number or {n} values (one per joint coordinate), got {len(values)}")
     return [scalar(v, name, nonnegative=nonnegative) for v in values]
+
+
+def integer(x, name: str, *, minimum: int | None = None, maximum: int | None = None) -> int:
+    """``x`` as an int (an integral number, not a bool) within [minimum, maximum]."""
+    if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, np.integer, float, np.floating)) or \
+            not math.isfinite(float(x)) or float(x) != int(x):
+        raise ValueError(f"{name}: expected an integer, got {x!r}")
+    v = int(x)
+    if (minimum is not None and v < minimum) or (maximum is not None and v > maximum):
+        raise ValueError(f"{name}: expected an integer in [{minimum}, {maximum}], got {v}")
+    return v
+
+
+def boolean(x, name: str) -> bool:
+    """``x`` as a bool: True, False (or numpy's bools)."""
+    if not isinstance(x, (bool, np.bool_)):
+        raise ValueError(f"{name}: expected True or False, got {x!r}")
+    return bool(x)
+
+
+def step_limit(x, name: str) -> float:
+    """A positive step limit in s, inf for none."""
+    try:
+        v = float(x)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: expected a positive number of s (inf for no limit), got {x!r}") from None
+    if not v > 0.0:  # NaN fails too
+        raise ValueError(f"{name}: expected a positive number of s (inf for no limit), got {v}")
+    return v

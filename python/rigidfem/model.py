@@ -10,7 +10,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from . import _checks, _core
+from . import _checks, _contract, _core
 from ._core import Body, JointSpec, Point, Profile
 from .beams import add_beam
 from .frames import transform  # noqa: F401 (re-exported: rigidfem.model.transform)
@@ -266,3 +266,6 @@ class System(_core._System):
 
     def __repr__(self) -> str:
         return f"<rigidfem System: {self.nbodies} bodies, nq={self.nq}, {self.np} prescribed>"
+
+
+_contract.guard_methods(System)

@@ -15,8 +15,8 @@ name                   scheme                                                   
 ``"generalized_alpha"`` Chung–Hulbert generalised-α with ρ∞, Newton                ``dt`` or adaptive
 ``"implicit_spring"``  generalised-α whose Newton matrix is                       ``dt`` or adaptive
                        M + diag(γ′h b + β′h² c), O(n) per iteration (ABA)
-``"scipy:Radau"`` …    SciPy's ``solve_ivp`` (Radau, BDF, LSODA) with the C++      ``rtol``/``atol``
-                       ``rhs`` and ``jacobian`` (Python per step: the slow path)
+``"scipy:Radau"`` …    SciPy's solvers (Radau, BDF, LSODA, RK45, DOP853) with the  ``rtol``/``atol``
+                       C++ ``rhs`` and ``jacobian`` (Python per step: the slow path)
 =====================  =========================================================  ===========
 
 The implicit methods solve M(q) q̈ = f(q, q̇, t) at the end of each step by Newton's
@@ -118,7 +118,7 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
              first_step: float | None = None, stiffness_warning: bool = True,
              max_steps: int = 1_000_000, max_step: float = np.inf, adaptive: bool | None = None, beta: float = 0.25,
              gamma: float = 0.5, alpha: float = -0.05, rho_inf: float = 0.8, newton_tol: float = 1e-10,
-             newton_max_iterations: int = 10, iteration_matrix: str = "auto") -> Result:
+             newton_max_iterations: int = 10, iteration_matrix: str = "auto", stop=None) -> Result:
     """Integrate ``system`` from ``t0`` to ``t_end`` (s) in C++ (no Python per step).
 
     Parameters
@@ -126,14 +126,16 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
     method : str
         See the module docstring: "euler", "symplectic_euler", "rk4", "dopri5", "rkf45",
         "newmark", "hht", "generalized_alpha", "implicit_spring", or "scipy:Radau", "scipy:BDF",
-        "scipy:LSODA". "implicit_spring" is generalised-α (``rho_inf``) whose Newton matrix
-        holds only the coordinates' springs and dampers, M + diag(γ'h b + β'h² c): the
-        articulated-body algorithm solves it in O(n), so a stiff beam takes steps far beyond
-        the explicit stability limit at O(n) per Newton iteration.
+        "scipy:LSODA", "scipy:RK45", "scipy:DOP853". "implicit_spring" is generalised-α (``rho_inf``)
+        whose Newton matrix holds only the coordinates' springs and dampers,
+        M + diag(γ'h b + β'h² c): the articulated-body algorithm solves it in O(n), so a stiff beam
+        takes steps far beyond the explicit stability limit at O(n) per Newton iteration.
     dt : float
-        Step (s) of the fixed-step methods.
+        Step (s) of the fixed-step methods: steps end on t0 + k·dt exactly, the last on t_end.
     rtol, atol : float or (2 nq,) array
-        Error control of adaptive methods, per component of y = [q, q̇] (m, rad; per s).
+        Error control of adaptive methods, per component of y = [q, q̇] (m, rad; per s). With
+        atol = 0 a component's tolerance is purely relative (an exactly zero component counts as
+        exact). SciPy's methods raise rtol to their floor 100 ε.
     first_step : float, optional
         First step (s) of an adaptive run; estimated (Hairer's rule) by default.
     stiffness_warning : bool
@@ -148,7 +150,8 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
     progress : bool
         Show a progress bar (tqdm when installed).
     max_steps, max_step
-        Limits: a run that needs more steps raises SimulationError.
+        Limits: a run that needs more steps (accepted and rejected) raises SimulationError, which
+        carries the partial result.
     adaptive : bool, optional
         Step-size control: on by default for dopri5 and rkf45 (``False`` runs them at the
         fixed step ``dt``), off by default for the Newmark family (``True`` switches on its
@@ -161,6 +164,10 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
         Newton matrix of the Newmark family: "tangent" (the exact tangent
         M + γ'h ∂r/∂q̇ + β'h² ∂r/∂q, analytic for recursive systems, dense LU), "spring" (the
         O(n) matrix of "implicit_spring") or "auto" (spring for implicit_spring, else tangent).
+    stop : threading.Event, optional
+        Checked about every 0.05 s of wall time: once set, the run stops and returns its partial
+        result (with a RuntimeWarning). The way to stop a run in a worker thread, which Ctrl-C
+        does not reach (Python delivers signals to the main thread only).
 
     Returns
     -------
@@ -168,10 +175,16 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
 
     Raises
     ------
+    ValueError
+        Bad input, naming the argument.
     SimulationError
-        With the time, the step size and the cause (step size underflow, NaN state,
-        Newton divergence, singular matrix, max_steps). Ctrl-C returns the partial result
-        with a RuntimeWarning instead.
+        With the time, the step size and the cause (step size underflow, NaN state, Newton
+        divergence, singular matrix, max_steps). Its ``result`` attribute holds the partial
+        Result up to the last accepted step, ``time`` and ``cause`` the failure's time (s) and
+        cause.
+
+    Ctrl-C in the main thread — in the C++ loop, in a Python drive or force law, or in a
+    ``scipy:`` method — returns the partial result with a RuntimeWarning (``result.interrupted``).
     """
     n = system.nq
     q0 = np.zeros(n) if q0 is None else _checks.array(q0, (n,), "q0")
@@ -181,28 +194,32 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
     if not t_end > t0:
         raise ValueError(f"t_end: expected a time after t0 = {t0} s, got {t_end}")
     t_eval = np.zeros(0) if t_eval is None else _checks.vector(t_eval, "t_eval")
-    if method.startswith("scipy:"):
-        return _simulate_scipy(system, method[6:], t0, t_end, q0, qd0, t_eval, rtol, atol, max_step)
-    opt = _core.IntegratorOptions()
-    opt.method = method
-    opt.dt = 0.0 if dt is None else _checks.scalar(dt, "dt", positive=True)
-    if first_step is not None:
-        opt.dt = _checks.scalar(first_step, "first_step", positive=True)
-    opt.rtol = _tolerance(rtol, "rtol", n)
-    opt.atol = _tolerance(atol, "atol", n)
-    opt.max_step = float(max_step)
-    opt.max_steps = int(max_steps)
-    opt.adaptive = -1 if adaptive is None else int(bool(adaptive))
-    opt.beta, opt.gamma, opt.alpha, opt.rho_inf = float(beta), float(gamma), float(alpha), float(rho_inf)
-    opt.newton_tol = _checks.scalar(newton_tol, "newton_tol", positive=True)
-    opt.newton_max_iterations = int(newton_max_iterations)
-    opt.iteration_matrix = iteration_matrix
+    if not isinstance(method, str):
+        raise ValueError(f"method: expected a method name such as 'dopri5' (see rigidfem.simulate), got {method!r}")
+    max_steps = _checks.integer(max_steps, "max_steps", minimum=1, maximum=2**62)
+    max_step = _checks.step_limit(max_step, "max_step")
+    rtol, atol = _tolerance(rtol, "rtol", n), _tolerance(atol, "atol", n)
+    if stop is not None and not callable(getattr(stop, "is_set", None)):
+        raise ValueError(f"stop: expected None or a threading.Event (an object with is_set()), got {stop!r}")
     bar = _ProgressBar(t0, t_end) if progress else None
     try:
-        t, q, qd, stats, interrupted = _core._integrate(system, t0, t_end, q0, qd0, t_eval, opt, bar)
+        if method.startswith("scipy:"):
+            run = _run_scipy(system, method[6:], t0, t_end, q0, qd0, t_eval, rtol, atol, max_step, max_steps,
+                             _keep_going(bar, stop))
+        else:
+            opt = _options(method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, beta, gamma, alpha,
+                           rho_inf, newton_tol, newton_max_iterations, iteration_matrix)
+            run = _core._integrate(system, t0, t_end, q0, qd0, t_eval, opt, _keep_going(bar, stop))
     finally:
         if bar is not None:
             bar.close()
+    t, q, qd, stats, interrupted, failure = run
+    result = Result(system, t, q, qd, stats, method, interrupted)
+    if failure is not None:
+        message, time, cause = failure
+        error = _core.SimulationError(message)
+        error.result, error.time, error.cause = result, time, cause
+        raise error
     if stiffness_warning and np.isfinite(stats.get("stiff_at", np.nan)):
         warnings.warn(f"{method}: the problem is stiff from t = {stats['stiff_at']:.6g} s on (h rho > 3.25): the step is "
                       "bounded by stability, the cost grows with the highest frequency and loose tolerances leave "
@@ -211,36 +228,123 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
     if interrupted:
         warnings.warn(f"simulation interrupted at t = {t[-1] if len(t) else t0:g} s: returning the partial result",
                       RuntimeWarning, stacklevel=2)
-    return Result(system, t, q, qd, stats, method, interrupted)
+    return result
+
+
+def _options(method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, beta, gamma, alpha, rho_inf,
+             newton_tol, newton_max_iterations, iteration_matrix):
+    """The C++ integrator's options, each checked and converted."""
+    opt = _core.IntegratorOptions()
+    opt.method = method
+    opt.dt = 0.0 if dt is None else _checks.scalar(dt, "dt", positive=True)
+    if first_step is not None:
+        opt.dt = _checks.scalar(first_step, "first_step", positive=True)
+    opt.rtol, opt.atol = rtol, atol
+    opt.max_step, opt.max_steps = max_step, max_steps
+    opt.adaptive = -1 if adaptive is None else int(_checks.boolean(adaptive, "adaptive"))
+    opt.beta, opt.gamma = _checks.scalar(beta, "beta"), _checks.scalar(gamma, "gamma")
+    opt.alpha, opt.rho_inf = _checks.scalar(alpha, "alpha"), _checks.scalar(rho_inf, "rho_inf")
+    opt.newton_tol = _checks.scalar(newton_tol, "newton_tol", positive=True)
+    opt.newton_max_iterations = _checks.integer(newton_max_iterations, "newton_max_iterations", minimum=1,
+                                                maximum=10**6)
+    if not isinstance(iteration_matrix, str):
+        raise ValueError(f"iteration_matrix: expected 'auto', 'tangent' or 'spring', got {iteration_matrix!r}")
+    opt.iteration_matrix = iteration_matrix
+    return opt
+
+
+def _keep_going(bar, stop):
+    """The monitor of a run, called about every 0.05 s with t: updates the progress bar, and
+    returns False once ``stop`` is set. None when there is nothing to do."""
+    if bar is None and stop is None:
+        return None
+
+    def keep_going(t):
+        if bar is not None:
+            bar(t)
+        return stop is None or not stop.is_set()
+
+    return keep_going
 
 
 def _tolerance(x, name, n) -> np.ndarray:
-    tol = np.atleast_1d(np.asarray(x, dtype=float))
-    if tol.ndim != 1 or tol.size not in (1, 2 * n) or not np.all(np.isfinite(tol)) or np.any(tol < 0):
+    try:
+        tol = np.atleast_1d(np.asarray(x, dtype=float))
+    except (TypeError, ValueError):
+        tol = None
+    if tol is None or tol.ndim != 1 or tol.size not in (1, 2 * n) or not np.all(np.isfinite(tol)) or np.any(tol < 0):
         raise ValueError(f"{name}: expected a non-negative number or {2 * n} (2 nq) of them, got {x!r}")
     return tol
 
 
-def _simulate_scipy(system, name, t0, t_end, q0, qd0, t_eval, rtol, atol, max_step) -> Result:
-    """SciPy's solve_ivp with the C++ rhs and Jacobian (analytic for recursive systems; slow path)."""
+def _run_scipy(system, name, t0, t_end, q0, qd0, t_eval, rtol, atol, max_step, max_steps, keep_going):
+    """SciPy's step-by-step solvers (the OdeSolver classes behind solve_ivp) with the C++ rhs and
+    Jacobian (analytic for recursive systems), stepped here so that max_steps, Ctrl-C and ``stop``
+    hold as in the C++ loop (Python per step: the slow path). Returns what _core._integrate does."""
     import time
 
-    from scipy.integrate import solve_ivp
+    import scipy.integrate
 
     if name not in SCIPY_METHODS:
         raise ValueError(f"method: expected one of {['scipy:' + m for m in SCIPY_METHODS]}, got 'scipy:{name}'")
-    start = time.perf_counter()
-    jac = system.jacobian if name in ("Radau", "BDF", "LSODA") else None
-    sol = solve_ivp(system.rhs, (t0, t_end), np.concatenate([q0, qd0]), method=name, rtol=rtol, atol=atol,
-                    t_eval=t_eval if len(t_eval) else None, jac=jac, max_step=max_step, dense_output=False)
-    wall = time.perf_counter() - start
-    if not sol.success:
-        raise _core.SimulationError(f"at t = {sol.t[-1]} s: scipy {name} failed: {sol.message}")
+    if np.max(rtol) == 0.0 and np.min(atol) == 0.0:
+        raise ValueError("atol: expected positive values when rtol is zero")
     n = system.nq
-    stats = {"steps": len(sol.t) - 1 if not len(t_eval) else -1, "rejected_steps": -1, "rhs_evaluations": int(sol.nfev),
-             "jacobians": int(sol.njev), "factorizations": int(sol.nlu), "newton_iterations": -1, "wall_time": wall,
+    start = time.perf_counter()
+    solver_class = getattr(scipy.integrate, name)
+    options = {"jac": system.jacobian} if name in ("Radau", "BDF", "LSODA") else {}
+    rtol = np.maximum(rtol, 100 * np.finfo(float).eps)  # SciPy's floor, without its warning
+    solver = solver_class(system.rhs, t0, np.concatenate([q0, qd0]), t_end, rtol=rtol if rtol.size > 1 else rtol[0],
+                          atol=atol if atol.size > 1 else atol[0], max_step=max_step, **options)
+    ts, ys = ([t0], [solver.y.copy()]) if not len(t_eval) else ([], [])
+    ts, ys = _scipy_outputs(t_eval, t0, t0, None, solver.y, ts, ys)
+    steps, last_check, interrupted, failure = 0, start, False, None
+    try:
+        while solver.status == "running":
+            if steps >= max_steps:
+                failure = _failure(solver.t, f"max_steps = {max_steps} reached (scipy {name})")
+                break
+            t_before = solver.t
+            message = solver.step()
+            if solver.status == "failed":
+                failure = _failure(solver.t, f"scipy {name} failed: {message}")
+                break
+            steps += 1
+            dense = solver.dense_output() if len(t_eval) else None
+            ts, ys = _scipy_outputs(t_eval, t_before, solver.t, dense, solver.y, ts, ys)
+            if keep_going is not None and time.perf_counter() - last_check > 0.05:
+                last_check = time.perf_counter()
+                if not keep_going(solver.t):
+                    interrupted = True
+                    break
+    except KeyboardInterrupt:
+        interrupted = True
+    y = np.array(ys).reshape(len(ys), 2 * n)
+    stats = {"steps": steps, "rejected_steps": -1, "rhs_evaluations": int(solver.nfev), "jacobians": int(solver.njev),
+             "factorizations": int(solver.nlu), "newton_iterations": -1, "wall_time": time.perf_counter() - start,
              "stiff_at": float("nan")}
-    return Result(system, sol.t, sol.y[:n].T.copy(), sol.y[n:].T.copy(), stats, "scipy:" + name)
+    return np.array(ts, dtype=float), y[:, :n].copy(), y[:, n:].copy(), stats, interrupted, failure
+
+
+def _scipy_outputs(t_eval, t_before, t_after, dense, y_after, ts, ys):
+    """Append the outputs of a step (t_before, t_after]: each requested time it covers by the
+    solver's dense output (t_eval given), or the step's end."""
+    if not len(t_eval):
+        if t_after > t_before:
+            ts.append(t_after)
+            ys.append(y_after.copy())
+        return ts, ys
+    lo = np.searchsorted(t_eval, t_before, side="right" if ts else "left")
+    hi = np.searchsorted(t_eval, t_after, side="right")
+    for tk in t_eval[lo:hi]:
+        ts.append(float(tk))
+        ys.append(y_after.copy() if tk == t_after or dense is None else dense(tk))
+    return ts, ys
+
+
+def _failure(t, cause):
+    """(message, time, cause) of a failed run, as _core._integrate reports it."""
+    return f"at t = {t:.10g} s: {cause}", float(t), cause
 
 
 class _ProgressBar:

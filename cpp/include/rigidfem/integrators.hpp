@@ -6,6 +6,7 @@
 /// The methods are listed once, in the table of integrate.cpp (stepper.hpp says how to add one).
 #pragma once
 
+#include <exception>
 #include <functional>
 #include <limits>
 #include <string>
@@ -69,6 +70,10 @@ struct Trajectory {
   std::vector<VecX> q, qd;  // (len t) x (nq)
   IntegratorStats stats;
   bool interrupted = false;  ///< the monitor asked to stop: the trajectory ends early
+  /// The exception that ended the run early — a SimulationError (numerical failure, max_steps),
+  /// or one thrown by a user callback (a Python drive, force law or monitor: KeyboardInterrupt) —
+  /// or null. The trajectory then holds the outputs of the steps accepted before it.
+  std::exception_ptr error;
 };
 
 /// Called about every 0.05 s of wall time with the current time; returning false stops
@@ -78,6 +83,9 @@ using Monitor = std::function<bool(double)>;
 /// Integrates from (t0, q0, q̇0) to t_end. Output at `t_eval` (increasing, within
 /// [t0, t_end]) by each method's dense output — Dormand–Prince's own continuous extension,
 /// cubic Hermite interpolation of y and ẏ otherwise — or at every step if it is empty.
+/// Fixed steps land on t0 + k·dt exactly (the last one on t_end). Bad options throw
+/// std::invalid_argument; a failure during the run is returned in Trajectory::error with the
+/// partial trajectory.
 Trajectory integrate(const System& sys, double t0, double t_end, const VecX& q0, const VecX& qd0,
                      const Eigen::Ref<const VecX>& t_eval, const IntegratorOptions& options, const Monitor& monitor);
 

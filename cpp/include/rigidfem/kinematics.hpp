@@ -29,6 +29,10 @@ void kinematics(const System& sys, Data& d, bool rates = true);
 /// twists or rates: all the recursive algorithms need. Exact joints only.
 void frames_and_axes(const System& sys, Data& d);
 
+/// (qa) => T_p only, the cheapest pass (positions): the frames after each elementary factor for
+/// exact joints, jcalc without rates for linear ones.
+void frames(const System& sys, Data& d);
+
 /// A load at the current state, global: point of application x (m), force F (N), torque τ
 /// (N·m), with its time scale and load factor applied and follower loads turned with the body.
 struct AppliedLoad {

@@ -2,6 +2,8 @@
 /// outputs of a simulation result.
 #pragma once
 
+#include <vector>
+
 #include "rigidfem/system.hpp"
 
 namespace rigidfem {
@@ -25,6 +27,9 @@ Energies energies(const System& sys, Data& d, double t, const Eigen::Ref<const V
 const Mat4& body_pose(const System& sys, Data& d, int body, double t, const Eigen::Ref<const VecX>& q);
 /// Global position (3) in m of the point r (body frame) of a body at (t, q).
 Vec3 point_position(const System& sys, Data& d, const Point& point, double t, const Eigen::Ref<const VecX>& q);
+/// Global positions (k, 3) in m of several points at (t, q), from one kinematics pass.
+MatX point_positions(const System& sys, Data& d, const std::vector<Point>& points, double t,
+                     const Eigen::Ref<const VecX>& q);
 /// Global velocity (3) in m/s of the point r of a body at (t, q, q̇).
 Vec3 point_velocity(const System& sys, Data& d, const Point& point, double t, const Eigen::Ref<const VecX>& q,
                     const Eigen::Ref<const VecX>& qd);
@@ -38,7 +43,7 @@ struct StateOutputs {
 StateOutputs evaluate_outputs(const System& sys, const Eigen::Ref<const VecX>& t, const Eigen::Ref<const RowMatX>& Q,
                               const Eigen::Ref<const RowMatX>& QD);
 /// Global positions (N, 3) of the point r (body frame) of `body` at (t_k, q_k), expressed in
-/// the frame of body `frame` (−1: global).
+/// the frame of body `frame` (−1: global): one positions-only kinematics pass per sample.
 MatX point_positions(const System& sys, int body, const Vec3& r, int frame, const Eigen::Ref<const VecX>& t,
                      const Eigen::Ref<const RowMatX>& Q);
 

@@ -17,8 +17,13 @@ namespace rigidfem {
 struct Tolerances {
   VecX atol, rtol;
 };
+/// RMS of v_i / sc_i, with 0/0 counted as 0 (an exactly zero component under a pure relative
+/// tolerance); 0 for an empty vector (nq = 0).
+double scaled_rms(const VecX& v, const VecX& sc);
 /// Scaled RMS norm of an error e against the weights atol + rtol max(|y0|, |y1|), per component.
 double error_norm(const VecX& e, const VecX& y0, const VecX& y1, const VecX& atol, const VecX& rtol);
+/// max |v_i|, 0 for an empty vector.
+inline double max_abs(const VecX& v) { return v.size() ? v.cwiseAbs().maxCoeff() : 0.0; }
 /// Cubic Hermite interpolation of y on [t0, t0 + h] at θ = (t − t0)/h from y and ẏ at both ends.
 VecX hermite(double theta, double h, const VecX& y0, const VecX& f0, const VecX& y1, const VecX& f1);
 /// SimulationError naming the time, the step size and the cause.

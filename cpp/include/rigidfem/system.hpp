@@ -30,7 +30,9 @@ struct Coordinate {
 /// How the equations of motion are evaluated.
 enum class Algorithm { Lagrange, Recursive };
 
-class System {
+/// Made by Model::compile as a shared object (weak_from_this identifies it, e.g. to the
+/// workspaces the bindings keep per thread).
+class System : public std::enable_shared_from_this<System> {
  public:
   /// Recursive (O(n), the default) or the book's Lagrange formulation; systems with linear
   /// joints always use Lagrange.
