@@ -1,4 +1,4 @@
-"""``python -m benchmarks {scaling,peers} [--quick] [--output DIR]``, from the root of a checkout."""
+"""``python -m benchmarks {scaling,peers,scale} [--quick] [--output DIR]``, from the root of a checkout."""
 
 from __future__ import annotations
 
@@ -10,6 +10,7 @@ import sys
 COMMANDS = {
     "scaling": "forward-dynamics and implicit-step cost against the number of coordinates",
     "peers": "rigidfem against Pinocchio and MuJoCo (needs: pip install pin mujoco)",
+    "scale": "hidden costs at scale: Python calls against C++, outputs, building long beams",
 }
 
 
