@@ -4,6 +4,7 @@
 #include <vector>
 
 #include "bindings.hpp"
+#include "rigidfem/constraints.hpp"
 #include "rigidfem/dynamics.hpp"
 #include "rigidfem/kinematics.hpp"
 #include "rigidfem/outputs.hpp"
@@ -117,6 +118,75 @@ void bind_dynamics(py::module_& m) {
                              "Pseudo-inertia H_p = int r r^T dm (4, 4) of every body, body frame (kg, kg m, kg m^2).")
       .def_property_readonly("placements", [](const System& s) { return s.B; },
                              "Constant joint placements B_p (4, 4) in the parent frame.")
+      .def_readonly("nl", &System::nl, "Number of constraint equations of the loop closures (multipliers).")
+      .def_property_readonly(
+          "loop_names",
+          [](const System& s) {
+            std::vector<std::string> names;
+            for (const Loop& L : s.loops) names.push_back(L.name);
+            return names;
+          },
+          "Names of the loop closures, in the order of loop_reactions().")
+      .def_property_readonly(
+          "loop_kinds",
+          [](const System& s) {
+            std::vector<std::string> kinds;
+            for (const Loop& L : s.loops) kinds.push_back(loop_kind_name(L.kind));
+            return kinds;
+          },
+          "Kind of every loop closure ('revolute', ..., 'distance').")
+      .def(
+          "loop_constraints",
+          [](const System& s, double t, const RefV& q, const RefV& qd) {
+            Workspace d(s);
+            loop_equations(s, *d, t, q, qd);
+            return py::make_tuple(VecX((*d).g), VecX((*d).gd), free_jacobian(s, *d));
+          },
+          py::arg("t"), py::arg("q"), py::arg("qd"),
+          "(g, gd, G): the loop closures' constraint equations g(q, t) (nl,) (m, or the cosine for direction\n"
+          "rows), their rates gd = G qd + dg/dt (nl,) and the Jacobian G = dg/dq (nl, nq).")
+      .def(
+          "loop_multipliers",
+          [](const System& s, double t, const RefV& q, const RefV& qd) {
+            Workspace d(s);
+            rigidfem::forward_dynamics(s, *d, t, q, qd);
+            return VecX((*d).lambda);
+          },
+          py::arg("t"), py::arg("q"), py::arg("qd"),
+          "Multipliers lambda (nl,) of M qdd = f + G^T lambda at the forward-dynamics accelerations.")
+      .def(
+          "loop_reactions",
+          [](const System& s, double t, const RefV& q, const RefV& qd) {
+            Workspace d(s);
+            rigidfem::forward_dynamics(s, *d, t, q, qd);
+            return rigidfem::loop_reactions(s, *d, (*d).lambda);
+          },
+          py::arg("t"), py::arg("q"), py::arg("qd"),
+          "Reaction of every loop closure on its body b (nloops, 6): force (N) and torque (N m, about frame B's\n"
+          "origin) in frame A's axes; for a distance loop (an actuator) the force along the line in column 0,\n"
+          "positive pushing b away from a.")
+      .def(
+          "_loop_reaction_history",
+          [](const System& s, const RefV& t, const Eigen::Ref<const RowMatX>& q, const Eigen::Ref<const RowMatX>& qd) {
+            Workspace d(s);
+            RowMatX W(t.size(), 6 * s.loops.size());
+            for (Eigen::Index k = 0; k < t.size(); ++k) {
+              rigidfem::forward_dynamics(s, *d, t(k), q.row(k).transpose(), qd.row(k).transpose());
+              const RowMatX w = rigidfem::loop_reactions(s, *d, (*d).lambda);
+              W.row(k) = Eigen::Map<const Eigen::RowVectorXd>(w.data(), w.size());
+            }
+            return W;
+          },
+          py::arg("t"), py::arg("q"), py::arg("qd"))
+      .def(
+          "_assemble",
+          [](const System& s, double t, const RefV& q, const RefV& qd, double tol, int max_iterations) {
+            Workspace d(s);
+            VecX x = q, xd = qd;
+            project_onto_loops(s, *d, t, x, xd, tol, max_iterations);
+            return py::make_tuple(x, xd);
+          },
+          py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("tol"), py::arg("max_iterations"))
       .def(
           "forward_dynamics", [](const System& s, double t, const RefV& q, const RefV& qd) {
             Workspace d(s);

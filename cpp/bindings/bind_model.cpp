@@ -68,6 +68,14 @@ void bind_model(py::module_& m) {
              ProfilePtr scale) { model.add_load({body, point, force, torque, follower, std::move(scale)}); },
           py::arg("body"), py::arg("point"), py::arg("force"), py::arg("torque"), py::arg("follower"),
           py::arg("scale"))
+      .def(
+          "_add_loop",
+          [](Model& model, const std::string& name, const std::string& kind, int a, const Mat4& frame_a, int b,
+             const Mat4& frame_b, double length, ProfilePtr drive) {
+            return model.add_loop({name, parse_loop_kind(kind, "kind"), a, b, frame_a, frame_b, length, std::move(drive)});
+          },
+          py::arg("name"), py::arg("kind"), py::arg("a"), py::arg("frame_a"), py::arg("b"), py::arg("frame_b"),
+          py::arg("length"), py::arg("drive"))
       .def("_body_index", &Model::body_index, py::arg("name"))
       .def("_coordinate_index", &Model::coordinate_index, py::arg("body"), py::arg("coordinate"))
       .def_property("gravity", &Model::gravity, &Model::set_gravity, "Gravitational acceleration (m/s^2), global.")

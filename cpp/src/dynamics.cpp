@@ -1,7 +1,9 @@
 #include "rigidfem/dynamics.hpp"
 
 #include <cmath>
+#include <limits>
 
+#include "rigidfem/constraints.hpp"
 #include "rigidfem/derivatives.hpp"
 #include "rigidfem/errors.hpp"
 #include "rigidfem/lagrange.hpp"
@@ -59,10 +61,11 @@ void set_load_factor(Data& d, double load_factor) {
 }  // namespace
 
 void dynamics_kinematics(const System& sys, Data& d) {
-  if (recursive(sys))
+  if (recursive(sys) && sys.nl == 0)
     frames_and_axes(sys, d);
   else
-    kinematics(sys, d);
+    kinematics(sys, d);  // loops: T̈ and the twists U for g, G and γ (the axes come with them)
+  if (sys.nl > 0) constraint_equations(sys, d);
 }
 
 void generalized_forces(const System& sys, Data& d) {
@@ -96,9 +99,14 @@ void driving_forces(const System& sys, Data& d) {
   check_data(sys, d);
   if (sys.np == 0) return;
   set_accelerations(sys, d, d.qdd);
-  if (recursive(sys)) return rnea_driving_forces(sys, d);
-  kinematics(sys, d);  // T̈ now holds the full accelerations
-  lagrange_driving_forces(sys, d);
+  if (recursive(sys)) {
+    rnea_driving_forces(sys, d);
+  } else {
+    kinematics(sys, d);  // T̈ now holds the full accelerations
+    lagrange_driving_forces(sys, d);
+  }
+  // The prescribed rows of M q̈ = f + τ + Gᵀλ: the loops carry part of the load.
+  if (sys.nl > 0) d.tau -= d.G(Eigen::all, sys.drive_coords).transpose() * d.lambda;
 }
 
 VecX inverse_dynamics(const System& sys, Data& d) {
@@ -116,12 +124,74 @@ const VecX& forward_dynamics(const System& sys, Data& d, double t, const Eigen::
   dynamics_kinematics(sys, d);
   if (recursive(sys)) {
     aba(sys, d);
-    return d.qdd;
+  } else {
+    lagrange_forces(sys, d);
+    lagrange_mass_matrix(sys, d);
+    accelerations(sys, d);
   }
-  lagrange_forces(sys, d);
-  lagrange_mass_matrix(sys, d);
-  accelerations(sys, d);
+  if (sys.nl > 0) close_loops(sys, d);
   return d.qdd;
+}
+
+namespace {
+
+/// The loop with the largest |g| (its name and that residual), for messages.
+std::string worst_loop(const System& sys, const Data& d) {
+  Eigen::Index r = 0;
+  const double worst = d.g.cwiseAbs().maxCoeff(&r);
+  std::size_t k = 0;
+  while (k + 1 < sys.loops.size() && sys.loop_row[k + 1] <= r) ++k;
+  return "loop '" + sys.loops[k].name + "' (" + loop_kind_name(sys.loops[k].kind) + ", residual " + num(worst) + ")";
+}
+
+}  // namespace
+
+void close_loops(const System& sys, Data& d) {
+  const MatX G = free_jacobian(sys, d);
+  MatX Y = G.transpose();  // Y = M⁻¹ Gᵀ, column by column with the tree's factorisation
+  if (recursive(sys)) {
+    VecX y;
+    for (int j = 0; j < sys.nl; ++j) {
+      y = Y.col(j);
+      aba_solve(sys, d, y, y);
+      Y.col(j) = y;
+    }
+  } else {
+    Y = d.llt.solve(Y);
+  }
+  d.lambda = least_norm(G * Y, d.gamma - G * d.qdd);
+  d.qdd += Y * d.lambda;
+  set_accelerations(sys, d, d.qdd);
+  if (!d.qdd.allFinite()) throw SimulationError(d.t, "accelerations of the closed loops are NaN or inf");
+}
+
+void loop_equations(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                    const Eigen::Ref<const VecX>& qd) {
+  set_state(sys, d, t, q, qd);
+  kinematics(sys, d);
+  constraint_equations(sys, d);
+}
+
+double project_onto_loops(const System& sys, Data& d, double t, VecX& q, VecX& qd, double tol, int max_iterations) {
+  if (sys.nl == 0) return 0.0;
+  double residual = 0.0;
+  for (int it = 0;; ++it) {
+    loop_equations(sys, d, t, q, qd);
+    residual = d.g.cwiseAbs().maxCoeff();
+    if (residual <= tol) break;
+    if (it == max_iterations || !std::isfinite(residual) || sys.nq == 0)
+      throw SimulationError(t, "the closed loops cannot be assembled: Gauss-Newton from the given coordinates left " +
+                                   worst_loop(sys, d) + " after " + std::to_string(it) +
+                                   " iterations; give coordinates closer to a closed configuration");
+    const MatX G = free_jacobian(sys, d);
+    const VecX dq = G.transpose() * least_norm(G * G.transpose(), d.g);
+    q -= dq;
+    // Stagnation at round-off (large coordinates): the residual left is what the numbers carry.
+    if (sys.nq == 0 || dq.cwiseAbs().maxCoeff() <= 1e-15 * (1.0 + q.cwiseAbs().maxCoeff())) tol = std::numeric_limits<double>::infinity();
+  }
+  const MatX G = free_jacobian(sys, d);
+  qd -= G.transpose() * least_norm(G * G.transpose(), d.gd);
+  return residual;
 }
 
 const MatX& mass_matrix(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q) {

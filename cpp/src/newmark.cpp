@@ -9,6 +9,7 @@
 #include <cmath>
 #include <limits>
 
+#include "rigidfem/constraints.hpp"
 #include "rigidfem/dynamics.hpp"
 #include "rigidfem/errors.hpp"
 #include "rigidfem/kinematics.hpp"
@@ -19,7 +20,7 @@ namespace rigidfem {
 namespace {
 
 struct NewmarkState {
-  VecX q, v, qdd, a;
+  VecX q, v, qdd, a, lambda;  // lambda (nl): the loops' multipliers at the same time
 };
 
 class NewmarkFamily final : public Stepper {
@@ -55,7 +56,7 @@ class NewmarkFamily final : public Stepper {
   void start(double t0, const VecX& q0, const VecX& qd0) override {
     ++stats_.rhs_evaluations;
     const VecX qdd = forward_dynamics(sys_, d_, t0, q0, qd0);
-    s_ = {q0, qd0, qdd, qdd};
+    s_ = {q0, qd0, qdd, qdd, d_.lambda};
     y_.resize(2 * sys_.nq);
     y_ << q0, qd0;
   }
@@ -111,12 +112,13 @@ class NewmarkFamily final : public Stepper {
       // mode's large acceleration does not throw the first iterate far off.
       const VecX a1 = (-(0.5 - beta_) / beta_) * s.a;
       s1.qdd = ((1.0 - am_) * a1 - af_ * s.qdd + am_ * s.a) / (1.0 - af_);
+      s1.lambda = s.lambda;
       double previous = std::numeric_limits<double>::infinity();
       for (int it = 0; it < max_it_; ++it) {
         update(h, s, s1);
         const VecX r = residual(t + h, s1);
-        const VecX dx =
-            spring_ ? spring_correction(h, r, bp, gp) : tangent_correction(t + h, h, r, bp, gp, it == 0);
+        VecX dx = spring_ ? spring_correction(h, r, bp, gp) : tangent_correction(t + h, h, r, bp, gp, it == 0);
+        if (sys_.nl > 0) close_loops_correction(h * h * bp, s1, dx);
         ++stats_.newton_iterations;
         if (!dx.allFinite()) break;
         s1.qdd += dx;
@@ -148,13 +150,38 @@ class NewmarkFamily final : public Stepper {
     s1.v = s.v + h * ((1.0 - gamma_) * s.a + gamma_ * s1.a);
   }
 
-  /// r = M(q) q̈ − f(q, q̇, t) at the iterate (inverse dynamics: O(n) for recursive systems).
+  /// r = M(q) q̈ − f(q, q̇, t) − Gᵀλ at the iterate (inverse dynamics: O(n) for recursive
+  /// systems; with loops, g and G are left in d_ for close_loops_correction).
   VecX residual(double t, const NewmarkState& s1) {
     set_state(sys_, d_, t, s1.q, s1.v);
     set_accelerations(sys_, d_, s1.qdd);
     dynamics_kinematics(sys_, d_);
     ++stats_.rhs_evaluations;
-    return inverse_dynamics(sys_, d_);
+    VecX r = inverse_dynamics(sys_, d_);
+    if (sys_.nl > 0) r -= free_jacobian(sys_, d_).transpose() * s1.lambda;
+    return r;
+  }
+
+  /// Index 3 (Arnold & Brüls): the Newton step of [S −Gᵀ; G 0] [Δq̈; Δλ] = −[r; g/(β'h²)] by
+  /// its Schur complement. dx = −S⁻¹ r on entry; Y = S⁻¹ Gᵀ by nl solves with the iteration
+  /// matrix, (G Y) Δλ = −g/(β'h²) − G dx, then dx += Y Δλ and λ += Δλ. O(n·nl + nl³).
+  void close_loops_correction(double bh2, NewmarkState& s1, VecX& dx) {
+    const MatX G = free_jacobian(sys_, d_);
+    const VecX g = d_.g;
+    MatX Y = G.transpose();
+    if (spring_) {
+      VecX y;
+      for (int j = 0; j < sys_.nl; ++j) {
+        y = Y.col(j);
+        solve_armature(sys_, d_, y, y);
+        Y.col(j) = y;
+      }
+    } else {
+      Y = lu_.solve(Y);
+    }
+    const VecX dl = least_norm(G * Y, -g / bh2 - G * dx);
+    dx += Y * dl;
+    s1.lambda += dl;
   }
 
   /// Newton: −S⁻¹ r with the tangent S = M + γ' h ∂r/∂q̇ + β' h² ∂r/∂q, kept while h stays

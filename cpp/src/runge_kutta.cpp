@@ -23,6 +23,13 @@ class FirstOrder {
     ydot.head(n) = y.tail(n);
     ydot.tail(n) = forward_dynamics(sys_, d_, t, y.head(n), y.tail(n));
   }
+  /// y onto the loops' constraint manifold at t (closure residual <= 1e-12).
+  void project(double t, VecX& y) {
+    const int n = sys_.nq;
+    VecX q = y.head(n), qd = y.tail(n);
+    project_onto_loops(sys_, d_, t, q, qd, 1e-12, 10);
+    y << q, qd;
+  }
 
  private:
   const System& sys_;
@@ -176,6 +183,11 @@ class RungeKutta final : public Stepper {
   }
 
   const VecX& state() const override { return y_; }
+
+  void project(double t) override {
+    ode_.project(t, y_);
+    ode_.eval(t, y_, f_);  // the next step starts from the projected state
+  }
 
   VecX dense(double t) const override {
     const double theta = (t - t0_) / h_;

@@ -15,6 +15,10 @@ std::shared_ptr<const System> Model::compile(Algorithm algorithm) const {
   s.nbodies = static_cast<int>(bodies_.size());
   s.gravity = gravity_;
   s.loads = loads_;
+  s.loops = loops_;
+  s.loop_row.push_back(0);
+  for (const Loop& L : loops_) s.loop_row.push_back(s.loop_row.back() + loop_rows(L.kind));
+  s.nl = s.loop_row.back();
   s.coord_start.push_back(0);
   for (int p = 0; p < s.nbodies; ++p) {
     const BodySpec& b = bodies_[p];
@@ -116,6 +120,11 @@ Data::Data(const System& s)
       f(VecX::Zero(s.nq)),
       qdd(VecX::Zero(s.nq)),
       tau(VecX::Zero(s.np)),
+      g(VecX::Zero(s.nl)),
+      gd(VecX::Zero(s.nl)),
+      gamma(VecX::Zero(s.nl)),
+      G(MatX::Zero(s.nl, s.nc)),
+      lambda(VecX::Zero(s.nl)),
       axes(s.nuses, Vec6::Zero()),
       v(s.nbodies, Vec6::Zero()),
       c(s.nbodies, Vec6::Zero()),

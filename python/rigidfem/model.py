@@ -10,7 +10,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from . import _checks, _contract, _core
+from . import _checks, _contract, _core, loops
 from ._core import Body, JointSpec, Point, Profile
 from .beams import add_beam
 from .frames import transform  # noqa: F401 (re-exported: rigidfem.model.transform)
@@ -176,6 +176,40 @@ class Model(_core._Model):
             raise ValueError(f"point: expected a Point or Body of this model, got {point!r}")
         return point
 
+    def add_loop_joint(self, kind: str, a, b, *, frame_a=None, frame_b=None, length: float | None = None,
+                       name: str | None = None) -> str:
+        """Close a kinematic loop: a joint of ``kind`` between ``a`` and ``b`` (book ch. 2.6).
+
+        Parameters
+        ----------
+        kind : str
+            "revolute", "spherical", "universal", "prismatic", "cylindrical", "fixed" or
+            "distance" (``rigidfem.loops`` tabulates what each leaves free; axes are those of
+            frame A, z for revolute, prismatic and cylindrical joints).
+        a, b : Body, Point or ``model.ground``
+            The two bodies (rigid bodies or rfes of a beam). A Point places the joint frame at
+            that point with the body's axes; a Body at its frame.
+        frame_a, frame_b : (4, 4) array, optional
+            Pose of the joint frame in the body's frame (``rigidfem.transform``), for a Body.
+            Frames A and B coincide when the loop is closed (distance: their origins are
+            ``length`` apart).
+        length : float
+            m, distance loops only.
+        name : str, optional
+            Names its reaction in ``System.loop_names``; "loop<k>" by default.
+
+        Returns the loop's name. The initial coordinates of a simulation must close every loop:
+        ``System.assemble`` finds them from a guess.
+        """
+        return loops.add_loop_joint(self, kind, a, b, frame_a=frame_a, frame_b=frame_b, length=length, name=name)
+
+    def add_actuator(self, a, b, length, *, name: str | None = None) -> str:
+        """A linear actuator (hydraulic cylinder under position control) between the points ``a``
+        and ``b`` (Point or Body): their distance is held at ``length`` (m), a number or a
+        ``rigidfem.motion`` profile l(t). Its force (N, positive pushing the points apart) is the
+        loop's reaction, column 0 of ``System.loop_reactions``. Returns its name."""
+        return loops.add_actuator(self, a, b, length, name=name)
+
     def add_beam(self, name: str, parent, length: float, material, section, elements: int,
                  formulation: str = "modified", deform=None, linear: bool = False, joint=None, placement=None,
                  tip_mass: float = 0.0, tip_inertia=(0.0, 0.0, 0.0), tip_offset=(0.0, 0.0, 0.0)):
@@ -257,6 +291,14 @@ class System(_core._System):
         """Global velocity (3,) in m/s of a ``Point`` (or a ``Body``'s origin)."""
         return self._velocity(point, q, qd, t)
 
+    def assemble(self, q, qd=None, t: float | None = None, tol: float = 1e-12, max_iterations: int = 50):
+        """(q, qd) closing every loop, nearest to the guess: Gauss–Newton on g(q, t) = 0 with
+        least-norm corrections until max |g| <= ``tol`` (m, or the cosine of direction rows),
+        then the velocities projected onto G q̇ + ∂g/∂t = 0. Raises ``SimulationError`` naming the
+        loop that cannot be closed from this guess. ``t`` (s) for prescribed motions; q in m and
+        rad, qd per s (zero by default)."""
+        return loops.assemble(self, q, qd, t, tol, max_iterations)
+
     def coordinate_index(self, name: str) -> int:
         """Index in q of the coordinate called ``name`` (e.g. ``"link1.rz"``)."""
         names = self.coordinate_names
@@ -265,7 +307,8 @@ class System(_core._System):
         return names.index(name)
 
     def __repr__(self) -> str:
-        return f"<rigidfem System: {self.nbodies} bodies, nq={self.nq}, {self.np} prescribed>"
+        loops_ = f", {len(self.loop_names)} loops ({self.nl} constraints)" if self.nl else ""
+        return f"<rigidfem System: {self.nbodies} bodies, nq={self.nq}, {self.np} prescribed{loops_}>"
 
 
 _contract.guard_methods(System)

@@ -94,6 +94,14 @@ class Result:
         """Kinetic + gravity + elastic energy (J)."""
         return self._outputs[2] + self._outputs[3] + self._outputs[4]
 
+    @functools.cached_property
+    def loop_reactions(self) -> np.ndarray:
+        """Reactions of the loop closures (len(t), nloops, 6): force (N) and torque (N·m) on body
+        b in frame A's axes, per ``system.loop_names``; an actuator's force in column 0."""
+        n = len(self.system.loop_names)
+        W = self.system._loop_reaction_history(self.t, self.q, self.qd)
+        return W.reshape(len(self.t), n, 6)
+
     def position(self, point, frame: Body | None = None) -> np.ndarray:
         """Positions (len(t), 3) in m of a ``Point`` (or a ``Body``'s origin), in the global
         frame or in the frame of the body ``frame``."""
@@ -183,6 +191,12 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
         Result up to the last accepted step, ``time`` and ``cause`` the failure's time (s) and
         cause.
 
+    Systems with loop closures (``Model.add_loop_joint``, ``add_actuator``): q0 and qd0 must close
+    every loop (``System.assemble`` finds them); explicit methods project every accepted step back
+    onto the loops (closure residual <= 1e-12), the Newmark family solves the index-3 equations
+    (Arnold & Brüls: the constraints hold at every step to Newton's tolerance). ``scipy:`` methods
+    integrate the constrained accelerations without projection (their residual drifts).
+
     Ctrl-C in the main thread — in the C++ loop, in a Python drive or force law, or in a
     ``scipy:`` method — returns the partial result with a RuntimeWarning (``result.interrupted``).
     """
@@ -201,6 +215,7 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
     rtol, atol = _tolerance(rtol, "rtol", n), _tolerance(atol, "atol", n)
     if stop is not None and not callable(getattr(stop, "is_set", None)):
         raise ValueError(f"stop: expected None or a threading.Event (an object with is_set()), got {stop!r}")
+    _check_closed(system, t0, q0, qd0)
     bar = _ProgressBar(t0, t_end) if progress else None
     try:
         if method.startswith("scipy:"):
@@ -229,6 +244,19 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
         warnings.warn(f"simulation interrupted at t = {t[-1] if len(t) else t0:g} s: returning the partial result",
                       RuntimeWarning, stacklevel=2)
     return result
+
+
+def _check_closed(system, t0, q0, qd0, tol=1e-8):
+    """ValueError unless (q0, qd0) close every loop (to tol, m or cosine) and move along them."""
+    if not system.nl:
+        return
+    g, gd, _ = system.loop_constraints(t0, q0, qd0)
+    names = system.loop_names
+    for what, v in (("q0", g), ("qd0", gd)):
+        if np.max(np.abs(v)) > tol:
+            raise ValueError(f"{what}: expected initial {'coordinates' if what == 'q0' else 'rates'} that close every "
+                             f"loop of {names} (max |g{'' if what == 'q0' else 'd'}| = {np.max(np.abs(v)):.3g} > {tol:g}); "
+                             "system.assemble(q0, qd0, t0) finds the nearest ones")
 
 
 def _options(method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, beta, gamma, alpha, rho_inf,

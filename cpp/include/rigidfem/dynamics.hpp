@@ -13,7 +13,8 @@
 namespace rigidfem {
 
 /// The kinematics the system's formulation needs: T_p and the axes (recursive), or T_p, Ṫ_p, T̈_p
-/// and the twists U_u (Lagrange).
+/// and the twists U_u (Lagrange, and every system with loops, whose constraint equations it then
+/// evaluates: g, ġ and G; γ when the free accelerations in d.qdda are zero).
 void dynamics_kinematics(const System& sys, Data& d);
 /// Whether ∂r/∂(q, q̇) is analytic (recursive) rather than differenced (4 nq residuals, Lagrange).
 inline bool analytic_derivatives(const System& sys) { return sys.algorithm == Algorithm::Recursive; }
@@ -69,6 +70,22 @@ MatX rhs_jacobian(const System& sys, Data& d, double t, const Eigen::Ref<const V
 /// ignored). −∂f/∂q is the tangent stiffness, −∂f/∂q̇ the damping and gyroscopic matrix.
 std::pair<MatX, MatX> force_jacobians(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
                                       const Eigen::Ref<const VecX>& qd, double load_factor, bool static_drives);
+
+// Loop closures (sys.nl > 0): M q̈ = f + Gᵀλ with g(q, t) = 0 (constraints.hpp).
+/// After the tree's forward dynamics at the state of d (d.qdd, and its factorisation: ABA's
+/// articulated inertias or A's Cholesky factor) and constraint_equations: Y = M⁻¹ Gᵀ by nl
+/// solves with that factorisation, (G Y) λ = γ − G q̈_tree by a rank-revealing factorisation
+/// (redundant loops: the least-norm λ), q̈ = q̈_tree + Y λ into d.qdd, λ into d.lambda.
+/// O(n·nl + nl³): no n×n factorisation with the recursive engine.
+void close_loops(const System& sys, Data& d);
+/// Moves (q, q̇) onto the constraint manifold at t: Gauss–Newton on g(q, t) = 0 with the
+/// least-norm corrections Δq = −Gᵀ (G Gᵀ)⁺ g until max |g| <= tol (m, and for direction rows
+/// the cosine), then q̇ ← q̇ − Gᵀ (G Gᵀ)⁺ ġ. Returns max |g| reached; SimulationError naming the
+/// loop with the largest residual when it stays above tol after max_iterations.
+/// g, ġ, G and γ (γ for q̈_free = 0) into d at (t, q, q̇).
+void loop_equations(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                    const Eigen::Ref<const VecX>& qd);
+double project_onto_loops(const System& sys, Data& d, double t, VecX& q, VecX& qd, double tol, int max_iterations);
 
 // The operator of the implicit methods.
 /// Factorises M + diag(δ) (δ (nq) ≥ 0) at the state of the last inverse_dynamics: O(n) by the

@@ -8,6 +8,7 @@
 #include <vector>
 
 #include "rigidfem/joint_motion.hpp"
+#include "rigidfem/loops.hpp"
 #include "rigidfem/profiles.hpp"
 
 namespace rigidfem {
@@ -106,10 +107,13 @@ class Model {
   /// Adds a constant generalised force, or a law Q(t, q, q̇), on one joint coordinate.
   void add_generalized_force(int body, int coordinate, double value, ForceLaw law);
   void add_load(const Load& load);
+  /// Closes a loop (loops.hpp); returns its index. Checks the bodies, frames and length.
+  int add_loop(const Loop& loop);
   void set_gravity(const Vec3& g);
 
   const Vec3& gravity() const { return gravity_; }
   const std::vector<BodySpec>& bodies() const { return bodies_; }
+  const std::vector<Loop>& loops() const { return loops_; }
   int body_index(const std::string& name) const;  ///< −1 for "ground"; throws if unknown
   int coordinate_index(int body, const std::string& coordinate) const;
 
@@ -123,6 +127,7 @@ class Model {
   std::vector<BodySpec> bodies_;
   std::vector<std::vector<CoordinateSpec>> coords_;  // (nbodies) x (ncoords of the joint)
   std::vector<Load> loads_;
+  std::vector<Loop> loops_;
 };
 
 }  // namespace rigidfem

@@ -55,6 +55,9 @@ class Stepper {
   virtual const VecX& state() const = 0;
   /// y at a time t within the last accepted step (dense output).
   virtual VecX dense(double t) const = 0;
+  /// Systems with loops: moves the current state onto the constraint manifold at t (explicit
+  /// methods, whose steps drift off it); the Newmark family satisfies g(q) = 0 in every step.
+  virtual void project(double /*t*/) {}
   /// h ρ of the last attempted step (ρ the dominant eigenvalue) where the method estimates it, else 0.
   virtual double h_rho() const { return 0.0; }
   virtual StepControl control() const = 0;

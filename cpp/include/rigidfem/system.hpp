@@ -71,6 +71,10 @@ class System : public std::enable_shared_from_this<System> {
   std::vector<int> zyx_pitch;           // coordinate index of φ2 in every exact joint with φ3, φ2 and φ1
   Vec3 gravity = Vec3::Zero();          // m/s², global
   std::vector<Load> loads;
+  // Loop closures: constraint rows loop_row[k] .. loop_row[k + 1] − 1 of g(q, t) = 0.
+  std::vector<Loop> loops;
+  std::vector<int> loop_row;            // (nloops + 1)
+  int nl = 0;                           ///< constraint rows (multipliers λ)
 
   std::vector<std::string> coordinate_names() const;  ///< (nq)
   std::vector<std::string> prescribed_names() const;  ///< (np)
@@ -122,6 +126,10 @@ struct Data {
   VecX qdd;                    // (nq)
   VecX tau;                    // (np) driving forces of the prescribed coordinates
   Eigen::LLT<MatX> llt;
+  // Loop closures (constraints.hpp):
+  VecX g, gd, gamma;           // (nl) g(q, t), ġ, and γ with G q̈ = γ
+  MatX G;                      // (nl, nc) ∂g/∂q over all coordinates
+  VecX lambda;                 // (nl) multipliers of the last constrained forward dynamics
   // Recursive algorithms (ground coordinates, at the global origin):
   std::vector<Vec6> axes;      // (nuses) coordinate axes s = (ω, v_O)
   std::vector<Vec6> v, c, a;   // (nbodies) spatial velocity, joint bias acceleration, acceleration

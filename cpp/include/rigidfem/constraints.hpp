@@ -1,0 +1,35 @@
+/// The constraint equations of the loop closures, g(q, t) = 0 (m rows), at the state of a Data:
+/// their values g, rates ġ = G q̇ + g_t, Jacobian G = ∂g/∂q (all coordinates: free columns for
+/// the equations of motion, prescribed ones for the driving forces) and the acceleration right-hand
+/// side γ with G q̈ = γ (every term of g̈ but G q̈ of the free coordinates).
+///
+/// Rows, with d = r_B − r_A and a_i, b_j the axes of frames A and B (global):
+///   position   d·a_i = 0  (i = x, y, z; prismatic and cylindrical: x, y)   λ: force on B along a_i
+///   direction  b_j·a_i = 0 (revolute, cylindrical: z·x, z·y; prismatic and fixed: also x·y;
+///                           universal: y·x)                                λ: torque λ b_j × a_i on B
+///   distance   |d| − l(t) = 0                                              λ: force along d/|d| on B
+/// Each quantity is tracked with its rate, its second rate at q̈_free = 0 and its Jacobian row(s):
+/// for a vector e fixed in body p, ∂e/∂q_i = U_u e over the uses u of coordinate i on p's path.
+#pragma once
+
+#include "rigidfem/system.hpp"
+
+namespace rigidfem {
+
+/// => d.g, d.gd, d.G (nl, nc), d.gamma at the state of d. Needs the kinematics with rates
+/// (kinematics(sys, d, true): T, Ṫ, T̈ at q̈_free = 0, and the twists U).
+void constraint_equations(const System& sys, Data& d);
+
+/// The free columns of d.G (nl, nq).
+MatX free_jacobian(const System& sys, const Data& d);
+
+/// x = A⁺ b by a complete orthogonal decomposition with pivots below 1e-10 of the largest dropped:
+/// the multipliers of redundant rows (a planar loop closed in 3D) share the load with least norm.
+VecX least_norm(const MatX& A, const VecX& b);
+
+/// The wrench each loop joint applies to its body B, in frame A's axes: (force N, torque N·m about
+/// B's frame origin) per loop, from the multipliers λ (nl); for a Distance loop the force along the
+/// line (positive pushing B away from A) in the first component, the rest zero. (nloops, 6).
+RowMatX loop_reactions(const System& sys, const Data& d, const VecX& lambda);
+
+}  // namespace rigidfem

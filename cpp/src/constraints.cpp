@@ -1,0 +1,186 @@
+#include "rigidfem/constraints.hpp"
+
+#include <Eigen/QR>
+#include <cmath>
+
+#include "rigidfem/errors.hpp"
+
+namespace rigidfem {
+
+namespace {
+
+using Mat3X = Eigen::Matrix<double, 3, Eigen::Dynamic>;
+
+/// A vector quantity x(q, t) fixed in a body: its value, rate, second rate at q̈_free = 0, and
+/// ∂x/∂q (3, nc) over all coordinates.
+struct Track {
+  Vec3 x, xd, xdd;
+  Mat3X J;
+};
+
+/// Column h of frame P = T_p F in body p (h = 0..2: an axis, 3: the origin) with its rates and its
+/// Jacobian ∂x/∂q_i = Σ_u U_u x̃ over the uses u on the path from p to the ground (x̃ = (x, 1)
+/// for the origin, (x, 0) for an axis). The ground (p = −1): F itself, at rest.
+Track track(const System& sys, const Data& d, int p, const Mat4& F, int h) {
+  Track tr;
+  tr.J = Mat3X::Zero(3, sys.nc);
+  if (p < 0) {
+    tr.x = F.block<3, 1>(0, h);
+    tr.xd.setZero();
+    tr.xdd.setZero();
+    return tr;
+  }
+  const Eigen::Vector4d c = F.col(h);
+  tr.x = (d.T[p] * c).head<3>();
+  tr.xd = (d.Td[p] * c).head<3>();
+  tr.xdd = (d.Tdd[p] * c).head<3>();
+  const Eigen::Vector4d xh(tr.x(0), tr.x(1), tr.x(2), c(3));
+  for (int k = p; k >= 0; k = sys.parent[k])
+    for (int u = sys.use_start[k]; u < sys.use_start[k + 1]; ++u)
+      tr.J.col(sys.use_coord[u]) += (d.U[u] * xh).head<3>();
+  return tr;
+}
+
+/// d = r_B − r_A as a track.
+Track difference(const Track& b, const Track& a) { return {b.x - a.x, b.xd - a.xd, b.xdd - a.xdd, b.J - a.J}; }
+
+/// Row r of the constraints: value, rate, −(second rate at q̈_free = 0), Jacobian.
+void put(Data& d, int r, double g, double gd, double bias, const Eigen::Ref<const Eigen::RowVectorXd>& G) {
+  d.g(r) = g;
+  d.gd(r) = gd;
+  d.gamma(r) = -bias;
+  d.G.row(r) = G;
+}
+
+/// g = x·y: ġ = ẋ·y + x·ẏ, g̈ = ẍ·y + 2 ẋ·ẏ + x·ÿ, ∂g/∂q = yᵀ ∂x/∂q + xᵀ ∂y/∂q.
+void dot_row(Data& d, int r, const Track& x, const Track& y) {
+  put(d, r, x.x.dot(y.x), x.xd.dot(y.x) + x.x.dot(y.xd), x.xdd.dot(y.x) + 2.0 * x.xd.dot(y.xd) + x.x.dot(y.xdd),
+      y.x.transpose() * x.J + x.x.transpose() * y.J);
+}
+
+/// g = |x| − l(t): ġ = x·ẋ/|x| − l̇, g̈ = (ẋ·ẋ + x·ẍ)/|x| − (x·ẋ)²/|x|³ − l̈, ∂g/∂q = xᵀ ∂x/∂q / |x|.
+void distance_row(Data& d, int r, const Track& x, const MotionState& l, const std::string& name) {
+  const double n = x.x.norm();
+  if (!(n > 1e-12 * std::max(1.0, std::abs(l.q))))
+    throw SimulationError(d.t, "the distance of loop '" + name + "' is zero, where its direction is undefined");
+  const double s = x.x.dot(x.xd);
+  put(d, r, n - l.q, s / n - l.qd, (x.xd.squaredNorm() + x.x.dot(x.xdd)) / n - s * s / (n * n * n) - l.qdd,
+      x.x.transpose() * x.J / n);
+}
+
+}  // namespace
+
+void constraint_equations(const System& sys, Data& d) {
+  for (std::size_t k = 0; k < sys.loops.size(); ++k) {
+    const Loop& L = sys.loops[k];
+    int r = sys.loop_row[k];
+    const Track rA = track(sys, d, L.body_a, L.frame_a, 3), rB = track(sys, d, L.body_b, L.frame_b, 3);
+    const Track dr = difference(rB, rA);
+    if (L.kind == LoopKind::Distance) {
+      const MotionState l = L.drive ? L.drive->at(d.t) : MotionState{L.length, 0.0, 0.0};
+      if (!std::isfinite(l.q) || !std::isfinite(l.qd) || !std::isfinite(l.qdd))
+        throw SimulationError(d.t, "the length drive of loop '" + L.name + "' returned NaN or inf");
+      distance_row(d, r, dr, l, L.name);
+      continue;
+    }
+    Track a[3], b[3];
+    for (int i = 0; i < 3; ++i) {
+      a[i] = track(sys, d, L.body_a, L.frame_a, i);
+      b[i] = track(sys, d, L.body_b, L.frame_b, i);
+    }
+    enum { X, Y, Z };
+    // Position rows d·a_i: all three, or x and y for the joints that slide along z.
+    const bool slides = L.kind == LoopKind::Prismatic || L.kind == LoopKind::Cylindrical;
+    for (int i = 0; i < (slides ? 2 : 3); ++i) dot_row(d, r++, dr, a[i]);
+    // Direction rows b_j·a_i.
+    switch (L.kind) {
+      case LoopKind::Revolute:
+      case LoopKind::Cylindrical:
+        dot_row(d, r++, b[Z], a[X]);
+        dot_row(d, r++, b[Z], a[Y]);
+        break;
+      case LoopKind::Prismatic:
+      case LoopKind::Fixed:
+        dot_row(d, r++, b[Z], a[X]);
+        dot_row(d, r++, b[Z], a[Y]);
+        dot_row(d, r++, b[X], a[Y]);
+        break;
+      case LoopKind::Universal: dot_row(d, r++, b[Y], a[X]); break;
+      default: break;
+    }
+  }
+}
+
+VecX least_norm(const MatX& A, const VecX& b) {
+  Eigen::CompleteOrthogonalDecomposition<MatX> cod(A);
+  cod.setThreshold(1e-10);
+  return cod.solve(b);
+}
+
+MatX free_jacobian(const System& sys, const Data& d) { return d.G(Eigen::all, sys.free_coords); }
+
+RowMatX loop_reactions(const System& sys, const Data& d, const VecX& lambda) {
+  RowMatX W = RowMatX::Zero(static_cast<Eigen::Index>(sys.loops.size()), 6);
+  for (std::size_t k = 0; k < sys.loops.size(); ++k) {
+    const Loop& L = sys.loops[k];
+    const int r0 = sys.loop_row[k];
+    const Mat4 PA = (L.body_a < 0 ? Mat4::Identity() : d.T[L.body_a]) * L.frame_a;
+    const Mat4 PB = (L.body_b < 0 ? Mat4::Identity() : d.T[L.body_b]) * L.frame_b;
+    const Mat3 RA = PA.topLeftCorner<3, 3>(), RB = PB.topLeftCorner<3, 3>();
+    if (L.kind == LoopKind::Distance) {
+      W(k, 0) = lambda(r0);
+      continue;
+    }
+    // Force Σ λ_i a_i at B's origin from the position rows; torque Σ λ b_j × a_i from the rest.
+    const bool slides = L.kind == LoopKind::Prismatic || L.kind == LoopKind::Cylindrical;
+    const int npos = slides ? 2 : 3;
+    Vec3 F = Vec3::Zero(), tau = Vec3::Zero();
+    for (int i = 0; i < npos; ++i) F += lambda(r0 + i) * RA.col(i);
+    auto torque = [&](int row, int j, int i) { tau += lambda(r0 + row) * RB.col(j).cross(RA.col(i)); };
+    switch (L.kind) {
+      case LoopKind::Revolute:
+      case LoopKind::Cylindrical:
+        torque(npos, 2, 0);
+        torque(npos + 1, 2, 1);
+        break;
+      case LoopKind::Prismatic:
+      case LoopKind::Fixed:
+        torque(npos, 2, 0);
+        torque(npos + 1, 2, 1);
+        torque(npos + 2, 0, 1);
+        break;
+      case LoopKind::Universal: torque(npos, 1, 0); break;
+      default: break;
+    }
+    W.row(k).head<3>() = RA.transpose() * F;
+    W.row(k).tail<3>() = RA.transpose() * tau;
+  }
+  return W;
+}
+
+int loop_rows(LoopKind kind) {
+  switch (kind) {
+    case LoopKind::Revolute: return 5;
+    case LoopKind::Spherical: return 3;
+    case LoopKind::Universal: return 4;
+    case LoopKind::Prismatic: return 5;
+    case LoopKind::Cylindrical: return 4;
+    case LoopKind::Fixed: return 6;
+    case LoopKind::Distance: return 1;
+  }
+  return 0;
+}
+
+namespace {
+const char* kind_names[] = {"revolute", "spherical", "universal", "prismatic", "cylindrical", "fixed", "distance"};
+}
+
+const char* loop_kind_name(LoopKind kind) { return kind_names[static_cast<int>(kind)]; }
+
+LoopKind parse_loop_kind(const std::string& name, const std::string& argument) {
+  for (int k = 0; k < 7; ++k)
+    if (name == kind_names[k]) return static_cast<LoopKind>(k);
+  bad(argument, "one of revolute, spherical, universal, prismatic, cylindrical, fixed, distance", "'" + name + "'");
+}
+
+}  // namespace rigidfem

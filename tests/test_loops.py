@@ -1,0 +1,174 @@
+"""Closed kinematic chains: loop joints and actuators (M q̈ = f + Gᵀλ, g(q, t) = 0).
+
+References computed here: the four-bar's closed-form position analysis (law of cosines), the
+power balance τ θ̇ = dE/dt of a driven loop, Newton–Euler for a body held by a loop joint, the
+same pendulum built as a tree, and the order of the index-3 generalised-α.
+"""
+
+import numpy as np
+import pytest
+
+import rigidfem as rf
+
+A, B, C, D = 0.3, 0.8, 0.6, 0.7  # crank, coupler, rocker, ground link (m)
+G0 = 9.81
+
+
+def rod(L, m=1.0):
+    """A slender rod along x: mass m (kg), centre at L/2."""
+    return dict(mass=m, inertia=(1e-4, m * L * L / 12, m * L * L / 12), com=(L / 2, 0, 0))
+
+
+def four_bar(crank_drive=None, algorithm="recursive", kind="revolute"):
+    """Planar four-bar in the x–y plane, gravity −y; the loop closes coupler tip to rocker tip
+    (a revolute in 3D: 3 of its 5 rows are redundant for the planar motion)."""
+    m = rf.Model(gravity=(0, -G0, 0))
+    crank = m.add_body("crank", m.ground, rf.Joint.revolute("z"), **rod(A))
+    coupler = m.add_body("coupler", crank, rf.Joint.revolute("z"), **rod(B), placement=rf.transform((A, 0, 0)))
+    rocker = m.add_body("rocker", m.ground, rf.Joint.revolute("z"), **rod(C), placement=rf.transform((D, 0, 0)))
+    m.add_loop_joint(kind, coupler.point((B, 0, 0)), rocker.point((C, 0, 0)), name="C")
+    if crank_drive is not None:
+        m.prescribe(crank, crank_drive)
+    return m.compile(algorithm)
+
+
+def closed_form(t1):
+    """Coupler and rocker angles (absolute, rad) of the open four-bar for crank angle t1."""
+    Ax, Ay = A * np.cos(t1), A * np.sin(t1)
+    ex, ey = Ax - D, Ay
+    e = np.hypot(ex, ey)
+    t3 = np.arctan2(ey, ex) + np.arccos((e * e + C * C - B * B) / (2 * e * C))
+    Px, Py = D + C * np.cos(t3), C * np.sin(t3)
+    return np.arctan2(Py - Ay, Px - Ax), t3
+
+
+def wrap(angle):
+    """Angle differences in (−π, π]."""
+    return np.angle(np.exp(1j * np.asarray(angle)))
+
+
+def closed_q(t1):
+    t2, t3 = closed_form(t1)
+    return np.array([t1, t2 - t1, t3])
+
+
+@pytest.mark.parametrize("algorithm", ["recursive", "lagrange"])
+@pytest.mark.parametrize("method", ["dopri5", "generalized_alpha", "implicit_spring"])
+def test_driven_four_bar_follows_the_closed_form_and_the_power_balance(algorithm, method):
+    """Crank driven at θ1 = 0.4 + 2t + t²: rocker and coupler angles against the closed form at every
+    output, closure residual ≤ 1e-12, and the crank torque against τ θ̇1 = dE/dt (E: kinetic +
+    gravity energy, differenced here)."""
+    s = four_bar(rf.motion.polynomial([0.4, 2.0, 1.0]), algorithm)
+    assert (s.nq, s.np, s.nl) == (2, 1, 5)
+    q0, qd0 = s.assemble(closed_q(0.4)[1:] + 0.02, t=0.0)
+    # The rates the loop allows with θ̇1(0) = 2 rad/s: differenced closed form.
+    h = 1e-6
+    qd_exact = (closed_q(0.4 + 2 * h)[1:] - closed_q(0.4 - 2 * h)[1:]) / (2 * h)
+    np.testing.assert_allclose(wrap(q0 - closed_q(0.4)[1:]), 0.0, atol=1e-12)
+    _, qd0 = s.assemble(q0, qd_exact + 0.1, t=0.0)
+    np.testing.assert_allclose(qd0, qd_exact, atol=1e-7)
+    t = np.linspace(0.0, 1.0, 201)
+    r = rf.simulate(s, 1.0, method=method, dt=1e-3, q0=q0, qd0=qd0, t_eval=t, rtol=1e-10, atol=1e-12)
+    theta1 = 0.4 + 2 * t + t * t
+    exact = np.array([closed_q(x)[1:] for x in theta1])
+    np.testing.assert_allclose(wrap(r.q - exact), 0.0, atol=1e-9)
+    residual = [np.abs(s.loop_constraints(tk, qk, qdk)[0]).max() for tk, qk, qdk in zip(r.t, r.q, r.qd)]
+    assert max(residual) <= 1e-12
+    E = r.kinetic_energy + r.gravity_energy
+    power = r.driving_forces[:, 0] * (2 + 2 * t)
+    dEdt = np.gradient(E, t, edge_order=2)
+    np.testing.assert_allclose(power[2:-2], dEdt[2:-2], atol=2e-3 * np.abs(power).max())
+
+
+def test_free_four_bar_conserves_energy_and_generalized_alpha_converges_at_order_two():
+    s = four_bar()
+    q0, _ = s.assemble(closed_q(0.4))
+    ref = rf.simulate(s, 1.0, method="dopri5", q0=q0, rtol=1e-12, atol=1e-12)
+    assert np.ptp(ref.energy) < 1e-9 * np.abs(ref.energy).max() + 1e-9
+    errors = []
+    for h in (4e-3, 2e-3, 1e-3):
+        r = rf.simulate(s, 1.0, method="generalized_alpha", q0=q0, dt=h)
+        errors.append(np.abs(r.q[-1] - ref.q[-1]).max())
+    ratios = np.array(errors[:-1]) / np.array(errors[1:])
+    np.testing.assert_allclose(ratios, 4.0, rtol=0.05)
+
+
+def test_redundant_loop_gives_the_tree_motion_and_newton_euler_reactions():
+    """A rod (m = 2 kg, L = 1 m) as a pendulum about z: once as a tree (revolute on the ground),
+    once as a free body closed to the ground by a revolute loop (5 rows, none redundant) and once
+    moving in the plane (planar joint) closed by a revolute loop (5 rows, 3 of them redundant).
+    The angles agree, and the loop's reaction is Newton–Euler's m (a_c − g) on the rod."""
+    m_, L = 2.0, 1.0
+    theta0 = 0.7
+
+    def model(joint):
+        mod = rf.Model(gravity=(0, -G0, 0))
+        rod_ = mod.add_body("rod", mod.ground, joint, **rod(L, m_))
+        return mod, rod_
+
+    tree, _ = model(rf.Joint.revolute("z"))
+    tree = tree.compile()
+    t = np.linspace(0, 1.5, 31)
+    ref = rf.simulate(tree, 1.5, q0=[theta0], rtol=1e-11, atol=1e-12, t_eval=t)
+    for joint in (rf.Joint.free(), rf.Joint.planar("xy")):
+        mod, body = model(joint)
+        mod.add_loop_joint("revolute", mod.ground, body, name="pin")
+        s = mod.compile()
+        guess = np.zeros(s.nq)
+        guess[s.coordinate_index("rod.rz")] = theta0
+        q0, _ = s.assemble(guess)
+        r = rf.simulate(s, 1.5, q0=q0, rtol=1e-11, atol=1e-12, t_eval=t)
+        np.testing.assert_allclose(r.q[:, s.coordinate_index("rod.rz")], ref.q[:, 0], atol=1e-8)
+        # Newton–Euler: the pin pulls the rod with F = m (a_c − g), a_c of the centre at L/2.
+        th, w = ref.q[:, 0], ref.qd[:, 0]
+        al = ref.qdd[:, 0]
+        e, n = np.c_[np.cos(th), np.sin(th)], np.c_[-np.sin(th), np.cos(th)]
+        ac = L / 2 * (al[:, None] * n - (w * w)[:, None] * e)
+        F = m_ * (ac - np.array([0.0, -G0]))
+        W = r.loop_reactions[:, 0, :]  # on the rod (b), in the ground frame A's axes
+        np.testing.assert_allclose(W[:, :2], F, atol=1e-6)
+        np.testing.assert_allclose(W[:, 2:], 0.0, atol=1e-6)
+
+
+def test_actuator_luffs_a_boom_along_the_triangle():
+    """A boom (revolute on the ground) raised by a cylinder from (0.5, 0) on the ground to the boom's
+    point at 1 m, length l(t) = 0.9 + 0.3 t: the boom angle from the law of cosines, and the
+    cylinder's power −F l̇ (F pushing positive) against dE/dt."""
+    mod = rf.Model(gravity=(0, -G0, 0))
+    boom = mod.add_body("boom", mod.ground, rf.Joint.revolute("z"), **rod(2.0, 5.0))
+    name = mod.add_actuator(mod.ground.point((0.5, 0, 0)), boom.point((1.0, 0, 0)), rf.motion.polynomial([0.9, 0.3]), name="cylinder")
+    s = mod.compile()
+    assert s.loop_names == [name] and s.loop_kinds == ["distance"]
+    t = np.linspace(0, 1, 101)
+
+    def angle(tt):
+        l = 0.9 + 0.3 * tt
+        return np.arccos((0.25 + 1.0 - l * l) / (2 * 0.5 * 1.0))
+
+    q0, qd0 = s.assemble([angle(0.0)], [0.0])
+    r = rf.simulate(s, 1.0, method="generalized_alpha", dt=1e-3, q0=q0, qd0=qd0, t_eval=t)
+    np.testing.assert_allclose(r.q[:, 0], angle(t), atol=1e-9)
+    F = r.loop_reactions[:, 0, 0]
+    dEdt = np.gradient(r.kinetic_energy + r.gravity_energy, t, edge_order=2)
+    np.testing.assert_allclose(F * 0.3, dEdt, atol=2e-3 * np.abs(dEdt).max())
+    # It pushes while the boom leans outboard (cos θ > 0) and pulls once past the vertical.
+    assert F[0] > 0 and np.cos(r.q[0, 0]) > 0 and F[-1] < 0 and np.cos(r.q[-1, 0]) < 0
+
+
+def test_bad_loops_are_value_errors_and_unreachable_ones_simulation_errors():
+    mod = rf.Model()
+    a = mod.add_body("a", mod.ground, rf.Joint.revolute("z"), **rod(1.0))
+    with pytest.raises(ValueError, match="^kind: expected one of"):
+        mod.add_loop_joint("hinge", mod.ground, a)
+    with pytest.raises(ValueError, match="^b: expected a body other than a"):
+        mod.add_loop_joint("spherical", a, a.point((1, 0, 0)))
+    with pytest.raises(ValueError, match="^length: expected a positive distance"):
+        mod.add_loop_joint("distance", mod.ground, a)
+    with pytest.raises(ValueError, match="^frame_a: expected a rigid transformation"):
+        mod.add_loop_joint("revolute", mod.ground, a, frame_a=2 * np.eye(4))
+    mod.add_loop_joint("distance", mod.ground.point((0.0, 3.0, 0.0)), a.point((1, 0, 0)), length=0.5, name="rope")
+    s = mod.compile()
+    with pytest.raises(ValueError, match=r"^q0: expected initial coordinates that close every loop of \['rope'\]"):
+        rf.simulate(s, 1.0, q0=[0.0])
+    with pytest.raises(rf.SimulationError, match="loop 'rope' \\(distance, residual"):
+        s.assemble([0.0])  # the point at 1 m from the pin never comes within 0.5 m of (0, 3)
