@@ -11,6 +11,7 @@ COMMANDS = {
     "scaling": "forward-dynamics and implicit-step cost against the number of coordinates",
     "peers": "rigidfem against Pinocchio and MuJoCo (needs: pip install pin mujoco)",
     "scale": "hidden costs at scale: Python calls against C++, outputs, building long beams",
+    "loops": "closed loops: cost per step against n and the number of constraint rows, against a dense solve",
 }
 
 

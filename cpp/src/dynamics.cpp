@@ -175,19 +175,20 @@ void loop_equations(const System& sys, Data& d, double t, const Eigen::Ref<const
 double project_onto_loops(const System& sys, Data& d, double t, VecX& q, VecX& qd, double tol, int max_iterations) {
   if (sys.nl == 0) return 0.0;
   double residual = 0.0;
+  bool stalled = false;  // the last correction was at round-off level
   for (int it = 0;; ++it) {
     loop_equations(sys, d, t, q, qd);
     residual = d.g.cwiseAbs().maxCoeff();
-    if (residual <= tol) break;
-    if (it == max_iterations || !std::isfinite(residual) || sys.nq == 0)
+    if (residual <= tol || (stalled && residual <= 1e-9)) break;  // converged, or at the round-off floor
+    if (it == max_iterations || stalled || !std::isfinite(residual) || sys.nq == 0)
       throw SimulationError(t, "the closed loops cannot be assembled: Gauss-Newton from the given coordinates left " +
                                    worst_loop(sys, d) + " after " + std::to_string(it) +
-                                   " iterations; give coordinates closer to a closed configuration");
+                                   " iterations (the loop is out of reach, or its coordinates cannot move it); give "
+                                   "coordinates closer to a closed configuration");
     const MatX G = free_jacobian(sys, d);
     const VecX dq = G.transpose() * least_norm(G * G.transpose(), d.g);
     q -= dq;
-    // Stagnation at round-off (large coordinates): the residual left is what the numbers carry.
-    if (sys.nq == 0 || dq.cwiseAbs().maxCoeff() <= 1e-15 * (1.0 + q.cwiseAbs().maxCoeff())) tol = std::numeric_limits<double>::infinity();
+    stalled = dq.cwiseAbs().maxCoeff() <= 1e-15 * (1.0 + q.cwiseAbs().maxCoeff());
   }
   const MatX G = free_jacobian(sys, d);
   qd -= G.transpose() * least_norm(G * G.transpose(), d.gd);
