@@ -172,3 +172,9 @@ def test_bad_loops_are_value_errors_and_unreachable_ones_simulation_errors():
         rf.simulate(s, 1.0, q0=[0.0])
     with pytest.raises(rf.SimulationError, match="loop 'rope' \\(distance, residual"):
         s.assemble([0.0])  # the point at 1 m from the pin never comes within 0.5 m of (0, 3)
+    # A rope on the pivot, which no coordinate moves: G = 0, nothing to assemble with.
+    mod2 = rf.Model()
+    b = mod2.add_body("b", mod2.ground, rf.Joint.revolute("z"), **rod(1.0))
+    mod2.add_actuator(mod2.ground.point((0.0, 0.6, 0.0)), b.origin, 0.5, name="stuck")
+    with pytest.raises(rf.SimulationError, match="loop 'stuck' \\(distance, residual 0.1\\)"):
+        mod2.compile().assemble([0.3])
