@@ -35,10 +35,13 @@ def family(modes, system, suffix):
 
 @pytest.mark.parametrize("formulation,deform", [("modified", ("bend_z",)), ("classical", ("axial", "shear_y", "bend_z"))])
 def test_bending_frequencies_converge_at_second_order(formulation, deform):
-    # m = 20 -> 40 (-> 80): all five modes resolved. The classical model of this extreme section
-    # (rotary inertia ρ I l ~ 1e-13 kg m² beside rfe masses ~ 1e-2 kg) is an eigenproblem
-    # conditioned to ~4e-6, the discretisation error at m = 80, so it stops at m = 40.
-    ms = (10, 20, 40, 80) if formulation == "modified" else (10, 20, 40)
+    # m = 20 -> 40 -> 80: all five modes resolved, each doubling divides the error by 4 (order
+    # 2, not more: an error that falls faster is round-off, not convergence). The classical model
+    # of this extreme section (rotary inertia ρ I l ~ 1e-13 kg m² beside rfe masses ~ 1e-2 kg,
+    # axial springs: ω_max²/ω₁² ≈ 2e11 at m = 80) keeps its mode 1 on the O(m⁻²) line only
+    # because modal_analysis takes the low modes from the flexibility form (μ = 1/ω²); the
+    # stiffness form K φ = ω² M φ alone is accurate to ε ω_max²/ω₁² ≈ 4e-5 there.
+    ms = (10, 20, 40, 80)
     ref = euler_bernoulli(SLENDER.Iz)
     errors = []
     for m in ms:
@@ -48,8 +51,9 @@ def test_bending_frequencies_converge_at_second_order(formulation, deform):
     errors = np.array(errors)
     assert errors[0, 0] < 3e-3  # first frequency within 0.3 % at m = 10
     order = np.log2(errors[1:-1] / errors[2:])
-    assert np.all(order >= 1.9), order
+    assert np.all((order >= 1.9) & (order <= 2.1)), order
     assert np.all(errors[-1] < (5e-4 if formulation == "modified" else 1.5e-3))
+    assert errors[-1, 0] < 4e-5  # mode 1 at m = 80: 3.6e-5 (the O(m⁻²) line), both formulations
 
 
 def check_wave_family(make_system, c):

@@ -76,9 +76,8 @@ def test_steady_spin_modal_analysis():
         tension=lambda x: rho * A * W**2 * (L**2 - x**2) / 2, softening=W**2, n=2)
     omegas = []
     for m in (20, 40):
-        model, h = rf.samples.kane_beam(elements=m)
-        model.prescribe(h["hub"], rf.motion.polynomial([0.0, W]))  # a steady spin replaces the spin-up
-        modes = rf.modal_analysis(model.compile())
+        model, h = rf.samples.kane_beam(omega=W, duration=15.0, elements=m)
+        modes = rf.modal_analysis(model.compile(), t=20.0)  # the spin-up's steady phase: Ω = W after 15 s
         assert modes.stable
         omegas.append(modes.omega[:2])
     err = np.array([np.abs(w / ref - 1) for w in omegas])
@@ -86,9 +85,9 @@ def test_steady_spin_modal_analysis():
     assert np.all(err[1] < 4e-3)
     at_rest = hermite_cantilever_frequencies(L, lambda x: E * I, lambda x: rho * A, lambda x: rho * I, n=1)
     assert omegas[-1][0] > 1.4 * at_rest[0]  # centrifugal stiffening is substantial at Ω = 6
-    model, h = rf.samples.kane_beam(elements=20, linear=True)
-    w1 = rf.modal_analysis(model.compile()).omega[0]
-    model.prescribe(h["hub"], rf.motion.polynomial([0.0, W]))
-    modes = rf.modal_analysis(model.compile())
+    model, h = rf.samples.kane_beam(omega=W, duration=15.0, elements=20, linear=True)
+    system = model.compile()
+    w1 = rf.modal_analysis(system, t=0.0).omega[0]  # at rest before the spin-up
+    modes = rf.modal_analysis(system, t=20.0)
     assert not modes.stable
     assert modes.eigenvalues.real.max() == pytest.approx(np.sqrt(W**2 - w1**2), rel=0.01)

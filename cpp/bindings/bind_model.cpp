@@ -1,12 +1,115 @@
 // Joint, Body, Point, Load and Model. The friendly keyword API lives in
 // rigidfem/model.py; these are the primitives it calls.
+#include <cmath>
+#include <memory>
+
 #include "bindings.hpp"
+#include "rigidfem/errors.hpp"
 #include "rigidfem/model.hpp"
 #include "rigidfem/system.hpp"
 
 namespace rigidfem::bindings {
 
+namespace {
+
+// rigidfem._core.ForceLawError: a ValueError and a SimulationError (see ForceLawError in model.hpp).
+PyObject* force_law_error = nullptr;
+
+Vec3 finite_offset(const Vec3& r) {
+  if (!r.allFinite()) bad("r", "a finite offset (3,) in m in the body frame", "NaN or inf");
+  return r;
+}
+
+std::string short_repr(const py::handle& x) {
+  std::string s = py::repr(x);
+  return s.size() > 80 ? s.substr(0, 77) + "..." : s;
+}
+
+// The value of what a force law returned if it is one finite number (a Python or numpy real
+// scalar, or anything else float() takes), else false with `got` describing it.
+bool force_value(const py::object& r, double& value, std::string& got) {
+  PyObject* o = r.ptr();
+  if (PyFloat_CheckExact(o)) {
+    value = PyFloat_AS_DOUBLE(o);
+  } else {
+    if (r.is_none() || PyBool_Check(o) || PyUnicode_Check(o) || PyBytes_Check(o)) {
+      got = short_repr(r);
+      return false;
+    }
+    if (py::hasattr(r, "dtype") && py::hasattr(r, "ndim")) {  // numpy scalars and arrays
+      if (r.attr("ndim").cast<int>() != 0) {
+        got = "an array of shape " + std::string(py::str(r.attr("shape")));
+        return false;
+      }
+      const std::string kind = py::str(r.attr("dtype").attr("kind"));
+      if (kind != "f" && kind != "i" && kind != "u") {
+        got = short_repr(r);
+        return false;
+      }
+    }
+    value = PyFloat_AsDouble(o);
+    if (value == -1.0 && PyErr_Occurred()) {
+      PyErr_Clear();
+      got = short_repr(r);
+      return false;
+    }
+  }
+  if (!std::isfinite(value)) {
+    got = num(value);
+    return false;
+  }
+  return true;
+}
+
+// A Python force law Q(t, q, q̇) as a ForceLaw (called with or without the GIL held) that checks
+// what it returns; the law's own exceptions (ZeroDivisionError, KeyboardInterrupt ...) propagate.
+ForceLaw python_force_law(const py::function& f, const std::string& coordinate) {
+  // The reference is dropped under the GIL wherever the last copy of the law dies.
+  std::shared_ptr<py::object> law(new py::object(f), [](py::object* o) {
+    py::gil_scoped_acquire gil;
+    delete o;
+  });
+  const std::string name = py::hasattr(f, "__qualname__") ? std::string(py::str(f.attr("__qualname__")))
+                                                           : short_repr(f);
+  const std::string what = "the force law '" + name + "' on coordinate '" + coordinate + "'";
+  return [law, what](double t, double q, double qd) {
+    py::gil_scoped_acquire gil;
+    const py::object r = (*law)(t, q, qd);
+    double value = 0.0;
+    std::string got;
+    if (force_value(r, value, got)) return value;
+    const std::string state = "q = " + num(q, 10) + ", qd = " + num(qd, 10);
+    throw ForceLawError(t, what + " returned " + got + " at " + state + "; expected a finite number (N or N·m)",
+                        "force: expected " + what + " to return a finite number (N or N·m), got " + got +
+                            " at t = " + num(t, 10) + " s, " + state);
+  };
+}
+
+}  // namespace
+
 void bind_model(py::module_& m) {
+  // A ValueError where a System method meets it, and a SimulationError (registered by module.cpp
+  // before bind_model) as which a simulation reports it, with its time and cause.
+  const py::object bases = py::make_tuple(m.attr("SimulationError"), py::handle(PyExc_ValueError));
+  force_law_error = PyErr_NewExceptionWithDoc(
+      "rigidfem._core.ForceLawError",
+      "A Python force law returned no finite number (None, a string, an array, NaN or inf): a ValueError\n"
+      "(and a SimulationError, with `time` and `cause`), raised by System methods; simulate() raises it as\n"
+      "the SimulationError at that time.",
+      bases.ptr(), nullptr);
+  if (force_law_error == nullptr) throw py::error_already_set();
+  m.attr("ForceLawError") = py::handle(force_law_error);
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const ForceLawError& e) {
+      py::object error = py::reinterpret_borrow<py::object>(force_law_error)(e.what());
+      error.attr("time") = e.time;
+      error.attr("cause") = e.cause;
+      PyErr_SetObject(force_law_error, error.ptr());
+    }
+  });
+
   py::class_<Joint>(m, "JointSpec", "Active coordinates of a joint with their springs and dampers.")
       .def(py::init([](const std::string& kind, const std::vector<std::string>& coordinates) {
              std::vector<Axis> axes;
@@ -34,21 +137,28 @@ void bind_model(py::module_& m) {
 
   py::class_<Body>(m, "Body", "Handle of a body of a Model (index -1 is the ground).")
       .def(py::init<>(), "The ground.")
-      .def(py::init([](int index, const std::string& name) { return Body{index, name}; }), py::arg("index"),
-           py::arg("name"))
+      .def(py::init([](int index, const std::string& name, std::uint64_t model) { return Body{index, name, model}; }),
+           py::arg("index"), py::arg("name"), py::arg("model") = 0)
       .def_readonly("index", &Body::index)
       .def_readonly("name", &Body::name)
+      .def_readonly("model", &Body::model, "Id of the Model that made the handle (0: unknown).")
       .def(
-          "point", [](const Body& b, const Vec3& r) { return Point(b.index, r); }, py::arg("r"),
-          "The material point at r (m, body frame).")
+          "point", [](const Body& b, const Vec3& r) { return Point(b.index, finite_offset(r), b.model); },
+          py::arg("r"), "The material point at r (m, body frame).")
       .def_property_readonly("origin", [](const Body& b) { return Point(b); }, "The point at the body frame's origin.")
       .def("__repr__", [](const Body& b) { return "<rigidfem Body '" + b.name + "' #" + std::to_string(b.index) + ">"; });
 
   py::class_<Point>(m, "Point", "A material point: body index and position r (m) in the body frame.")
-      .def(py::init<int, const Vec3&>(), py::arg("body"), py::arg("r"))
+      .def(py::init([](int body, const Vec3& r) { return Point(body, finite_offset(r)); }), py::arg("body"),
+           py::arg("r"))
       .def(py::init<const Body&>(), py::arg("body"))
       .def_readonly("body", &Point::body)
-      .def_readonly("r", &Point::r);
+      .def_readonly("r", &Point::r)
+      .def_readonly("model", &Point::model, "Id of the Model whose body the point is on (0: unknown).")
+      .def("__repr__", [](const Point& p) {
+        return "<rigidfem Point on body #" + std::to_string(p.body) + " at r = (" + num(p.r.x()) + ", " + num(p.r.y()) +
+               ", " + num(p.r.z()) + ") m>";
+      });
   py::implicitly_convertible<Body, Point>();
 
   m.def("pseudo_inertia", &pseudo_inertia, py::arg("mass"), py::arg("com"), py::arg("inertia"),
@@ -59,9 +169,52 @@ void bind_model(py::module_& m) {
       .def(py::init<const Vec3&>(), py::arg("gravity"))
       .def("_add_body", &Model::add_body, py::arg("name"), py::arg("parent"), py::arg("joint"), py::arg("placement"),
            py::arg("mass"), py::arg("com"), py::arg("inertia"))
+      .def(
+          "_add_bodies",
+          [](Model& model, const std::vector<std::string>& names, const std::vector<int>& parents, const Joint& joint,
+             const Eigen::Ref<const RowMatX>& stiffness, const Eigen::Ref<const RowMatX>& damping,
+             const Eigen::Ref<const RowMatX>& placements, const Eigen::Ref<const VecX>& masses,
+             const Eigen::Ref<const RowMatX>& coms, const Eigen::Ref<const RowMatX>& inertias) {
+            const auto n = static_cast<Eigen::Index>(names.size());
+            const Eigen::Index k = joint.ncoords();
+            if (static_cast<Eigen::Index>(parents.size()) != n || stiffness.rows() != n || stiffness.cols() != k ||
+                damping.rows() != n || damping.cols() != k || placements.rows() != n || placements.cols() != 16 ||
+                masses.size() != n || coms.rows() != n || coms.cols() != 3 || inertias.rows() != n ||
+                inertias.cols() != 9)
+              bad("bodies", "one row per name: parents (n), stiffness and damping (n, ncoords), placements (n, 16), "
+                            "masses (n), coms (n, 3), inertias (n, 9)", "other shapes");
+            std::vector<BodySpec> specs(n);
+            for (Eigen::Index i = 0; i < n; ++i) {
+              BodySpec& b = specs[i];
+              b.name = names[i];
+              b.parent = parents[i];
+              b.joint = joint;
+              for (Eigen::Index c = 0; c < k; ++c) {
+                b.joint.stiffness[c] = stiffness(i, c);
+                b.joint.damping[c] = damping(i, c);
+              }
+              b.placement = Eigen::Map<const Eigen::Matrix<double, 4, 4, Eigen::RowMajor>>(placements.data() + i * placements.outerStride());
+              b.mass = masses(i);
+              b.com = coms.row(i).transpose();
+              b.inertia = Eigen::Map<const Eigen::Matrix<double, 3, 3, Eigen::RowMajor>>(inertias.data() + i * inertias.outerStride());
+            }
+            return model.add_bodies(std::move(specs));
+          },
+          py::arg("names"), py::arg("parents"), py::arg("joint"), py::arg("stiffness"), py::arg("damping"),
+          py::arg("placements"), py::arg("masses"), py::arg("coms"), py::arg("inertias"),
+          "Adds bodies in order, each with `joint` but its own row of stiffness and damping; all are checked\n"
+          "before any is added. placements and inertias are row-major 4x4 and 3x3 per row.")
+      .def("_truncate", &Model::truncate, py::arg("n"), "Removes the bodies n, n + 1, ... (undo of a failed builder).")
       .def("_prescribe", &Model::prescribe, py::arg("body"), py::arg("coordinate"), py::arg("motion"))
-      .def("_add_generalized_force", &Model::add_generalized_force, py::arg("body"), py::arg("coordinate"),
-           py::arg("value"), py::arg("law"))
+      .def(
+          "_add_generalized_force",
+          [](Model& model, int body, int coordinate, double value, const py::object& law) {
+            if (law.is_none()) return model.add_generalized_force(body, coordinate, value, nullptr);
+            if (!PyCallable_Check(law.ptr())) bad("force", "a number or a function Q(t, q, qd)", short_repr(law));
+            const std::string name = model.coordinate_name(body, coordinate);  // checks body and coordinate
+            model.add_generalized_force(body, coordinate, value, python_force_law(law, name));
+          },
+          py::arg("body"), py::arg("coordinate"), py::arg("value"), py::arg("law"))
       .def(
           "_add_load",
           [](Model& model, int body, const Vec3& point, const Vec3& force, const Vec3& torque, bool follower,
@@ -77,6 +230,14 @@ void bind_model(py::module_& m) {
           py::arg("name"), py::arg("kind"), py::arg("a"), py::arg("frame_a"), py::arg("b"), py::arg("frame_b"),
           py::arg("length"), py::arg("drive"))
       .def("_body_index", &Model::body_index, py::arg("name"))
+      .def(
+          "_body_name",
+          [](const Model& model, int index) {
+            if (index < 0 || index >= static_cast<int>(model.bodies().size())) bad("index", "a body index", std::to_string(index));
+            return model.bodies()[index].name;
+          },
+          py::arg("index"))
+      .def_property_readonly("id", &Model::id, "Unique id of this model, carried by its Body and Point handles.")
       .def("_coordinate_index", &Model::coordinate_index, py::arg("body"), py::arg("coordinate"))
       .def_property("gravity", &Model::gravity, &Model::set_gravity, "Gravitational acceleration (m/s^2), global.")
       .def_property_readonly("nbodies", [](const Model& model) { return model.bodies().size(); })

@@ -1,6 +1,7 @@
 #include "rigidfem/model.hpp"
 
 #include <algorithm>
+#include <atomic>
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
@@ -19,16 +20,21 @@ void require_finite(const M& x, const std::string& argument) {
 }
 
 void check_inertia(const Mat3& I, const std::string& body) {
-  const std::string arg = "inertia of body '" + body + "'";
-  require_finite(I, arg);
+  const auto arg = [&body] { return "inertia of body '" + body + "'"; };  // built for a message only
+  if (!I.allFinite()) bad(arg(), "finite values", "NaN or inf");
   const double scale = I.cwiseAbs().maxCoeff();
-  if ((I - I.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale) bad(arg, "a symmetric 3x3 tensor", "an asymmetric one");
-  Eigen::SelfAdjointEigenSolver<Mat3> es(I);
-  const Vec3 l = es.eigenvalues();  // ascending
-  if (!(l(0) > 0.0)) bad(arg, "a positive definite tensor (kg·m²)", "principal moments " + num8(l(0)) + ", " + num8(l(1)) + ", " + num8(l(2)));
+  if ((I - I.transpose()).cwiseAbs().maxCoeff() > 1e-12 * scale) bad(arg(), "a symmetric 3x3 tensor", "an asymmetric one");
+  Vec3 l;  // principal moments, ascending
+  if (I(0, 1) == 0.0 && I(0, 2) == 0.0 && I(1, 2) == 0.0 && I(1, 0) == 0.0 && I(2, 0) == 0.0 && I(2, 1) == 0.0) {
+    l = I.diagonal();  // principal axes already (every rfe of a beam)
+    std::sort(l.data(), l.data() + 3);
+  } else {
+    l = Eigen::SelfAdjointEigenSolver<Mat3>(I, Eigen::EigenvaluesOnly).eigenvalues();
+  }
+  if (!(l(0) > 0.0)) bad(arg(), "a positive definite tensor (kg·m²)", "principal moments " + num8(l(0)) + ", " + num8(l(1)) + ", " + num8(l(2)));
   // A real body's principal moments satisfy the triangle inequality I_a + I_b >= I_c.
   if (l(0) + l(1) < l(2) * (1.0 - 1e-9))
-    bad(arg, "principal moments satisfying the triangle inequality I1 + I2 >= I3",
+    bad(arg(), "principal moments satisfying the triangle inequality I1 + I2 >= I3",
         num8(l(0)) + " + " + num8(l(1)) + " < " + num8(l(2)));
 }
 
@@ -66,7 +72,11 @@ Mat4 pseudo_inertia(double mass, const Vec3& com, const Mat3& inertia) {
   return H;
 }
 
-Model::Model(const Vec3& gravity) { set_gravity(gravity); }
+Model::Model(const Vec3& gravity) {
+  static std::atomic<std::uint64_t> models{0};
+  id_ = ++models;
+  set_gravity(gravity);
+}
 
 void Model::set_gravity(const Vec3& g) {
   require_finite(g, "gravity");
@@ -75,9 +85,9 @@ void Model::set_gravity(const Vec3& g) {
 
 int Model::body_index(const std::string& name) const {
   if (name == "ground") return -1;
-  for (size_t p = 0; p < bodies_.size(); ++p)
-    if (bodies_[p].name == name) return static_cast<int>(p);
-  bad("parent", "the name of a body already in the model or 'ground'", "'" + name + "'");
+  const auto it = index_of_.find(name);
+  if (it == index_of_.end()) bad("parent", "the name of a body already in the model or 'ground'", "'" + name + "'");
+  return it->second;
 }
 
 void Model::check_body(int body, const char* argument) const {
@@ -86,17 +96,18 @@ void Model::check_body(int body, const char* argument) const {
         "index " + std::to_string(body));
 }
 
-Body Model::add_body(const std::string& name, int parent, const Joint& joint, const Mat4& placement, double mass,
-                     const Vec3& com, const Mat3& inertia) {
+void Model::check_spec(const BodySpec& b, int index) const {
+  const std::string& name = b.name;
   if (name.empty() || name == "ground") bad("name", "a non-empty name other than 'ground'", "'" + name + "'");
-  for (const auto& b : bodies_)
-    if (b.name == name) bad("name", "a name not yet used in this model", "duplicate '" + name + "'");
-  if (parent < -1 || parent >= static_cast<int>(bodies_.size()))
-    bad("parent", "a body already in the model or the ground", "index " + std::to_string(parent));
-  if (!(mass > 0.0) || !std::isfinite(mass)) bad("mass", "a positive finite mass in kg", num8(mass));
-  require_finite(com, "com");
-  check_inertia(inertia, name);
-  check_placement(placement, "placement");
+  if (index_of_.count(name))
+    bad("name", "a name not yet used in this model", "duplicate '" + name + "'");
+  if (b.parent < -1 || b.parent >= index)
+    bad("parent", "a body already in the model or the ground", "index " + std::to_string(b.parent));
+  if (!(b.mass > 0.0) || !std::isfinite(b.mass)) bad("mass", "a positive finite mass in kg", num8(b.mass));
+  require_finite(b.com, "com");
+  check_inertia(b.inertia, name);
+  check_placement(b.placement, "placement");
+  const Joint& joint = b.joint;
   const int n = joint.ncoords();
   if (static_cast<int>(joint.stiffness.size()) != n || static_cast<int>(joint.rest.size()) != n ||
       static_cast<int>(joint.damping.size()) != n)
@@ -110,14 +121,52 @@ Body Model::add_body(const std::string& name, int parent, const Joint& joint, co
   }
   for (const auto& c : joint.coupled) {
     if (!joint.linear) bad("joint", "coupled coordinates only on a linear joint", "an exact joint");
-    if (c.body < 0 || c.body >= static_cast<int>(bodies_.size()) || c.slot < 0 ||
-        c.slot >= bodies_[c.body].joint.ncoords())
+    // The coupled body may be an earlier body of the same batch: its joint is then not in bodies_ yet,
+    // so add_bodies checks the slot against the batch (see there).
+    if (c.body < 0 || c.body >= index || c.slot < 0 ||
+        (c.body < static_cast<int>(bodies_.size()) && c.slot >= bodies_[c.body].joint.ncoords()))
       bad("joint", "coupled coordinates of bodies already in the model", "body " + std::to_string(c.body));
     require_finite(c.G, "coupling generator");
   }
-  bodies_.push_back({name, parent, placement, joint, mass, com, 0.5 * (inertia + inertia.transpose())});
-  coords_.emplace_back(n);
-  return Body{static_cast<int>(bodies_.size()) - 1, name};
+}
+
+Body Model::add_body(const std::string& name, int parent, const Joint& joint, const Mat4& placement, double mass,
+                     const Vec3& com, const Mat3& inertia) {
+  std::vector<BodySpec> one;
+  one.push_back({name, parent, placement, joint, mass, com, inertia});
+  return add_bodies(std::move(one)).front();
+}
+
+std::vector<Body> Model::add_bodies(std::vector<BodySpec> bodies) {
+  const int n0 = static_cast<int>(bodies_.size()), n = static_cast<int>(bodies.size());
+  // Check every body, entering its name as it passes (so a batch cannot repeat a name either);
+  // a bad one takes the names entered so far out again.
+  index_of_.reserve(index_of_.size() + bodies.size());
+  int k = 0;
+  try {
+    for (; k < n; ++k) {
+      const BodySpec& b = bodies[k];
+      check_spec(b, n0 + k);
+      for (const auto& c : b.joint.coupled)
+        if (c.body >= n0 && c.slot >= bodies[c.body - n0].joint.ncoords())
+          bad("joint", "coupled coordinates of bodies already in the model", "body " + std::to_string(c.body));
+      index_of_.emplace(b.name, n0 + k);
+    }
+  } catch (...) {
+    for (int j = 0; j < k; ++j) index_of_.erase(bodies[j].name);
+    throw;
+  }
+  std::vector<Body> handles;
+  handles.reserve(bodies.size());
+  bodies_.reserve(bodies_.size() + bodies.size());
+  coords_.reserve(coords_.size() + bodies.size());
+  for (BodySpec& b : bodies) {
+    b.inertia = 0.5 * (b.inertia + b.inertia.transpose());
+    handles.push_back(Body{static_cast<int>(bodies_.size()), b.name, id_});
+    coords_.emplace_back(b.joint.ncoords());
+    bodies_.push_back(std::move(b));
+  }
+  return handles;
 }
 
 int Model::coordinate_index(int body, const std::string& coordinate) const {
@@ -143,9 +192,26 @@ int Model::resolve_coordinate(int body, int coordinate) const {
   return coordinate;
 }
 
+void Model::truncate(int n) {
+  if (n < 0 || n > static_cast<int>(bodies_.size()))
+    bad("n", "a number of bodies 0.." + std::to_string(bodies_.size()), std::to_string(n));
+  for (int p = n; p < static_cast<int>(bodies_.size()); ++p) index_of_.erase(bodies_[p].name);
+  bodies_.resize(n);
+  coords_.resize(n);
+  loads_.erase(std::remove_if(loads_.begin(), loads_.end(), [n](const Load& l) { return l.body >= n; }), loads_.end());
+}
+
+std::string Model::coordinate_name(int body, int coordinate) const {
+  const int k = resolve_coordinate(body, coordinate);
+  return bodies_[body].name + "." + axis_name(bodies_[body].joint.axes[k]);
+}
+
 void Model::prescribe(int body, int coordinate, ProfilePtr motion) {
   const int k = resolve_coordinate(body, coordinate);
   if (!motion) bad("motion", "a motion profile (rigidfem.motion.*)", "None");
+  if (coords_[body][k].drive)
+    bad("coordinate", "a coordinate not prescribed yet (each takes one motion)",
+        "'" + coordinate_name(body, k) + "', prescribed already");
   coords_[body][k].drive = std::move(motion);
 }
 

@@ -37,18 +37,47 @@ def vec3(x, name: str) -> np.ndarray:
     return array(x, (3,), name)
 
 
-def scalar(x, name: str, *, positive: bool = False, nonnegative: bool = False) -> float:
+def scalar(x, name: str, *, positive: bool = False, nonnegative: bool = False, unit: str = "") -> float:
+    """``x`` as a finite float: a real number (not a string, not a bool), positive or non-negative
+    if asked; ``unit`` goes into the messages."""
+    expected = ("positive " if positive else "non-negative " if nonnegative else "") + "number" + \
+        (f" in {unit}" if unit else "")
+    if isinstance(x, (str, bytes, bool, np.bool_)):
+        raise ValueError(f"{name}: expected a {expected}, got {x!r}")
     try:
         v = float(x)
     except (TypeError, ValueError):
-        raise ValueError(f"{name}: expected a number, got {x!r}") from None
+        raise ValueError(f"{name}: expected a {expected}, got {x!r}") from None
     if not math.isfinite(v):
-        raise ValueError(f"{name}: expected a finite number, got {v}")
-    if positive and not v > 0.0:
-        raise ValueError(f"{name}: expected a positive number, got {v}")
-    if nonnegative and not v >= 0.0:
-        raise ValueError(f"{name}: expected a non-negative number, got {v}")
+        raise ValueError(f"{name}: expected a finite {expected}, got {v}")
+    if (positive and not v > 0.0) or (nonnegative and not v >= 0.0):
+        raise ValueError(f"{name}: expected a {expected}, got {v}")
     return v
+
+
+def pose_time(system, t) -> float:
+    """The time (s) of a pose of ``system``: ``t``, or 0 when omitted, which only a system without
+    prescribed coordinates allows (their drives make the pose depend on t)."""
+    if t is not None:
+        return t
+    if system.np:
+        names = system.prescribed_names
+        listed = ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
+        raise ValueError(f"t: required because the system has prescribed coordinates ({listed}) whose drives "
+                         "make the pose depend on time; pass t in s")
+    return 0.0
+
+
+def same_model(handle, system, name: str, expected: str = "a Point or Body of the model this system was compiled "
+                                                          "from") -> None:
+    """Raise ValueError if the Body or Point ``handle`` was made by another model than the one
+    ``system`` was compiled from (handles and systems of unknown origin pass)."""
+    from ._core import Body, Point
+
+    if isinstance(handle, (Body, Point)):
+        own = getattr(system, "_model_id", 0)  # 0: a system made without Model.compile
+        if handle.model and own and handle.model != own:
+            raise ValueError(f"{name}: expected {expected}, got {handle!r} of another model")
 
 
 def per_coordinate(x, n: int, name: str, *, nonnegative: bool = False) -> list[float]:

@@ -5,6 +5,12 @@ the force Jacobians of ``System.force_jacobians`` (in C++: analytic for the defa
 recursive engine, central differences for ``compile(algorithm="lagrange")``):
 K = −∂f/∂q (tangent stiffness: springs, gravity and preload, centrifugal terms of a
 prescribed spin) and C = −∂f/∂q̇ (dampers, gyroscopic terms).
+
+Every answer is a result or an exception: a system without free coordinates (nq = 0)
+gets an empty result; bad arguments raise ``ValueError`` naming the argument; a
+singular mass matrix (gimbal lock), a mechanism in statics (a coordinate nothing
+resists) or non-finite matrices raise one ``SimulationError`` that names the time,
+the cause and the coordinates concerned. No LinAlgError or LinAlgWarning escapes.
 """
 
 from __future__ import annotations
@@ -13,10 +19,68 @@ from dataclasses import dataclass, field
 
 import numpy as np
 import scipy.linalg
+import scipy.optimize
+from scipy.linalg import lapack
 
 from . import _checks
 from ._core import SimulationError
 
+_EPS = np.finfo(float).eps
+#: The tangent stiffness counts as singular when its reciprocal condition number, after symmetric
+#: scaling by its row sizes (which removes the mix of units, N/m beside N·m/rad), is below this.
+_RCOND_SINGULAR = 1e-13
+#: The mass matrix (scaled by its diagonal) only below this: a chain of m rfes in relative
+#: coordinates is legitimately conditioned to ~ m⁴ (7e9 at m = 160), a gimbal lock to ~1/ε².
+_RCOND_MASS = 16 * _EPS
+
+
+def _frame(t: float, what: str) -> str:
+    return f"at t = {t} s: {what}"
+
+
+def _require_finite(t: float, what: str, **matrices) -> None:
+    for name, a in matrices.items():
+        if not np.all(np.isfinite(a)):
+            raise SimulationError(f"{_frame(t, what)}: {name} has NaN or inf entries (forces, drives or "
+                                  "their derivatives overflow at this time and configuration)")
+
+
+def _row_scale(A: np.ndarray) -> np.ndarray:
+    """(n,) symmetric scaling s with A_ij / (s_i s_j) of order one: s_i = sqrt(max |row i|, |column i|)."""
+    a = np.abs(A)
+    s = np.sqrt(np.maximum(a.max(axis=0), a.max(axis=1)))
+    s[~(s > 0)] = 1.0  # an all-zero row stays zero: singular
+    return s
+
+
+def _describe_null_space(A: np.ndarray, names, limit: int = 3) -> str:
+    """The coordinates of A's (near) null space: "payload.rz", "(ball.rz + ball.rx)" for a
+    combination, or "6 independent motions of body.x, ..." for a large one."""
+    s = _row_scale(A)
+    _, sv, Vt = np.linalg.svd(A / s[:, None] / s[None, :])
+    null = sv <= max(1e-8 * sv[0], sv[-1])
+    V, _ = np.linalg.qr(Vt[null].T / s[:, None])  # back to the unscaled coordinates (m and rad)
+    names = list(names) if names is not None and len(names) == len(A) else [f"q[{i}]" for i in range(len(A))]
+    if V.shape[1] > limit:  # the coordinates that carry a large null space
+        weight = np.sum(V**2, axis=1)
+        picked = [names[i] for i in range(len(A)) if weight[i] >= 0.1 * weight.max()]
+        return f"{V.shape[1]} independent motions of " + ", ".join(picked)
+    parts = []
+    for v in V.T:
+        v = v / v[np.argmax(np.abs(v))]
+        big = [i for i in range(len(v)) if abs(v[i]) >= 0.1]
+        if len(big) == 1:
+            parts.append(names[big[0]])
+            continue
+        text = ""
+        for i in big:
+            size = "" if abs(abs(v[i]) - 1) < 1e-3 else f"{abs(v[i]):.2g}·"
+            text += (" − " if v[i] < 0 else " + " if text else "") + size + names[i]
+        parts.append(f"({text})")
+    return ", ".join(parts)
+
+
+# --------------------------------------------------------------------------- statics
 
 @dataclass
 class Equilibrium:
@@ -30,36 +94,67 @@ class Equilibrium:
     history: list = field(default_factory=list, repr=False)  #: (load factor, iterations, residual) per step
 
 
+def _solve_tangent(K: np.ndarray, f: np.ndarray):
+    """Δq (nq,) with K Δq = f, or None when K is singular to working precision."""
+    s = _row_scale(K)
+    Ks = K / s[:, None] / s[None, :]
+    lu, piv, info = lapack.dgetrf(Ks)
+    if info != 0:
+        return None
+    rcond, info = lapack.dgecon(lu, np.linalg.norm(Ks, 1))
+    if info != 0 or not rcond > _RCOND_SINGULAR:  # NaN fails too
+        return None
+    x, info = lapack.dgetrs(lu, piv, f / s)
+    return x / s if info == 0 else None
+
+
+def _integer_at_least_one(x, name: str) -> int:
+    v = _checks.integer(x, name)
+    if v < 1:
+        raise ValueError(f"{name}: expected an integer >= 1, got {v}")
+    return v
+
+
 def static_equilibrium(system, q0=None, t: float = 0.0, load_steps: int = 10, tol: float = 1e-10,
                        max_iterations: int = 50) -> Equilibrium:
     """Solve f(q) = 0 by Newton's method with load stepping.
 
     Gravity, point forces, torques and applied generalised forces are scaled together
     by λ = 1/n, 2/n, ..., 1 (n = ``load_steps``); each step starts from the previous
-    one's solution. Prescribed coordinates are held at their values at time ``t`` (s),
-    at rest. A step converges when the Newton correction satisfies
-    max |Δq| ≤ tol · max(1, max |q|) (m and rad).
+    one's solution (``q0``, m and rad, default 0, for the first). Prescribed coordinates
+    are held at their values at time ``t`` (s), at rest. A step converges when the
+    Newton correction satisfies max |Δq| ≤ tol · max(1, max |q|) (m and rad).
 
-    Raises ``SimulationError`` when Newton does not converge within ``max_iterations``
-    in a load step or the tangent stiffness is singular.
+    A system without free coordinates (nq = 0) returns at once with ``q`` of shape (0,).
+
+    Raises ``ValueError`` for a bad argument, and ``SimulationError`` (naming t) when
+    Newton does not converge within ``max_iterations`` in a load step, when forces or
+    their Jacobian are not finite, or when the tangent stiffness K = −∂f/∂q is singular:
+    the message then names the coordinates nothing resists (a mechanism, e.g. the yaw
+    of a hanging payload, or a buckling/limit point).
     """
+    t = _checks.scalar(t, "t")
     n = system.nq
     q = np.zeros(n) if q0 is None else _checks.array(q0, (n,), "q0").copy()
-    steps = int(load_steps)
-    if steps < 1:
-        raise ValueError(f"load_steps: expected an integer >= 1, got {load_steps}")
+    steps = _integer_at_least_one(load_steps, "load_steps")
     tol = _checks.scalar(tol, "tol", positive=True)
+    max_iterations = _integer_at_least_one(max_iterations, "max_iterations")
+    if n == 0:
+        return Equilibrium(q, True, 0, 0.0, steps, [(k / steps, 0, 0.0) for k in range(1, steps + 1)])
     history, total = [], 0
     for k in range(1, steps + 1):
         lam = k / steps
+        what = f"statics at load factor {lam:.4g}"
         f = system.static_forces(t, q, lam)
         for it in range(1, max_iterations + 1):
             K = -system.force_jacobians(t, q, np.zeros(n), lam, True)[0]
-            try:
-                dq = scipy.linalg.solve(K, f)
-            except (scipy.linalg.LinAlgError, ValueError):
-                raise SimulationError(f"at t = {t} s: statics: tangent stiffness singular at load factor {lam:.4g} "
-                                      "(a mechanism, or a buckling/limit point)") from None
+            _require_finite(t, what, **{"f(q)": f, "tangent stiffness K": K})
+            dq = _solve_tangent(K, f)
+            if dq is None:
+                raise SimulationError(
+                    f"{_frame(t, what)}: the tangent stiffness K = −∂f/∂q is singular to working precision: "
+                    f"nothing resists {_describe_null_space(K, system.coordinate_names)}. A mechanism (give these "
+                    "coordinates stiffness, prescribe or lock them), or a buckling/limit point")
             # Backtracking line search on |f| keeps large-rotation steps from overshooting.
             alpha, norm0 = 1.0, np.max(np.abs(f))
             while True:
@@ -73,21 +168,23 @@ def static_equilibrium(system, q0=None, t: float = 0.0, load_steps: int = 10, to
             if np.max(np.abs(alpha * dq)) <= tol * max(1.0, np.max(np.abs(q))):
                 break
         else:
-            raise SimulationError(f"at t = {t} s: statics: Newton did not converge in {max_iterations} iterations at "
+            raise SimulationError(f"{_frame(t, 'statics')}: Newton did not converge in {max_iterations} iterations at "
                                   f"load factor {lam:.4g} (residual {np.max(np.abs(f)):.3e}); try more load_steps")
         history.append((lam, it, float(np.max(np.abs(f)))))
     return Equilibrium(q, True, total, float(np.max(np.abs(f))), steps, history)
 
 
+# --------------------------------------------------------------------------- modes
+
 @dataclass
 class Modes:
-    """Result of ``modal_analysis``, modes sorted by natural frequency."""
+    """Result of ``modal_analysis``: one entry per mode (k = nq), sorted by natural frequency."""
 
-    omega: np.ndarray           #: (k,) natural (undamped) circular frequencies |λ|, rad/s
+    omega: np.ndarray           #: (k,) undamped natural circular frequencies, rad/s (a divergence: √(−ω²))
     frequencies_hz: np.ndarray  #: (k,) omega / 2π, Hz
-    damping_ratios: np.ndarray  #: (k,) ζ = −Re λ / |λ| (zero without damping, negative when unstable)
-    shapes: np.ndarray          #: (nq, k) mode shapes (real parts), max |entry| = 1
-    eigenvalues: np.ndarray     #: (k,) λ = −ζω + iω√(1 − ζ²); Re λ > 0 marks an unstable mode
+    damping_ratios: np.ndarray  #: (k,) modal ζ = φᴴCφ / (2ω φᴴMφ): > 1 overdamped, inf damped ω = 0, < 0 unstable
+    shapes: np.ndarray          #: (nq, k) undamped mode shapes (real parts), max |entry| = 1
+    eigenvalues: np.ndarray     #: (k,) per mode the root of det(λ²M + λC + K) with the largest Re, Im ≥ 0; 1/s
     q: np.ndarray               #: (nq,) configuration linearised about
 
     @property
@@ -99,46 +196,167 @@ class Modes:
     C: np.ndarray = field(repr=False)  #: (nq, nq) −∂f/∂q̇
 
 
-def modal_analysis(system, q=None, qd=None, t: float = 0.0) -> Modes:
-    """Natural frequencies and mode shapes of the system linearised about (q, q̇) at t.
+def _check_mass_matrix(M: np.ndarray, names, t: float) -> None:
+    """SimulationError naming the coordinates without inertia unless M is positive definite."""
+    s = np.sqrt(np.abs(np.diag(M)))
+    singular = not np.all(s > 0)
+    if not singular:
+        Ms = M / s[:, None] / s[None, :]
+        L, info = lapack.dpotrf(Ms)
+        singular = info != 0
+        if not singular:
+            rcond, info = lapack.dpocon(L, np.linalg.norm(Ms, 1))
+            singular = info != 0 or not rcond > _RCOND_MASS
+    if singular:
+        raise SimulationError(f"{_frame(t, 'modal analysis')}: the mass matrix A(q) is singular to working "
+                              f"precision: no inertia along {_describe_null_space(M, names)} (Euler angles in "
+                              "gimbal lock at pitch ±π/2, or massless bodies)")
 
-    M ẍ + C ẋ + K x = 0 with M = A(q), K = −∂f/∂q, C = −∂f/∂q̇. Default q = 0 (the
-    undeformed configuration for beams), q̇ = 0; prescribed coordinates follow their
-    drives at t, so a steady prescribed spin adds its centrifugal (K) and gyroscopic
-    (C) terms; pass an equilibrium q to include the geometric stiffness of a preload.
-    Without C the symmetric problem K φ = ω² M φ is solved; otherwise the first-order
-    (state-space) one, giving damped eigenvalues.
+
+def _undamped(K: np.ndarray, M: np.ndarray):
+    """ω² (n,) ascending and mode shapes Φ (n, n) with ΦᵀMΦ = I of K φ = ω² M φ (K symmetric).
+
+    The stiffness form eigh(K, M) is accurate to ε ω_max² in ω², which for a stiff beam
+    (ω_max²/ω₁² ~ 1e11) spoils the low modes. When K is positive definite the flexibility
+    form M φ = μ K φ, μ = 1/ω², gives the low modes to ε ω_i²/ω₁² instead; with a wide
+    spectrum both are solved and each mode taken from the better one, split at a gap near
+    the geometric mean of ω₁² and ω_max² where the two errors are equal.
     """
+    n = len(K)
+    try:
+        mu, X = scipy.linalg.eigh(M, K)  # raises when K is not positive definite
+    except np.linalg.LinAlgError:
+        mu = None
+    if mu is None or not mu[0] > 0:  # a zero mode, a divergence (spin softening, buckling): stiffness form
+        w2, Phi = scipy.linalg.eigh(K, M)
+        w2[np.abs(w2) <= 64 * n * _EPS * np.max(np.abs(w2))] = 0.0  # rigid-body modes: zero, not ±round-off
+        return w2, Phi
+    w2, Phi = 1.0 / mu[::-1], X[:, ::-1] / np.sqrt(mu[::-1])
+    if w2[-1] <= 1e6 * w2[0]:
+        return w2, Phi
+    w2s, Phis = scipy.linalg.eigh(K, M)
+    gm = np.sqrt(w2[0] * w2[-1])
+    near = np.flatnonzero((w2[1:] >= gm / 10) & (w2[:-1] <= gm * 10)) + 1  # splits k: flexibility below k
+    if near.size == 0:
+        return w2, Phi
+    k = near[np.argmax(w2[near] / w2[near - 1])]
+    return np.concatenate([w2[:k], w2s[k:]]), np.hstack([Phi[:, :k], Phis[:, k:]])
+
+
+def _roots(W: np.ndarray, Kt: np.ndarray, Ct: np.ndarray, basis: np.ndarray):
+    """One root per mode of ÿ + Ct ẏ + Kt y = 0 (modal coordinates y, (n,)).
+
+    First-order form in z = (W y, ẏ), W = diag(W) ≈ diag(ω), so that the matrix is of
+    size ω_max, not ω_max² (the low roots keep their accuracy). Each root λ with Im λ ≥ 0
+    goes to the column of ``basis`` (n, n) that carries most of its y; a mode takes, of its
+    roots, the one with the largest real part (the slower of an overdamped pair, the
+    growing one of a divergence). Returns λ (n,) and the y of each (n, n), |z| = 1.
+    """
+    n = len(W)
+    A = np.block([[np.zeros((n, n)), np.diag(W)], [-Kt / W[None, :], -Ct]])
+    ev, Z = np.linalg.eig(A)
+    ev = np.where(np.abs(ev) <= 64 * n * _EPS * np.max(np.abs(A)), 0.0, ev)  # zero roots: exactly zero
+    keep = ev.imag >= 0
+    ev, Y = ev[keep], Z[:n, keep] / W[:, None]
+    P = np.abs(np.linalg.lstsq(basis, Y, rcond=None)[0]) ** 2  # (n modes, candidates)
+    owner = np.argmax(P, axis=0)
+    pick = -np.ones(n, dtype=int)
+    for k in range(n):
+        mine = np.flatnonzero(owner == k)
+        if mine.size:
+            pick[k] = mine[np.lexsort((ev[mine].imag, ev[mine].real))[-1]]
+    empty, unused = np.flatnonzero(pick < 0), np.setdiff1d(np.arange(ev.size), pick)
+    if empty.size:  # strongly coupled modes (e.g. a degenerate pair split by gyroscopic terms)
+        rows, cols = scipy.optimize.linear_sum_assignment(-P[np.ix_(empty, unused)])
+        pick[empty[rows]] = unused[cols]
+    return ev[pick], Y[:, pick]
+
+
+def modal_analysis(system, q=None, qd=None, t: float = 0.0) -> Modes:
+    """Natural frequencies, damping ratios and mode shapes of the system linearised about (q, q̇) at t.
+
+    M ẍ + C ẋ + K x = 0 with M = A(q), K = −∂f/∂q, C = −∂f/∂q̇ (``q`` in m and rad, default
+    0: the undeformed configuration for beams; ``qd`` in m/s and rad/s, default 0; ``t`` in s).
+    Prescribed coordinates follow their drives at t, so a steady prescribed spin adds its
+    centrifugal (K) and gyroscopic (C) terms; pass an equilibrium q to include the geometric
+    stiffness of a preload.
+
+    - ``omega`` (rad/s) and ``shapes`` come from the undamped problem K φ = ω² M φ, solved
+      once (in its flexibility form μ = 1/ω² when K is positive definite, which keeps the
+      lowest frequency of a stiff beam accurate). With gyroscopic terms (skew part of C) or
+      circulatory ones (skew part of K) the undamped problem is M ẍ + G ẋ + K x = 0 with the
+      skew part G of C, ω = |λ| and the shapes are the real parts of its complex modes. A
+      negative ω² (divergence) is reported as its growth rate √(−ω²).
+    - ``damping_ratios``: ζ = φᴴ D φ / (2 ω φᴴ M φ) from the symmetric part D of C (exactly
+      c/(2√(km)) for one spring–mass, μω/2 for Kelvin–Voigt damping), > 1 for an overdamped
+      mode (whose ω stays the undamped one); 0 for an undamped ω = 0 mode, inf for a damped
+      one; −Re λ/|λ| < 0 for a mode whose undamped root grows (−1 for a divergence).
+    - ``eigenvalues`` (1/s): per mode, the root of the full quadratic problem det(λ²M + λC + K)
+      = 0 with the largest real part (Im ≥ 0): −ζω + iω√(1 − ζ²) for light proportional
+      damping, the slower real root of an overdamped mode, iω without damping.
+
+    A system without free coordinates (nq = 0) gives empty arrays. Raises ``ValueError`` for
+    a bad argument and ``SimulationError`` (naming t) when the mass matrix is singular (it
+    names the coordinates, e.g. Euler angles in gimbal lock) or the matrices are not finite.
+    """
+    t = _checks.scalar(t, "t")
     n = system.nq
     q = np.zeros(n) if q is None else _checks.array(q, (n,), "q")
     qd = np.zeros(n) if qd is None else _checks.array(qd, (n,), "qd")
+    if n == 0:
+        e = np.zeros((0, 0))
+        return Modes(np.zeros(0), np.zeros(0), np.zeros(0), e, np.zeros(0, complex), q, e, e.copy(), e.copy())
     M = system.mass_matrix(q, t)
     dfdq, dfdqd = system.force_jacobians(t, q, qd)
     K, C = -dfdq, -dfdqd
-    scale = max(np.max(np.abs(K)), 1e-300)
-    # C counts as absent below 1e-9 of its natural unit sqrt(|K| |M|) (the Lagrange engine's central
-    # differences leave noise ~1e-12 of it); the symmetric solver is then far more accurate for the
-    # low modes of stiff beams.
-    if np.max(np.abs(C)) <= 1e-9 * np.sqrt(scale * np.max(np.abs(M))) and \
-            np.max(np.abs(K - K.T)) <= 1e-6 * scale:
-        w2, X = scipy.linalg.eigh(0.5 * (K + K.T), M)
-        # λ = ±iω for ω² > 0; a negative ω² is a divergence, reported by its growing root λ = +sqrt(−ω²).
-        lam = np.where(w2 >= 0, 1j * np.sqrt(np.abs(w2)), np.sqrt(np.abs(w2)) + 0j)
-        omega = np.abs(lam)
-        zeta = -lam.real / np.where(omega > 0, omega, 1.0)
-        shapes = X
-    else:
-        Minv = np.linalg.inv(M)
-        S = np.block([[np.zeros((n, n)), np.eye(n)], [-Minv @ K, -Minv @ C]])
-        ev, V = np.linalg.eig(S)
-        keep = ev.imag >= -1e-12 * np.abs(ev)  # one of each conjugate pair
-        ev, V = ev[keep], V[:n, keep]
-        order = np.argsort(np.abs(ev))
-        lam, V = ev[order][:n], V[:, order][:, :n]
-        omega = np.abs(lam)
-        zeta = -lam.real / np.where(omega > 0, omega, 1.0)
-        shapes = (V * np.exp(-1j * np.angle(V[np.argmax(np.abs(V), axis=0), range(V.shape[1])]))).real
-    order = np.argsort(np.abs(omega))
-    shapes = shapes[:, order]
-    shapes = shapes / np.max(np.abs(shapes), axis=0)
+    _require_finite(t, "modal analysis", **{"mass matrix": M, "stiffness K = −∂f/∂q": K,
+                                            "damping/gyroscopic matrix C = −∂f/∂q̇": C})
+    names = system.coordinate_names
+    _check_mass_matrix(M, names, t)
+    try:
+        omega, zeta, shapes, lam = _modes(M, K, C)
+    except np.linalg.LinAlgError as err:  # the eigensolvers' own failures, rare after the checks above
+        raise SimulationError(f"{_frame(t, 'modal analysis')}: eigensolver failed ({err})") from err
+    order = np.argsort(omega, kind="stable")
+    shapes = shapes[:, order] / np.max(np.abs(shapes[:, order]), axis=0)
     return Modes(omega[order], omega[order] / (2 * np.pi), zeta[order], shapes, lam[order], q, M, K, C)
+
+
+def _modes(M: np.ndarray, K: np.ndarray, C: np.ndarray):
+    """(ω, ζ, shapes, λ) in solver order; see ``modal_analysis``."""
+    n = len(M)
+    Ks, Ka = 0.5 * (K + K.T), 0.5 * (K - K.T)
+    D, G = 0.5 * (C + C.T), 0.5 * (C - C.T)
+    k_scale = max(np.max(np.abs(K)), 1e-300)
+    # C (its parts) count as absent below 1e-9 of their natural unit sqrt(|K| |M|): the Lagrange
+    # engine's central differences leave noise ~1e-12 of it, and round-off in K's symmetry likewise.
+    c_small = 1e-9 * np.sqrt(k_scale * np.max(np.abs(M)))
+    damped = np.max(np.abs(D)) > c_small
+    conservative = np.max(np.abs(G)) <= c_small and np.max(np.abs(Ka)) <= 1e-6 * k_scale
+    w2, Phi = _undamped(Ks, M)
+    W = np.sqrt(np.abs(w2))
+    W = np.where(W > 0, W, max(1e-8 * W.max(), 1e-300) if W.max() > 0 else 1.0)  # scaling only
+    if conservative:
+        lam0 = np.where(w2 > 0, 1j * np.sqrt(np.abs(w2)), np.sqrt(np.abs(w2)) + 0j)
+        Yc = np.eye(n)
+        shapes = Phi
+    else:  # gyroscopic or circulatory: the undamped problem is not symmetric; solve it in the basis Φ
+        lam0, Yc = _roots(W, Phi.T @ K @ Phi, Phi.T @ G @ Phi, np.diag(1 / (np.sqrt(2) * W)))
+        lam0 = np.where(np.abs(lam0.imag) <= 1e-12 * np.abs(lam0), lam0.real + 0j, lam0)
+        psi = Phi @ Yc
+        pivot = psi[np.argmax(np.abs(psi), axis=0), range(n)]
+        shapes = (psi * np.exp(-1j * np.angle(pivot))).real
+    omega = np.abs(lam0)
+    growing = lam0.real > 1e-9 * omega
+    zeta = np.where(growing, -lam0.real / np.where(omega > 0, omega, 1.0), 0.0)
+    if not damped:
+        return omega, zeta, shapes, lam0
+    Dm = np.real(np.einsum("ik,ij,jk->k", Yc.conj(), Phi.T @ D @ Phi, Yc))  # φᴴDφ
+    Mm = np.real(np.einsum("ik,ik->k", Yc.conj(), Yc))                      # φᴴMφ (ΦᵀMΦ = I)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        modal = np.where(omega > 0, Dm / (2 * omega * Mm), np.where(Dm > 1e-12 * np.max(np.abs(Dm)), np.inf, 0.0))
+    zeta = np.where(growing, zeta, modal)
+    # The damped roots go to the undamped modes they are made of (Yc: each of unit energy |z| = 1).
+    basis = np.diag(1 / (np.sqrt(2) * W)) if conservative else Yc
+    lam, _ = _roots(W, Phi.T @ K @ Phi, Phi.T @ C @ Phi, basis)
+    return omega, zeta, shapes, lam

@@ -13,6 +13,8 @@ make frequencies and deflections converge as O(m⁻²).
 
 from __future__ import annotations
 
+import functools
+import operator
 from collections.abc import Callable, Sequence
 from dataclasses import dataclass, field
 
@@ -33,15 +35,30 @@ _GAUSS = np.polynomial.legendre.leggauss(8)  # exact for polynomials of degree �
 
 @dataclass(frozen=True)
 class Property:
-    """A beam property along the arc length s: one value, a function of s, or one per segment."""
+    """A beam property along the arc length s: one value, a function of s, or one per segment.
+
+    ``at(s)`` is the value (a Material or Section) at one s; ``sample(s, fields)`` the named
+    fields at an array of s at once, (len(fields), *s.shape) or broadcastable to it, without a
+    Python call per s unless the property is a function of s.
+    """
 
     at: Callable[[float], object]
     breakpoints: tuple[float, ...] = ()
+    table: Callable[[np.ndarray, tuple[str, ...]], np.ndarray] | None = None
+
+    def sample(self, s: np.ndarray, fields: tuple[str, ...]) -> np.ndarray:
+        if self.table is not None:
+            return self.table(s, fields)
+        values = [self.at(x) for x in s.ravel()]
+        return np.array([[getattr(v, f) for v in values] for f in fields], dtype=float).reshape(len(fields), *s.shape)
 
     @staticmethod
     def of(value, kind: type, name: str, length: float, elements: int) -> Property:
         if isinstance(value, kind):
-            return Property(lambda s: value)
+            def constant(s, fields):  # (len(fields), 1, ...): broadcasts against s
+                return np.array([getattr(value, f) for f in fields], dtype=float).reshape(-1, *[1] * np.ndim(s))
+
+            return Property(lambda s: value, (), constant)
         if callable(value):
             def checked(s):
                 v = value(s)
@@ -56,19 +73,54 @@ class Property:
                                  f"(one per segment), got {len(value)} items")
             d = length / elements
             values = list(value)
+
+            def per_segment(s, fields):  # the values of the segment holding each s
+                segment = np.clip(np.floor_divide(s, d), 0, elements - 1).astype(int)
+                return np.array([[getattr(v, f) for v in values] for f in fields], dtype=float)[:, segment]
+
             return Property(lambda s: values[min(max(int(s // d), 0), elements - 1)],
-                            tuple(k * d for k in range(1, elements)))
+                            tuple(k * d for k in range(1, elements)), per_segment)
         raise ValueError(f"{name}: expected a {kind.__name__}, a function of s or a list per segment, got {value!r}")
 
 
-def _integrate(fun, a: float, b: float, breakpoints=()) -> np.ndarray:
-    """∫_a^b fun(s) ds by 8-point Gauss–Legendre on each piece between breakpoints."""
-    cuts = [a] + [x for x in breakpoints if a < x < b] + [b]
-    total = 0.0
-    for lo, hi in zip(cuts[:-1], cuts[1:]):
-        s = 0.5 * (hi - lo) * _GAUSS[0] + 0.5 * (hi + lo)
-        total = total + 0.5 * (hi - lo) * sum(w * np.asarray(fun(x), float) for w, x in zip(_GAUSS[1], s))
-    return np.asarray(total)
+def _pieces(a: np.ndarray, b: np.ndarray, breakpoints):
+    """The intervals [a_i, b_i] cut at the breakpoints inside them: (lo, hi, owner, first), piece k
+    being [lo_k, hi_k] of interval owner_k, and first_i the first piece of interval i."""
+    B = np.unique(np.asarray(breakpoints, dtype=float))
+    n = len(a)
+    if not len(B):
+        return a, b, np.arange(n), np.arange(n)
+    i0 = np.searchsorted(B, a, side="right")  # the first breakpoint > a_i
+    inner = np.maximum(np.searchsorted(B, b, side="left") - i0, 0)  # breakpoints strictly inside
+    count = inner + 1
+    first = np.cumsum(count) - count
+    owner = np.repeat(np.arange(n), count)
+    j = np.arange(owner.size) - first[owner]  # the piece's number within its interval
+    last = len(B) - 1
+    lo = np.where(j == 0, a[owner], B[np.clip(i0[owner] + j - 1, 0, last)])
+    hi = np.where(j == inner[owner], b[owner], B[np.clip(i0[owner] + j, 0, last)])
+    return lo, hi, owner, first
+
+
+def _integrate(fun, a, b, breakpoints=()) -> np.ndarray:
+    """∫_{a_i}^{b_i} fun ds over every interval i by 8-point Gauss–Legendre on each piece between
+    breakpoints: ``fun(s, owner)`` takes the nodes s (8, pieces) and the index of each piece's
+    interval (pieces,) and returns a list of values, each (8, pieces) or broadcastable to it.
+    Returns (nvalues, len(a)); each interval's sum runs in the same order however many there are,
+    so one interval is integrated exactly as many are."""
+    a, b = np.atleast_1d(np.asarray(a, dtype=float)), np.atleast_1d(np.asarray(b, dtype=float))
+    lo, hi, owner, first = _pieces(a, b, breakpoints)
+    half, mid = 0.5 * (hi - lo), 0.5 * (hi + lo)
+    x, w = _GAUSS
+    nodes = x[:, None] * half + mid  # (8, pieces)
+    rows = []
+    for v in fun(nodes, owner):
+        v = np.broadcast_to(v, nodes.shape)
+        total = w[0] * v[0]
+        for k in range(1, len(w)):
+            total = total + w[k] * v[k]
+        rows.append(half * total)
+    return np.add.reduceat(np.array(rows), first, axis=1)
 
 
 def _as_property(value, kind, name) -> Property:
@@ -85,6 +137,37 @@ class RfeParameters:
     H: np.ndarray          #: (4, 4) pseudo-inertia ∫ r rᵀ dm
 
 
+class _RfeTable:
+    """The parameters of n rfes as arrays: mass (n,), com (n, 3), inertia (n, 3, 3), H (n, 4, 4)."""
+
+    def __init__(self, H: np.ndarray):
+        self.H = H
+        self.mass = H[:, 3, 3]
+        self.com = H[:, :3, 3] / self.mass[:, None]
+        self.inertia = _inertia_about_com(H)
+
+    def __getitem__(self, i: int) -> RfeParameters:
+        return RfeParameters(self.mass[i], self.com[i].copy(), self.inertia[i].copy(), self.H[i].copy())
+
+
+def _pseudo_inertias(mat: Property, sec: Property, start, end, origin) -> np.ndarray:
+    """H (n, 4, 4) of the rfes [start_i, end_i] with frames at the arc lengths origin_i (see rfe_parameters)."""
+    x0 = np.atleast_1d(np.asarray(origin, dtype=float))
+
+    def density(s, owner):  # [ρA, ρA x, ρA x², ρ Iz, ρ Iy]
+        (rho,), (A, Iz, Iy) = mat.sample(s, ("rho",)), sec.sample(s, ("A", "Iz", "Iy"))
+        x = s - x0[owner]  # (8, pieces)
+        rhoA = rho * A
+        return [rhoA, rhoA * x, rhoA * x * x, rho * Iz, rho * Iy]
+
+    mass, first, xx, yy, zz = _integrate(density, start, end, mat.breakpoints + sec.breakpoints)
+    H = np.zeros((len(mass), 4, 4))
+    H[:, 0, 0], H[:, 1, 1], H[:, 2, 2] = xx, yy, zz
+    H[:, 0, 3] = H[:, 3, 0] = first
+    H[:, 3, 3] = mass
+    return H
+
+
 def rfe_parameters(material, section, start: float, end: float, origin: float | None = None) -> RfeParameters:
     """Mass, centre of mass, inertia and pseudo-inertia of the beam piece [start, end] (m),
     in a frame on the beam axis at arc length ``origin`` (default ``start``).
@@ -95,37 +178,57 @@ def rfe_parameters(material, section, start: float, end: float, origin: float | 
     """
     mat = _as_property(material, Material, "material")
     sec = _as_property(section, Section, "section")
-    x0 = start if origin is None else origin
-
-    def density(s):  # [ρA, ρA x, ρA x², ρ Iz, ρ Iy]
-        m, c = mat.at(s), sec.at(s)
-        x = s - x0
-        return [m.rho * c.A, m.rho * c.A * x, m.rho * c.A * x * x, m.rho * c.Iz, m.rho * c.Iy]
-
-    mass, first, xx, yy, zz = _integrate(density, start, end, mat.breakpoints + sec.breakpoints)
-    H = np.zeros((4, 4))
-    H[:3, :3] = np.diag([xx, yy, zz])
-    H[0, 3] = H[3, 0] = first
-    H[3, 3] = mass
-    com = np.array([first / mass, 0.0, 0.0])
-    return RfeParameters(mass, com, _inertia_about_com(H), H)
+    return _RfeTable(_pseudo_inertias(mat, sec, start, end, start if origin is None else origin))[0]
 
 
 def _inertia_about_com(H: np.ndarray) -> np.ndarray:
-    """Inverse of the pseudo-inertia: I_O = tr(S) 1 − S with S = ∫r rᵀ dm, shifted to the c.o.m."""
-    m = H[3, 3]
-    c = H[:3, 3] / m
-    S = H[:3, :3]
-    I_O = np.trace(S) * np.eye(3) - S
-    return I_O - m * (c @ c * np.eye(3) - np.outer(c, c))
+    """Inverse of the pseudo-inertia: I_O = tr(S) 1 − S with S = ∫r rᵀ dm, shifted to the c.o.m.
+    H (4, 4) or a stack (n, 4, 4); the inertia (3, 3) or (n, 3, 3) about the c.o.m."""
+    m = H[..., 3, 3, None, None]
+    c = H[..., :3, 3] / H[..., 3, 3, None]
+    S = H[..., :3, :3]
+    eye = np.eye(3)
+    I_O = np.trace(S, axis1=-2, axis2=-1)[..., None, None] * eye - S
+    cc = np.sum(c * c, axis=-1)[..., None, None]
+    return I_O - m * (cc * eye - c[..., :, None] * c[..., None, :])
 
 
 @dataclass(frozen=True)
 class SdeParameters:
-    """Stiffness c_k (N/m or N·m/rad) and damping b_k = μ c_k of one sde, by deformation."""
+    """Spring and damper constants of one sde by deformation: stiffness c_k (N/m or N·m/rad),
+    damping b_k = μ c_k (N·s/m or N·m·s/rad)."""
 
     stiffness: dict
     damping: dict
+
+
+SDE_DEFORMATIONS = ("axial", "shear_y", "shear_z", "torsion", "bend_y", "bend_z")
+
+
+class _SdeTable:
+    """The constants of n sdes as arrays (n, 6), columns in SDE_DEFORMATIONS order."""
+
+    def __init__(self, stiffness: np.ndarray, damping: np.ndarray):
+        self.stiffness, self.damping = stiffness, damping
+
+    def __getitem__(self, i: int) -> SdeParameters:
+        return SdeParameters(dict(zip(SDE_DEFORMATIONS, self.stiffness[i])),
+                             dict(zip(SDE_DEFORMATIONS, self.damping[i])))
+
+
+def _sde_table(mat: Property, sec: Property, start, end) -> _SdeTable:
+    """The sdes of the segments [start_i, end_i] (see sde_parameters)."""
+    def compliance(s, owner):  # 1 / (stiffness per unit length) of axial, shear_y, shear_z, torsion, bend_y, bend_z
+        (E, G), (A, J, Iy, Iz, ky, kz) = mat.sample(s, ("E", "G")), sec.sample(s, ("A", "J", "Iy", "Iz", "kappa_y",
+                                                                                  "kappa_z"))
+        return [1.0 / (E * A), 1.0 / (ky * G * A), 1.0 / (kz * G * A), 1.0 / (G * J), 1.0 / (E * Iy), 1.0 / (E * Iz)]
+
+    middle = 0.5 * (np.atleast_1d(np.asarray(start, dtype=float)) + np.atleast_1d(np.asarray(end, dtype=float)))
+    mu = mat.sample(middle, ("damping",))[0]
+    # An overflow (a stiffness of inf, and 0 · inf damping) is refused by add_body, naming the argument.
+    with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
+        c = (1.0 / _integrate(compliance, start, end, mat.breakpoints + sec.breakpoints)).T
+        return _SdeTable(c, mu[:, None] * c)
 
 
 def sde_parameters(material, section, start: float, end: float) -> SdeParameters:
@@ -136,16 +239,32 @@ def sde_parameters(material, section, start: float, end: float) -> SdeParameters
     """
     mat = _as_property(material, Material, "material")
     sec = _as_property(section, Section, "section")
+    return _sde_table(mat, sec, start, end)[0]
 
-    def compliance(s):  # 1 / (stiffness per unit length) of axial, shear_y, shear_z, torsion, bend_y, bend_z
-        m, c = mat.at(s), sec.at(s)
-        return 1.0 / np.array([m.E * c.A, c.kappa_y * m.G * c.A, c.kappa_z * m.G * c.A, m.G * c.J, m.E * c.Iy,
-                               m.E * c.Iz])
 
-    c = 1.0 / _integrate(compliance, start, end, mat.breakpoints + sec.breakpoints)
-    mu = mat.at(0.5 * (start + end)).damping
-    names = ("axial", "shear_y", "shear_z", "torsion", "bend_y", "bend_z")
-    return SdeParameters(dict(zip(names, c)), {k: mu * v for k, v in zip(names, c)})
+class _Rows(Sequence):
+    """A read-only list whose items are made from a table on access (a beam's rfe and sde parameters:
+    a long beam's hundred thousand of them cost nothing until read)."""
+
+    def __init__(self, table, n: int):
+        self._table, self._n = table, n
+
+    def __len__(self) -> int:
+        return self._n
+
+    def __getitem__(self, i):
+        if isinstance(i, slice):
+            return [self[k] for k in range(*i.indices(self._n))]
+        k = operator.index(i)
+        if not -self._n <= k < self._n:
+            raise IndexError(f"index {i} out of range for {self._n} items")
+        return self._table[k % self._n]
+
+    def __eq__(self, other) -> bool:
+        return isinstance(other, Sequence) and list(self) == list(other)
+
+    def __repr__(self) -> str:
+        return f"[{self[0]!r}, ...] ({self._n} items)" if self._n else "[]"
 
 
 @dataclass
@@ -160,8 +279,8 @@ class Beam:
     linear: bool
     rfes: list[Body]                      #: the m + 1 rigid finite elements, root to tip
     frames: np.ndarray                    #: (m + 1,) arc length of each rfe frame, m
-    rfe: list[RfeParameters] = field(repr=False)
-    sde: list[SdeParameters] = field(repr=False)
+    rfe: Sequence[RfeParameters] = field(repr=False)  #: (m + 1) inertia of each rfe
+    sde: Sequence[SdeParameters] = field(repr=False)  #: (m) springs and dampers of each sde
 
     @property
     def tip(self) -> Point:
@@ -178,13 +297,21 @@ class Beam:
 
     def points(self) -> list[Point]:
         """The beam's root, its m sde points (on the rfe before each sde) and its tip."""
-        sde = [self.rfes[i - 1].point((self.frames[i] - self.frames[i - 1], 0.0, 0.0))
-               for i in range(1, self.elements + 1)]
-        return [self.rfes[0].origin, *sde, self.tip]
+        return list(self._points)
 
-    def centerline(self, system, q, t: float = 0.0) -> np.ndarray:
-        """Deformed centre line (m + 2, 3) in the global frame (m): root, sde points, tip."""
-        return np.array([system.position(p, q, t) for p in self.points()])
+    @functools.cached_property
+    def _points(self) -> tuple[Point, ...]:
+        step = np.diff(self.frames)
+        sde = [self.rfes[i - 1].point((step[i - 1], 0.0, 0.0)) for i in range(1, self.elements + 1)]
+        return (self.rfes[0].origin, *sde, self.tip)
+
+    def centerline(self, system, q, t: float | None = None) -> np.ndarray:
+        """Deformed centre line (m + 2, 3) in the global frame (m): root, sde points, tip, from one
+        positions-only kinematics pass. ``t`` (s) is required when the system has prescribed
+        coordinates, as for ``System.position``."""
+        points = self._points
+        _checks.same_model(points[0], system, "system", "a system compiled from the beam's model")
+        return system._positions(list(points), q, _checks.pose_time(system, t))
 
 
 def add_beam(
@@ -204,7 +331,11 @@ def add_beam(
     tip_inertia=(0.0, 0.0, 0.0),
     tip_offset=(0.0, 0.0, 0.0),
 ) -> Beam:
-    """Divide a straight beam into rfes and sdes and add them to ``model`` (see ``Model.add_beam``)."""
+    """Divide a straight beam into rfes and sdes and add them to ``model`` (see ``Model.add_beam``).
+
+    O(m) in time and memory for the exact (nonlinear) model: the parameters of all rfes and sdes
+    come from one vectorised quadrature and the rfes 1..m are added in one call; the linear model's
+    couplings make it O(m²)."""
     L = _checks.scalar(length, "length", positive=True)
     if isinstance(elements, bool) or not isinstance(elements, (int, np.integer)) or elements < 1:
         raise ValueError(f"elements: expected an integer number of sdes >= 1, got {elements!r}")
@@ -224,12 +355,13 @@ def add_beam(
     tip_m = _checks.scalar(tip_mass, "tip_mass", nonnegative=True)
 
     d = L / m
-    frames = np.array([0.0] + [(i - 0.5) * d for i in range(1, m + 1)])
-    ends = np.array([0.5 * d] + [min((i + 0.5) * d, L) for i in range(1, m + 1)])
-    rfe = [rfe_parameters(mat, sec, lo, hi, origin=x) for lo, hi, x in zip([0.0, *frames[1:]], ends, frames)]
-    sde = [sde_parameters(mat, sec, (i - 1) * d, i * d) for i in range(1, m + 1)]
-    names = [f"{name}.rfe{i}" for i in range(m + 1)]
-    taken = set(model.body_names) & set(names)
+    i = np.arange(1, m + 1)
+    frames = np.concatenate([[0.0], (i - 0.5) * d])
+    ends = np.concatenate([[0.5 * d], np.minimum((i + 0.5) * d, L)])
+    H = _pseudo_inertias(mat, sec, np.concatenate([[0.0], frames[1:]]), ends, frames)
+    sde = _sde_table(mat, sec, (i - 1) * d, i * d)
+    names = [f"{name}.rfe{k}" for k in range(m + 1)]
+    taken = set(model.body_names).intersection(names)
     if taken:
         raise ValueError(f"name: expected a beam name whose rfe bodies are not in the model yet, got {name!r} "
                          f"({sorted(taken)[0]} exists)")
@@ -237,25 +369,39 @@ def add_beam(
         # A concentrated body at the tip (offset from s = L in beam axes) joins the last rfe.
         inertia = _tip_inertia(tip_inertia)
         offset = _checks.vec3(tip_offset, "tip_offset") + [L - frames[-1], 0.0, 0.0]
-        H = rfe[-1].H + _core.pseudo_inertia(tip_m, offset, inertia)
-        rfe[-1] = RfeParameters(H[3, 3], H[:3, 3] / H[3, 3], _inertia_about_com(H), H)
+        H[-1] = H[-1] + _core.pseudo_inertia(tip_m, offset, inertia)
+    rfe = _RfeTable(H)
 
-    coords = [DEFORMATIONS[k] for k in deform]
-    bodies = []
-    for i in range(m + 1):
-        if i == 0:
-            j, up, B = (joint if joint is not None else Joint.fixed()), parent, placement
+    # The sde joints: the chosen deformations' coordinates in the book's order, each with its column
+    # of the sde table.
+    template = Joint.custom([DEFORMATIONS[k] for k in deform])
+    columns = [SDE_DEFORMATIONS.index(next(k for k in deform if DEFORMATIONS[k] == c)) for c in template.coordinates]
+    first = model.nbodies
+    try:
+        root = model.add_body(names[0], parent, joint if joint is not None else Joint.fixed(), mass=rfe.mass[0],
+                              com=rfe.com[0], inertia=rfe.inertia[0], placement=placement)
+        if linear:
+            bodies = [root]
+            for k in range(1, m + 1):
+                j = Joint.custom(template.coordinates, stiffness=sde.stiffness[k - 1, columns],
+                                 damping=sde.damping[k - 1, columns])
+                _couple_linear(j, bodies, frames, k)
+                bodies.append(model.add_body(names[k], root, j, mass=rfe.mass[k], com=rfe.com[k],
+                                             inertia=rfe.inertia[k], placement=transform(translation=(frames[k], 0, 0))))
         else:
-            j = Joint.custom(coords, stiffness=[sde[i - 1].stiffness[k] for k in deform],
-                             damping=[sde[i - 1].damping[k] for k in deform])
-            if linear:
-                up, B = bodies[0], transform(translation=(frames[i], 0.0, 0.0))
-                _couple_linear(j, bodies, frames, i)
-            else:
-                up, B = bodies[-1], transform(translation=(frames[i] - frames[i - 1], 0.0, 0.0))
-        p = rfe[i]
-        bodies.append(model.add_body(names[i], up, j, mass=p.mass, com=p.com, inertia=p.inertia, placement=B))
-    return Beam(name, L, m, formulation, tuple(deform), bool(linear), bodies, frames, rfe, sde)
+            # rfe k hangs on rfe k − 1 at the distance between their frames.
+            placements = np.tile(np.eye(4), (m, 1, 1))
+            placements[:, 0, 3] = np.diff(frames)
+            bodies = [root, *model._add_bodies(
+                names[1:], list(range(root.index, root.index + m)), template,
+                np.ascontiguousarray(sde.stiffness[:, columns]).reshape(m, len(columns)),
+                np.ascontiguousarray(sde.damping[:, columns]).reshape(m, len(columns)),
+                placements.reshape(m, 16), rfe.mass[1:], rfe.com[1:], rfe.inertia[1:].reshape(m, 9))]
+    except BaseException:
+        model._truncate(first)  # nothing half-added
+        raise
+    return Beam(name, L, m, formulation, tuple(deform), bool(linear), bodies, frames, _Rows(rfe, m + 1),
+                _Rows(sde, m))
 
 
 def _tip_inertia(tip_inertia) -> np.ndarray:

@@ -41,7 +41,7 @@ def _frame(model, where, frame, name: str):
             raise ValueError(f"{name}: expected a Body or Point of this model, got {where!r}")
         body, origin = where.index, np.zeros(3)
     elif isinstance(where, Point):
-        if not -1 <= where.body < model.nbodies:
+        if not -1 <= where.body < model.nbodies or where.model not in (0, model.id):
             raise ValueError(f"{name}: expected a Body or Point of this model, got {where!r}")
         body, origin = where.body, np.asarray(where.r, dtype=float)
     else:
@@ -96,7 +96,7 @@ def assemble(system, q, qd=None, t: float | None = None, tol: float = 1e-12, max
     ``System.assemble``)."""
     q = _checks.array(q, (system.nq,), "q")
     qd = np.zeros(system.nq) if qd is None else _checks.array(qd, (system.nq,), "qd")
-    t = 0.0 if t is None else _checks.scalar(t, "t")
+    t = _checks.scalar(_checks.pose_time(system, t), "t")
     tol = _checks.scalar(tol, "tol", positive=True)
     max_iterations = _checks.integer(max_iterations, "max_iterations", minimum=1, maximum=10_000)
     return system._assemble(t, q, qd, tol, max_iterations)

@@ -34,17 +34,20 @@ class Material:
     damping: float = 0.0
 
     def __post_init__(self):
-        _checks.scalar(self.E, "E", positive=True)
-        _checks.scalar(self.rho, "rho", positive=True)
-        _checks.scalar(self.damping, "damping", nonnegative=True)
+        # Every field is stored as the float it was checked as (a string such as "7850" is refused,
+        # not stored to fail later).
+        E = _checks.scalar(self.E, "E", positive=True, unit="Pa (Young's modulus)")
+        rho = _checks.scalar(self.rho, "rho", positive=True, unit="kg/m³ (density)")
+        damping = _checks.scalar(self.damping, "damping", nonnegative=True, unit="s (retardation time)")
+        nu = None if self.nu is None else _checks.scalar(self.nu, "nu", unit="(-1, 0.5] (Poisson's ratio)")
+        if nu is not None and not -1.0 < nu <= 0.5:
+            raise ValueError(f"nu: expected Poisson's ratio in (-1, 0.5], got {nu}")
         if self.G is not None:
-            _checks.scalar(self.G, "G", positive=True)
-        elif self.nu is not None:
-            nu = _checks.scalar(self.nu, "nu")
-            if not -1.0 < nu <= 0.5:
-                raise ValueError(f"nu: expected Poisson's ratio in (-1, 0.5], got {nu}")
-        if self.G is None:
-            object.__setattr__(self, "G", self.E / (2.0 * (1.0 + (0.3 if self.nu is None else self.nu))))
+            G = _checks.scalar(self.G, "G", positive=True, unit="Pa (shear modulus)")
+        else:
+            G = E / (2.0 * (1.0 + (0.3 if nu is None else nu)))
+        for name, value in (("E", E), ("rho", rho), ("nu", nu), ("G", G), ("damping", damping)):
+            object.__setattr__(self, name, value)
 
 
 @dataclass(frozen=True)
@@ -71,9 +74,12 @@ class Section:
     kappa_y: float = 5.0 / 6.0
     kappa_z: float = 5.0 / 6.0
 
+    _UNITS = {"A": "m² (area)", "Iy": "m⁴ (second moment about y)", "Iz": "m⁴ (second moment about z)",
+              "J": "m⁴ (torsion constant)", "kappa_y": "(shear coefficient)", "kappa_z": "(shear coefficient)"}
+
     def __post_init__(self):
-        for name in ("A", "Iy", "Iz", "J", "kappa_y", "kappa_z"):
-            _checks.scalar(getattr(self, name), name, positive=True)
+        for name, unit in self._UNITS.items():  # stored as the checked floats
+            object.__setattr__(self, name, _checks.scalar(getattr(self, name), name, positive=True, unit=unit))
 
     @property
     def I0(self) -> float:

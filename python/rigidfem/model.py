@@ -62,11 +62,16 @@ class Model(_core._Model):
         return Body() if index < 0 else self._handle(index)
 
     def _handle(self, index: int) -> Body:
-        return Body(index, self.body_names[index])
+        return Body(index, self._body_name(index), self.id)
 
     def _owns(self, body: Body) -> bool:
-        """Whether the handle names a body of this model (or the ground)."""
-        return body.index == -1 or (0 <= body.index < self.nbodies and self.body_names[body.index] == body.name)
+        """Whether the handle names a body of this model (or the ground): made by this model, or,
+        for a handle of unknown origin (built by hand), with the name of the body at its index."""
+        if body.index == -1:
+            return True
+        if not 0 <= body.index < self.nbodies:
+            return False
+        return body.model == self.id if body.model else self._body_name(body.index) == body.name
 
     def _parent_index(self, parent) -> int:
         if isinstance(parent, Body):
@@ -131,7 +136,8 @@ class Model(_core._Model):
 
         The coordinate leaves the unknowns q; ``System.driving_forces`` reports the
         force (N) or torque (N·m) the drive must exert. ``coordinate`` names it
-        ("x", ..., "rx") when the joint has more than one.
+        ("x", ..., "rx") when the joint has more than one. A coordinate takes one motion:
+        prescribing it again is a ValueError.
         """
         if not isinstance(motion, Profile):
             raise ValueError(f"motion: expected a profile from rigidfem.motion, got {motion!r}")
@@ -144,7 +150,11 @@ class Model(_core._Model):
         """Apply a generalised force (N or N·m) on a joint coordinate of ``body``.
 
         ``force`` is a constant or a Python function ``Q(t, q, qd)`` of that
-        coordinate's own value and rate (slow path: called from C++ under the GIL).
+        coordinate's own value and rate (slow path: called from C++ under the GIL). The
+        function must return a finite number: anything else (None, a string, an array, NaN,
+        inf) raises a ValueError naming the law, the coordinate, the value and the time where
+        a System method calls it, and ``rigidfem.SimulationError`` at that time in a simulation
+        (both are ``rigidfem._core.ForceLawError``). Exceptions the function raises propagate.
         """
         k = self._coordinate(body, coordinate)
         if callable(force):
@@ -172,7 +182,7 @@ class Model(_core._Model):
             if not self._owns(point):
                 raise ValueError(f"point: expected a Point or Body of this model, got {point!r}")
             point = point.origin
-        if not isinstance(point, Point) or not 0 <= point.body < self.nbodies:
+        if not isinstance(point, Point) or not 0 <= point.body < self.nbodies or point.model not in (0, self.id):
             raise ValueError(f"point: expected a Point or Body of this model, got {point!r}")
         return point
 
@@ -282,14 +292,29 @@ class System(_core._System):
 
     def __init__(self, model, algorithm: str = "recursive"):
         super().__init__(model, algorithm)
+        self._model_id = model.id  # handles of other models are refused (_checks.same_model)
 
-    def position(self, point, q, t: float = 0.0) -> np.ndarray:
-        """Global position (3,) in m of a ``Point`` (or a ``Body``'s origin)."""
-        return self._position(point, q, t)
+    def position(self, point, q, t: float | None = None) -> np.ndarray:
+        """Global position (3,) in m of a ``Point`` (or a ``Body``'s origin) of this system's model.
 
-    def velocity(self, point, q, qd, t: float = 0.0) -> np.ndarray:
-        """Global velocity (3,) in m/s of a ``Point`` (or a ``Body``'s origin)."""
-        return self._velocity(point, q, qd, t)
+        ``t`` (s) is required when the system has prescribed coordinates (``np > 0``): their
+        drives place the bodies; without them it defaults to 0.
+        """
+        _checks.same_model(point, self, "point")
+        return self._position(point, q, _checks.pose_time(self, t))
+
+    def velocity(self, point, q, qd, t: float | None = None) -> np.ndarray:
+        """Global velocity (3,) in m/s of a ``Point`` (or a ``Body``'s origin); ``t`` as in ``position``."""
+        _checks.same_model(point, self, "point")
+        return self._velocity(point, q, qd, _checks.pose_time(self, t))
+
+    def transform(self, body, q, t: float | None = None) -> np.ndarray:
+        """Pose T_p (4, 4) in the global frame of a body (a ``Body`` handle or its index); ``t`` as in
+        ``position``."""
+        if isinstance(body, Body):
+            _checks.same_model(body, self, "body", "a Body of the model this system was compiled from")
+            body = body.index
+        return _transform(self, body, q, _checks.pose_time(self, t))
 
     def assemble(self, q, qd=None, t: float | None = None, tol: float = 1e-12, max_iterations: int = 50):
         """(q, qd) closing every loop, nearest to the guess: Gauss–Newton on g(q, t) = 0 with
@@ -312,3 +337,4 @@ class System(_core._System):
 
 
 _contract.guard_methods(System)
+_transform = _contract.guard("transform", _core._System.transform, ("body", "q", "t"))

@@ -111,6 +111,9 @@ class Result:
             raise ValueError(f"point: expected a Point or a Body, got {point!r}")
         if frame is not None and not isinstance(frame, Body):
             raise ValueError(f"frame: expected None or a Body, got {frame!r}")
+        _checks.same_model(point, self.system, "point")
+        if frame is not None:
+            _checks.same_model(frame, self.system, "frame", "None or a Body of the model this system was compiled from")
         return _core._point_positions(self.system, point.body, point.r, -1 if frame is None else frame.index,
                                       self.t, self.q)
 

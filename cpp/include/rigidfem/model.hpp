@@ -2,11 +2,14 @@
 /// loads) and its compilation into an immutable System (see system.hpp).
 #pragma once
 
+#include <cstdint>
 #include <functional>
 #include <memory>
 #include <string>
+#include <unordered_map>
 #include <vector>
 
+#include "rigidfem/errors.hpp"
 #include "rigidfem/joint_motion.hpp"
 #include "rigidfem/loops.hpp"
 #include "rigidfem/profiles.hpp"
@@ -42,23 +45,39 @@ struct Joint {
   int ncoords() const { return static_cast<int>(axes.size()); }
 };
 
-/// A handle to a body; index −1 is the ground.
+/// A handle to a body; index −1 is the ground. `model` is the id of the Model that made it
+/// (0: unknown, e.g. a handle built by hand), so that a System can refuse another model's handles.
 struct Body {
   int index = -1;
   std::string name = "ground";
+  std::uint64_t model = 0;
 };
 
-/// A material point of a body, r in the body frame (m).
+/// A material point of a body, r in the body frame (m); `model` as in Body.
 struct Point {
   int body = -1;
   Vec3 r = Vec3::Zero();
+  std::uint64_t model = 0;
   Point() = default;
-  Point(int b, const Vec3& r_) : body(b), r(r_) {}
-  Point(const Body& b) : body(b.index), r(Vec3::Zero()) {}  // NOLINT: implicit, the body's origin
+  Point(int b, const Vec3& r_, std::uint64_t model_ = 0) : body(b), r(r_), model(model_) {}
+  Point(const Body& b) : body(b.index), r(Vec3::Zero()), model(b.model) {}  // NOLINT: implicit, the body's origin
 };
 
 /// Generalised force law Q(t, q, q̇) of one coordinate (the slow path through Python).
 using ForceLaw = std::function<double(double, double, double)>;
+
+/// A force law that returned no finite number. Called by a System method it is bad input (its
+/// what() reads "force: expected ..., got ...", Python ValueError); inside a simulation the
+/// integrator reports it as the SimulationError at its time and cause.
+class ForceLawError : public SimulationError {
+ public:
+  ForceLawError(double t, const std::string& cause, std::string message)
+      : SimulationError(t, cause), message_(std::move(message)) {}
+  const char* what() const noexcept override { return message_.c_str(); }
+
+ private:
+  std::string message_;
+};
 
 /// A point force and/or torque on a body. Global components, or body components
 /// when follower; optionally scaled in time by a profile's value.
@@ -102,7 +121,13 @@ class Model {
   /// std::invalid_argument naming the argument for every bad value.
   Body add_body(const std::string& name, int parent, const Joint& joint, const Mat4& placement, double mass,
                 const Vec3& com, const Mat3& inertia);
-  /// Prescribes coordinate `coordinate` (−1: the joint's only one) of a body's joint.
+  /// Adds several bodies at once, in order (a parent may be an earlier body of the same batch):
+  /// all are checked before any is added, so a bad one leaves the model unchanged. O(n).
+  std::vector<Body> add_bodies(std::vector<BodySpec> bodies);
+  /// Removes the bodies n, n + 1, ... (the last added) with their drives, forces and loads: undoes
+  /// a builder that failed halfway (no remaining body refers to them: parents come first).
+  void truncate(int n);
+  /// Prescribes coordinate `coordinate` (−1: the joint's only one) of a body's joint, once.
   void prescribe(int body, int coordinate, ProfilePtr motion);
   /// Adds a constant generalised force, or a law Q(t, q, q̇), on one joint coordinate.
   void add_generalized_force(int body, int coordinate, double value, ForceLaw law);
@@ -114,17 +139,26 @@ class Model {
   const Vec3& gravity() const { return gravity_; }
   const std::vector<BodySpec>& bodies() const { return bodies_; }
   const std::vector<Loop>& loops() const { return loops_; }
+  /// Unique among the Models of this process (never 0): the `model` of the handles it makes.
+  std::uint64_t id() const { return id_; }
   int body_index(const std::string& name) const;  ///< −1 for "ground"; throws if unknown
   int coordinate_index(int body, const std::string& coordinate) const;
+  /// "body.rz": the name of coordinate `coordinate` (−1: the only one) of a body's joint.
+  std::string coordinate_name(int body, int coordinate) const;
 
   /// Freezes the description into an immutable System.
   std::shared_ptr<const System> compile(Algorithm algorithm) const;
 
  private:
   void check_body(int body, const char* argument) const;
+  /// Throws std::invalid_argument naming the argument unless `b` may be added as body `index`
+  /// (bodies 0..index−1 being those before it, their names in index_of_).
+  void check_spec(const BodySpec& b, int index) const;
   int resolve_coordinate(int body, int coordinate) const;
+  std::uint64_t id_;
   Vec3 gravity_;
   std::vector<BodySpec> bodies_;
+  std::unordered_map<std::string, int> index_of_;  // body name -> index
   std::vector<std::vector<CoordinateSpec>> coords_;  // (nbodies) x (ncoords of the joint)
   std::vector<Load> loads_;
   std::vector<Loop> loops_;
