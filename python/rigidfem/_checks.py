@@ -6,6 +6,8 @@ import math
 
 import numpy as np
 
+from ._core import Body, Point
+
 
 def array(x, shape: tuple[int, ...], name: str) -> np.ndarray:
     """``x`` as a finite float array of exactly ``shape``."""
@@ -72,8 +74,6 @@ def same_model(handle, system, name: str, expected: str = "a Point or Body of th
                                                           "from") -> None:
     """Raise ValueError if the Body or Point ``handle`` was made by another model than the one
     ``system`` was compiled from (handles and systems of unknown origin pass)."""
-    from ._core import Body, Point
-
     if isinstance(handle, (Body, Point)):
         own = getattr(system, "_model_id", 0)  # 0: a system made without Model.compile
         if handle.model and own and handle.model != own:
