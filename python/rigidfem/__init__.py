@@ -13,6 +13,7 @@ from ._core import (
     R3,
     Body,
     Data,
+    ForceLawError,
     JointSpec,
     Point,
     Profile,
@@ -28,6 +29,7 @@ from ._core import (
 )
 from .analysis import Equilibrium, Modes, modal_analysis, static_equilibrium
 from .beams import Beam, rfe_parameters, sde_parameters
+from . import loops  # noqa: E402 (rigidfem.loops: the loop kinds)
 from .joints import Joint
 from .materials import Material, Section
 from .frames import transform
@@ -47,6 +49,7 @@ __all__ = [
     "Joint",
     "JointSpec",
     "Material",
+    "ForceLawError",
     "Model",
     "Modes",
     "Point",

@@ -8,7 +8,7 @@ import numpy.typing
 import typing
 from . import stages
 from . import _bench
-__all__: list[str] = ['Body', 'Data', 'IntegratorOptions', 'JointSpec', 'Point', 'Profile', 'R1', 'R2', 'R3', 'SimulationError', 'callback_profile', 'constant_profile', 'euler_zyx', 'harmonic_profile', 'homogeneous', 'inverse', 'joint_transform', 'joint_transform_derivative', 'joint_transform_second_derivative', 'polynomial_profile', 'pseudo_inertia', 'skew', 'spin_up_profile', 'spline_profile', 'stages']
+__all__: list[str] = ['Body', 'Data', 'ForceLawError', 'IntegratorOptions', 'JointSpec', 'Point', 'Profile', 'R1', 'R2', 'R3', 'SimulationError', 'callback_profile', 'constant_profile', 'euler_zyx', 'harmonic_profile', 'homogeneous', 'inverse', 'joint_transform', 'joint_transform_derivative', 'joint_transform_second_derivative', 'polynomial_profile', 'pseudo_inertia', 'skew', 'spin_up_profile', 'spline_profile', 'stages']
 class SimulationError(RuntimeError):
     """
     A numerical failure, a RuntimeError whose message names the time (s) and the cause: a singular mass or iteration matrix, a step size below the minimum, a NaN or inf state, Newton divergence in a step or a load step of the statics, max_steps, gimbal lock of ZYX Euler angles.
@@ -23,6 +23,12 @@ class Profile:
         """
     def __repr__(self) -> str:
         ...
+class ForceLawError(SimulationError, ValueError):
+    """
+    A Python force law returned no finite number (None, a string, an array, NaN or inf): a ValueError
+    (and a SimulationError, with `time` and `cause`), raised by System methods; simulate() raises it as
+    the SimulationError at that time.
+    """
 class JointSpec:
     """
     Active coordinates of a joint with their springs and dampers.
@@ -79,7 +85,7 @@ class Body:
         The ground.
         """
     @typing.overload
-    def __init__(self, index: typing.SupportsInt | typing.SupportsIndex, name: str) -> None:
+    def __init__(self, index: typing.SupportsInt | typing.SupportsIndex, name: str, model: typing.SupportsInt | typing.SupportsIndex = 0) -> None:
         ...
     def __repr__(self) -> str:
         ...
@@ -90,6 +96,11 @@ class Body:
     @property
     def index(self) -> int:
         ...
+    @property
+    def model(self) -> int:
+        """
+        Id of the Model that made the handle (0: unknown).
+        """
     @property
     def name(self) -> str:
         ...
@@ -108,27 +119,47 @@ class Point:
     @typing.overload
     def __init__(self, body: Body) -> None:
         ...
+    def __repr__(self) -> str:
+        ...
     @property
     def body(self) -> int:
         ...
+    @property
+    def model(self) -> int:
+        """
+        Id of the Model whose body the point is on (0: unknown).
+        """
     @property
     def r(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
         ...
 class _Model:
     def __init__(self, gravity: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
         ...
+    def _add_bodies(self, names: collections.abc.Sequence[str], parents: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], joint: JointSpec, stiffness: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"], damping: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"], placements: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"], masses: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], coms: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"], inertias: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"]) -> list[Body]:
+        """
+        Adds bodies in order, each with `joint` but its own row of stiffness and damping; all are checked
+        before any is added. placements and inertias are row-major 4x4 and 3x3 per row.
+        """
     def _add_body(self, name: str, parent: typing.SupportsInt | typing.SupportsIndex, joint: JointSpec, placement: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"], mass: typing.SupportsFloat | typing.SupportsIndex, com: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], inertia: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 3]"]) -> Body:
         ...
-    def _add_generalized_force(self, body: typing.SupportsInt | typing.SupportsIndex, coordinate: typing.SupportsInt | typing.SupportsIndex, value: typing.SupportsFloat | typing.SupportsIndex, law: collections.abc.Callable[[float, float, float], typing.SupportsFloat | typing.SupportsIndex]) -> None:
+    def _add_generalized_force(self, body: typing.SupportsInt | typing.SupportsIndex, coordinate: typing.SupportsInt | typing.SupportsIndex, value: typing.SupportsFloat | typing.SupportsIndex, law: typing.Any) -> None:
         ...
     def _add_load(self, body: typing.SupportsInt | typing.SupportsIndex, point: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], force: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], torque: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], follower: bool, scale: Profile) -> None:
         ...
+    def _add_loop(self, name: str, kind: str, a: typing.SupportsInt | typing.SupportsIndex, frame_a: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"], b: typing.SupportsInt | typing.SupportsIndex, frame_b: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"], length: typing.SupportsFloat | typing.SupportsIndex, drive: Profile) -> int:
+        ...
     def _body_index(self, name: str) -> int:
+        ...
+    def _body_name(self, index: typing.SupportsInt | typing.SupportsIndex) -> str:
         ...
     def _coordinate_index(self, body: typing.SupportsInt | typing.SupportsIndex, coordinate: str) -> int:
         ...
     def _prescribe(self, body: typing.SupportsInt | typing.SupportsIndex, coordinate: typing.SupportsInt | typing.SupportsIndex, motion: Profile) -> None:
         ...
+    def _truncate(self, n: typing.SupportsInt | typing.SupportsIndex) -> None:
+        """
+        Removes the bodies n, n + 1, ... (undo of a failed builder).
+        """
     @property
     def body_names(self) -> list[str]:
         ...
@@ -141,10 +172,19 @@ class _Model:
     def gravity(self, arg1: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
         ...
     @property
+    def id(self) -> int:
+        """
+        Unique id of this model, carried by its Body and Point handles.
+        """
+    @property
     def nbodies(self) -> int:
         ...
 class _System:
     def __init__(self, model: _Model, algorithm: str) -> None:
+        ...
+    def _assemble(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], tol: typing.SupportsFloat | typing.SupportsIndex, max_iterations: typing.SupportsInt | typing.SupportsIndex) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]]:
+        ...
+    def _loop_reaction_history(self, t: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
         ...
     def _position(self, point: Point, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], t: typing.SupportsFloat | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
         ...
@@ -207,6 +247,21 @@ class _System:
         """
         Kinetic energy 1/2 sum tr(dT H dT^T) (J).
         """
+    def loop_constraints(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]]:
+        """
+        (g, gd, G): the loop closures' constraint equations g(q, t) (nl,) (m, or the cosine for direction
+        rows), their rates gd = G qd + dg/dt (nl,) and the Jacobian G = dg/dq (nl, nq).
+        """
+    def loop_multipliers(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        Multipliers lambda (nl,) of M qdd = f + G^T lambda at the forward-dynamics accelerations.
+        """
+    def loop_reactions(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        """
+        Reaction of every loop closure on its body b (nloops, 6): force (N) and torque (N m, about frame B's
+        origin) in frame A's axes; for a distance loop (an actuator) the force along the line in column 0,
+        positive pushing b away from a.
+        """
     def make_data(self) -> ...:
         """
         A fresh workspace for the stage functions (allocated in place: a Data is never copied or moved).
@@ -265,6 +320,16 @@ class _System:
         Inertia tensor (3, 3) of every body about its centre of mass, body axes (kg m^2).
         """
     @property
+    def loop_kinds(self) -> list[str]:
+        """
+        Kind of every loop closure ('revolute', ..., 'distance').
+        """
+    @property
+    def loop_names(self) -> list[str]:
+        """
+        Names of the loop closures, in the order of loop_reactions().
+        """
+    @property
     def masses(self) -> list[float]:
         """
         Mass of every body (nbodies), kg.
@@ -276,6 +341,11 @@ class _System:
     def nc(self) -> int:
         """
         Number of all joint coordinates, nq + np.
+        """
+    @property
+    def nl(self) -> int:
+        """
+        Number of constraint equations of the loop closures (multipliers).
         """
     @property
     def np(self) -> int:
