@@ -114,8 +114,16 @@ def guard(function: str, compiled, parameters: tuple, method: bool = True):
     """``compiled`` with its conversion failures explained (see ``explain``): a method of System
     (``method``: the system is self), or a function whose first parameter is the system."""
 
+    # Booleans convert to 0 and 1 in the compiled call: refused for times and load factors.
+    numbers = [(k + (1 if method else 0), p) for k, p in enumerate(parameters) if p in ("t", "load_factor")]
+
     @functools.wraps(compiled)
     def call(*args, **kwargs):
+        for k, p in numbers:
+            v = args[k] if k < len(args) else kwargs.get(p)
+            if isinstance(v, (bool, np.bool_)):
+                system = args[0] if args else kwargs.get("system")
+                raise explain(function, parameters, (), {p: v}, system)
         try:
             return compiled(*args, **kwargs)
         except TypeError as e:
