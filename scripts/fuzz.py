@@ -6,6 +6,7 @@ process (crashes and hangs caught), outcomes tallied by the class of call.
     python scripts/fuzz.py --minutes 15 --report --minimize --save   # ... minimise new violations into the corpus
     python scripts/fuzz.py --replay tests/fuzz_corpus         # re-run the saved cases
     python scripts/fuzz.py --show tests/fuzz_corpus/x.json    # a saved case as a script
+    FUZZ_PACKAGE=/tmp/pkg python scripts/fuzz.py ...          # fuzz another build (an unpacked wheel)
 
 The contract, the generators and the worker protocol are in tests/fuzz_contract.py; the suite's
 fixed-seed run is tests/test_contract.py.
