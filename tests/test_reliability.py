@@ -243,3 +243,18 @@ def test_positions_of_many_points_in_one_pass():
     points = h["beam"].points()
     one_by_one = np.array([s.position(p, q, 0.0) for p in points])
     np.testing.assert_allclose(s._positions(points, q, 0.0), one_by_one, rtol=0, atol=1e-15)
+
+
+def test_lagrange_jacobians_check_their_inputs_and_fixed_only_models_run():
+    """Found by the fuzzer and UBSan: the Lagrange force_jacobians copied q before any size check
+    (a write past the end: SIGSEGV), and nq = 0 indexed empty use tables."""
+    system = samples.double_pendulum()[0].compile("lagrange")
+    with pytest.raises(ValueError, match="^q: expected 2 \\(nq\\) values, got 0"):
+        system.force_jacobians(0.0, np.zeros(0), np.zeros(2), 1.0, False)
+    with pytest.raises(ValueError, match="^t: "):
+        system.jacobian(np.inf, np.zeros(4))
+    model = rf.Model()
+    body = model.add_body("b", model.ground, rf.Joint.fixed(), 1.0, (1, 1, 1), placement=rf.transform((1, 2, 3)))
+    fixed = model.compile()
+    assert fixed.forward_dynamics(0.0, [], []).shape == (0,)
+    np.testing.assert_array_equal(fixed.position(body.point((1, 0, 0)), []), [2.0, 2.0, 3.0])

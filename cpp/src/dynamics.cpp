@@ -261,6 +261,8 @@ VecX rhs(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& y) 
 
 MatX rhs_jacobian(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& y) {
   const int n = 2 * sys.nq;
+  check_vector(y, n, "y", "2 nq");
+  if (!std::isfinite(t)) bad("t", "a finite time in s", num(t));
   MatX J(n, n);
   if (analytic_derivatives(sys)) {
     check_vector(y, n, "y", "2 nq");
@@ -276,6 +278,8 @@ MatX rhs_jacobian(const System& sys, Data& d, double t, const Eigen::Ref<const V
 std::pair<MatX, MatX> force_jacobians(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
                                       const Eigen::Ref<const VecX>& qd, double load_factor, bool static_drives) {
   set_load_factor(d, load_factor);
+  // The state's checks first: the Lagrange branch copies q and q̇ before any stage sees them.
+  set_state(sys, d, t, q, static_drives ? VecX::Zero(sys.nq) : VecX(qd));
   if (analytic_derivatives(sys)) {
     // f = −r(q, q̇, q̈ = 0): the analytic derivatives of the recursive inverse dynamics.
     if (static_drives)

@@ -86,7 +86,8 @@ inline int own_use(const System& sys, int i) { return sys.use_start[sys.coords[i
 /// The uses that move body p's joint, for joint_motion and joint_frames.
 inline JointUses joint_uses(const System& sys, int p) {
   const int u0 = sys.use_start[p];
-  return {sys.use_start[p + 1] - u0, &sys.use_coord[u0], &sys.use_axis[u0], &sys.use_G[u0], sys.joint[p].linear};
+  return {sys.use_start[p + 1] - u0, sys.use_coord.data() + u0, sys.use_axis.data() + u0, sys.use_G.data() + u0,
+          sys.joint[p].linear};  // data() + u0: defined also for no uses
 }
 
 /// X_parent(p), or `root` for a body on the ground.
