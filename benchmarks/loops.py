@@ -75,24 +75,18 @@ def _fit_exponent(x, y) -> float:
 
 
 def exponents(table: Table) -> Table:
-    """Fitted exponents of the step cost in n (at each m) and in m (at each n)."""
+    """Fitted exponents of each cost in n (at each m) and in m (at each n)."""
+    costs = {"forward_dynamics": "forward_dynamics_s", "implicit_step": "implicit_step_s",
+             "dense_solve": "dense_augmented_solve_s"}
     rows = []
-    data = table.rows
-    for m in sorted({r["m"] for r in data}):
-        sel = [r for r in data if r["m"] == m]
-        if len(sel) > 1:
-            rows.append({"fit": f"in n at m = {m}",
-                         "forward_dynamics": _fit_exponent([r["n"] for r in sel], [r["forward_dynamics_s"] for r in sel]),
-                         "implicit_step": _fit_exponent([r["n"] for r in sel], [r["implicit_step_s"] for r in sel]),
-                         "dense_solve": _fit_exponent([r["n"] for r in sel], [r["dense_augmented_solve_s"] for r in sel])})
-    for n in sorted({r["n"] for r in data}):
-        sel = [r for r in data if r["n"] == n]
-        if len(sel) > 1:
-            rows.append({"fit": f"in m at n = {n}",
-                         "forward_dynamics": _fit_exponent([r["m"] for r in sel], [r["forward_dynamics_s"] for r in sel]),
-                         "implicit_step": _fit_exponent([r["m"] for r in sel], [r["implicit_step_s"] for r in sel]),
-                         "dense_solve": _fit_exponent([r["m"] for r in sel], [r["dense_augmented_solve_s"] for r in sel])})
-    return Table(rows, ("fit", "forward_dynamics", "implicit_step", "dense_solve"))
+    for size, fixed in (("n", "m"), ("m", "n")):
+        for value in sorted({r[fixed] for r in table.rows}):
+            sel = [r for r in table.rows if r[fixed] == value]
+            if len(sel) > 1:
+                rows.append({"fit": f"in {size} at {fixed} = {value}"} |
+                            {name: _fit_exponent([r[size] for r in sel], [r[col] for r in sel])
+                             for name, col in costs.items()})
+    return Table(rows, ("fit", *costs))
 
 
 def run(output_dir="bench", quick: bool = False) -> dict:

@@ -167,8 +167,11 @@ def test_bad_loops_are_value_errors_and_unreachable_ones_simulation_errors():
     with pytest.raises(ValueError, match="^frame_a: expected a rigid transformation"):
         mod.add_loop_joint("revolute", mod.ground, a, frame_a=2 * np.eye(4))
     mod.add_loop_joint("distance", mod.ground.point((0.0, 3.0, 0.0)), a.point((1, 0, 0)), length=0.5, name="rope")
+    with pytest.raises(ValueError, match="^name: expected a name not used by another loop, got 'rope'"):
+        mod.add_loop_joint("spherical", mod.ground, a, name="rope")
+    assert mod.add_loop_joint("distance", mod.ground, a.point((1, 0, 0)), length=1.0) == "loop1"  # the default
     s = mod.compile()
-    with pytest.raises(ValueError, match=r"^q0: expected initial coordinates that close every loop of \['rope'\]"):
+    with pytest.raises(ValueError, match=r"^q0: expected initial coordinates that close every loop of \['rope', 'loop1'\]"):
         rf.simulate(s, 1.0, q0=[0.0])
     with pytest.raises(rf.SimulationError, match="loop 'rope' \\(distance, residual"):
         s.assemble([0.0])  # the point at 1 m from the pin never comes within 0.5 m of (0, 3)

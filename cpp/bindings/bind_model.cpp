@@ -225,7 +225,9 @@ void bind_model(py::module_& m) {
           "_add_loop",
           [](Model& model, const std::string& name, const std::string& kind, int a, const Mat4& frame_a, int b,
              const Mat4& frame_b, double length, ProfilePtr drive) {
-            return model.add_loop({name, parse_loop_kind(kind, "kind"), a, b, frame_a, frame_b, length, std::move(drive)});
+            const int k =
+                model.add_loop({name, parse_loop_kind(kind, "kind"), a, b, frame_a, frame_b, length, std::move(drive)});
+            return model.loops()[k].name;
           },
           py::arg("name"), py::arg("kind"), py::arg("a"), py::arg("frame_a"), py::arg("b"), py::arg("frame_b"),
           py::arg("length"), py::arg("drive"))

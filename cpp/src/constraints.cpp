@@ -2,6 +2,9 @@
 
 #include <Eigen/QR>
 #include <cmath>
+#include <stdexcept>
+#include <utility>
+#include <vector>
 
 #include "rigidfem/errors.hpp"
 
@@ -43,6 +46,29 @@ Track track(const System& sys, const Data& d, int p, const Mat4& F, int h) {
 
 /// d = r_B − r_A as a track.
 Track difference(const Track& b, const Track& a) { return {b.x - a.x, b.xd - a.xd, b.xdd - a.xdd, b.J - a.J}; }
+
+enum { X, Y, Z };
+
+/// The rows of a loop kind (not Distance): position rows d·a_i for i < positions (x, y, z; two
+/// for the joints that slide along z), then direction rows b_j·a_i for each pair (j, i).
+struct RowLayout {
+  int positions;
+  std::vector<std::pair<int, int>> directions;
+};
+
+const RowLayout& layout(LoopKind kind) {
+  static const RowLayout revolute{3, {{Z, X}, {Z, Y}}}, spherical{3, {}}, universal{3, {{Y, X}}},
+      prismatic{2, {{Z, X}, {Z, Y}, {X, Y}}}, cylindrical{2, {{Z, X}, {Z, Y}}}, fixed{3, {{Z, X}, {Z, Y}, {X, Y}}};
+  switch (kind) {
+    case LoopKind::Revolute: return revolute;
+    case LoopKind::Spherical: return spherical;
+    case LoopKind::Universal: return universal;
+    case LoopKind::Prismatic: return prismatic;
+    case LoopKind::Cylindrical: return cylindrical;
+    case LoopKind::Fixed: return fixed;
+    default: throw std::logic_error("layout: a distance loop has one row of its own");
+  }
+}
 
 /// Row r of the constraints: value, rate, −(second rate at q̈_free = 0), Jacobian.
 void put(Data& d, int r, double g, double gd, double bias, const Eigen::Ref<const Eigen::RowVectorXd>& G) {
@@ -88,26 +114,9 @@ void constraint_equations(const System& sys, Data& d) {
       a[i] = track(sys, d, L.body_a, L.frame_a, i);
       b[i] = track(sys, d, L.body_b, L.frame_b, i);
     }
-    enum { X, Y, Z };
-    // Position rows d·a_i: all three, or x and y for the joints that slide along z.
-    const bool slides = L.kind == LoopKind::Prismatic || L.kind == LoopKind::Cylindrical;
-    for (int i = 0; i < (slides ? 2 : 3); ++i) dot_row(d, r++, dr, a[i]);
-    // Direction rows b_j·a_i.
-    switch (L.kind) {
-      case LoopKind::Revolute:
-      case LoopKind::Cylindrical:
-        dot_row(d, r++, b[Z], a[X]);
-        dot_row(d, r++, b[Z], a[Y]);
-        break;
-      case LoopKind::Prismatic:
-      case LoopKind::Fixed:
-        dot_row(d, r++, b[Z], a[X]);
-        dot_row(d, r++, b[Z], a[Y]);
-        dot_row(d, r++, b[X], a[Y]);
-        break;
-      case LoopKind::Universal: dot_row(d, r++, b[Y], a[X]); break;
-      default: break;
-    }
+    const RowLayout& rows = layout(L.kind);
+    for (int i = 0; i < rows.positions; ++i) dot_row(d, r++, dr, a[i]);
+    for (const auto& [j, i] : rows.directions) dot_row(d, r++, b[j], a[i]);
   }
 }
 
@@ -132,26 +141,11 @@ RowMatX loop_reactions(const System& sys, const Data& d, const VecX& lambda) {
       continue;
     }
     // Force Σ λ_i a_i at B's origin from the position rows; torque Σ λ b_j × a_i from the rest.
-    const bool slides = L.kind == LoopKind::Prismatic || L.kind == LoopKind::Cylindrical;
-    const int npos = slides ? 2 : 3;
+    const RowLayout& rows = layout(L.kind);
     Vec3 F = Vec3::Zero(), tau = Vec3::Zero();
-    for (int i = 0; i < npos; ++i) F += lambda(r0 + i) * RA.col(i);
-    auto torque = [&](int row, int j, int i) { tau += lambda(r0 + row) * RB.col(j).cross(RA.col(i)); };
-    switch (L.kind) {
-      case LoopKind::Revolute:
-      case LoopKind::Cylindrical:
-        torque(npos, 2, 0);
-        torque(npos + 1, 2, 1);
-        break;
-      case LoopKind::Prismatic:
-      case LoopKind::Fixed:
-        torque(npos, 2, 0);
-        torque(npos + 1, 2, 1);
-        torque(npos + 2, 0, 1);
-        break;
-      case LoopKind::Universal: torque(npos, 1, 0); break;
-      default: break;
-    }
+    int r = r0;
+    for (int i = 0; i < rows.positions; ++i) F += lambda(r++) * RA.col(i);
+    for (const auto& [j, i] : rows.directions) tau += lambda(r++) * RB.col(j).cross(RA.col(i));
     W.row(k).head<3>() = RA.transpose() * F;
     W.row(k).tail<3>() = RA.transpose() * tau;
   }
@@ -159,16 +153,9 @@ RowMatX loop_reactions(const System& sys, const Data& d, const VecX& lambda) {
 }
 
 int loop_rows(LoopKind kind) {
-  switch (kind) {
-    case LoopKind::Revolute: return 5;
-    case LoopKind::Spherical: return 3;
-    case LoopKind::Universal: return 4;
-    case LoopKind::Prismatic: return 5;
-    case LoopKind::Cylindrical: return 4;
-    case LoopKind::Fixed: return 6;
-    case LoopKind::Distance: return 1;
-  }
-  return 0;
+  if (kind == LoopKind::Distance) return 1;
+  const RowLayout& rows = layout(kind);
+  return rows.positions + static_cast<int>(rows.directions.size());
 }
 
 namespace {

@@ -148,17 +148,7 @@ std::string worst_loop(const System& sys, const Data& d) {
 
 void close_loops(const System& sys, Data& d) {
   const MatX G = free_jacobian(sys, d);
-  MatX Y = G.transpose();  // Y = M⁻¹ Gᵀ, column by column with the tree's factorisation
-  if (recursive(sys)) {
-    VecX y;
-    for (int j = 0; j < sys.nl; ++j) {
-      y = Y.col(j);
-      aba_solve(sys, d, y, y);
-      Y.col(j) = y;
-    }
-  } else {
-    Y = d.llt.solve(Y);
-  }
+  const MatX Y = solve_armature(sys, d, G.transpose());  // M⁻¹ Gᵀ with the tree's factorisation
   d.lambda = least_norm(G * Y, d.gamma - G * d.qdd);
   d.qdd += Y * d.lambda;
   set_accelerations(sys, d, d.qdd);
@@ -332,6 +322,18 @@ void factor_armature(const System& sys, Data& d, const VecX& armature) {
 void solve_armature(const System& sys, Data& d, const VecX& b, VecX& x) {
   if (recursive(sys)) return aba_solve(sys, d, b, x);
   x = d.llt.solve(b);
+}
+
+MatX solve_armature(const System& sys, Data& d, const MatX& B) {
+  if (!recursive(sys)) return d.llt.solve(B);
+  MatX X(B.rows(), B.cols());
+  VecX x;
+  for (Eigen::Index j = 0; j < B.cols(); ++j) {
+    x = B.col(j);
+    aba_solve(sys, d, x, x);
+    X.col(j) = x;
+  }
+  return X;
 }
 
 }  // namespace rigidfem

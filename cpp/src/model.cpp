@@ -246,9 +246,11 @@ int Model::add_loop(const Loop& loop) {
   }
   if (loop.kind == LoopKind::Distance && !loop.drive && !(loop.length > 0.0 && std::isfinite(loop.length)))
     bad("length", "a positive distance in m", num8(loop.length));
+  Loop named = loop;
+  if (named.name.empty()) named.name = "loop" + std::to_string(loops_.size());
   for (const Loop& other : loops_)
-    if (other.name == loop.name) bad("name", "a name not used by another loop", "'" + loop.name + "'");
-  loops_.push_back(loop);
+    if (other.name == named.name) bad("name", "a name not used by another loop", "'" + named.name + "'");
+  loops_.push_back(std::move(named));
   return static_cast<int>(loops_.size()) - 1;
 }
 

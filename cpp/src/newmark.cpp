@@ -167,19 +167,8 @@ class NewmarkFamily final : public Stepper {
   /// matrix, (G Y) Δλ = −g/(β'h²) − G dx, then dx += Y Δλ and λ += Δλ. O(n·nl + nl³).
   void close_loops_correction(double bh2, NewmarkState& s1, VecX& dx) {
     const MatX G = free_jacobian(sys_, d_);
-    const VecX g = d_.g;
-    MatX Y = G.transpose();
-    if (spring_) {
-      VecX y;
-      for (int j = 0; j < sys_.nl; ++j) {
-        y = Y.col(j);
-        solve_armature(sys_, d_, y, y);
-        Y.col(j) = y;
-      }
-    } else {
-      Y = lu_.solve(Y);
-    }
-    const VecX dl = least_norm(G * Y, -g / bh2 - G * dx);
+    const MatX Y = spring_ ? solve_armature(sys_, d_, G.transpose()) : MatX(lu_.solve(G.transpose()));
+    const VecX dl = least_norm(G * Y, -d_.g / bh2 - G * dx);
     dx += Y * dl;
     s1.lambda += dl;
   }

@@ -83,12 +83,8 @@ def add_actuator(model, a, b, length, *, name: str | None = None) -> str:
 
 
 def _add(model, name, kind, ia, Fa, ib, Fb, length, drive) -> str:
-    if name is None:
-        name = f"loop{len(getattr(model, '_loop_names', []))}"
-    name = str(name)
-    model._add_loop(name, kind, ia, Fa, ib, Fb, length, drive)
-    model.__dict__.setdefault("_loop_names", []).append(name)
-    return name
+    """The loop added (its name: ``name``, or "loop<k>" when None)."""
+    return model._add_loop("" if name is None else str(name), kind, ia, Fa, ib, Fb, length, drive)
 
 
 def assemble(system, q, qd=None, t: float | None = None, tol: float = 1e-12, max_iterations: int = 50):

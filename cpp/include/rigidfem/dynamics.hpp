@@ -93,5 +93,8 @@ double project_onto_loops(const System& sys, Data& d, double t, VecX& q, VecX& q
 void factor_armature(const System& sys, Data& d, const VecX& armature);
 /// After factor_armature: x = (M + diag δ)⁻¹ b (x may be b).
 void solve_armature(const System& sys, Data& d, const VecX& b, VecX& x);
+/// After factor_armature (or a forward dynamics, which leaves δ = 0 factorised): X = (M + diag δ)⁻¹ B,
+/// column by column (nq, k): the Y = M⁻¹Gᵀ of the loop closures.
+MatX solve_armature(const System& sys, Data& d, const MatX& B);
 
 }  // namespace rigidfem

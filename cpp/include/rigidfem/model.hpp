@@ -132,7 +132,8 @@ class Model {
   /// Adds a constant generalised force, or a law Q(t, q, q̇), on one joint coordinate.
   void add_generalized_force(int body, int coordinate, double value, ForceLaw law);
   void add_load(const Load& load);
-  /// Closes a loop (loops.hpp); returns its index. Checks the bodies, frames and length.
+  /// Closes a loop (loops.hpp); returns its index. Checks the bodies, frames, length and name
+  /// (an empty name becomes "loop<index>").
   int add_loop(const Loop& loop);
   void set_gravity(const Vec3& g);
 
