@@ -6,6 +6,15 @@ recursive engine, central differences for ``compile(algorithm="lagrange")``):
 K = −∂f/∂q (tangent stiffness: springs, gravity and preload, centrifugal terms of a
 prescribed spin) and C = −∂f/∂q̇ (dampers, gyroscopic terms).
 
+Closed chains (``System.nl`` > 0: loop joints and actuators, M q̈ = f + Gᵀλ, g(q, t) = 0):
+statics solves f(q) + G(q)ᵀλ = 0, g(q, t) = 0 for (q, λ) by Newton's method on the bordered
+system [[K_t, −Gᵀ], [G, 0]], and modal analysis linearises in the null space N of G (the
+motions the loops allow), with K_t = K − ∂(Gᵀλ)/∂q: the tree's stiffness plus the loops'
+geometric stiffness −λᵀ∂²g/∂q², whose second derivatives are central differences of
+G(q)ᵀλ at fixed λ (relative accuracy ~1e-10). Redundant constraint rows (a planar loop closed
+by a 3D joint has three) are handled by the rank-revealing SVD of G, rows scaled to unit
+length; λ is the least-norm one, as in ``System.loop_multipliers``.
+
 Every answer is a result or an exception: a system without free coordinates (nq = 0)
 gets an empty result; bad arguments raise ``ValueError`` naming the argument; a
 singular mass matrix (gimbal lock), a mechanism in statics (a coordinate nothing
@@ -53,17 +62,22 @@ def _row_scale(A: np.ndarray) -> np.ndarray:
     return s
 
 
-def _describe_null_space(A: np.ndarray, names, limit: int = 3) -> str:
+def _describe_null_space(A: np.ndarray, names, limit: int = 3, basis: np.ndarray | None = None) -> str:
     """The coordinates of A's (near) null space: "payload.rz", "(ball.rz + ball.rx)" for a
-    combination, or "6 independent motions of body.x, ..." for a large one."""
+    combination, or "6 independent motions of body.x, ..." for a large one. With ``basis``
+    (nq, k), A is (k, k) in the coordinates y of q = basis · y (the loops' null space)."""
     s = _row_scale(A)
     _, sv, Vt = np.linalg.svd(A / s[:, None] / s[None, :])
     null = sv <= max(1e-8 * sv[0], sv[-1])
-    V, _ = np.linalg.qr(Vt[null].T / s[:, None])  # back to the unscaled coordinates (m and rad)
-    names = list(names) if names is not None and len(names) == len(A) else [f"q[{i}]" for i in range(len(A))]
+    V = Vt[null].T / s[:, None]  # back to the unscaled coordinates (m and rad)
+    if basis is not None:
+        V = basis @ V
+    V, _ = np.linalg.qr(V)
+    n = len(V)
+    names = list(names) if names is not None and len(names) == n else [f"q[{i}]" for i in range(n)]
     if V.shape[1] > limit:  # the coordinates that carry a large null space
         weight = np.sum(V**2, axis=1)
-        picked = [names[i] for i in range(len(A)) if weight[i] >= 0.1 * weight.max()]
+        picked = [names[i] for i in range(n) if weight[i] >= 0.1 * weight.max()]
         return f"{V.shape[1]} independent motions of " + ", ".join(picked)
     parts = []
     for v in V.T:
@@ -80,6 +94,108 @@ def _describe_null_space(A: np.ndarray, names, limit: int = 3) -> str:
     return ", ".join(parts)
 
 
+# --------------------------------------------------------------------------- loops
+
+#: Constraint rows of each loop kind (``rigidfem.loops``), in the order of ``System.loop_kinds``.
+_LOOP_ROWS = {"revolute": 5, "spherical": 3, "universal": 4, "prismatic": 5, "cylindrical": 4, "fixed": 6,
+              "distance": 1}
+#: A row of G counts as zero below this fraction of the largest row (round-off of a row that is
+#: zero in exact arithmetic, e.g. the out-of-plane rows of a planar loop).
+_ROW_ZERO = 1e-10
+#: G's rank: singular values of G (rows scaled to unit length) above this fraction of the largest;
+#: the same threshold as the least-norm solves of the dynamics (complete orthogonal decomposition).
+_RANK_TOL = 1e-10
+
+
+def _loop_of_rows(system) -> list:
+    """The name of the loop of every constraint row (nl)."""
+    rows = []
+    for name, kind in zip(system.loop_names, system.loop_kinds):
+        rows += [name] * _LOOP_ROWS[kind]
+    return rows
+
+
+def _worst_loop(system, g: np.ndarray) -> str:
+    names = _loop_of_rows(system)
+    i = int(np.argmax(np.abs(g)))
+    return f"loop '{names[i]}'" if len(names) == len(g) else f"row {i}"
+
+
+@dataclass
+class _Constraints:
+    """The loops' Jacobian G (nl, nq) at one configuration, split by its SVD (rows scaled to unit
+    length: the rank does not depend on the units, m beside cosines)."""
+
+    G: np.ndarray
+    rank: int
+    R: np.ndarray     #: (nq, r) orthonormal basis of G's row space
+    N: np.ndarray     #: (nq, nq − r) orthonormal basis of its null space: the motions the loops allow
+    live: np.ndarray  #: (nl,) rows that are not zero
+    U: np.ndarray     #: (live rows, r) left singular vectors of the scaled live rows
+    sv: np.ndarray    #: (r,) their singular values
+    norms: np.ndarray  #: (nl,) row lengths
+
+    @classmethod
+    def of(cls, G: np.ndarray) -> "_Constraints":
+        nl, n = G.shape
+        norms = np.linalg.norm(G, axis=1)
+        live = norms > _ROW_ZERO * max(norms.max(initial=0.0), 1e-300)
+        if not live.any() or n == 0:
+            return cls(G, 0, np.zeros((n, 0)), np.eye(n), live, np.zeros((int(live.sum()), 0)), np.zeros(0), norms)
+        U, sv, Vt = np.linalg.svd(G[live] / norms[live, None])
+        r = int(np.sum(sv > _RANK_TOL * sv[0]))
+        return cls(G, r, Vt[:r].T, Vt[r:].T, live, U[:, :r], sv[:r], norms)
+
+    def correction(self, g: np.ndarray) -> np.ndarray:
+        """Least-norm Δq (nq,) with G Δq = −g (least squares over the rows the rank keeps)."""
+        gs = g[self.live] / self.norms[self.live]
+        return -self.R @ ((self.U.T @ gs) / self.sv)
+
+    def multipliers(self, h: np.ndarray) -> np.ndarray:
+        """Least-norm λ (nl,) minimising |Gᵀλ − h| (h (nq,))."""
+        lam = np.zeros(len(self.G))
+        if self.rank == 0:
+            return lam
+        # Scaled rows: Gᵀλ = Gsᵀ μ with μ = D λ on the live rows; one μ, then the least-norm λ is its
+        # projection onto range(G) = D·range(U) (the λ that Gᵀ maps to zero are left out).
+        mu = self.U @ ((self.R.T @ h) / self.sv)
+        lam[self.live] = mu / self.norms[self.live]
+        B, _ = np.linalg.qr(self.U * self.norms[self.live, None])
+        lam[self.live] = B @ (B.T @ lam[self.live])
+        return lam
+
+
+def _loop_jacobian(system, t: float, q: np.ndarray):
+    g, _, G = system.loop_constraints(t, q, np.zeros(len(q)))
+    return g, G
+
+
+def _constraint_stiffness(system, t: float, q: np.ndarray, lam: np.ndarray) -> np.ndarray:
+    """The loops' geometric stiffness −∂(G(q)ᵀλ)/∂q = −Σ λ_i ∂²g_i/∂q² (nq, nq) at fixed λ:
+    central differences of G with steps h_j = ε^⅓ max(1, |q_j|) (relative error ~1e-10),
+    symmetrised (it is a sum of Hessians)."""
+    n = len(q)
+    Kg = np.zeros((n, n))
+    if not np.any(lam):
+        return Kg
+    for j in range(n):
+        h = _EPS ** (1 / 3) * max(1.0, abs(q[j]))
+        qp, qm = q.copy(), q.copy()
+        qp[j] += h
+        qm[j] -= h
+        Kg[:, j] = -(_loop_jacobian(system, t, qp)[1].T @ lam - _loop_jacobian(system, t, qm)[1].T @ lam) / (qp[j] - qm[j])
+    return 0.5 * (Kg + Kg.T)
+
+
+def _close_loops(system, q: np.ndarray, t: float, what: str) -> np.ndarray:
+    """q assembled onto the loops (``System.assemble``), or the SimulationError naming the loop."""
+    try:
+        return system.assemble(q, None, t)[0]
+    except SimulationError as err:
+        raise SimulationError(f"{err} ({what} starts from the coordinates closed onto the loops "
+                              f"{system.loop_names})") from err
+
+
 # --------------------------------------------------------------------------- statics
 
 @dataclass
@@ -92,6 +208,11 @@ class Equilibrium:
     residual: float          #: max |f(q)| at the end, N or N·m
     load_steps: int
     history: list = field(default_factory=list, repr=False)  #: (load factor, iterations, residual) per step
+    #: (nl,) the loops' multipliers λ of f + Gᵀλ = 0 (least-norm where rows are redundant), in the
+    #: units of ``System.loop_multipliers``; empty without loops. ``System.loop_reactions(t, q, 0)``
+    #: gives the reactions (force and torque) when the drives are at rest at t.
+    multipliers: np.ndarray = field(default_factory=lambda: np.zeros(0))
+    constraint_residual: float = 0.0  #: max |g(q, t)| at the end (m, or cosines), 0 without loops
 
 
 def _solve_tangent(K: np.ndarray, f: np.ndarray):
@@ -127,11 +248,18 @@ def static_equilibrium(system, q0=None, t: float = 0.0, load_steps: int = 10, to
 
     A system without free coordinates (nq = 0) returns at once with ``q`` of shape (0,).
 
+    Closed chains (loop joints, actuators): ``q0`` is first closed onto the loops
+    (``System.assemble``), then each step solves f(q) + G(q)ᵀλ = 0, g(q, t) = 0 by Newton
+    on the bordered system [[K_t, −Gᵀ], [G, 0]] (Δq, Δλ), K_t = −∂f/∂q − ∂(Gᵀλ)/∂q, in the
+    null space of G (redundant rows allowed); ``residual`` is then max |f + Gᵀλ| and the
+    result carries λ (``multipliers``) and max |g| (``constraint_residual``).
+
     Raises ``ValueError`` for a bad argument, and ``SimulationError`` (naming t) when
     Newton does not converge within ``max_iterations`` in a load step, when forces or
-    their Jacobian are not finite, or when the tangent stiffness K = −∂f/∂q is singular:
-    the message then names the coordinates nothing resists (a mechanism, e.g. the yaw
-    of a hanging payload, or a buckling/limit point).
+    their Jacobian are not finite, when ``q0`` cannot be closed onto the loops (naming the
+    loop), or when the tangent stiffness K = −∂f/∂q (with loops: K_t in the motions the loops
+    allow) is singular: the message then names the coordinates nothing resists (a mechanism,
+    e.g. the yaw of a hanging payload, or a buckling/limit point).
     """
     t = _checks.scalar(t, "t")
     n = system.nq
@@ -139,8 +267,13 @@ def static_equilibrium(system, q0=None, t: float = 0.0, load_steps: int = 10, to
     steps = _integer_at_least_one(load_steps, "load_steps")
     tol = _checks.scalar(tol, "tol", positive=True)
     max_iterations = _integer_at_least_one(max_iterations, "max_iterations")
+    if system.nl:
+        q = _close_loops(system, q, t, "static_equilibrium")
     if n == 0:
-        return Equilibrium(q, True, 0, 0.0, steps, [(k / steps, 0, 0.0) for k in range(1, steps + 1)])
+        return Equilibrium(q, True, 0, 0.0, steps, [(k / steps, 0, 0.0) for k in range(1, steps + 1)],
+                           np.zeros(system.nl))
+    if system.nl:
+        return _constrained_statics(system, q, t, steps, tol, max_iterations)
     history, total = [], 0
     for k in range(1, steps + 1):
         lam = k / steps
@@ -151,10 +284,7 @@ def static_equilibrium(system, q0=None, t: float = 0.0, load_steps: int = 10, to
             _require_finite(t, what, **{"f(q)": f, "tangent stiffness K": K})
             dq = _solve_tangent(K, f)
             if dq is None:
-                raise SimulationError(
-                    f"{_frame(t, what)}: the tangent stiffness K = −∂f/∂q is singular to working precision: "
-                    f"nothing resists {_describe_null_space(K, system.coordinate_names)}. A mechanism (give these "
-                    "coordinates stiffness, prescribe or lock them), or a buckling/limit point")
+                raise _mechanism(t, what, K, system.coordinate_names)
             # Backtracking line search on |f| keeps large-rotation steps from overshooting.
             alpha, norm0 = 1.0, np.max(np.abs(f))
             while True:
@@ -174,11 +304,87 @@ def static_equilibrium(system, q0=None, t: float = 0.0, load_steps: int = 10, to
     return Equilibrium(q, True, total, float(np.max(np.abs(f))), steps, history)
 
 
+def _mechanism(t: float, what: str, K: np.ndarray, names, basis=None) -> SimulationError:
+    within = "" if basis is None else " within the motions the loops allow"
+    return SimulationError(
+        f"{_frame(t, what)}: the tangent stiffness K = −∂f/∂q{'' if basis is None else ' − ∂(Gᵀλ)/∂q'} is singular "
+        f"to working precision{within}: nothing resists {_describe_null_space(K, names, basis=basis)}. A mechanism "
+        "(give these coordinates stiffness, prescribe or lock them), or a buckling/limit point")
+
+
+def _constrained_statics(system, q: np.ndarray, t: float, steps: int, tol: float, max_iterations: int) -> Equilibrium:
+    """``static_equilibrium`` of a closed chain, from q on the loops: Newton on the bordered system
+
+        [K_t  −Gᵀ] [Δq]   [f + Gᵀλ]
+        [G     0 ] [Δλ] = [  −g   ],   K_t = −∂f/∂q − ∂(Gᵀλ)/∂q,
+
+    solved in the null space N of G: Δq = −G⁺g + N y with (NᵀK_tN) y = Nᵀ(f + K_t G⁺g), then the
+    least-norm λ + Δλ of Gᵀ(λ + Δλ) = K_tΔq − f. A backtracking line search keeps |Nᵀ f| (the
+    load the loops do not carry) from growing."""
+    n, names = system.nq, system.coordinate_names
+    zero = np.zeros(n)
+
+    def state(q, lam_factor):
+        f = system.static_forces(t, q, lam_factor)
+        g, G = _loop_jacobian(system, t, q)
+        c = _Constraints.of(G)
+        return f, g, c
+
+    def unbalance(f, c):  # max |f + Gᵀλ| with the least-squares λ: the part of f the loops do not carry
+        return float(np.max(np.abs(c.N @ (c.N.T @ f)))) if c.N.shape[1] else 0.0
+
+    history, total = [], 0
+    for k in range(1, steps + 1):
+        lf = k / steps
+        what = f"statics at load factor {lf:.4g}"
+        f, g, c = state(q, lf)
+        lam = c.multipliers(-f)
+        for it in range(1, max_iterations + 1):
+            K = -system.force_jacobians(t, q, zero, lf, True)[0]
+            _require_finite(t, what, **{"f(q)": f, "tangent stiffness K": K, "loop Jacobian G": c.G, "g(q)": g})
+            Kt = K + _constraint_stiffness(system, t, q, lam)
+            _require_finite(t, what, **{"geometric stiffness of the loops": Kt})
+            dq = c.correction(g)
+            N = c.N
+            if N.shape[1]:
+                y = _solve_tangent(N.T @ Kt @ N, N.T @ (f - Kt @ dq))
+                if y is None:
+                    raise _mechanism(t, what, N.T @ Kt @ N, names, N)
+                dq = dq + N @ y
+            # Backtracking line search on the unbalanced load keeps large-rotation steps from overshooting.
+            alpha, norm0 = 1.0, unbalance(f, c)
+            while True:
+                q_new = q + alpha * dq
+                f_new, g_new, c_new = state(q_new, lf)
+                if unbalance(f_new, c_new) <= norm0 or alpha < 1e-3:
+                    break
+                alpha *= 0.5
+            lam_newton = c.multipliers(Kt @ dq - f)
+            q, f, g, c = q_new, f_new, g_new, c_new
+            lam = lam_newton if alpha == 1.0 else c.multipliers(-f)
+            total += 1
+            if np.max(np.abs(alpha * dq)) <= tol * max(1.0, np.max(np.abs(q))):
+                break
+        else:
+            lam = c.multipliers(-f)
+            raise SimulationError(
+                f"{_frame(t, 'statics')}: Newton did not converge in {max_iterations} iterations at load factor "
+                f"{lf:.4g} (residual max |f + Gᵀλ| = {np.max(np.abs(f + c.G.T @ lam)):.3e}, loops' residual "
+                f"max |g| = {np.max(np.abs(g)):.3e} in {_worst_loop(system, g)}); try more load_steps or a q0 nearer "
+                "the equilibrium")
+        lam = c.multipliers(-f)
+        history.append((lf, it, float(np.max(np.abs(f + c.G.T @ lam)))))
+    lam = c.multipliers(-f)
+    return Equilibrium(q, True, total, float(np.max(np.abs(f + c.G.T @ lam))), steps, history, lam,
+                       float(np.max(np.abs(g))))
+
+
 # --------------------------------------------------------------------------- modes
 
 @dataclass
 class Modes:
-    """Result of ``modal_analysis``: one entry per mode (k = nq), sorted by natural frequency."""
+    """Result of ``modal_analysis``: one entry per mode (k = nq, or nq − rank G with loops), sorted
+    by natural frequency."""
 
     omega: np.ndarray           #: (k,) undamped natural circular frequencies, rad/s (a divergence: √(−ω²))
     frequencies_hz: np.ndarray  #: (k,) omega / 2π, Hz
@@ -192,12 +398,18 @@ class Modes:
         """No eigenvalue with a positive real part (to 1e-9 of its modulus)."""
         return bool(np.all(self.eigenvalues.real <= 1e-9 * np.abs(self.eigenvalues)))
     M: np.ndarray = field(repr=False)  #: (nq, nq) mass matrix
-    K: np.ndarray = field(repr=False)  #: (nq, nq) tangent stiffness −∂f/∂q
+    K: np.ndarray = field(repr=False)  #: (nq, nq) tangent stiffness −∂f/∂q (with loops: − ∂(Gᵀλ)/∂q as well)
     C: np.ndarray = field(repr=False)  #: (nq, nq) −∂f/∂q̇
+    #: (nq, k) orthonormal basis N of the motions the loops allow (null space of G); the modes are
+    #: those of NᵀMN, NᵀKN, NᵀCN, shapes = N φ. None without loops.
+    basis: np.ndarray | None = field(default=None, repr=False)
+    #: (nl,) the loops' multipliers λ (least squares of f + Gᵀλ = 0) in the geometric stiffness; empty without loops
+    multipliers: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
 
 
-def _check_mass_matrix(M: np.ndarray, names, t: float) -> None:
-    """SimulationError naming the coordinates without inertia unless M is positive definite."""
+def _check_mass_matrix(M: np.ndarray, names, t: float, basis: np.ndarray | None = None) -> None:
+    """SimulationError naming the coordinates without inertia unless M is positive definite
+    (``basis``: M is NᵀAN in the loops' null space N)."""
     s = np.sqrt(np.abs(np.diag(M)))
     singular = not np.all(s > 0)
     if not singular:
@@ -209,7 +421,7 @@ def _check_mass_matrix(M: np.ndarray, names, t: float) -> None:
             singular = info != 0 or not rcond > _RCOND_MASS
     if singular:
         raise SimulationError(f"{_frame(t, 'modal analysis')}: the mass matrix A(q) is singular to working "
-                              f"precision: no inertia along {_describe_null_space(M, names)} (Euler angles in "
+                              f"precision: no inertia along {_describe_null_space(M, names, basis=basis)} (Euler angles in "
                               "gimbal lock at pitch ±π/2, or massless bodies)")
 
 
@@ -295,9 +507,18 @@ def modal_analysis(system, q=None, qd=None, t: float = 0.0) -> Modes:
       = 0 with the largest real part (Im ≥ 0): −ζω + iω√(1 − ζ²) for light proportional
       damping, the slower real root of an overdamped mode, iω without damping.
 
+    Closed chains (loop joints, actuators): (q, q̇) must close the loops (``static_equilibrium``
+    or ``System.assemble`` find such q). The equations are linearised in the motions the loops
+    allow, q = q₀ + N y with N an orthonormal basis of the null space of G = ∂g/∂q (SVD; redundant
+    rows allowed): NᵀMN ÿ + NᵀCN ẏ + NᵀK_tN y = 0 with K_t = K − ∂(Gᵀλ)/∂q, the loops' geometric
+    stiffness at the multipliers λ of f + Gᵀλ = 0 (least squares: exact at an equilibrium). There
+    are nq − rank G modes; ``shapes`` are N φ in the full coordinates, ``basis`` is N and
+    ``multipliers`` λ. (About a moving state the rates of G are not linearised.)
+
     A system without free coordinates (nq = 0) gives empty arrays. Raises ``ValueError`` for
-    a bad argument and ``SimulationError`` (naming t) when the mass matrix is singular (it
-    names the coordinates, e.g. Euler angles in gimbal lock) or the matrices are not finite.
+    a bad argument (q or qd that do not close the loops, naming them) and ``SimulationError``
+    (naming t) when the mass matrix is singular (it names the coordinates, e.g. Euler angles in
+    gimbal lock) or the matrices are not finite.
     """
     t = _checks.scalar(t, "t")
     n = system.nq
@@ -312,6 +533,8 @@ def modal_analysis(system, q=None, qd=None, t: float = 0.0) -> Modes:
     _require_finite(t, "modal analysis", **{"mass matrix": M, "stiffness K = −∂f/∂q": K,
                                             "damping/gyroscopic matrix C = −∂f/∂q̇": C})
     names = system.coordinate_names
+    if system.nl:
+        return _constrained_modes(system, q, qd, t, M, K, C)
     _check_mass_matrix(M, names, t)
     try:
         omega, zeta, shapes, lam = _modes(M, K, C)
@@ -320,6 +543,42 @@ def modal_analysis(system, q=None, qd=None, t: float = 0.0) -> Modes:
     order = np.argsort(omega, kind="stable")
     shapes = shapes[:, order] / np.max(np.abs(shapes[:, order]), axis=0)
     return Modes(omega[order], omega[order] / (2 * np.pi), zeta[order], shapes, lam[order], q, M, K, C)
+
+
+def _constrained_modes(system, q: np.ndarray, qd: np.ndarray, t: float, M: np.ndarray, K: np.ndarray,
+                       C: np.ndarray, tol: float = 1e-8) -> Modes:
+    """``modal_analysis`` of a closed chain: the modes of NᵀMN, NᵀK_tN, NᵀCN (N: null space of G)."""
+    what = "modal analysis"
+    g, gd, G = system.loop_constraints(t, q, qd)
+    _require_finite(t, what, **{"loop Jacobian G": G, "g(q)": g, "ġ": gd})
+    for name, v in (("q", g), ("qd", gd)):
+        if np.max(np.abs(v)) > tol:
+            raise ValueError(
+                f"{name}: expected {'coordinates' if name == 'q' else 'rates'} that close every loop of "
+                f"{system.loop_names} (max |g{'' if name == 'q' else 'd'}| = {np.max(np.abs(v)):.3g} > {tol:g} in "
+                f"{_worst_loop(system, v)}); rigidfem.static_equilibrium or system.assemble(q, qd, t) finds them")
+    c = _Constraints.of(G)
+    f = system.generalized_forces(t, q, qd)
+    _require_finite(t, what, **{"f(q, q̇)": f})
+    lam = c.multipliers(-f)
+    Kt = K + _constraint_stiffness(system, t, q, lam)
+    _require_finite(t, what, **{"geometric stiffness of the loops": Kt})
+    N = c.N
+    k = N.shape[1]
+    if k == 0:  # the loops leave nothing free
+        e = np.zeros(0)
+        return Modes(e, e.copy(), e.copy(), np.zeros((system.nq, 0)), np.zeros(0, complex), q, M, Kt, C, N, lam)
+    Mr, Kr, Cr = N.T @ M @ N, N.T @ Kt @ N, N.T @ C @ N
+    Mr = 0.5 * (Mr + Mr.T)
+    _check_mass_matrix(Mr, system.coordinate_names, t, basis=N)
+    try:
+        omega, zeta, phi, ev = _modes(Mr, Kr, Cr)
+    except np.linalg.LinAlgError as err:
+        raise SimulationError(f"{_frame(t, what)}: eigensolver failed ({err})") from err
+    order = np.argsort(omega, kind="stable")
+    shapes = N @ phi[:, order]
+    shapes = shapes / np.max(np.abs(shapes), axis=0)
+    return Modes(omega[order], omega[order] / (2 * np.pi), zeta[order], shapes, ev[order], q, M, Kt, C, N, lam)
 
 
 def _modes(M: np.ndarray, K: np.ndarray, C: np.ndarray):
