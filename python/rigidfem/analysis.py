@@ -89,7 +89,7 @@ def _describe_null_space(A: np.ndarray, names, limit: int = 3, basis: np.ndarray
         text = ""
         for i in big:
             size = "" if abs(abs(v[i]) - 1) < 1e-3 else f"{abs(v[i]):.2g}·"
-            text += (" − " if v[i] < 0 else " + " if text else "") + size + names[i]
+            text += ((" − " if text else "−") if v[i] < 0 else " + " if text else "") + size + names[i]
         parts.append(f"({text})")
     return ", ".join(parts)
 
