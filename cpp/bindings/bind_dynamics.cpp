@@ -178,6 +178,24 @@ void bind_dynamics(py::module_& m) {
             return W;
           },
           py::arg("t"), py::arg("q"), py::arg("qd"))
+      .def_property_readonly(
+          "element_names",
+          [](const System& s) {
+            std::vector<std::string> names;
+            for (const ForceElement& E : s.elements) names.push_back(E.name);
+            return names;
+          },
+          "Names of the force elements (spring-dampers and cylinders), in the order of element_states().")
+      .def(
+          "element_states",
+          [](const System& s, double t, const RefV& q, const RefV& qd) {
+            Workspace d(s);
+            return rigidfem::element_states(s, *d, t, q, qd);
+          },
+          py::arg("t"), py::arg("q"), py::arg("qd"),
+          "Length l (m), rate dl/dt (m/s) and axial force F (N, positive pushing the two points apart) of every\n"
+          "force element (nelements, 3).")
+      .def("_element_force_history", &rigidfem::element_force_history, py::arg("t"), py::arg("q"), py::arg("qd"))
       .def(
           "_assemble",
           [](const System& s, double t, const RefV& q, const RefV& qd, double tol, int max_iterations) {

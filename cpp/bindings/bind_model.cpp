@@ -2,6 +2,7 @@
 // rigidfem/model.py; these are the primitives it calls.
 #include <cmath>
 #include <memory>
+#include <optional>
 
 #include "bindings.hpp"
 #include "rigidfem/errors.hpp"
@@ -61,9 +62,11 @@ bool force_value(const py::object& r, double& value, std::string& got) {
   return true;
 }
 
-// A Python force law Q(t, q, q̇) as a ForceLaw (called with or without the GIL held) that checks
+// A Python force law Q(t, x, ẋ) as a ForceLaw (called with or without the GIL held) that checks
 // what it returns; the law's own exceptions (ZeroDivisionError, KeyboardInterrupt ...) propagate.
-ForceLaw python_force_law(const py::function& f, const std::string& coordinate) {
+// `on` names what it acts on ("coordinate 'hub.rz'"), x and xd its arguments ("q", "qd").
+ForceLaw python_law(const py::function& f, const std::string& on, const char* x = "q", const char* xd = "qd",
+                    const char* units = "N or N·m") {
   // The reference is dropped under the GIL wherever the last copy of the law dies.
   std::shared_ptr<py::object> law(new py::object(f), [](py::object* o) {
     py::gil_scoped_acquire gil;
@@ -71,17 +74,18 @@ ForceLaw python_force_law(const py::function& f, const std::string& coordinate) 
   });
   const std::string name = py::hasattr(f, "__qualname__") ? std::string(py::str(f.attr("__qualname__")))
                                                            : short_repr(f);
-  const std::string what = "the force law '" + name + "' on coordinate '" + coordinate + "'";
-  return [law, what](double t, double q, double qd) {
+  const std::string what = "the force law '" + name + "' on " + on;
+  return [law, what, x, xd, units](double t, double q, double qd) {
     py::gil_scoped_acquire gil;
     const py::object r = (*law)(t, q, qd);
     double value = 0.0;
     std::string got;
     if (force_value(r, value, got)) return value;
-    const std::string state = "q = " + num(q, 10) + ", qd = " + num(qd, 10);
-    throw ForceLawError(t, what + " returned " + got + " at " + state + "; expected a finite number (N or N·m)",
-                        "force: expected " + what + " to return a finite number (N or N·m), got " + got +
-                            " at t = " + num(t, 10) + " s, " + state);
+    const std::string state = std::string(x) + " = " + num(q, 10) + ", " + xd + " = " + num(qd, 10);
+    const std::string expected = std::string("a finite number (") + units + ")";
+    throw ForceLawError(t, what + " returned " + got + " at " + state + "; expected " + expected,
+                        "force: expected " + what + " to return " + expected + ", got " + got + " at t = " +
+                            num(t, 10) + " s, " + state);
   };
 }
 
@@ -212,7 +216,7 @@ void bind_model(py::module_& m) {
             if (law.is_none()) return model.add_generalized_force(body, coordinate, value, nullptr);
             if (!PyCallable_Check(law.ptr())) bad("force", "a number or a function Q(t, q, qd)", short_repr(law));
             const std::string name = model.coordinate_name(body, coordinate);  // checks body and coordinate
-            model.add_generalized_force(body, coordinate, value, python_force_law(law, name));
+            model.add_generalized_force(body, coordinate, value, python_law(law, "coordinate '" + name + "'"));
           },
           py::arg("body"), py::arg("coordinate"), py::arg("value"), py::arg("law"))
       .def(
@@ -231,6 +235,18 @@ void bind_model(py::module_& m) {
           },
           py::arg("name"), py::arg("kind"), py::arg("a"), py::arg("frame_a"), py::arg("b"), py::arg("frame_b"),
           py::arg("length"), py::arg("drive"))
+      .def(
+          "_add_force_element",
+          [](Model& model, const std::string& name, int a, const Vec3& point_a, int b, const Vec3& point_b,
+             double stiffness, double damping, double length, double force, ProfilePtr profile,
+             const std::optional<py::function>& law) {
+            ForceElement e{name, a, b, point_a, point_b, stiffness, damping, length, force, std::move(profile), {}};
+            const std::string label = name.empty() ? "element" + std::to_string(model.force_elements().size()) : name;
+            if (law) e.law = python_law(*law, "force element '" + label + "'", "l", "ld", "N");
+            return model.force_elements()[model.add_force_element(e)].name;
+          },
+          py::arg("name"), py::arg("a"), py::arg("point_a"), py::arg("b"), py::arg("point_b"), py::arg("stiffness"),
+          py::arg("damping"), py::arg("length"), py::arg("force"), py::arg("profile"), py::arg("law"))
       .def("_body_index", &Model::body_index, py::arg("name"))
       .def(
           "_body_name",

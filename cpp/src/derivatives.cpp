@@ -2,6 +2,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <tuple>
+#include <utility>
 #include <vector>
 
 namespace rigidfem {
@@ -30,6 +32,44 @@ struct Tangent {
   std::vector<Vec6> v, a, f;  // δv_p, δa_p, δf̄_p
 };
 
+// A load on a body (the load's own point moving with it: the geometric term of the tangent).
+struct BodyLoad {
+  int body;
+  bool follower;
+  AppliedLoad load;
+};
+
+// δ(r, ṙ) of a point x (global) of body b along the direction of the tangent w: a point carried
+// by the coordinate moves by δx = s_v + s_ω × x (position), and its velocity ṙ = v_O + ω × x
+// changes by δv_O + δω × x + ω × δx.
+std::pair<Vec3, Vec3> point_tangent(const Data& d, const Tangent& w, int b, const Vec3& x, const Vec6& s,
+                                    bool position) {
+  if (b < 0 || !w.inside[b]) return {Vec3::Zero(), Vec3::Zero()};
+  const Vec3 dx = position ? Vec3(s.tail<3>() + s.head<3>().cross(x)) : Vec3::Zero();
+  return {dx, w.v[b].tail<3>() + w.v[b].head<3>().cross(x) + d.v[b].head<3>().cross(dx)};
+}
+
+// The change of a force element's force f_B = F e = −f_A along the tangent (its points' motion
+// under the fixed force is the geometric term of BodyLoad): with δd = δr_B − δr_A,
+//   δe = (1 − e eᵀ) δd / l,  δl = e·δd,  δl̇ = δe·ḋ + e·δḋ,  δf_B = (F_l δl + F_l̇ δl̇) e + F δe,
+// applied at r_B and r_A as −δf_ext.
+void element_tangent(const System& sys, const Data& d, const ForceElement& E, const ElementState& st, const Vec6& s,
+                     bool position, Tangent& w) {
+  const auto [dxb, dvb] = point_tangent(d, w, E.body_b, st.xb, s, position);
+  const auto [dxa, dva] = point_tangent(d, w, E.body_a, st.xa, s, position);
+  const Vec3 dd = dxb - dxa, ddd = dvb - dva;
+  if (dd.isZero(0.0) && ddd.isZero(0.0)) return;
+  const Vec3 de = (dd - st.e * st.e.dot(dd)) / st.l;
+  const double dl = st.e.dot(dd), dld = de.dot(st.vb - st.va) + st.e.dot(ddd);
+  const auto [Fl, Fld] = axial_force_derivatives(E, d.t, st.l, st.ld, d.load_factor);
+  const Vec3 df = (Fl * dl + Fld * dld) * st.e + st.F * de;
+  for (const auto& [body, x, f] : {std::tuple<int, Vec3, Vec3>{E.body_b, st.xb, df}, {E.body_a, st.xa, -df}}) {
+    if (body < 0) continue;
+    w.f[body].head<3>() -= x.cross(f);
+    w.f[body].tail<3>() -= f;
+  }
+}
+
 // Column ∂r/∂q_j (position) or ∂r/∂q̇_j (rate) for the coordinate j with use uj on body bj,
 // into col (nq). Only the bodies carried by q_j (bj and its subtree) have tangents:
 //   position: the later axes turn, δs_u = s_j ×m s_u, and so do inertias and follower loads;
@@ -37,8 +77,9 @@ struct Tangent {
 // Then δc = Σ (δv ×m s_u + v ×m δs_u) q̇_u, δv = Σ δs_u q̇_u, δa_p = δa_λ + δc + Σ δs_u q̈_u,
 // δf_p = δI a + I δa + δv ×* I v + v ×* (δI v + I δv) − δf_ext, summed over subtrees, and
 // δr_i = δs_iᵀ f̄_b + s_iᵀ δf̄_b.
-void tangent_column(const System& sys, const Data& d, const std::vector<AppliedLoad>& loads, int uj, int bj,
-                    bool position, Tangent& w, Eigen::Ref<VecX> col) {
+void tangent_column(const System& sys, const Data& d, const std::vector<BodyLoad>& loads,
+                    const std::vector<ElementState>& elements, int uj, int bj, bool position, Tangent& w,
+                    Eigen::Ref<VecX> col) {
   const Vec6& s = d.axes[uj];
   auto turned = [&](int p, int u) { return position && w.inside[p] && (p != bj || u > uj); };
   for (int p = 0; p < sys.nbodies; ++p) {
@@ -72,9 +113,9 @@ void tangent_column(const System& sys, const Data& d, const std::vector<AppliedL
   // Loads on carried bodies: a point fixed in the body moves with velocity v_s + ω_s × x;
   // a follower load turns with the body, δf = s ×* f.
   for (std::size_t k = 0; position && k < loads.size(); ++k) {
-    const Load& L = sys.loads[k];
+    const BodyLoad& L = loads[k];
     if (!w.inside[L.body]) continue;
-    const AppliedLoad& l = loads[k];
+    const AppliedLoad& l = L.load;
     if (L.follower) {
       Vec6 fl;
       fl << l.x.cross(l.F) + l.tau, l.F;
@@ -84,6 +125,7 @@ void tangent_column(const System& sys, const Data& d, const std::vector<AppliedL
       w.f[L.body].head<3>() -= dx.cross(l.F);
     }
   }
+  for (std::size_t k = 0; k < elements.size(); ++k) element_tangent(sys, d, sys.elements[k], elements[k], s, position, w);
   accumulate_subtrees(sys, w.f);
   for (int k = 0; k < sys.nq; ++k) {
     const int b = sys.coords[sys.free_coords[k]].body, u = sys.q_use[k];
@@ -96,14 +138,21 @@ void tangent_column(const System& sys, const Data& d, const std::vector<AppliedL
 std::pair<MatX, MatX> rnea_derivatives(const System& sys, Data& d) {
   spatial_kinematics(sys, d);
   rnea_pass(sys, d);
-  std::vector<AppliedLoad> loads;
-  for (const Load& L : sys.loads) loads.push_back(applied_load(d, L));
+  std::vector<BodyLoad> loads;
+  for (const Load& L : sys.loads) loads.push_back({L.body, L.follower, applied_load(d, L)});
+  std::vector<ElementState> elements;
+  for (const ForceElement& E : sys.elements) {
+    elements.push_back(element_state(d, E, true));
+    const auto [on_b, on_a] = element_loads(elements.back());
+    if (E.body_b >= 0) loads.push_back({E.body_b, false, on_b});
+    if (E.body_a >= 0) loads.push_back({E.body_a, false, on_a});
+  }
   MatX dq(sys.nq, sys.nq), dqd(sys.nq, sys.nq);
   Tangent w(sys);
   for (int j = 0; j < sys.nq; ++j) {
     const int i = sys.free_coords[j], b = sys.coords[i].body, u = sys.q_use[j];
-    tangent_column(sys, d, loads, u, b, true, w, dq.col(j));
-    tangent_column(sys, d, loads, u, b, false, w, dqd.col(j));
+    tangent_column(sys, d, loads, elements, u, b, true, w, dq.col(j));
+    tangent_column(sys, d, loads, elements, u, b, false, w, dqd.col(j));
     // −∂Q_j/∂(q_j, q̇_j) of the coordinate's own spring, damper and force law.
     const Coordinate& c = sys.coords[i];
     dq(j, j) += c.stiffness;

@@ -1,5 +1,6 @@
 #include "rigidfem/kinematics.hpp"
 
+#include <algorithm>
 #include <cmath>
 
 #include "rigidfem/errors.hpp"
@@ -98,6 +99,40 @@ AppliedLoad applied_load(const Data& d, const Load& L) {
   const Mat3 R = d.T[L.body].topLeftCorner<3, 3>();
   return {(d.T[L.body] * L.point.homogeneous()).head<3>(), s * (L.follower ? Vec3(R * L.force) : L.force),
           s * (L.follower ? Vec3(R * L.torque) : L.torque)};
+}
+
+namespace {
+
+// Position and velocity of a point p (body frame) of body b: from v_b = (ω, v_O) (spatial) or Ṫ_b.
+void moving_point(const Data& d, int b, const Vec3& p, bool spatial, Vec3& x, Vec3& v) {
+  if (b < 0) {
+    x = p;
+    v.setZero();
+    return;
+  }
+  x = (d.T[b] * p.homogeneous()).head<3>();
+  v = spatial ? Vec3(d.v[b].tail<3>() + d.v[b].head<3>().cross(x)) : Vec3((d.Td[b] * p.homogeneous()).head<3>());
+}
+
+}  // namespace
+
+ElementState element_state(const Data& d, const ForceElement& element, bool spatial) {
+  ElementState s;
+  moving_point(d, element.body_a, element.point_a, spatial, s.xa, s.va);
+  moving_point(d, element.body_b, element.point_b, spatial, s.xb, s.vb);
+  const Vec3 r = s.xb - s.xa;
+  s.l = r.norm();
+  if (!(s.l > 1e-12 * std::max(1.0, s.xa.norm())))
+    throw SimulationError(d.t, "the points of force element '" + element.name +
+                                   "' coincide (l = 0: its line of action is undefined)");
+  s.e = r / s.l;
+  s.ld = s.e.dot(s.vb - s.va);
+  s.F = axial_force(element, d.t, s.l, s.ld, d.load_factor);
+  return s;
+}
+
+std::pair<AppliedLoad, AppliedLoad> element_loads(const ElementState& s) {
+  return {{s.xb, s.F * s.e, Vec3::Zero()}, {s.xa, -s.F * s.e, Vec3::Zero()}};
 }
 
 double passive_force(const System& sys, const Data& d, int i) {

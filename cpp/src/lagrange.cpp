@@ -28,6 +28,11 @@ void load_composites(const System& sys, Data& d) {
     Z.leftCols<3>() += Vec4(a.x.homogeneous()) * a.F.transpose();
     Z.topLeftCorner<3, 3>() -= 0.5 * skew(a.tau);
   }
+  for (const ForceElement& E : sys.elements) {
+    const auto [on_b, on_a] = element_loads(element_state(d, E, false));
+    for (const auto& [body, a] : {std::pair<int, const AppliedLoad&>{E.body_b, on_b}, {E.body_a, on_a}})
+      if (body >= 0) d.Zbar[body].leftCols<3>() += Vec4(a.x.homogeneous()) * a.F.transpose();
+  }
   accumulate_subtrees(sys, d.Zbar);
 }
 

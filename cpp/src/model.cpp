@@ -5,6 +5,7 @@
 #include <cmath>
 #include <sstream>
 #include <stdexcept>
+#include <tuple>
 
 #include "rigidfem/errors.hpp"
 
@@ -199,6 +200,11 @@ void Model::truncate(int n) {
   bodies_.resize(n);
   coords_.resize(n);
   loads_.erase(std::remove_if(loads_.begin(), loads_.end(), [n](const Load& l) { return l.body >= n; }), loads_.end());
+  loops_.erase(std::remove_if(loops_.begin(), loops_.end(), [n](const Loop& l) { return std::max(l.body_a, l.body_b) >= n; }),
+               loops_.end());
+  elements_.erase(std::remove_if(elements_.begin(), elements_.end(),
+                                 [n](const ForceElement& e) { return std::max(e.body_a, e.body_b) >= n; }),
+                  elements_.end());
 }
 
 std::string Model::coordinate_name(int body, int coordinate) const {
@@ -252,6 +258,27 @@ int Model::add_loop(const Loop& loop) {
     if (other.name == named.name) bad("name", "a name not used by another loop", "'" + named.name + "'");
   loops_.push_back(std::move(named));
   return static_cast<int>(loops_.size()) - 1;
+}
+
+int Model::add_force_element(const ForceElement& element) {
+  if (element.body_a != -1) check_body(element.body_a, "a");  // −1: the ground
+  if (element.body_b != -1) check_body(element.body_b, "b");
+  if (element.body_a == element.body_b)
+    bad("b", "a body other than a (a force element joins two bodies)", "the same body");
+  require_finite(element.point_a, "a");
+  require_finite(element.point_b, "b");
+  for (const auto& [value, name, expected] :
+       {std::tuple<double, const char*, const char*>{element.stiffness, "stiffness", "a finite stiffness >= 0 in N/m"},
+        {element.damping, "damping", "a finite damping coefficient >= 0 in N·s/m"},
+        {element.length, "length", "a finite rest length >= 0 in m"}})
+    if (!(value >= 0.0 && std::isfinite(value))) bad(name, expected, num8(value));
+  if (!std::isfinite(element.force)) bad("force", "a finite force in N", num8(element.force));
+  ForceElement named = element;
+  if (named.name.empty()) named.name = "element" + std::to_string(elements_.size());
+  for (const ForceElement& other : elements_)
+    if (other.name == named.name) bad("name", "a name not used by another force element", "'" + named.name + "'");
+  elements_.push_back(std::move(named));
+  return static_cast<int>(elements_.size()) - 1;
 }
 
 }  // namespace rigidfem

@@ -26,6 +26,8 @@ double elastic_energy(const System& sys, const Data& d) {
   check_data(sys, d);
   double V = 0.0;
   for (int i = 0; i < sys.nc; ++i) V += 0.5 * sys.coords[i].stiffness * std::pow(d.qa(i) - sys.coords[i].rest, 2);
+  for (const ForceElement& E : sys.elements)  // ½ k (l − l₀)² of the force elements' springs
+    if (E.stiffness != 0.0) V += 0.5 * E.stiffness * std::pow(element_state(d, E, false).l - E.length, 2);
   return V;
 }
 
@@ -33,6 +35,8 @@ double dissipated_power(const System& sys, const Data& d) {
   check_data(sys, d);
   double P = 0.0;
   for (int i = 0; i < sys.nc; ++i) P += sys.coords[i].damping * d.qda(i) * d.qda(i);
+  for (const ForceElement& E : sys.elements)  // c l̇² of the force elements' dampers
+    if (E.damping != 0.0) P += E.damping * std::pow(element_state(d, E, false).ld, 2);
   return P;
 }
 
@@ -71,6 +75,29 @@ Vec3 point_velocity(const System& sys, Data& d, const Point& point, double t, co
   set_state(sys, d, t, q, qd);
   kinematics(sys, d);
   return (d.Td[point.body] * point.r.homogeneous()).head<3>();
+}
+
+MatX element_states(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                    const Eigen::Ref<const VecX>& qd) {
+  set_state(sys, d, t, q, qd);
+  kinematics(sys, d);  // with rates: l̇ needs Ṫ
+  MatX S(sys.elements.size(), 3);
+  for (std::size_t k = 0; k < sys.elements.size(); ++k) {
+    const ElementState e = element_state(d, sys.elements[k], false);
+    S.row(k) << e.l, e.ld, e.F;
+  }
+  return S;
+}
+
+MatX element_force_history(const System& sys, const Eigen::Ref<const VecX>& t, const Eigen::Ref<const RowMatX>& Q,
+                           const Eigen::Ref<const RowMatX>& QD) {
+  if (Q.rows() != t.size() || QD.rows() != t.size() || Q.cols() != sys.nq || QD.cols() != sys.nq)
+    throw std::invalid_argument("q, qd: expected (len(t), nq) arrays");
+  MatX F(t.size(), sys.elements.size());
+  Data d(sys);
+  for (Eigen::Index k = 0; k < t.size(); ++k)
+    F.row(k) = element_states(sys, d, t(k), Q.row(k).transpose(), QD.row(k).transpose()).col(2).transpose();
+  return F;
 }
 
 StateOutputs evaluate_outputs(const System& sys, const Eigen::Ref<const VecX>& t, const Eigen::Ref<const RowMatX>& Q,

@@ -55,6 +55,14 @@ void spatial_kinematics(const System& sys, Data& d) {
     d.fext[L.body].head<3>() += a.x.cross(a.F) + a.tau;
     d.fext[L.body].tail<3>() += a.F;
   }
+  for (const ForceElement& E : sys.elements) {
+    const auto [on_b, on_a] = element_loads(element_state(d, E, true));
+    for (const auto& [body, a] : {std::pair<int, const AppliedLoad&>{E.body_b, on_b}, {E.body_a, on_a}}) {
+      if (body < 0) continue;
+      d.fext[body].head<3>() += a.x.cross(a.F);
+      d.fext[body].tail<3>() += a.F;
+    }
+  }
 }
 
 void rnea_pass(const System& sys, Data& d) {

@@ -16,6 +16,7 @@ std::shared_ptr<const System> Model::compile(Algorithm algorithm) const {
   s.gravity = gravity_;
   s.loads = loads_;
   s.loops = loops_;
+  s.elements = elements_;
   s.loop_row.push_back(0);
   for (const Loop& L : loops_) s.loop_row.push_back(s.loop_row.back() + loop_rows(L.kind));
   s.nl = s.loop_row.back();

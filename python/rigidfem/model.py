@@ -10,7 +10,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from . import _checks, _contract, _core, loops
+from . import _checks, _contract, _core, force_elements, loops
 from ._core import Body, JointSpec, Point, Profile
 from .beams import add_beam
 from .frames import transform  # noqa: F401 (re-exported: rigidfem.model.transform)
@@ -219,6 +219,26 @@ class Model(_core._Model):
         ``rigidfem.motion`` profile l(t). Its force (N, positive pushing the points apart) is the
         loop's reaction, column 0 of ``System.loop_reactions``. Returns its name."""
         return loops.add_actuator(self, a, b, length, name=name)
+
+    def add_spring_damper(self, a, b, *, stiffness: float, length: float, damping: float = 0.0,
+                          name: str | None = None) -> str:
+        """A linear spring-damper between the points ``a`` and ``b`` (Point, Body or
+        ``model.ground``; rigid bodies or rfes of a beam): axial force
+        F = −k (l − l₀) − c l̇ (N, > 0 pushing the points apart) with ``stiffness`` k (N/m),
+        rest ``length`` l₀ (m) and ``damping`` c (N·s/m). No constraint: it acts on trees and
+        closed chains alike (``rigidfem.force_elements``). Returns its name ("element<k>" by
+        default), which ``System.element_names`` lists."""
+        return force_elements.add_force_element(self, a, b, stiffness=stiffness, damping=damping, length=length,
+                                                name=name)
+
+    def add_cylinder(self, a, b, force, *, damping: float = 0.0, name: str | None = None) -> str:
+        """A hydraulic cylinder under force control between the points ``a`` and ``b``: it pushes
+        them apart with ``force`` (N; negative pulls) — a number, a ``rigidfem.motion`` profile
+        F(t) or a Python function ``force(t, l, ld)`` of time (s), length (m) and its rate (m/s)
+        (the slow path: called under the GIL at every evaluation) — less its ``damping`` c l̇
+        (N·s/m). Position control is ``add_actuator``. Returns its name ("element<k>" by
+        default); ``System.element_states`` and ``Result.element_forces`` give its force."""
+        return force_elements.add_force_element(self, a, b, damping=damping, force=force, name=name)
 
     def add_beam(self, name: str, parent, length: float, material, section, elements: int,
                  formulation: str = "modified", deform=None, linear: bool = False, joint=None, placement=None,

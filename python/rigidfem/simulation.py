@@ -102,6 +102,12 @@ class Result:
         W = self.system._loop_reaction_history(self.t, self.q, self.qd)
         return W.reshape(len(self.t), n, 6)
 
+    @functools.cached_property
+    def element_forces(self) -> np.ndarray:
+        """Axial forces (len(t), nelements) in N of the force elements (spring-dampers, cylinders),
+        per ``system.element_names``; positive pushing the two points apart."""
+        return self.system._element_force_history(self.t, self.q, self.qd)
+
     def position(self, point, frame: Body | None = None) -> np.ndarray:
         """Positions (len(t), 3) in m of a ``Point`` (or a ``Body``'s origin), in the global
         frame or in the frame of the body ``frame``."""

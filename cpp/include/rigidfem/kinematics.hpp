@@ -7,6 +7,7 @@
 #pragma once
 
 #include <string>
+#include <utility>
 
 #include "rigidfem/system.hpp"
 
@@ -40,6 +41,19 @@ struct AppliedLoad {
 };
 /// Needs T_p of the load's body.
 AppliedLoad applied_load(const Data& d, const Load& L);
+/// A force element (force_elements.hpp) at the current state: its points r_A, r_B (global, m),
+/// their velocities, the unit vector e = (r_B − r_A)/l, the length l (m), its rate l̇ = e·(v_B − v_A)
+/// (m/s) and the axial force F (N, > 0 pushing). The velocities come from the spatial velocities
+/// v_p of the recursive algorithms (`spatial`) or from Ṫ_p (kinematics with rates). A
+/// SimulationError at t if the points coincide (l = 0: no line of action).
+struct ElementState {
+  Vec3 xa, xb, va, vb, e;
+  double l, ld, F;
+};
+ElementState element_state(const Data& d, const ForceElement& element, bool spatial);
+/// The element's loads: F e on body b at r_B and −F e on body a at r_A (none on the ground).
+std::pair<AppliedLoad, AppliedLoad> element_loads(const ElementState& s);
+
 /// Q_i of springs, dampers and applied generalised forces on coordinate i (all coordinates):
 /// −c_i (q_i − q_i⁰) − b_i q̇_i + λ (Q_i + Q_i(t, q_i, q̇_i)).
 double passive_force(const System& sys, const Data& d, int i);

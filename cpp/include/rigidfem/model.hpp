@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "rigidfem/errors.hpp"
+#include "rigidfem/force_elements.hpp"
 #include "rigidfem/joint_motion.hpp"
 #include "rigidfem/loops.hpp"
 #include "rigidfem/profiles.hpp"
@@ -135,11 +136,15 @@ class Model {
   /// Closes a loop (loops.hpp); returns its index. Checks the bodies, frames, length and name
   /// (an empty name becomes "loop<index>").
   int add_loop(const Loop& loop);
+  /// Adds a force element between two bodies (force_elements.hpp); returns its index. Checks the
+  /// bodies, points and parameters (an empty name becomes "element<index>").
+  int add_force_element(const ForceElement& element);
   void set_gravity(const Vec3& g);
 
   const Vec3& gravity() const { return gravity_; }
   const std::vector<BodySpec>& bodies() const { return bodies_; }
   const std::vector<Loop>& loops() const { return loops_; }
+  const std::vector<ForceElement>& force_elements() const { return elements_; }
   /// Unique among the Models of this process (never 0): the `model` of the handles it makes.
   std::uint64_t id() const { return id_; }
   int body_index(const std::string& name) const;  ///< −1 for "ground"; throws if unknown
@@ -163,6 +168,7 @@ class Model {
   std::vector<std::vector<CoordinateSpec>> coords_;  // (nbodies) x (ncoords of the joint)
   std::vector<Load> loads_;
   std::vector<Loop> loops_;
+  std::vector<ForceElement> elements_;
 };
 
 }  // namespace rigidfem

@@ -8,11 +8,12 @@
 
 namespace rigidfem {
 
-/// Energies after kinematics with rates (J): ½ Σ tr(Ṫ_p H_p Ṫ_pᵀ); −Σ m_p gᵀ r_Cp; ½ Σ c_i (q_i − q_i⁰)².
+/// Energies after kinematics with rates (J): ½ Σ tr(Ṫ_p H_p Ṫ_pᵀ); −Σ m_p gᵀ r_Cp; ½ Σ c_i (q_i − q_i⁰)²
+/// plus ½ Σ k (l − l₀)² of the force elements.
 double kinetic_energy(const System& sys, const Data& d);
 double gravity_energy(const System& sys, const Data& d);
 double elastic_energy(const System& sys, const Data& d);
-/// Power dissipated by the dampers, Σ b_i q̇_i² (W).
+/// Power dissipated by the dampers, Σ b_i q̇_i² + Σ c l̇² of the force elements (W).
 double dissipated_power(const System& sys, const Data& d);
 
 /// The energies (J) and the dissipated power (W) at (t, q, q̇).
@@ -33,6 +34,14 @@ MatX point_positions(const System& sys, Data& d, const std::vector<Point>& point
 /// Global velocity (3) in m/s of the point r of a body at (t, q, q̇).
 Vec3 point_velocity(const System& sys, Data& d, const Point& point, double t, const Eigen::Ref<const VecX>& q,
                     const Eigen::Ref<const VecX>& qd);
+
+/// Every force element's length l (m), rate l̇ (m/s) and axial force F (N, > 0 pushing the points
+/// apart) at (t, q, q̇): rows of (nelements, 3). Applied parts of F at load factor 1.
+MatX element_states(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                    const Eigen::Ref<const VecX>& qd);
+/// The axial forces F (N) at (t_k, q_k, q̇_k): (N, nelements).
+MatX element_force_history(const System& sys, const Eigen::Ref<const VecX>& t, const Eigen::Ref<const RowMatX>& Q,
+                           const Eigen::Ref<const RowMatX>& QD);
 
 /// Quantities at a batch of states (t_k, q_k, q̇_k), rows k: accelerations, driving
 /// forces and energies (J). Used for simulation results.

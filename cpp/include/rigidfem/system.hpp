@@ -75,6 +75,7 @@ class System : public std::enable_shared_from_this<System> {
   std::vector<Loop> loops;
   std::vector<int> loop_row;            // (nloops + 1)
   int nl = 0;                           ///< constraint rows (multipliers λ)
+  std::vector<ForceElement> elements;   // force elements between two bodies (force_elements.hpp)
 
   std::vector<std::string> coordinate_names() const;  ///< (nq)
   std::vector<std::string> prescribed_names() const;  ///< (np)

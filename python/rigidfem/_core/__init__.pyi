@@ -142,6 +142,8 @@ class _Model:
         """
     def _add_body(self, name: str, parent: typing.SupportsInt | typing.SupportsIndex, joint: JointSpec, placement: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"], mass: typing.SupportsFloat | typing.SupportsIndex, com: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], inertia: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 3]"]) -> Body:
         ...
+    def _add_force_element(self, name: str, a: typing.SupportsInt | typing.SupportsIndex, point_a: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], b: typing.SupportsInt | typing.SupportsIndex, point_b: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], stiffness: typing.SupportsFloat | typing.SupportsIndex, damping: typing.SupportsFloat | typing.SupportsIndex, length: typing.SupportsFloat | typing.SupportsIndex, force: typing.SupportsFloat | typing.SupportsIndex, profile: Profile, law: collections.abc.Callable | None) -> str:
+        ...
     def _add_generalized_force(self, body: typing.SupportsInt | typing.SupportsIndex, coordinate: typing.SupportsInt | typing.SupportsIndex, value: typing.SupportsFloat | typing.SupportsIndex, law: typing.Any) -> None:
         ...
     def _add_load(self, body: typing.SupportsInt | typing.SupportsIndex, point: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], force: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], torque: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], follower: bool, scale: Profile) -> None:
@@ -184,6 +186,8 @@ class _System:
         ...
     def _assemble(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], tol: typing.SupportsFloat | typing.SupportsIndex, max_iterations: typing.SupportsInt | typing.SupportsIndex) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]]:
         ...
+    def _element_force_history(self, t: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        ...
     def _loop_reaction_history(self, t: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
         ...
     def _position(self, point: Point, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], t: typing.SupportsFloat | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
@@ -207,6 +211,11 @@ class _System:
     def elastic_energy(self, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], t: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> float:
         """
         Energy of the joint springs 1/2 sum c (q - q_rest)^2 (J).
+        """
+    def element_states(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        """
+        Length l (m), rate dl/dt (m/s) and axial force F (N, positive pushing the two points apart) of every
+        force element (nelements, 3).
         """
     def force_jacobians(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], load_factor: typing.SupportsFloat | typing.SupportsIndex = 1.0, static: bool = False) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]]:
         """
@@ -308,6 +317,11 @@ class _System:
     def damping(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
         Damping coefficient b_i of each free coordinate (nq,), N s/m or N m s/rad.
+        """
+    @property
+    def element_names(self) -> list[str]:
+        """
+        Names of the force elements (spring-dampers and cylinders), in the order of element_states().
         """
     @property
     def gravity(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:

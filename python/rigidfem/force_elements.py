@@ -1,0 +1,64 @@
+"""Force elements between two bodies: spring-dampers and hydraulic cylinders under force control.
+
+An element joins a point A on body ``a`` and a point B on body ``b`` (rigid bodies, rfes of a
+beam or the ground) and acts along the line between them (book ch. 7.3). With l = |r_B − r_A|
+its length and l̇ its rate it pushes the points apart with the axial force
+
+    F = −k (l − l₀) − c l̇ + F(t)      (N; F > 0 pushes, F < 0 pulls),
+
+F e on B and −F e on A, e the unit vector from A to B. F(t) is a constant, a ``rigidfem.motion``
+profile (its value in N) or a Python function ``law(t, l, ld)`` (the slow path: called under the
+GIL at every evaluation, its derivatives by central differences). The spring's energy
+½ k (l − l₀)² counts in ``System.elastic_energy`` and the damper's c l̇² in
+``System.dissipated_power``; the applied part F(t) is scaled by the load factor of statics.
+``System.element_states`` gives (l, l̇, F) of every element and ``Result.element_forces`` their
+forces over a simulation. Unlike an actuator (``Model.add_actuator``, a constraint), an element
+adds no equation: any number of them can act on a tree or a closed chain.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from . import _checks
+from ._core import Body, Point, Profile
+
+
+def _point(model, where, name: str):
+    """(body index, point in that body's frame, m) of a Point, a Body (its origin) or the ground."""
+    if isinstance(where, Body):
+        if not model._owns(where):
+            raise ValueError(f"{name}: expected a Body or Point of this model, got {where!r}")
+        return where.index, np.zeros(3)
+    if isinstance(where, Point):
+        if not -1 <= where.body < model.nbodies or where.model not in (0, model.id):
+            raise ValueError(f"{name}: expected a Body or Point of this model, got {where!r}")
+        return where.body, np.asarray(where.r, dtype=float)
+    raise ValueError(f"{name}: expected a Body or Point of this model (or model.ground), got {where!r}")
+
+
+def _force(force):
+    """(constant N, profile or None, law or None) of the ``force`` argument."""
+    if isinstance(force, Profile):
+        return 0.0, force, None
+    if callable(force):
+        return 0.0, None, force
+    try:
+        return _checks.scalar(force, "force", unit="N"), None, None
+    except ValueError:
+        raise ValueError("force: expected a finite number in N, a rigidfem.motion profile F(t) or a function "
+                         f"law(t, l, ld) returning N, got {force!r}") from None
+
+
+def add_force_element(model, a, b, *, stiffness: float = 0.0, damping: float = 0.0, length: float = 0.0,
+                      force=0.0, name: str | None = None) -> str:
+    """The element added to ``model`` (see ``Model.add_spring_damper``, ``Model.add_cylinder``);
+    returns its name ("element<k>" when ``name`` is None)."""
+    ia, ra = _point(model, a, "a")
+    ib, rb = _point(model, b, "b")
+    stiffness = _checks.scalar(stiffness, "stiffness", nonnegative=True, unit="N/m")
+    damping = _checks.scalar(damping, "damping", nonnegative=True, unit="N s/m")
+    length = _checks.scalar(length, "length", nonnegative=True, unit="m")
+    constant, profile, law = _force(force)
+    return model._add_force_element("" if name is None else str(name), ia, ra, ib, rb, stiffness, damping, length,
+                                    constant, profile, law)
