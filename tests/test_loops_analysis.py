@@ -31,11 +31,13 @@ def wrap(angle):
     return np.angle(np.exp(1j * np.asarray(angle)))
 
 
-def four_bar(algorithm="recursive", spring=True, gravity=True):
+def four_bar(algorithm="recursive", spring=True, gravity=True, damping=0.0):
     """Planar four-bar in the x–y plane, gravity −y, closed by a revolute loop at the coupler tip
-    (3 of its 5 rows redundant in the plane). q = (crank, coupler relative to crank, rocker)."""
+    (3 of its 5 rows redundant in the plane). q = (crank, coupler relative to crank, rocker);
+    a torsional spring (and damper, N·m·s/rad) on the crank."""
     m = rf.Model(gravity=(0, -G0, 0) if gravity else None)
-    joint = rf.Joint.revolute("z", stiffness=K_CRANK, rest=REST) if spring else rf.Joint.revolute("z")
+    joint = (rf.Joint.revolute("z", stiffness=K_CRANK, rest=REST, damping=damping) if spring
+             else rf.Joint.revolute("z"))
     crank = m.add_body("crank", m.ground, joint, **rod(A))
     coupler = m.add_body("coupler", crank, rf.Joint.revolute("z"), **rod(B), placement=rf.transform((A, 0, 0)))
     rocker = m.add_body("rocker", m.ground, rf.Joint.revolute("z"), **rod(C), placement=rf.transform((D, 0, 0)))
@@ -104,6 +106,60 @@ def test_four_bar_statics_and_frequency_against_the_closed_form(algorithm):
     assert modes.stable and modes.damping_ratios[0] == 0.0
 
 
+@pytest.mark.parametrize("algorithm", ENGINES)
+def test_four_bar_damping_ratio_from_the_effective_inertia(algorithm):
+    """A damper c on the crank: m_eff θ̈ + c θ̇ + V'' θ = 0, ζ = c / (2 √(V'' m_eff)), and the root
+    −ζω + iω√(1 − ζ²)."""
+    theta, V2, m_eff, _, _ = four_bar_reference()
+    c = 0.3
+    s = four_bar(algorithm, damping=c)
+    eq = rf.static_equilibrium(s, q0=closed_q(theta + 0.2))
+    modes = rf.modal_analysis(s, q=eq.q)
+    w, zeta = np.sqrt(V2 / m_eff), c / (2 * np.sqrt(V2 * m_eff))
+    np.testing.assert_allclose(modes.omega, [w], rtol=1e-6)
+    np.testing.assert_allclose(modes.damping_ratios, [zeta], rtol=1e-6)
+    np.testing.assert_allclose(modes.eigenvalues, [w * (-zeta + 1j * np.sqrt(1 - zeta**2))], rtol=1e-6)
+
+
+# --------------------------------------------------------------------------- redundant loops
+
+L_PAR, W_PAR, M_COUPLER, K_PAR, REST_PAR = 0.5, 1.0, 2.0, 30.0, 0.9
+
+
+def parallelogram(algorithm):
+    """Three parallel rockers (1 kg, 0.5 m, pins 1 m apart on the ground) under one coupler (2 kg,
+    2 m) on the first's tip and closed onto the other two by revolute loops: in the plane 4 rows
+    for 4 coordinates, yet one degree of freedom (the rows are dependent at every configuration:
+    the classical overconstrained parallelogram). A spring on the first rocker."""
+    m = rf.Model(gravity=(0, -G0, 0))
+    r = [m.add_body(f"r{i}", m.ground, rf.Joint.revolute("z", stiffness=K_PAR if i == 0 else 0.0, rest=REST_PAR),
+                    **rod(L_PAR), placement=rf.transform((i * W_PAR, 0, 0))) for i in range(3)]
+    c = m.add_body("coupler", r[0], rf.Joint.revolute("z"), **rod(2 * W_PAR, M_COUPLER),
+                   placement=rf.transform((L_PAR, 0, 0)))
+    m.add_loop_joint("revolute", c.point((W_PAR, 0, 0)), r[1].point((L_PAR, 0, 0)), name="middle")
+    m.add_loop_joint("revolute", c.point((2 * W_PAR, 0, 0)), r[2].point((L_PAR, 0, 0)), name="end")
+    return m.compile(algorithm)
+
+
+@pytest.mark.parametrize("algorithm", ENGINES)
+def test_overconstrained_parallelogram_against_its_energy(algorithm):
+    """All rockers at θ, the coupler translating (its relative angle −θ): V = k(θ − θ0)²/2 +
+    g sin θ (3 m L/2 + m_c L), T = ½ (3 m L²/3 + m_c L²) θ̇²; rank G = 3 of 10 rows, one mode."""
+    a = G0 * (3 * L_PAR / 2 + M_COUPLER * L_PAR)
+    theta = brentq(lambda x: K_PAR * (x - REST_PAR) + a * np.cos(x), -1.0, 2.0, xtol=1e-15, rtol=1e-15)
+    w2 = (K_PAR - a * np.sin(theta)) / (L_PAR**2 + M_COUPLER * L_PAR**2)
+    s = parallelogram(algorithm)
+    assert (s.nq, s.nl) == (4, 10)
+    eq = rf.static_equilibrium(s, q0=[0.5, 0.52, 0.48, -0.5], load_steps=2)
+    np.testing.assert_allclose(eq.q, [theta, theta, theta, -theta], atol=1e-12)
+    # The split of the load between the dependent rows is the least-norm one, as in the dynamics.
+    np.testing.assert_allclose(eq.multipliers, s.loop_multipliers(0.0, eq.q, np.zeros(4)), atol=1e-8)
+    modes = rf.modal_analysis(s, q=eq.q)
+    assert modes.omega.shape == (1,)
+    np.testing.assert_allclose(modes.omega ** 2, [w2], rtol=1e-6)
+    np.testing.assert_allclose(modes.shapes[:, 0] * np.sign(modes.shapes[0, 0]), [1, 1, 1, -1], atol=1e-9)
+
+
 def test_four_bar_engines_agree():
     eqs = [rf.static_equilibrium(four_bar(a), q0=closed_q(1.5)) for a in ENGINES]
     np.testing.assert_allclose(eqs[0].q, eqs[1].q, atol=1e-12)
@@ -159,22 +215,29 @@ def test_pendulum_closed_by_a_loop_has_the_tree_statics_and_frequency(algorithm)
 
 
 @pytest.mark.parametrize("algorithm", ENGINES)
-def test_boom_held_by_an_actuator_is_a_structure_without_modes(algorithm):
-    """A 5 kg, 2 m boom on a pin, held by a cylinder of length l = 0.9 m from (0.5, 0) to the boom's
-    point at 1 m: θ from the law of cosines and the cylinder force from the moment balance about
-    the pin, F = m g cos θ l / (0.5 sin θ) (pushing); nothing left to vibrate."""
+@pytest.mark.parametrize("driven", [False, True])
+def test_boom_held_by_an_actuator_is_a_structure_without_modes(algorithm, driven):
+    """A 5 kg, 2 m boom on a pin, held by a cylinder of length l = 0.9 m (or l(t) = 0.6 + 0.6 t at
+    t = 0.5 s) from (0.5, 0) to the boom's point at 1 m: θ from the law of cosines and the cylinder
+    force from the moment balance about the pin, F = m g cos θ l / (0.5 sin θ) (pushing); nothing
+    left to vibrate."""
     m_, l = 5.0, 0.9
     mod = rf.Model(gravity=(0, -G0, 0))
     boom = mod.add_body("boom", mod.ground, rf.Joint.revolute("z"), **rod(2.0, m_))
-    mod.add_actuator(mod.ground.point((0.5, 0, 0)), boom.point((1.0, 0, 0)), l, name="cylinder")
+    length, t = (rf.motion.polynomial([0.6, 0.6]), 0.5) if driven else (l, 0.0)
+    mod.add_actuator(mod.ground.point((0.5, 0, 0)), boom.point((1.0, 0, 0)), length, name="cylinder")
     s = mod.compile(algorithm)
     theta = np.arccos(1.25 - l * l)
-    eq = rf.static_equilibrium(s, q0=[1.0])
+    eq = rf.static_equilibrium(s, q0=[1.0], t=t)
     np.testing.assert_allclose(eq.q, [theta], atol=1e-12)
     force = m_ * G0 * np.cos(theta) * l / (0.5 * np.sin(theta))
-    np.testing.assert_allclose(s.loop_reactions(0.0, eq.q, [0.0])[0, 0], force, rtol=1e-9)
-    np.testing.assert_allclose(np.abs(eq.multipliers), [force], rtol=1e-9)
-    modes = rf.modal_analysis(s, q=eq.q)
+    np.testing.assert_allclose(eq.multipliers, [force], rtol=1e-9)  # λ of a distance row: the push
+    if not driven:  # the dynamics' reaction at rest (with l̇ ≠ 0 the boom would be moving)
+        np.testing.assert_allclose(s.loop_reactions(t, eq.q, [0.0])[0, 0], force, rtol=1e-9)
+    if driven:  # the loop moves: q̇ = 0 does not follow it
+        with pytest.raises(ValueError, match=r"^qd: expected rates that close every loop of \['cylinder'\]"):
+            rf.modal_analysis(s, q=eq.q, t=t)
+    modes = rf.modal_analysis(s, q=eq.q, qd=s.assemble(eq.q, None, t)[1], t=t)
     assert modes.omega.shape == (0,) and modes.shapes.shape == (1, 0) and modes.stable
 
 
