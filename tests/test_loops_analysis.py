@@ -186,17 +186,18 @@ def pendulum(joint, algorithm, loop):
 
 @pytest.mark.parametrize("algorithm", ENGINES)
 def test_pendulum_closed_by_a_loop_has_the_tree_statics_and_frequency(algorithm):
-    """Equilibrium tan θ = −m g / (2F); ω² = V''/I_O = L √(F² + (mg/2)²) / (m L²/3 + 1e-4·0);
-    the tree, the free body closed by a revolute loop (5 rows, rank 5) and the planar body
-    closed by one (5 rows, rank 2) agree with it and with each other; the pin's reaction is
-    −(weight + F) (moment balance: no torque)."""
+    """Equilibrium tan θ = −m g / (2F), ω² = V''/I_O = L √(F² + (mg/2)²) / (m L²/3); the tree, the
+    free body closed by a revolute loop (5 rows, rank 5), the planar body closed by one (5 rows,
+    rank 2) and the tree's own pin duplicated by one (5 rows, all zero) agree with it and with each
+    other; the loop carries the pin's reaction −(weight + F) (moment balance: no torque), unless the
+    tree's pin carries it."""
     theta = np.arctan2(-M_ROD * G0 / 2, F_TIP)
     w2 = L_ROD * np.hypot(F_TIP, M_ROD * G0 / 2) / (M_ROD * L_ROD**2 / 3)
     tree = pendulum(rf.Joint.revolute("z"), algorithm, loop=False)
     eq = rf.static_equilibrium(tree, q0=[-0.8])
     np.testing.assert_allclose(eq.q, [theta], atol=1e-12)
     np.testing.assert_allclose(rf.modal_analysis(tree, q=eq.q).omega ** 2, [w2], rtol=1e-9)
-    for joint, nq, rank in ((rf.Joint.free(), 6, 5), (rf.Joint.planar("xy"), 3, 2)):
+    for joint, nq, rank in ((rf.Joint.free(), 6, 5), (rf.Joint.planar("xy"), 3, 2), (rf.Joint.revolute("z"), 1, 0)):
         s = pendulum(joint, algorithm, loop=True)
         assert (s.nq, s.nl) == (nq, 5)
         guess = np.full(nq, 0.05)  # off the loop: closed first
@@ -207,7 +208,7 @@ def test_pendulum_closed_by_a_loop_has_the_tree_statics_and_frequency(algorithm)
         np.testing.assert_allclose(np.delete(eq.q, i), 0.0, atol=1e-11)
         np.testing.assert_allclose(eq.multipliers, s.loop_multipliers(0.0, eq.q, np.zeros(nq)), atol=1e-8)
         W = s.loop_reactions(0.0, eq.q, np.zeros(nq))[0]  # on the rod, ground axes
-        np.testing.assert_allclose(W, [-F_TIP, M_ROD * G0, 0, 0, 0, 0], atol=1e-8)
+        np.testing.assert_allclose(W, [-F_TIP, M_ROD * G0, 0, 0, 0, 0] if rank else np.zeros(6), atol=1e-8)
         modes = rf.modal_analysis(s, q=eq.q)
         assert modes.omega.shape == (nq - rank,)
         np.testing.assert_allclose(modes.omega ** 2, [w2], rtol=1e-7)
