@@ -205,7 +205,7 @@ class Equilibrium:
     q: np.ndarray            #: (nq,) equilibrium coordinates, m and rad
     converged: bool          #: always True: a load step that does not converge raises SimulationError
     iterations: int          #: Newton iterations over all load steps
-    residual: float          #: max |f(q)| at the end, N or N·m
+    residual: float          #: max |f(q)| at the end (with loops max |f + Gᵀλ|), N or N·m
     load_steps: int
     history: list = field(default_factory=list, repr=False)  #: (load factor, iterations, residual) per step
     #: (nl,) the loops' multipliers λ of f + Gᵀλ = 0 (least-norm where rows are redundant), in the
