@@ -334,7 +334,8 @@ void bind_dynamics(py::module_& m) {
             Workspace d(s);
             return energies(s, *d, t, q, VecX::Zero(s.nq)).elastic;
           },
-          py::arg("q"), py::arg("t") = 0.0, "Energy of the joint springs 1/2 sum c (q - q_rest)^2 (J).")
+          py::arg("q"), py::arg("t") = 0.0, "Energy of the joint springs 1/2 sum c (q - q_rest)^2 and of the force elements' springs\n"
+          "1/2 sum k (l - l0)^2 (J).")
       .def(
           "potential_energy", [](const System& s, const RefV& q, double t) {
             Workspace d(s);
@@ -346,7 +347,8 @@ void bind_dynamics(py::module_& m) {
             Workspace d(s);
             return energies(s, *d, t, q, qd).dissipated;
           },
-          py::arg("q"), py::arg("qd"), py::arg("t") = 0.0, "Power dissipated by the joint dampers, sum b qd^2 (W).")
+          py::arg("q"), py::arg("qd"), py::arg("t") = 0.0, "Power dissipated by the joint dampers, sum b qd^2, and by the force elements' dampers,\n"
+          "sum c (dl/dt)^2 (W).")
       .def(
           "make_data", [](const System& s) { return std::make_unique<Data>(s); },
           "A fresh workspace for the stage functions (allocated in place: a Data is never copied or moved).");
