@@ -183,7 +183,8 @@ def _constraint_stiffness(system, t: float, q: np.ndarray, lam: np.ndarray) -> n
         qp, qm = q.copy(), q.copy()
         qp[j] += h
         qm[j] -= h
-        Kg[:, j] = -(_loop_jacobian(system, t, qp)[1].T @ lam - _loop_jacobian(system, t, qm)[1].T @ lam) / (qp[j] - qm[j])
+        Gp, Gm = _loop_jacobian(system, t, qp)[1], _loop_jacobian(system, t, qm)[1]
+        Kg[:, j] = -(Gp.T @ lam - Gm.T @ lam) / (qp[j] - qm[j])
     return 0.5 * (Kg + Kg.T)
 
 
@@ -307,8 +308,8 @@ def static_equilibrium(system, q0=None, t: float = 0.0, load_steps: int = 10, to
 def _mechanism(t: float, what: str, K: np.ndarray, names, basis=None) -> SimulationError:
     within = "" if basis is None else " within the motions the loops allow"
     return SimulationError(
-        f"{_frame(t, what)}: the tangent stiffness K = −∂f/∂q{'' if basis is None else ' − ∂(Gᵀλ)/∂q'} is singular "
-        f"to working precision{within}: nothing resists {_describe_null_space(K, names, basis=basis)}. A mechanism "
+        f"{_frame(t, what)}: the tangent stiffness K = −∂f/∂q{'' if basis is None else ' − ∂(Gᵀλ)/∂q'} is "
+        f"singular to working precision{within}: nothing resists {_describe_null_space(K, names, basis=basis)}. A mechanism "
         "(give these coordinates stiffness, prescribe or lock them), or a buckling/limit point")
 
 
@@ -398,7 +399,7 @@ class Modes:
         """No eigenvalue with a positive real part (to 1e-9 of its modulus)."""
         return bool(np.all(self.eigenvalues.real <= 1e-9 * np.abs(self.eigenvalues)))
     M: np.ndarray = field(repr=False)  #: (nq, nq) mass matrix
-    K: np.ndarray = field(repr=False)  #: (nq, nq) tangent stiffness −∂f/∂q (with loops: − ∂(Gᵀλ)/∂q as well)
+    K: np.ndarray = field(repr=False)  #: (nq, nq) tangent stiffness −∂f/∂q (loops: −∂f/∂q − ∂(Gᵀλ)/∂q)
     C: np.ndarray = field(repr=False)  #: (nq, nq) −∂f/∂q̇
     #: (nq, k) orthonormal basis N of the motions the loops allow (null space of G); the modes are
     #: those of NᵀMN, NᵀKN, NᵀCN, shapes = N φ. None without loops.
