@@ -1,4 +1,7 @@
-"""The README's main job and the notebooks run; the notebooks are executed headless."""
+"""The README's main job and the notebooks run; the notebooks are executed headless (the A-frame
+notebook, 04, asserts its own physical checks: statics against the rigid moment balance and beam
+theory, the payload's hanging line, the work balance, the loops' closure and the growth rate of the
+force-controlled drift)."""
 
 import pathlib
 
@@ -30,3 +33,15 @@ def test_there_are_notebooks():
 def test_notebook_executes(path):
     nb = nbformat.read(path, as_version=4)
     nbclient.NotebookClient(nb, timeout=300, kernel_name="python3", resources={"metadata": {"path": str(path.parent)}}).execute()
+
+
+def test_a_frame_notebook_is_committed_with_its_figures():
+    """notebooks/04_a_frame.ipynb is committed executed, so its plots show on the repository page:
+    every code cell has run, without errors, and the five figures are there as PNGs."""
+    path = pathlib.Path(__file__).parent.parent / "notebooks" / "04_a_frame.ipynb"
+    nb = nbformat.read(path, as_version=4)
+    code = [c for c in nb.cells if c.cell_type == "code"]
+    assert all(c.execution_count is not None for c in code)
+    outputs = [o for c in code for o in c.outputs]
+    assert not [o for o in outputs if o.output_type == "error"]
+    assert sum("image/png" in o.get("data", {}) for o in outputs) >= 5
