@@ -154,3 +154,42 @@ def test_bad_varying_length_input():
     s = model.compile()
     with pytest.raises(rf.SimulationError, match="free length of the beam of 'f.rfe0' is L = -0.1 m"):
         s.forward_dynamics(0.3, np.zeros(3), np.zeros(3))
+
+
+def extruded(length, elements, gravity=9.81):
+    """A steel tape (20 mm × 2 mm, bending about y) of free length `length` (a profile)."""
+    model = rf.Model(gravity=(0.0, 0.0, -gravity))
+    beam = model.add_beam("tape", model.ground, length, rf.Material(E=2.1e11, rho=7850.0),
+                          rf.Section.rectangle(0.02, 0.002), elements, deform=("bend_y",))
+    return beam, model.compile()
+
+
+def test_slow_extrusion_follows_the_static_deflection():
+    """Extruded at 5 cm/s (its first period, 0.1 s, is short against the 2 s of growth), the tip
+    stays at the static deflection of the current length, −ρA g L⁴/(8 EI), closer as m grows."""
+    section = rf.Section.rectangle(0.02, 0.002)
+    errors = []
+    for m in (4, 8, 16):
+        beam, s = extruded(rf.motion.polynomial([0.3, 0.05]), m)
+        q0 = rf.static_equilibrium(s).q
+        r = rf.simulate(s, 2.0, method="generalized_alpha", dt=1e-3, q0=q0, t_eval=np.linspace(0.0, 2.0, 21))
+        L = 0.3 + 0.05 * r.t
+        static = -7850.0 * section.A * 9.81 * L**4 / (8 * 2.1e11 * section.Iy)
+        errors.append(np.abs(beam.tip_positions(r)[:, 2] / static - 1.0).max())
+    assert errors[0] > errors[1] > errors[2]
+    assert errors[2] < 1e-2
+
+
+def test_retraction_pumps_vibration_and_extrusion_damps_it():
+    """The 'spaghetti problem': without damping or gravity the vibration energy (kinetic + elastic)
+    of a tape pulled into its guide grows — the axial drive feeds it — and of a tape pushed out
+    decays."""
+    energy = {}
+    for name, L in {"retract": rf.motion.polynomial([0.8, -0.5]), "extrude": rf.motion.polynomial([0.4, 0.5])}.items():
+        beam, s = extruded(L, 8, gravity=0.0)
+        r = rf.simulate(s, 0.8, method="generalized_alpha", dt=2e-4, rho_inf=1.0, q0=np.full(s.nq, 0.01),
+                        t_eval=np.linspace(0.0, 0.8, 801))
+        n = len(r.t) // 4
+        energy[name] = r.energy[:n].mean(), r.energy[-n:].mean()
+    assert energy["retract"][1] > 1.5 * energy["retract"][0]
+    assert energy["extrude"][1] < 0.8 * energy["extrude"][0]
