@@ -71,7 +71,7 @@ def test_public_classes_and_functions_have_docstrings():
 CPP = PACKAGE.parents[1] / "cpp"
 LAYERS = [
     {"errors", "transforms", "profiles"},
-    {"joint_motion", "loops", "force_elements"},
+    {"joint_motion", "loops", "force_elements", "flows"},
     {"model"},
     {"system"},
     {"kinematics", "constraints"},

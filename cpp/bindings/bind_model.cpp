@@ -247,6 +247,16 @@ void bind_model(py::module_& m) {
           },
           py::arg("name"), py::arg("a"), py::arg("point_a"), py::arg("b"), py::arg("point_b"), py::arg("stiffness"),
           py::arg("damping"), py::arg("length"), py::arg("force"), py::arg("profile"), py::arg("law"))
+      .def(
+          "_add_flow",
+          [](Model& model, ProfilePtr length, int first, int elements) {
+            Flow flow;
+            flow.length = std::move(length);
+            flow.first = first;
+            flow.elements = elements;
+            model.add_flow(std::move(flow));
+          },
+          py::arg("length"), py::arg("first"), py::arg("elements"))
       .def("_body_index", &Model::body_index, py::arg("name"))
       .def(
           "_body_name",

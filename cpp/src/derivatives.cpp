@@ -70,6 +70,23 @@ void element_tangent(const System& sys, const Data& d, const ForceElement& E, co
   }
 }
 
+// The change of the loads of the flowing material on one rfe (flow_loads) along the tangent (the
+// motion of their points under fixed forces is the geometric term of BodyLoad): its axis turns,
+// δe = s_ω × e when carried (position), and its angular velocity changes by δω;
+//   δF_C = −m (2 α (δω × e + ω × δe) + β δe) at x_C,  δF_turn = −ρA α² (δe − δe_prev) at the origin.
+void flow_tangent(const FlowTerm& f, const Vec6& s, bool position, Tangent& w) {
+  const bool carried = w.inside[f.body];
+  const bool prev_carried = position && f.prev >= 0 && w.inside[f.prev];
+  if (!carried && !prev_carried) return;
+  const Vec3 de = position && carried ? Vec3(s.head<3>().cross(f.e)) : Vec3::Zero();
+  const Vec3 de_prev = prev_carried ? Vec3(s.head<3>().cross(f.e_prev)) : Vec3::Zero();
+  const Vec3 dw = carried ? Vec3(w.v[f.body].head<3>()) : Vec3::Zero();
+  const Vec3 dF_c = -f.m * (2.0 * f.alpha * (dw.cross(f.e) + f.omega.cross(de)) + f.beta * de);
+  const Vec3 dF_turn = -f.rhoA * f.alpha * f.alpha * (de - de_prev);
+  w.f[f.body].head<3>() -= f.xc.cross(dF_c) + f.origin.cross(dF_turn);
+  w.f[f.body].tail<3>() -= dF_c + dF_turn;
+}
+
 // Column ∂r/∂q_j (position) or ∂r/∂q̇_j (rate) for the coordinate j with use uj on body bj,
 // into col (nq). Only the bodies carried by q_j (bj and its subtree) have tangents:
 //   position: the later axes turn, δs_u = s_j ×m s_u, and so do inertias and follower loads;
@@ -78,8 +95,8 @@ void element_tangent(const System& sys, const Data& d, const ForceElement& E, co
 // δf_p = δI a + I δa + δv ×* I v + v ×* (δI v + I δv) − δf_ext, summed over subtrees, and
 // δr_i = δs_iᵀ f̄_b + s_iᵀ δf̄_b.
 void tangent_column(const System& sys, const Data& d, const std::vector<BodyLoad>& loads,
-                    const std::vector<ElementState>& elements, int uj, int bj, bool position, Tangent& w,
-                    Eigen::Ref<VecX> col) {
+                    const std::vector<ElementState>& elements, const std::vector<FlowTerm>& flows, int uj, int bj,
+                    bool position, Tangent& w, Eigen::Ref<VecX> col) {
   const Vec6& s = d.axes[uj];
   auto turned = [&](int p, int u) { return position && w.inside[p] && (p != bj || u > uj); };
   for (int p = 0; p < sys.nbodies; ++p) {
@@ -126,6 +143,7 @@ void tangent_column(const System& sys, const Data& d, const std::vector<BodyLoad
     }
   }
   for (std::size_t k = 0; k < elements.size(); ++k) element_tangent(sys, d, sys.elements[k], elements[k], s, position, w);
+  for (const FlowTerm& f : flows) flow_tangent(f, s, position, w);
   accumulate_subtrees(sys, w.f);
   for (int k = 0; k < sys.nq; ++k) {
     const int b = sys.coords[sys.free_coords[k]].body, u = sys.q_use[k];
@@ -147,16 +165,22 @@ std::pair<MatX, MatX> rnea_derivatives(const System& sys, Data& d) {
     if (E.body_b >= 0) loads.push_back({E.body_b, false, on_b});
     if (E.body_a >= 0) loads.push_back({E.body_a, false, on_a});
   }
+  const std::vector<FlowTerm> flows = flow_terms(sys, d, true);
+  for (const FlowTerm& f : flows) {
+    const auto [coriolis, turn] = flow_loads(f);
+    loads.push_back({f.body, false, coriolis});
+    loads.push_back({f.body, false, turn});
+  }
   MatX dq(sys.nq, sys.nq), dqd(sys.nq, sys.nq);
   Tangent w(sys);
   for (int j = 0; j < sys.nq; ++j) {
     const int i = sys.free_coords[j], b = sys.coords[i].body, u = sys.q_use[j];
-    tangent_column(sys, d, loads, elements, u, b, true, w, dq.col(j));
-    tangent_column(sys, d, loads, elements, u, b, false, w, dqd.col(j));
+    tangent_column(sys, d, loads, elements, flows, u, b, true, w, dq.col(j));
+    tangent_column(sys, d, loads, elements, flows, u, b, false, w, dqd.col(j));
     // −∂Q_j/∂(q_j, q̇_j) of the coordinate's own spring, damper and force law.
     const Coordinate& c = sys.coords[i];
-    dq(j, j) += c.stiffness;
-    dqd(j, j) += c.damping;
+    dq(j, j) += d.spring_scale(i) * c.stiffness;
+    dqd(j, j) += d.spring_scale(i) * c.damping;
     if (c.force_law) {
       dq(j, j) -= d.load_factor * law_derivative(c, d, i, false);
       dqd(j, j) -= d.load_factor * law_derivative(c, d, i, true);

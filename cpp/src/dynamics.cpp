@@ -293,8 +293,9 @@ std::pair<MatX, MatX> force_jacobians(const System& sys, Data& d, double t, cons
     lagrange_forces(sys, d);
     VecX g = d.f;
     for (int k = 0; k < sys.nq; ++k) {
-      const Coordinate& c = sys.coords[sys.free_coords[k]];
-      g(k) += c.stiffness * (x(k) - c.rest) + c.damping * xd(k);
+      const int i = sys.free_coords[k];
+      const Coordinate& c = sys.coords[i];
+      g(k) += d.spring_scale(i) * (c.stiffness * (x(k) - c.rest) + c.damping * xd(k));
     }
     return g;
   };
@@ -303,10 +304,11 @@ std::pair<MatX, MatX> force_jacobians(const System& sys, Data& d, double t, cons
     dq.col(j) = central_difference(f, x, j);
     if (!static_drives) dqd.col(j) = central_difference(f, xd, j);
   }
-  for (int k = 0; k < sys.nq; ++k) {
-    const Coordinate& c = sys.coords[sys.free_coords[k]];
-    dq(k, k) -= c.stiffness;
-    dqd(k, k) -= c.damping;
+  for (int k = 0; k < sys.nq; ++k) {  // the scales at t (the state of the last evaluation)
+    const int i = sys.free_coords[k];
+    const Coordinate& c = sys.coords[i];
+    dq(k, k) -= d.spring_scale(i) * c.stiffness;
+    dqd(k, k) -= d.spring_scale(i) * c.damping;
   }
   return {dq, dqd};
 }

@@ -29,11 +29,86 @@ void set_state(const System& sys, Data& d, double t, const Eigen::Ref<const VecX
     d.qda(i) = m.qd;
     d.qdda(i) = m.qdd;
   }
+  if (!sys.flows.empty()) update_flows(sys, d, false);
 }
 
 void set_static_state(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q) {
   set_state(sys, d, t, q, VecX::Zero(sys.nq));
   for (int i : sys.drive_coords) d.qda(i) = d.qdda(i) = 0.0;
+  if (!sys.flows.empty()) update_flows(sys, d, true);
+}
+
+namespace {
+
+// H(λ L₀) of a uniform rfe from H(L₀): ∫ s² dm ∝ λ³, ∫ s dm ∝ λ², the rest (∫ y² dm, m) ∝ λ, s
+// being the coordinate along the rfe (x).
+Mat4 scaled_pseudo_inertia(const Mat4& H0, double lambda) {
+  Mat4 H = H0 * lambda;
+  H.row(0) *= lambda;
+  H.col(0) *= lambda;
+  return H;
+}
+
+// Angular velocity ω of body b: from v_b (spatial) or Ṙ Rᵀ = [ω]×.
+Vec3 angular_velocity(const Data& d, int b, bool spatial) {
+  if (spatial) return d.v[b].head<3>();
+  const Mat3 W = d.Td[b].topLeftCorner<3, 3>() * d.T[b].topLeftCorner<3, 3>().transpose();
+  return Vec3(W(2, 1), W(0, 2), W(1, 0));
+}
+
+}  // namespace
+
+void update_flows(const System& sys, Data& d, bool at_rest) {
+  for (std::size_t f = 0; f < sys.flows.size(); ++f) {
+    const Flow& F = sys.flows[f];
+    MotionState L = F.length->at(d.t);
+    if (!(L.q > 0.0 && std::isfinite(L.q) && std::isfinite(L.qd) && std::isfinite(L.qdd)))
+      throw SimulationError(d.t, "the free length of the beam of '" + sys.body_names[F.first] + "' is L = " +
+                                     num(L.q) + " m (a link of varying length needs 0 < L(t) < inf)");
+    if (at_rest) L.qd = L.qdd = 0.0;
+    d.flow[f] = L;
+    const double lambda = L.q / F.length0;
+    for (int k = 0; k <= F.elements; ++k) {
+      const int b = F.first + k;
+      const Mat4 H = scaled_pseudo_inertia(sys.H[b], lambda);
+      const double m = H(3, 3);
+      const Vec3 c = H.block<3, 1>(0, 3) / m;
+      const Mat3 Hs = H.topLeftCorner<3, 3>();
+      const Mat3 IO = Hs.trace() * Mat3::Identity() - Hs;  // H = [[½ tr(I_O) 1 − I_O, m c], [m cᵀ, m]]
+      d.H[b] = H;
+      d.mass[b] = m;
+      d.com[b] = c;
+      d.inertia[b] = IO - m * (c.squaredNorm() * Mat3::Identity() - c * c.transpose());
+      if (k > 0)
+        for (int i = sys.coord_start[b]; i < sys.coord_start[b + 1]; ++i) d.spring_scale(i) = 1.0 / lambda;
+    }
+  }
+}
+
+std::vector<FlowTerm> flow_terms(const System& sys, const Data& d, bool spatial) {
+  std::vector<FlowTerm> terms;
+  for (std::size_t f = 0; f < sys.flows.size(); ++f) {
+    const Flow& F = sys.flows[f];
+    const MotionState& L = d.flow[f];
+    const double rhoA = d.mass[F.first] / (F.share(0) * L.q);
+    for (int k = 0; k <= F.elements; ++k) {
+      const int b = F.first + k, prev = k > 0 ? b - 1 : sys.parent[b];
+      const double slip = 1.0 - F.xi(k);
+      FlowTerm t{b, prev, d.mass[b], rhoA, L.qd * slip, L.qdd * slip, d.T[b].block<3, 1>(0, 0), Vec3::Zero(),
+                 angular_velocity(d, b, spatial), (d.T[b] * d.com[b].homogeneous()).head<3>(),
+                 d.T[b].block<3, 1>(0, 3)};
+      // The axis the material comes from: rfe k − 1's, or for rfe 0 the guide's (x of T_parent B_0).
+      t.e_prev = k > 0 ? Vec3(d.T[prev].block<3, 1>(0, 0))
+                       : Vec3((prev >= 0 ? d.T[prev] : Mat4::Identity()).topLeftCorner<3, 3>() * sys.B[b].block<3, 1>(0, 0));
+      terms.push_back(t);
+    }
+  }
+  return terms;
+}
+
+std::pair<AppliedLoad, AppliedLoad> flow_loads(const FlowTerm& f) {
+  return {{f.xc, -f.m * (2.0 * f.alpha * f.omega.cross(f.e) + f.beta * f.e), Vec3::Zero()},
+          {f.origin, -f.rhoA * f.alpha * f.alpha * (f.e - f.e_prev), Vec3::Zero()}};
 }
 
 void set_accelerations(const System& sys, Data& d, const Eigen::Ref<const VecX>& qdd) {
@@ -139,7 +214,7 @@ double passive_force(const System& sys, const Data& d, int i) {
   const Coordinate& c = sys.coords[i];
   double applied = c.force;
   if (c.force_law) applied += c.force_law(d.t, d.qa(i), d.qda(i));
-  return -c.stiffness * (d.qa(i) - c.rest) - c.damping * d.qda(i) + d.load_factor * applied;
+  return -d.spring_scale(i) * (c.stiffness * (d.qa(i) - c.rest) + c.damping * d.qda(i)) + d.load_factor * applied;
 }
 
 namespace {

@@ -12,7 +12,7 @@ inline double trace_product(const Mat4& U, const Mat4& M) {
 }  // namespace
 
 void inertia_composites(const System& sys, Data& d) {
-  for (int p = 0; p < sys.nbodies; ++p) d.Wbar[p].noalias() = d.T[p] * sys.H[p] * d.Tdd[p].transpose();
+  for (int p = 0; p < sys.nbodies; ++p) d.Wbar[p].noalias() = d.T[p] * d.H[p] * d.Tdd[p].transpose();
   accumulate_subtrees(sys, d.Wbar);
 }
 
@@ -20,13 +20,17 @@ void load_composites(const System& sys, Data& d) {
   const Vec3 gl = d.load_factor * sys.gravity;
   const Vec4 g(gl.x(), gl.y(), gl.z(), 0.0);
   // Gravity: V = −Σ m gᵀ r_C, so Q_i = g̃ᵀ U_i T_p H_p e₄ = tr(U_i (T_p H_p e₄) g̃ᵀ).
-  for (int p = 0; p < sys.nbodies; ++p) d.Zbar[p].noalias() = (d.T[p] * sys.H[p].col(3)) * g.transpose();
+  for (int p = 0; p < sys.nbodies; ++p) d.Zbar[p].noalias() = (d.T[p] * d.H[p].col(3)) * g.transpose();
   for (const Load& L : sys.loads) {
     // Force F at point x: Q_i = F̃ᵀ U_i x = tr(U_i x F̃ᵀ); torque τ: tr(U_i [[−½S(τ), 0], [0, 0]]) = w_i · τ.
     const AppliedLoad a = applied_load(d, L);
     Mat4& Z = d.Zbar[L.body];
     Z.leftCols<3>() += Vec4(a.x.homogeneous()) * a.F.transpose();
     Z.topLeftCorner<3, 3>() -= 0.5 * skew(a.tau);
+  }
+  for (const FlowTerm& f : flow_terms(sys, d, false)) {
+    const auto [coriolis, turn] = flow_loads(f);
+    for (const AppliedLoad& a : {coriolis, turn}) d.Zbar[f.body].leftCols<3>() += Vec4(a.x.homogeneous()) * a.F.transpose();
   }
   for (const ForceElement& E : sys.elements) {
     const auto [on_b, on_a] = element_loads(element_state(d, E, false));
@@ -47,7 +51,7 @@ void lagrange_forces(const System& sys, Data& d) {
 }
 
 void lagrange_mass_matrix(const System& sys, Data& d) {
-  for (int p = 0; p < sys.nbodies; ++p) d.Hbar[p].noalias() = d.T[p] * sys.H[p] * d.T[p].transpose();
+  for (int p = 0; p < sys.nbodies; ++p) d.Hbar[p].noalias() = d.T[p] * d.H[p] * d.T[p].transpose();
   accumulate_subtrees(sys, d.Hbar);
   // a_ij = Σ tr(U_u H̄_b U_vᵀ) over the pairs of uses u of q_i and v of q_j (on body b)
   // with u on the path from the root to b: each pair once, mirrored.

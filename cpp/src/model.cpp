@@ -15,6 +15,22 @@ namespace {
 
 std::string num8(double x) { return num(x, 8); }
 
+// The growth x_k(t) = κ (L(t) − L₀) of the distance between two rfe frames of a link of varying
+// length (flows.hpp), with its rates κ L̇ and κ L̈.
+class Growth final : public Profile {
+ public:
+  Growth(ProfilePtr length, double kappa, double length0) : length_(std::move(length)), kappa_(kappa), length0_(length0) {}
+  MotionState at(double t) const override {
+    const MotionState L = length_->at(t);
+    return {kappa_ * (L.q - length0_), kappa_ * L.qd, kappa_ * L.qdd};
+  }
+  std::string describe() const override { return num8(kappa_) + " (L(t) - " + num8(length0_) + "), L(t) = " + length_->describe(); }
+
+ private:
+  ProfilePtr length_;
+  double kappa_, length0_;
+};
+
 template <class M>
 void require_finite(const M& x, const std::string& argument) {
   if (!x.allFinite()) bad(argument, "finite values", "NaN or inf");
@@ -202,6 +218,8 @@ void Model::truncate(int n) {
   loads_.erase(std::remove_if(loads_.begin(), loads_.end(), [n](const Load& l) { return l.body >= n; }), loads_.end());
   loops_.erase(std::remove_if(loops_.begin(), loops_.end(), [n](const Loop& l) { return std::max(l.body_a, l.body_b) >= n; }),
                loops_.end());
+  flows_.erase(std::remove_if(flows_.begin(), flows_.end(), [n](const Flow& f) { return f.first + f.elements >= n; }),
+               flows_.end());
   elements_.erase(std::remove_if(elements_.begin(), elements_.end(),
                                  [n](const ForceElement& e) { return std::max(e.body_a, e.body_b) >= n; }),
                   elements_.end());
@@ -279,6 +297,28 @@ int Model::add_force_element(const ForceElement& element) {
     if (other.name == named.name) bad("name", "a name not used by another force element", "'" + named.name + "'");
   elements_.push_back(std::move(named));
   return static_cast<int>(elements_.size()) - 1;
+}
+
+void Model::add_flow(Flow flow) {
+  if (!flow.length) bad("length", "a rigidfem.motion profile L(t) in m", "None");
+  const double L0 = flow.length->at(0.0).q;
+  if (!(L0 > 0.0 && std::isfinite(L0))) bad("length", "a profile with a positive length L(0) in m", num8(L0));
+  const int n = static_cast<int>(bodies_.size());
+  if (flow.elements < 1 || flow.first < 0 || flow.first + flow.elements > n - 1)
+    bad("elements", "the rfes of a beam of this model", std::to_string(flow.elements) + " from body " + std::to_string(flow.first));
+  for (int k = 1; k <= flow.elements; ++k) {
+    const int b = flow.first + k;
+    const Joint& j = bodies_[b].joint;
+    if (bodies_[b].parent != b - 1 || j.linear || j.axes.empty() || j.axes[0] != Axis::X || coords_[b][0].drive)
+      bad("beam", "a chain of rfes whose sde joints start with a free x coordinate (built by add_beam)",
+          "body '" + bodies_[b].name + "'");
+  }
+  for (const Flow& other : flows_)
+    if (other.first == flow.first) bad("beam", "a beam not given a varying length yet", "'" + bodies_[flow.first].name + "'");
+  flow.length0 = L0;
+  for (int k = 1; k <= flow.elements; ++k)
+    coords_[flow.first + k][0].drive = std::make_shared<Growth>(flow.length, flow.spacing(k), L0);
+  flows_.push_back(std::move(flow));
 }
 
 }  // namespace rigidfem

@@ -204,8 +204,9 @@ class NewmarkFamily final : public Stepper {
   /// of the tangent, geometric and gyroscopic, is left to the iterations).
   VecX spring_correction(double h, const VecX& r, double bp, double gp) {
     for (int k = 0; k < sys_.nq; ++k) {
-      const Coordinate& c = sys_.coords[sys_.free_coords[k]];
-      armature_(k) = gp * h * c.damping + bp * h * h * c.stiffness;
+      const int i = sys_.free_coords[k];
+      const Coordinate& c = sys_.coords[i];
+      armature_(k) = d_.spring_scale(i) * (gp * h * c.damping + bp * h * h * c.stiffness);
     }
     ++stats_.factorizations;
     factor_armature(sys_, d_, armature_);  // residual() left the state of the iterate in d_

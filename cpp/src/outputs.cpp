@@ -11,21 +11,22 @@ namespace rigidfem {
 double kinetic_energy(const System& sys, const Data& d) {
   check_data(sys, d);
   double E = 0.0;
-  for (int p = 0; p < sys.nbodies; ++p) E += 0.5 * (d.Td[p] * sys.H[p] * d.Td[p].transpose()).trace();
+  for (int p = 0; p < sys.nbodies; ++p) E += 0.5 * (d.Td[p] * d.H[p] * d.Td[p].transpose()).trace();
   return E;
 }
 
 double gravity_energy(const System& sys, const Data& d) {
   check_data(sys, d);
   double V = 0.0;
-  for (int p = 0; p < sys.nbodies; ++p) V -= sys.gravity.dot((d.T[p] * sys.H[p].col(3)).head<3>());
+  for (int p = 0; p < sys.nbodies; ++p) V -= sys.gravity.dot((d.T[p] * d.H[p].col(3)).head<3>());
   return V;
 }
 
 double elastic_energy(const System& sys, const Data& d) {
   check_data(sys, d);
   double V = 0.0;
-  for (int i = 0; i < sys.nc; ++i) V += 0.5 * sys.coords[i].stiffness * std::pow(d.qa(i) - sys.coords[i].rest, 2);
+  for (int i = 0; i < sys.nc; ++i)
+    V += 0.5 * d.spring_scale(i) * sys.coords[i].stiffness * std::pow(d.qa(i) - sys.coords[i].rest, 2);
   for (const ForceElement& E : sys.elements)  // ½ k (l − l₀)² of the force elements' springs
     if (E.stiffness != 0.0) V += 0.5 * E.stiffness * std::pow(element_state(d, E, false).l - E.length, 2);
   return V;
@@ -34,7 +35,7 @@ double elastic_energy(const System& sys, const Data& d) {
 double dissipated_power(const System& sys, const Data& d) {
   check_data(sys, d);
   double P = 0.0;
-  for (int i = 0; i < sys.nc; ++i) P += sys.coords[i].damping * d.qda(i) * d.qda(i);
+  for (int i = 0; i < sys.nc; ++i) P += d.spring_scale(i) * sys.coords[i].damping * d.qda(i) * d.qda(i);
   for (const ForceElement& E : sys.elements)  // c l̇² of the force elements' dampers
     if (E.damping != 0.0) P += E.damping * std::pow(element_state(d, E, false).ld, 2);
   return P;

@@ -45,8 +45,8 @@ void spatial_kinematics(const System& sys, Data& d) {
     d.v[p] = v;
     d.c[p] = c;
     const Mat3 R = d.T[p].topLeftCorner<3, 3>();
-    d.I[p] = spatial_inertia(sys.mass[p], R * sys.com[p] + d.T[p].topRightCorner<3, 1>(),
-                             R * sys.inertia[p] * R.transpose());
+    d.I[p] = spatial_inertia(d.mass[p], R * d.com[p] + d.T[p].topRightCorner<3, 1>(),
+                             R * d.inertia[p] * R.transpose());
     d.fext[p].setZero();
   }
   for (const Load& L : sys.loads) {
@@ -54,6 +54,13 @@ void spatial_kinematics(const System& sys, Data& d) {
     const AppliedLoad a = applied_load(d, L);
     d.fext[L.body].head<3>() += a.x.cross(a.F) + a.tau;
     d.fext[L.body].tail<3>() += a.F;
+  }
+  for (const FlowTerm& f : flow_terms(sys, d, true)) {
+    const auto [coriolis, turn] = flow_loads(f);
+    for (const AppliedLoad& a : {coriolis, turn}) {
+      d.fext[f.body].head<3>() += a.x.cross(a.F);
+      d.fext[f.body].tail<3>() += a.F;
+    }
   }
   for (const ForceElement& E : sys.elements) {
     const auto [on_b, on_a] = element_loads(element_state(d, E, true));

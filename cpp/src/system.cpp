@@ -16,6 +16,7 @@ std::shared_ptr<const System> Model::compile(Algorithm algorithm) const {
   s.gravity = gravity_;
   s.loads = loads_;
   s.loops = loops_;
+  s.flows = flows_;
   s.elements = elements_;
   s.loop_row.push_back(0);
   for (const Loop& L : loops_) s.loop_row.push_back(s.loop_row.back() + loop_rows(L.kind));
@@ -150,7 +151,13 @@ Data::Data(const System& s)
       S(s.nbodies),
       U6(s.nbodies),
       Dinv(s.nbodies),
-      u(s.nbodies) {}
+      u(s.nbodies),
+      H(s.H),
+      mass(s.mass),
+      com(s.com),
+      inertia(s.inertia),
+      spring_scale(VecX::Ones(s.nc)),
+      flow(s.flows.size()) {}
 
 void check_body(const System& sys, int body, const std::string& argument, bool ground_allowed) {
   if (body < (ground_allowed ? -1 : 0) || body >= sys.nbodies)

@@ -279,12 +279,34 @@ class Beam:
     linear: bool
     rfes: list[Body]                      #: the m + 1 rigid finite elements, root to tip
     frames: np.ndarray                    #: (m + 1,) arc length of each rfe frame, m
-    rfe: Sequence[RfeParameters] = field(repr=False)  #: (m + 1) inertia of each rfe
-    sde: Sequence[SdeParameters] = field(repr=False)  #: (m) springs and dampers of each sde
+    rfe: Sequence[RfeParameters] = field(repr=False)  #: (m + 1) inertia of each rfe (at L(0) if it varies)
+    sde: Sequence[SdeParameters] = field(repr=False)  #: (m) springs and dampers of each sde (at L(0))
+    length_profile: object = field(default=None, repr=False)  #: L(t) of a link of varying length, or None
+
+    @property
+    def varying(self) -> bool:
+        """Whether the free length varies in time (``add_beam(length=profile)``)."""
+        return self.length_profile is not None
+
+    def length_at(self, t) -> np.ndarray:
+        """The free length L(t) (m) at the times ``t`` (s): constant unless it varies."""
+        t = np.asarray(t, dtype=float)
+        if not self.varying:
+            return np.full(t.shape, self.length)
+        return np.vectorize(lambda x: self.length_profile(float(x))[0], otypes=[float])(t)
+
+    def tip_positions(self, result) -> np.ndarray:
+        """Global positions (len(t), 3) in m of the free end over a simulation ``result``: the last
+        rfe's origin plus its axis times its current length (L(t)/(2m) for a varying length)."""
+        last = self.rfes[-1]
+        origin = result.position(last.origin)
+        axis = result.position(last.point((1.0, 0.0, 0.0))) - origin
+        return origin + axis * (self.length_at(result.t) / (2 * self.elements))[:, None]
 
     @property
     def tip(self) -> Point:
-        """The beam's free end (s = L) on the last rfe."""
+        """The beam's free end (s = L) on the last rfe (at L(0) for a varying length: see
+        ``tip_positions``)."""
         return self.point(self.length)
 
     def point(self, s: float) -> Point:
@@ -311,7 +333,14 @@ class Beam:
         coordinates, as for ``System.position``."""
         points = self._points
         _checks.same_model(points[0], system, "system", "a system compiled from the beam's model")
-        return system._positions(list(points), q, _checks.pose_time(system, t))
+        t = _checks.pose_time(system, t)
+        if not self.varying:
+            return system._positions(list(points), q, t)
+        # The sdes are the rfes' origins; the tip lies L(t)/(2m) along the last rfe's axis.
+        last = self.rfes[-1]
+        X = system._positions([b.origin for b in self.rfes] + [last.point((1.0, 0.0, 0.0))], q, t)
+        tip = X[-2] + (X[-1] - X[-2]) * self.length_at(t) / (2 * self.elements)
+        return np.vstack([X[:-1], tip])
 
 
 def add_beam(
@@ -335,7 +364,12 @@ def add_beam(
 
     O(m) in time and memory for the exact (nonlinear) model: the parameters of all rfes and sdes
     come from one vectorised quadrature and the rfes 1..m are added in one call; the linear model's
-    couplings make it O(m²)."""
+    couplings make it O(m²). A ``length`` given as a ``rigidfem.motion`` profile L(t) makes a link
+    of varying free length (``rigidfem.flows``): built at L(0), its sde joints get a prescribed
+    "x" coordinate first that spreads the rfes over L(t)."""
+    flow = None
+    if isinstance(length, _core.Profile):
+        flow, length = length, _flow_length(length, material, section, deform, formulation, linear, tip_mass)
     L = _checks.scalar(length, "length", positive=True)
     if isinstance(elements, bool) or not isinstance(elements, (int, np.integer)) or elements < 1:
         raise ValueError(f"elements: expected an integer number of sdes >= 1, got {elements!r}")
@@ -376,6 +410,11 @@ def add_beam(
     # of the sde table.
     template = Joint.custom([DEFORMATIONS[k] for k in deform])
     columns = [SDE_DEFORMATIONS.index(next(k for k in deform if DEFORMATIONS[k] == c)) for c in template.coordinates]
+    if flow is not None:  # the growth coordinate "x" first, without spring (its column: axial, zeroed)
+        template = Joint.custom(["x", *template.coordinates])
+        columns = [SDE_DEFORMATIONS.index("axial"), *columns]
+        sde = _SdeTable(sde.stiffness.copy(), sde.damping.copy())
+        sde.stiffness[:, columns[0]] = sde.damping[:, columns[0]] = 0.0
     first = model.nbodies
     try:
         root = model.add_body(names[0], parent, joint if joint is not None else Joint.fixed(), mass=rfe.mass[0],
@@ -397,11 +436,32 @@ def add_beam(
                 np.ascontiguousarray(sde.stiffness[:, columns]).reshape(m, len(columns)),
                 np.ascontiguousarray(sde.damping[:, columns]).reshape(m, len(columns)),
                 placements.reshape(m, 16), rfe.mass[1:], rfe.com[1:], rfe.inertia[1:].reshape(m, 9))]
+        if flow is not None:
+            model._add_flow(flow, root.index, m)
     except BaseException:
         model._truncate(first)  # nothing half-added
         raise
     return Beam(name, L, m, formulation, tuple(deform), bool(linear), bodies, frames, _Rows(rfe, m + 1),
-                _Rows(sde, m))
+                _Rows(sde, m), flow)
+
+
+def _flow_length(profile, material, section, deform, formulation, linear, tip_mass) -> float:
+    """L(0) of a link of varying length, refusing what it does not support (yet)."""
+    L0 = profile(0.0)[0]
+    if not (np.isfinite(L0) and L0 > 0.0):
+        raise ValueError(f"length: expected a profile L(t) with a positive length L(0) in m, got L(0) = {L0}")
+    if not isinstance(material, Material) or not isinstance(section, Section):
+        raise ValueError("material, section: expected one Material and one Section for a beam of varying length "
+                         "(its material flows along it: a uniform beam), got properties varying along it")
+    if linear:
+        raise ValueError("linear: expected False for a beam of varying length (the linear model is not supported), "
+                         "got True")
+    if deform is not None and "axial" in ((deform,) if isinstance(deform, str) else tuple(deform)):
+        raise ValueError("deform: expected deformations without 'axial' for a beam of varying length (its sde "
+                         "joints' x coordinate spreads the rfes over L(t)), got 'axial'")
+    if _checks.scalar(tip_mass, "tip_mass", nonnegative=True) > 0.0:
+        raise ValueError(f"tip_mass: expected 0 for a beam of varying length (not supported yet), got {tip_mass}")
+    return L0
 
 
 def _tip_inertia(tip_inertia) -> np.ndarray:

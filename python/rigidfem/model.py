@@ -240,7 +240,7 @@ class Model(_core._Model):
         default); ``System.element_states`` and ``Result.element_forces`` give its force."""
         return force_elements.add_force_element(self, a, b, damping=damping, force=force, name=name)
 
-    def add_beam(self, name: str, parent, length: float, material, section, elements: int,
+    def add_beam(self, name: str, parent, length, material, section, elements: int,
                  formulation: str = "modified", deform=None, linear: bool = False, joint=None, placement=None,
                  tip_mass: float = 0.0, tip_inertia=(0.0, 0.0, 0.0), tip_offset=(0.0, 0.0, 0.0)):
         """Add a flexible beam divided into ``elements`` sdes and ``elements + 1`` rfes.
@@ -251,8 +251,11 @@ class Model(_core._Model):
             The rfes are named ``name.rfe0`` ... ``name.rfe<m>``.
         parent : Body or str
             What the beam's first rfe hangs from.
-        length : float
-            L, m; the beam lies along the x axis of its frame.
+        length : float or rigidfem.motion profile
+            L, m; the beam lies along the x axis of its frame. A profile L(t) makes a link of
+            varying free length sliding out of (L̇ > 0) or into its guide, the beam's frame
+            (``rigidfem.flows``: uniform beams without axial deformation, tip mass or the
+            linear model).
         material : Material, function of s, or list of m
             ``rigidfem.Material`` (constant), a function of the arc length s (m), or one
             per segment (stepped beams).

@@ -8,6 +8,7 @@
 
 #include <string>
 #include <utility>
+#include <vector>
 
 #include "rigidfem/system.hpp"
 
@@ -53,6 +54,26 @@ struct ElementState {
 ElementState element_state(const Data& d, const ForceElement& element, bool spatial);
 /// The element's loads: F e on body b at r_B and −F e on body a at r_A (none on the ground).
 std::pair<AppliedLoad, AppliedLoad> element_loads(const ElementState& s);
+
+/// Links of varying length (flows.hpp) at d.t: L, v, v̇ into d.flow (the rates zero `at_rest`),
+/// the rfes' mass properties at L(t) into d.H, d.mass, d.com, d.inertia, and L₀/L into the spring
+/// scales of their sdes. A SimulationError if L(t) <= 0 or is not finite.
+void update_flows(const System& sys, Data& d, bool at_rest);
+/// One rfe of a link of varying length at the current state: its body and the body `prev` whose
+/// axis e_prev the material leaves at the rfe's origin (rfe k − 1; for rfe 0 the guide: the
+/// parent, e_prev = x of T_parent B_0), its mass m and mass per length ρA, the flow speed
+/// α = v (1 − ξ) and acceleration β = v̇ (1 − ξ) relative to its frame, its axis e, angular
+/// velocity ω, centre of mass x_C and origin (global). Velocities as in element_state.
+struct FlowTerm {
+  int body, prev;
+  double m, rhoA, alpha, beta;
+  Vec3 e, e_prev, omega, xc, origin;
+};
+std::vector<FlowTerm> flow_terms(const System& sys, const Data& d, bool spatial);
+/// The loads of the flowing material (inertia moved to the right-hand side): on rfe k
+/// −m (2 α ω × e + β e) at x_C (Coriolis and relative acceleration), and −ρA α² (e − e_prev)
+/// at its origin (the turn at the sde).
+std::pair<AppliedLoad, AppliedLoad> flow_loads(const FlowTerm& f);
 
 /// Q_i of springs, dampers and applied generalised forces on coordinate i (all coordinates):
 /// −c_i (q_i − q_i⁰) − b_i q̇_i + λ (Q_i + Q_i(t, q_i, q̇_i)).

@@ -10,6 +10,7 @@
 #include <vector>
 
 #include "rigidfem/errors.hpp"
+#include "rigidfem/flows.hpp"
 #include "rigidfem/force_elements.hpp"
 #include "rigidfem/joint_motion.hpp"
 #include "rigidfem/loops.hpp"
@@ -136,6 +137,10 @@ class Model {
   /// Closes a loop (loops.hpp); returns its index. Checks the bodies, frames, length and name
   /// (an empty name becomes "loop<index>").
   int add_loop(const Loop& loop);
+  /// Makes the beam of rfes flow.first .. flow.first + flow.elements a link of varying free length
+  /// L(t) (flows.hpp): checks the chain and the length, sets L₀ = L(0) and prescribes the first
+  /// ("x") coordinate of every sde joint with its growth κ_k (L(t) − L₀).
+  void add_flow(Flow flow);
   /// Adds a force element between two bodies (force_elements.hpp); returns its index. Checks the
   /// bodies, points and parameters (an empty name becomes "element<index>").
   int add_force_element(const ForceElement& element);
@@ -144,6 +149,7 @@ class Model {
   const Vec3& gravity() const { return gravity_; }
   const std::vector<BodySpec>& bodies() const { return bodies_; }
   const std::vector<Loop>& loops() const { return loops_; }
+  const std::vector<Flow>& flows() const { return flows_; }
   const std::vector<ForceElement>& force_elements() const { return elements_; }
   /// Unique among the Models of this process (never 0): the `model` of the handles it makes.
   std::uint64_t id() const { return id_; }
@@ -168,6 +174,7 @@ class Model {
   std::vector<std::vector<CoordinateSpec>> coords_;  // (nbodies) x (ncoords of the joint)
   std::vector<Load> loads_;
   std::vector<Loop> loops_;
+  std::vector<Flow> flows_;
   std::vector<ForceElement> elements_;
 };
 

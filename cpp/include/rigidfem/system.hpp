@@ -75,6 +75,7 @@ class System : public std::enable_shared_from_this<System> {
   std::vector<Loop> loops;
   std::vector<int> loop_row;            // (nloops + 1)
   int nl = 0;                           ///< constraint rows (multipliers λ)
+  std::vector<Flow> flows;              // links of varying length (flows.hpp)
   std::vector<ForceElement> elements;   // force elements between two bodies (force_elements.hpp)
 
   std::vector<std::string> coordinate_names() const;  ///< (nq)
@@ -142,6 +143,14 @@ struct Data {
   std::vector<Subspace> U6;    // (nbodies) I^A S
   std::vector<Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>> Dinv;  // (nbodies) (Sᵀ I^A S)⁻¹
   std::vector<Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>> u;    // (nbodies) τ − Sᵀ p^A
+  // Mass properties and spring scales at t: the System's, but for the rfes of links of varying
+  // length (flows.hpp), which set_state updates with L(t).
+  std::vector<Mat4> H;         // (nbodies) 4x4 pseudo-inertia, body frame
+  std::vector<double> mass;    // (nbodies)
+  std::vector<Vec3> com;       // (nbodies)
+  std::vector<Mat3> inertia;   // (nbodies) about the centre of mass, body axes
+  VecX spring_scale;           // (nc) factor of each coordinate's stiffness and damping (L₀/L for sdes)
+  std::vector<MotionState> flow;  // (nflows) L, v = L̇, v̇ at t (zero rates at rest)
 };
 
 /// Throws std::invalid_argument unless d is a workspace made for sys (a Data of another system
