@@ -48,3 +48,13 @@ def hermite_cantilever_frequencies(L, EI, rhoA, rhoI, tension=None, softening=0.
         M[2 * e:2 * e + 4, 2 * e:2 * e + 4] += Me
     w2 = scipy.linalg.eigh(K[2:, 2:], M[2:, 2:], eigvals_only=True)[:n]  # clamped at x = 0
     return np.sqrt(w2)
+
+
+def pytest_collection_modifyitems(config, items):
+    """Tests marked slow (long studies) run only when the marker expression names them (-m slow)."""
+    if "slow" in (config.getoption("markexpr") or ""):
+        return
+    skip = pytest.mark.skip(reason="long study: select with -m slow")
+    for item in items:
+        if "slow" in item.keywords:
+            item.add_marker(skip)

@@ -312,19 +312,10 @@ def test_classical_formulation_gives_the_same_rod():
         np.testing.assert_allclose(classical[1], modified[1], rtol=0, atol=1e-11)
 
 
-def _only_when_selected(request):
-    """The slow studies run with ``-m slow`` only (the marker alone does not take them out of the default
-    run)."""
-    expr = request.config.getoption("markexpr") or ""
-    if "slow" not in expr or "not slow" in expr:
-        pytest.skip("long study: select with -m slow")
-
-
 @pytest.mark.slow
-def test_reference_converges_in_degree_and_tolerance(request, reference):
+def test_reference_converges_in_degree_and_tolerance(reference):
     """The reference at N = 7 against N = 5, N = 9 and N = 7 with DOP853 at rtol 1e-11: its own error is
     far below the RFEM errors it measures (1.3e-5 m at m = 16, 3.3e-6 m at m = 32)."""
-    _only_when_selected(request)
     runs = {N: reference_run(N) for N in (5, 9)}
     runs["tight"] = reference_run(N_REF, rtol=1e-11, atol=1e-13)
     diff = {key: [np.abs(np.asarray(a) - np.asarray(b)).max() for a, b in zip(run[:4], reference[:4])]
@@ -336,9 +327,8 @@ def test_reference_converges_in_degree_and_tolerance(request, reference):
 
 
 @pytest.mark.slow
-def test_rfem_rod_at_m32_stays_on_the_second_order_line(request, reference):
+def test_rfem_rod_at_m32_stays_on_the_second_order_line(reference):
     """m = 32 (34 coordinates, about 30 s): the ratio of the m = 16 and m = 32 errors is still 4."""
-    _only_when_selected(request)
     d_ref, x_ref = reference[:2]
     e16 = np.abs(rfem_run(16)[0] - d_ref).max()
     d32, x32, _, _, closure, _ = rfem_run(32, rtol=1e-7, atol=1e-9)
