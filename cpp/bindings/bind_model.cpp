@@ -248,6 +248,25 @@ void bind_model(py::module_& m) {
           py::arg("name"), py::arg("a"), py::arg("point_a"), py::arg("b"), py::arg("point_b"), py::arg("stiffness"),
           py::arg("damping"), py::arg("length"), py::arg("force"), py::arg("profile"), py::arg("law"))
       .def(
+          "_add_rope",
+          [](Model& model, const std::string& name, int a, const Vec3& point_a, int b, const Vec3& point_b, double EA,
+             double DA, double length, ProfilePtr unstretched) {
+            ForceElement e;
+            e.name = name;
+            e.body_a = a;
+            e.body_b = b;
+            e.point_a = point_a;
+            e.point_b = point_b;
+            e.rope = true;
+            e.EA = EA;
+            e.DA = DA;
+            e.length = length;
+            e.unstretched = std::move(unstretched);
+            return model.force_elements()[model.add_force_element(e)].name;
+          },
+          py::arg("name"), py::arg("a"), py::arg("point_a"), py::arg("b"), py::arg("point_b"), py::arg("EA"),
+          py::arg("DA"), py::arg("length"), py::arg("unstretched"))
+      .def(
           "_add_flow",
           [](Model& model, ProfilePtr length, int first, int elements) {
             Flow flow;

@@ -291,6 +291,11 @@ int Model::add_force_element(const ForceElement& element) {
         {element.length, "length", "a finite rest length >= 0 in m"}})
     if (!(value >= 0.0 && std::isfinite(value))) bad(name, expected, num8(value));
   if (!std::isfinite(element.force)) bad("force", "a finite force in N", num8(element.force));
+  if (element.rope) {
+    if (!(element.EA > 0.0 && std::isfinite(element.EA))) bad("EA", "a positive axial stiffness EA in N", num8(element.EA));
+    if (!(element.DA >= 0.0 && std::isfinite(element.DA))) bad("DA", "a finite axial damping DA >= 0 in N·s", num8(element.DA));
+    if (!element.unstretched && !(element.length > 0.0)) bad("length", "a positive unstretched length in m", num8(element.length));
+  }
   ForceElement named = element;
   if (named.name.empty()) named.name = "element" + std::to_string(elements_.size());
   for (const ForceElement& other : elements_)

@@ -12,7 +12,15 @@ GIL at every evaluation, its derivatives by central differences). The spring's e
 ½ k (l − l₀)² counts in ``System.elastic_energy`` and the damper's c l̇² in
 ``System.dissipated_power``; the applied part F(t) is scaled by the load factor of statics.
 ``System.element_states`` gives (l, l̇, F) of every element and ``Result.element_forces`` their
-forces over a simulation. Unlike an actuator (``Model.add_actuator``, a constraint), an element
+forces over a simulation.
+
+A rope (``Model.add_rope``) is a massless tension-only element: with l_u its unstretched length
+(a number, or a profile l_u(t) paid out by a winch) it pulls with the tension
+
+    T = (EA (l − l_u) + DA (l̇ − l̇_u)) / l_u   while positive, and 0 when slack,
+
+a spring EA/l_u and a damper DA/l_u acting only while the rope pulls (F = −T); ½ (EA/l_u)
+(l − l_u)² counts as elastic energy while it is stretched. Unlike an actuator (``Model.add_actuator``, a constraint), an element
 adds no equation: any number of them can act on a tree or a closed chain.
 """
 
@@ -62,3 +70,18 @@ def add_force_element(model, a, b, *, stiffness: float = 0.0, damping: float = 0
     constant, profile, law = _force(force)
     return model._add_force_element("" if name is None else str(name), ia, ra, ib, rb, stiffness, damping, length,
                                     constant, profile, law)
+
+
+def add_rope(model, a, b, *, EA: float, length, damping: float = 0.0, name: str | None = None) -> str:
+    """A rope between ``a`` and ``b`` (see ``Model.add_rope``); returns its name."""
+    ia, ra = _point(model, a, "a")
+    ib, rb = _point(model, b, "b")
+    EA = _checks.scalar(EA, "EA", positive=True, unit="N")
+    DA = _checks.scalar(damping, "damping", nonnegative=True, unit="N s")
+    if isinstance(length, Profile):
+        lu = length(0.0)[0]
+        if not (np.isfinite(lu) and lu > 0.0):
+            raise ValueError(f"length: expected a profile l_u(t) with a positive length at t = 0 in m, got {lu}")
+        return model._add_rope("" if name is None else str(name), ia, ra, ib, rb, EA, DA, 0.0, length)
+    return model._add_rope("" if name is None else str(name), ia, ra, ib, rb, EA, DA,
+                           _checks.scalar(length, "length", positive=True, unit="m"), None)

@@ -240,6 +240,15 @@ class Model(_core._Model):
         default); ``System.element_states`` and ``Result.element_forces`` give its force."""
         return force_elements.add_force_element(self, a, b, damping=damping, force=force, name=name)
 
+    def add_rope(self, a, b, *, EA: float, length, damping: float = 0.0, name: str | None = None) -> str:
+        """A massless rope between the points ``a`` and ``b`` (book ch. 7.1: a hoisting rope): it
+        only pulls, with the tension T = (EA (l − l_u) + DA (l̇ − l̇_u))/l_u while positive, 0 when
+        slack. ``EA`` (N) is its axial stiffness, ``damping`` DA (N·s) its axial damping, and
+        ``length`` its unstretched length l_u (m): a number or a ``rigidfem.motion`` profile
+        l_u(t) paid out by a winch. Returns its name; ``System.element_states`` gives its
+        force F = −T (N)."""
+        return force_elements.add_rope(self, a, b, EA=EA, length=length, damping=damping, name=name)
+
     def add_beam(self, name: str, parent, length, material, section, elements: int,
                  formulation: str = "modified", deform=None, linear: bool = False, joint=None, placement=None,
                  tip_mass: float = 0.0, tip_inertia=(0.0, 0.0, 0.0), tip_offset=(0.0, 0.0, 0.0)):
