@@ -93,8 +93,6 @@ PENDING = {
     # -- known and being fixed (the lead's list); at 66ee91f the fixed ones are out of this table:
     #    Material/Section strings, Point NaN offsets, prescribing twice, foreign handles, force laws
     #    returning non-numbers, statics/modal analysis of nq = 0 and their LinAlgErrors
-    "omit_t": "mass_matrix, kinetic/gravity/elastic/potential_energy, dissipated_power take no t with drives "
-              "(evaluated at t = 0); position/velocity/transform are fixed",
     "drive_non_number": "rf.motion.function(f) with f returning a string -> ValueError 'could not convert string to "
                         "float' (no argument name) from every call",
     "modal": "modal_analysis: damping_ratios inf for a damped mode of zero frequency (revolute + damper, no spring)",
@@ -106,33 +104,18 @@ PENDING = {
     "model_body_lookup": "Model.body('nope') -> 'parent: ...'; Model.body(3) -> TypeError",
     "compile_types": "Model.compile(None) / compile(3) -> pybind TypeError",
     "coordinate_types": "prescribe(..., coordinate=3) -> pybind TypeError",
-    "simulate_system_arg": "simulate(model)/simulate(None) -> AttributeError",
-    "complex_arrays": "complex q/qd/y/q0 silently lose their imaginary part (every System method, simulate, "
-                      "statics, modal, stages)",
-    "row_vectors": "a (1, nq) array is taken for q",
-    "scipy_unchecked": "scipy: methods accept t_eval outside [t0, t_end], dt=nan, first_step=nan, adaptive='yes'",
-    "tolerance_arrays_nq0": "rtol/atol as an empty array (nq = 0): C++ methods refuse it with a self-contradicting "
-                            "message, scipy: methods fail with numpy's 'zero-size array' ValueError or IndexError",
-    "static_types": "force_jacobians(static=None) accepted (pybind's bool conversion)",
-    "static_true": "force_jacobians(t, q, qd, lf, True) does not check qd (wrong size, [None] * n accepted)",
-    "scipy_rtol_arrays": "simulate(method='scipy:Radau'/'scipy:BDF', rtol=array) -> 'truth value of an array' "
-                         "ValueError",
     "core_function_types": "rf.R1('x'), rf.skew(None), rf.homogeneous(R, 'x'), rf.inverse(np.zeros((5, 4))), "
                            "rf.pseudo_inertia(m, 'x', I) -> pybind TypeError",
     "point_ctor_types": "rf.Point(0, 'r'), rf.Point(0, (1.0, 2.0)), rf.Point('b0', r) -> pybind TypeError",
     "joint_internals_types": "JointSpec.add_coupling(body, slot, np.eye(3)) -> pybind TypeError",
-    "hugeint_vectors": "q = [10**30] * nq or a bool array is taken, but when another argument is wrong the guard "
-                       "blames q",
 }
 
 #: Violations that no input group can leave out (they come from what a run does), known and not fixed
 #: yet: (name, kind, called function, pattern of the outcome). The suite tolerates them; delete an
 #: entry once fixed.
-PENDING_OUTCOMES = [
-    # a scipy: run whose state overflows ends in ValueError('y: ...') or scipy's own "array must not contain
-    # infs or NaNs" instead of SimulationError (at t = ..., NaN state)
-    ("scipy_nan_state", "rejected_valid", r"^rf\.simulate$", r"^ValueError: y: expected .* finite values, got NaN"),
-    ("scipy_nan_state", "bad_message", r"^rf\.simulate$", r"^ValueError: array must not contain infs or NaNs"),
+PENDING_OUTCOMES: list = [
+    # (a scipy: run whose state overflowed ended in ValueError('y: ...') or scipy's own "array must not
+    # contain infs or NaNs": fixed, a SimulationError at the last accepted time now)
 ]
 
 # ------------------------------------------------------------------------------------------------
@@ -1751,6 +1734,9 @@ class Gen:
         amb = kw.get("rtol", {}).get("e") in ("0.0",) and kw.get("atol", {}).get("e") in ("0.0",)
         if absent and (kw.get("adaptive", {}).get("e") == "True" or "first_step" in kw):
             absent = []  # an adaptive Newmark run needs no dt; first_step serves as the step when dt is absent
+        if "first_step" in kw and not kw["first_step"].get("bad") and kw.get("adaptive", {}).get("names") == \
+                ["adaptive", "dt"]:
+            del kw["adaptive"]["bad"]  # adaptive=False without dt: first_step serves as the step
         self.emit("rf.simulate", args, params, kw, out=out, label=f"simulate:{mlabel}", ambiguous=amb,
                   absent_bad=absent)
         self.results.append(out)
@@ -1873,7 +1859,9 @@ class Gen:
             args = [A("system"), self.vector_arg("q")]
             params = ["system", "q"]
             if self.chance(0.5) or self.n_prescribed:
-                args.append(self.time_arg())
+                t = self.time_arg()
+                t["role"] = "topt"  # None is the default: fine without drives
+                args.append(t)
                 params.append("t")
             return self.emit(f"{bm['var']}.centerline", args, params, label="Beam.centerline")
         s = self.choice([0.0, bm["length"], bm["length"] * 0.3]) if self.chance(0.8) else None
