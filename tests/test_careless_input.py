@@ -231,3 +231,124 @@ def test_scipy_zero_atol_at_zero_state_is_a_simulation_error_naming_atol():
     with pytest.raises(rf.SimulationError, match=r"at t = -1 s") as e:
         rf.simulate(s, -0.8, method="scipy:Radau", t0=-1.0, atol=0.0)
     assert "atol" in str(e.value)
+
+
+# -- wrong types for the compiled classes and helpers: ValueError naming the argument ----------------
+
+@pytest.mark.parametrize("call, name", [
+    (lambda: rf.Point(0, "r"), "r"),
+    (lambda: rf.Point(0, (1.0, 2.0)), "r"),
+    (lambda: rf.Point(0, (1.0, 2.0, 3.0j)), "r"),
+    (lambda: rf.Point("b0", (0.0, 0.0, 0.0)), "body"),
+    (lambda: rf.Point(1.5, (0.0, 0.0, 0.0)), "body"),
+    (lambda: rf.Point(None, (0.0, 0.0, 0.0)), "body"),
+    (lambda: rf.Body(0, "b").point("x"), "r"),
+    (lambda: rf.R1("x"), "phi1"),
+    (lambda: rf.R1([1.0]), "phi1"),
+    (lambda: rf.R2(None), "phi2"),
+    (lambda: rf.R3(np.complex128(1.0)), "phi3"),
+    (lambda: rf.euler_zyx(0.1, "y", 0.3), "phi2"),
+    (lambda: rf.skew(None), "w"),
+    (lambda: rf.skew(np.zeros(4)), "w"),
+    (lambda: rf.homogeneous(np.eye(3), "x"), "r"),
+    (lambda: rf.homogeneous(np.eye(4), np.zeros(3)), "R"),
+    (lambda: rf.inverse(np.zeros((5, 4))), "T"),
+    (lambda: rf.inverse(np.eye(4) + 0j), "T"),
+    (lambda: rf.pseudo_inertia(1.0, "x", np.eye(3)), "com"),
+    (lambda: rf.pseudo_inertia("1", np.zeros(3), np.eye(3)), "mass"),
+    (lambda: rf.pseudo_inertia(1.0, np.zeros(3), np.eye(4)), "inertia"),
+    (lambda: rf.Joint.spherical().add_coupling(0, 0, np.eye(3)), "G"),
+    (lambda: rf.Joint.spherical().add_coupling(0, 0, np.full((4, 4), np.nan)), "G"),
+    (lambda: rf.Joint.spherical().add_coupling("b0", 0, np.eye(4)), "body"),
+    (lambda: rf.Joint.spherical().add_coupling(0, 1.5, np.eye(4)), "slot"),
+    (lambda: rf.motion.constant(-1.0)(None), "t"),
+    (lambda: rf.motion.constant(-1.0)("0.5"), "t"),
+    (lambda: rf.motion.constant(-1.0)(True), "t"),
+    (lambda: rf.motion.constant(-1.0)(float("nan")), "t"),
+])
+def test_compiled_classes_and_helpers_name_the_argument(call, name):
+    with pytest.raises(ValueError, match=named(name)):
+        call()
+
+
+def test_helpers_still_take_what_they_took():
+    np.testing.assert_array_equal(rf.R3(np.float32(0.0)), np.eye(3))
+    np.testing.assert_array_equal(rf.R1(0), np.eye(3))
+    np.testing.assert_array_equal(rf.homogeneous([[1, 0, 0], [0, 1, 0], [0, 0, 1]], (1, 2, 3))[:3, 3], [1, 2, 3])
+    p = rf.Point(np.int64(2), [0.5, 0.0, 0.0])
+    assert p.body == 2 and p.r[0] == 0.5
+    assert rf.motion.constant(2.0)(np.float64(0.5)) == (2.0, 0.0, 0.0)
+    assert rf.motion.constant(2.0)(1) == (2.0, 0.0, 0.0)
+
+
+@pytest.mark.parametrize("call, name", [
+    (lambda: rf.motion.constant("x"), "value"),
+    (lambda: rf.motion.constant(1j), "value"),
+    (lambda: rf.motion.harmonic(None, 1.0), "amplitude"),
+    (lambda: rf.motion.harmonic(1.0, "w"), "omega"),
+    (lambda: rf.motion.harmonic(1.0, 1.0, phase=[0.0]), "phase"),
+    (lambda: rf.motion.spin_up("6", 0.5), "omega"),
+    (lambda: rf.motion.spin_up(6.0, None), "duration"),
+    (lambda: rf.motion.polynomial("ab"), "coefficients"),
+    (lambda: rf.motion.polynomial([1.0, None]), "coefficients"),
+    (lambda: rf.motion.polynomial(3.0), "coefficients"),
+])
+def test_motion_profiles_name_the_argument(call, name):
+    with pytest.raises(ValueError, match=named(name)):
+        call()
+
+
+def test_model_lookups_name_the_argument():
+    m = rf.Model()
+    m.add_body("b0", m.ground, rf.Joint.revolute("z"), mass=1.0, inertia=(1, 1, 1))
+    for bad in ("nope", None, 3):
+        with pytest.raises(ValueError, match=named("name")):
+            m.body(bad)
+    assert m.body("b0").name == "b0" and m.body("ground").index == -1
+    for algorithm in (None, 3):
+        with pytest.raises(ValueError, match=named("algorithm")):
+            m.compile(algorithm)
+    with pytest.raises(ValueError, match=named("coordinate")):
+        m.prescribe(m.body("b0"), rf.motion.constant(0.0), coordinate=3)
+    with pytest.raises(ValueError, match=named("coordinate")):
+        m.add_generalized_force(m.body("b0"), 1.0, coordinate=3)
+
+
+def test_a_nan_coupling_generator_is_named():
+    m = rf.Model()
+    m.add_body("b0", m.ground, rf.Joint.custom(["x", "z", "rx"]), mass=1.0, inertia=(1, 1, 1))
+    j = rf.Joint.fixed()
+    j.linear = True
+    with pytest.raises(ValueError, match=named("G")):
+        j.add_coupling(0, 0, np.full((4, 4), np.nan))
+
+
+@pytest.mark.parametrize("elements", [10**12, 2**63, 10**30, rf.beams.MAX_ELEMENTS + 1])
+def test_huge_element_counts_are_refused_at_once(elements):
+    m = rf.Model()
+    with pytest.raises(ValueError, match=named("elements")) as e:
+        m.add_beam("beam", m.ground, 1.0, rf.Material(E=2.1e11, rho=7850.0), rf.Section.circle(0.01), elements)
+    assert str(rf.beams.MAX_ELEMENTS) in str(e.value)
+    assert m.nbodies == 0
+
+
+# -- drives returning non-numbers ------------------------------------------------------------------
+
+@pytest.mark.parametrize("returned", [("a", 0.0, 0.0), (np.nan, 0.0, 0.0), (0.0, 0.0), None, "abc",
+                                      (0.0, 1j, 0.0), (0.0, None, 0.0)])
+def test_a_drive_returning_non_numbers_is_named_with_its_time(returned):
+    def drive(t):
+        return returned
+
+    m = rf.Model()
+    b = m.add_body("b", m.ground, rf.Joint.revolute("z"), mass=1.0, inertia=(0.1, 0.1, 0.1), com=(0.3, 0, 0))
+    m.add_body("c", b, rf.Joint.revolute("z"), mass=1.0, inertia=(0.1, 0.1, 0.1), com=(0.3, 0, 0),
+               placement=rf.transform((0.5, 0, 0)))
+    m.prescribe(b, rf.motion.function(drive))
+    s = m.compile()
+    with pytest.raises(ValueError, match=named("f")) as e:
+        s.forward_dynamics(2.5, np.zeros(1), np.zeros(1))
+    assert "drive" in str(e.value) and "t = 2.5" in str(e.value)
+    with pytest.raises(rf.SimulationError, match=r"t = 0\b") as e:
+        rf.simulate(s, 0.1, method="rk4", dt=0.01)
+    assert e.value.time == 0.0 and "drive" in e.value.cause
