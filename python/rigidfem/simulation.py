@@ -146,9 +146,11 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
     rtol, atol : float or (2 nq,) array
         Error control of adaptive methods, per component of y = [q, q̇] (m, rad; per s). With
         atol = 0 a component's tolerance is purely relative (an exactly zero component counts as
-        exact). SciPy's methods raise rtol to their floor 100 ε.
+        exact). SciPy's methods raise rtol to their floor 100 ε; scipy:Radau and scipy:BDF take one
+        rtol, the smallest given.
     first_step : float, optional
-        First step (s) of an adaptive run; estimated (Hairer's rule) by default.
+        First step (s) of an adaptive run (scipy: methods too); estimated (Hairer's rule) by
+        default. scipy: methods check dt, adaptive, beta, ... like the others but do not use them.
     stiffness_warning : bool
         dopri5 runs Hairer's stiffness test (h ρ > 3.25 over 15 accepted steps): its step is
         then bounded by stability, so it costs ~t ω_max/3.3 steps, and at loose tolerances
