@@ -352,3 +352,16 @@ def test_a_drive_returning_non_numbers_is_named_with_its_time(returned):
     with pytest.raises(rf.SimulationError, match=r"t = 0\b") as e:
         rf.simulate(s, 0.1, method="rk4", dt=0.01)
     assert e.value.time == 0.0 and "drive" in e.value.cause
+
+
+def test_a_bad_vector_is_named_even_when_a_drive_fails_first():
+    """A drive evaluated at t = 1e300 overflows before the compiled code looks at qdd's size: the
+    wrong qdd is the error, not the numerical failure it runs into."""
+    m = rf.Model()
+    b = m.add_body("b", m.ground, rf.Joint.custom(["y", "rz"]), mass=1.0, inertia=(0.1, 0.1, 0.1))
+    m.prescribe(b, rf.motion.polynomial([-1.0, 0.5, 0.5, 2.0]), coordinate="y")
+    s = m.compile()
+    with pytest.raises(rf.SimulationError):  # the failure itself, with good arguments
+        s.inverse_dynamics_derivatives(1e300, np.zeros(1), np.zeros(1), np.zeros(1))
+    with pytest.raises(ValueError, match=named("qdd")):
+        s.inverse_dynamics_derivatives(1e300, np.zeros(1), np.zeros(1), np.zeros(2))

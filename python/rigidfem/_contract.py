@@ -13,6 +13,7 @@ import functools
 import numpy as np
 
 from . import _checks
+from ._core import SimulationError
 
 #: What each argument of the compiled methods expects, by name; sizes in terms of the system.
 _EXPECTED = {
@@ -237,6 +238,15 @@ def guard(function: str, compiled, parameters: tuple, method: bool = True):
                 raise
             system = args[0] if args else kwargs.get("system")
             raise explain(function, parameters, args[1:] if method else args, kwargs, system) from None
+        except SimulationError:
+            # a numerical failure met before the compiled code checked every argument (a drive
+            # evaluated at a huge t before the size of qdd was looked at): name a bad argument instead
+            system = args[0] if args else kwargs.get("system")
+            given = dict(zip(parameters, args[1:] if method else args)) | kwargs
+            for name in parameters:
+                if name in VECTORS and name in given and _problem(name, given[name], system):
+                    raise _refuse(function, parameters, name, given[name], args, kwargs) from None
+            raise
 
     return call
 
