@@ -10,18 +10,42 @@ worker processes; see tests/fuzz_contract.py. ``scripts/fuzz.py`` runs longer ca
 The generators of the violations being fixed (fuzz_contract.PENDING) are left out here, and the
 saved cases of open violations (tests/fuzz_corpus, "status": "open") are expected to fail until
 they are fixed; set their status to "fixed" then, so that they guard against a relapse.
+
+Environment: ``RIGIDFEM_CONTRACT_BUDGET`` (s, default 55) is the wall time after which no new random
+case starts; the number of cases drawn (2000 at the default) grows in proportion to it, so a slower
+build (scripts/sanitize.sh: ASan + UBSan) given a larger budget runs as many cases or more, a faster
+machine given a larger budget runs more. ``RIGIDFEM_CONTRACT_TIMEOUT`` (s per case, default 15) is the
+time after which a case counts as a hang; raise it with the budget for a sanitizer build. The cases
+are a prefix of one derandomised stream: a longer run repeats a shorter one's cases first.
 """
 
+import os
 import time
 
 import pytest
 
 import fuzz_contract as fc
 
+
+def _seconds(variable: str, default: float) -> float:
+    """A positive number of seconds from the environment variable, else the default."""
+    text = os.environ.get(variable, "").strip()
+    if not text:
+        return default
+    try:
+        value = float(text)
+    except ValueError:
+        raise ValueError(f"{variable}: expected a positive number of seconds, got {text!r}") from None
+    if not 0.0 < value < float("inf"):
+        raise ValueError(f"{variable}: expected a positive number of seconds, got {text!r}")
+    return value
+
+
 SEED = 20261110
-CASES = 2000         # about 45 s on two cores (hypothesis draws them in a thread while workers run them)
-BUDGET = 55.0        # s: no new case after this (a slower machine runs fewer; each run is a prefix)
-TIMEOUT = 15.0       # s per case before it counts as a hang
+DEFAULT_BUDGET = 55.0
+BUDGET = _seconds("RIGIDFEM_CONTRACT_BUDGET", DEFAULT_BUDGET)  # s: no new case after this (a prefix of the stream)
+CASES = 50 * max(40, round(40 * BUDGET / DEFAULT_BUDGET))  # whole batches of 50; 2000: about 45 s on two cores
+TIMEOUT = _seconds("RIGIDFEM_CONTRACT_TIMEOUT", 15.0)     # s per case before it counts as a hang
 
 
 def _explain(tally, limit=12):

@@ -134,7 +134,13 @@ void bind_model(py::module_& m) {
       .def_readwrite("linear", &Joint::linear, "The book's linear model: T = [[1 + S(phi), r], [0, 1]].")
       .def_property_readonly("ncoords", &Joint::ncoords)
       .def(
-          "add_coupling", [](Joint& j, int body, int slot, const Mat4& G) { j.coupled.push_back({body, slot, G}); },
+          "add_coupling",
+          [](Joint& j, const py::object& body, const py::object& slot, const py::object& G) {
+            const Mat4 g = matrix_arg<Mat4>(G, "G", "a generator (4, 4)");
+            if (!g.allFinite()) bad("G", "a generator (4, 4) of finite values", "NaN or inf");
+            j.coupled.push_back({static_cast<int>(int_arg(body, "body", "a body index (int)")),
+                                 static_cast<int>(int_arg(slot, "slot", "a coordinate index (int)")), g});
+          },
           py::arg("body"), py::arg("slot"), py::arg("G"),
           "Let coordinate `slot` of an earlier body (index) also move this linear joint, with generator G (4, 4)\n"
           "in this joint's frame: T = 1 + sum G q (used by the linear model of beams).");
@@ -147,14 +153,21 @@ void bind_model(py::module_& m) {
       .def_readonly("name", &Body::name)
       .def_readonly("model", &Body::model, "Id of the Model that made the handle (0: unknown).")
       .def(
-          "point", [](const Body& b, const Vec3& r) { return Point(b.index, finite_offset(r), b.model); },
+          "point",
+          [](const Body& b, const py::object& r) {
+            return Point(b.index, finite_offset(matrix_arg<Vec3>(r, "r", "an offset (3,) in m in the body frame")),
+                         b.model);
+          },
           py::arg("r"), "The material point at r (m, body frame).")
       .def_property_readonly("origin", [](const Body& b) { return Point(b); }, "The point at the body frame's origin.")
       .def("__repr__", [](const Body& b) { return "<rigidfem Body '" + b.name + "' #" + std::to_string(b.index) + ">"; });
 
   py::class_<Point>(m, "Point", "A material point: body index and position r (m) in the body frame.")
-      .def(py::init([](int body, const Vec3& r) { return Point(body, finite_offset(r)); }), py::arg("body"),
-           py::arg("r"))
+      .def(py::init([](const py::object& body, const py::object& r) {
+             return Point(static_cast<int>(int_arg(body, "body", "a body index (int; -1 the ground)")),
+                          finite_offset(matrix_arg<Vec3>(r, "r", "an offset (3,) in m in the body frame")));
+           }),
+           py::arg("body"), py::arg("r"))
       .def(py::init<const Body&>(), py::arg("body"))
       .def_readonly("body", &Point::body)
       .def_readonly("r", &Point::r)
@@ -165,7 +178,13 @@ void bind_model(py::module_& m) {
       });
   py::implicitly_convertible<Body, Point>();
 
-  m.def("pseudo_inertia", &pseudo_inertia, py::arg("mass"), py::arg("com"), py::arg("inertia"),
+  m.def(
+      "pseudo_inertia",
+      [](const py::object& mass, const py::object& com, const py::object& inertia) {
+        return pseudo_inertia(real_arg(mass, "mass", "a mass in kg"), matrix_arg<Vec3>(com, "com", "a point (3,) in m"),
+                              matrix_arg<Mat3>(inertia, "inertia", "an inertia tensor (3, 3) in kg m^2"));
+      },
+      py::arg("mass"), py::arg("com"), py::arg("inertia"),
         "Pseudo-inertia H = int r r^T dm (4, 4) of a body: mass (kg), centre of mass com (3,) m and\n"
         "inertia tensor (3, 3) about the centre of mass (kg m^2), all in the body frame.");
 

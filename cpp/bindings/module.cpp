@@ -12,14 +12,34 @@
 namespace rigidfem::bindings {
 
 void bind_transforms(py::module_& m) {
-  m.def("R1", &R1, py::arg("phi1"), "Rotation matrix about x by phi1 (rad), (3, 3).");
-  m.def("R2", &R2, py::arg("phi2"), "Rotation matrix about y by phi2 (rad), (3, 3).");
-  m.def("R3", &R3, py::arg("phi3"), "Rotation matrix about z by phi3 (rad), (3, 3).");
-  m.def("euler_zyx", &euler_zyx, py::arg("phi3"), py::arg("phi2"), py::arg("phi1"),
-        "R3(phi3) R2(phi2) R1(phi1), book eq. (2.7): yaw, pitch, roll in rad. (3, 3).");
-  m.def("skew", &skew, py::arg("w"), "Skew-symmetric S(w) with S(w) x = w x x. (3, 3).");
-  m.def("homogeneous", &homogeneous, py::arg("R"), py::arg("r"), "[[R, r], [0, 1]] (4, 4); r in m.");
-  m.def("inverse", &inverse, py::arg("T"), "Inverse of a homogeneous transform, [[R^T, -R^T r], [0, 1]] (4, 4).");
+  // Arguments as py::object: a wrong type is a ValueError naming it (NaN in, NaN out is fine here).
+  const auto angle = [](const py::object& x, const char* name) { return real_arg(x, name, "an angle in rad"); };
+  m.def("R1", [angle](const py::object& phi1) { return R1(angle(phi1, "phi1")); }, py::arg("phi1"),
+        "Rotation matrix about x by phi1 (rad), (3, 3).");
+  m.def("R2", [angle](const py::object& phi2) { return R2(angle(phi2, "phi2")); }, py::arg("phi2"),
+        "Rotation matrix about y by phi2 (rad), (3, 3).");
+  m.def("R3", [angle](const py::object& phi3) { return R3(angle(phi3, "phi3")); }, py::arg("phi3"),
+        "Rotation matrix about z by phi3 (rad), (3, 3).");
+  m.def(
+      "euler_zyx",
+      [angle](const py::object& phi3, const py::object& phi2, const py::object& phi1) {
+        return euler_zyx(angle(phi3, "phi3"), angle(phi2, "phi2"), angle(phi1, "phi1"));
+      },
+      py::arg("phi3"), py::arg("phi2"), py::arg("phi1"),
+      "R3(phi3) R2(phi2) R1(phi1), book eq. (2.7): yaw, pitch, roll in rad. (3, 3).");
+  m.def(
+      "skew", [](const py::object& w) { return skew(matrix_arg<Vec3>(w, "w", "a vector (3,)")); }, py::arg("w"),
+      "Skew-symmetric S(w) with S(w) x = w x x. (3, 3).");
+  m.def(
+      "homogeneous",
+      [](const py::object& R, const py::object& r) {
+        return homogeneous(matrix_arg<Mat3>(R, "R", "a rotation matrix (3, 3)"),
+                           matrix_arg<Vec3>(r, "r", "a translation (3,) in m"));
+      },
+      py::arg("R"), py::arg("r"), "[[R, r], [0, 1]] (4, 4); r in m.");
+  m.def(
+      "inverse", [](const py::object& T) { return inverse(matrix_arg<Mat4>(T, "T", "a homogeneous transform (4, 4)")); },
+      py::arg("T"), "Inverse of a homogeneous transform, [[R^T, -R^T r], [0, 1]] (4, 4).");
 
   auto axes_of = [](const std::vector<std::string>& names) {
     std::vector<Axis> axes;
@@ -50,7 +70,8 @@ void bind_profiles(py::module_& m) {
   py::class_<Profile, ProfilePtr>(m, "Profile", "A prescribed motion q(t) with its rates (see rigidfem.motion).")
       .def(
           "__call__",
-          [](const Profile& p, double t) {
+          [](const Profile& p, const py::object& time) {
+            const double t = real_arg(time, "t", "a finite time in s");
             if (!std::isfinite(t)) bad("t", "a finite time in s", num(t));
             const MotionState s = p.at(t);
             return py::make_tuple(s.q, s.qd, s.qdd);

@@ -143,7 +143,7 @@ void Model::check_spec(const BodySpec& b, int index) const {
     if (c.body < 0 || c.body >= index || c.slot < 0 ||
         (c.body < static_cast<int>(bodies_.size()) && c.slot >= bodies_[c.body].joint.ncoords()))
       bad("joint", "coupled coordinates of bodies already in the model", "body " + std::to_string(c.body));
-    require_finite(c.G, "coupling generator");
+    if (!c.G.allFinite()) bad("joint", "coupling generators G (4, 4) of finite values", "NaN or inf");
   }
 }
 

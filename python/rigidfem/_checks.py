@@ -9,12 +9,32 @@ import numpy as np
 from ._core import Body, Point
 
 
-def array(x, shape: tuple[int, ...], name: str) -> np.ndarray:
-    """``x`` as a finite float array of exactly ``shape``."""
+def _floats(x, name: str, expected: str) -> np.ndarray:
+    """``x`` as a float array; complex numbers (numpy would drop their imaginary parts) and strings
+    (numpy would parse them) are refused, like anything else that is not a number."""
     try:
-        a = np.asarray(x, dtype=float)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name}: expected numbers of shape {shape}, got {x!r}") from None
+        a = np.asarray(x)
+    except (TypeError, ValueError, OverflowError):  # ragged nested sequences
+        a = None
+    kind = "" if a is None else a.dtype.kind
+    if kind == "c":
+        raise ValueError(f"{name}: expected real numbers ({expected}), got complex values {_short(x)}")
+    if kind in ("f", "i", "u", "b", "O"):
+        try:
+            return np.asarray(a, dtype=float)
+        except (TypeError, ValueError, OverflowError):  # objects that are not numbers, ints beyond floats
+            pass
+    raise ValueError(f"{name}: expected {expected}, got {_short(x)}")
+
+
+def _short(x) -> str:
+    s = repr(x)
+    return s if len(s) <= 200 else s[:197] + "..."
+
+
+def array(x, shape: tuple[int, ...], name: str) -> np.ndarray:
+    """``x`` as a finite float array of exactly ``shape`` (real numbers: complex ones are refused)."""
+    a = _floats(x, name, f"numbers of shape {shape}")
     if a.shape != shape:
         raise ValueError(f"{name}: expected shape {shape}, got {a.shape}")
     if not np.all(np.isfinite(a)):
@@ -23,11 +43,8 @@ def array(x, shape: tuple[int, ...], name: str) -> np.ndarray:
 
 
 def vector(x, name: str, min_length: int = 0) -> np.ndarray:
-    """``x`` as a finite 1-D float array of at least ``min_length`` values."""
-    try:
-        a = np.asarray(x, dtype=float)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name}: expected a 1-D sequence of numbers, got {x!r}") from None
+    """``x`` as a finite 1-D float array of at least ``min_length`` values (real numbers)."""
+    a = _floats(x, name, "a 1-D sequence of real numbers")
     if a.ndim != 1 or a.size < min_length:
         raise ValueError(f"{name}: expected a 1-D sequence of at least {min_length} numbers, got shape {a.shape}")
     if not np.all(np.isfinite(a)):
@@ -44,7 +61,7 @@ def scalar(x, name: str, *, positive: bool = False, nonnegative: bool = False, u
     if asked; ``unit`` goes into the messages."""
     expected = ("positive " if positive else "non-negative " if nonnegative else "") + "number" + \
         (f" in {unit}" if unit else "")
-    if isinstance(x, (str, bytes, bool, np.bool_)):
+    if isinstance(x, (str, bytes, bool, np.bool_, complex, np.complexfloating)):
         raise ValueError(f"{name}: expected a {expected}, got {x!r}")
     try:
         v = float(x)

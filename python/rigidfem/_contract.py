@@ -12,6 +12,9 @@ import functools
 
 import numpy as np
 
+from . import _checks
+from ._core import SimulationError
+
 #: What each argument of the compiled methods expects, by name; sizes in terms of the system.
 _EXPECTED = {
     "t": "a finite time in s",
@@ -52,6 +55,19 @@ SIGNATURES = {
 }
 
 
+#: The parameters that take vectors of real numbers, and how many per free coordinate.
+VECTORS = {"q": 1, "qd": 1, "qdd": 1, "y": 2}
+
+#: Methods whose t has a default (0) that only a system without prescribed coordinates may use.
+OPTIONAL_T = frozenset({"mass_matrix", "kinetic_energy", "gravity_energy", "elastic_energy", "potential_energy",
+                        "dissipated_power"})
+
+#: Vectors the compiled method ignores when a flag is set (it does not check them then): checked here.
+UNREAD = {"force_jacobians": ("qd", "static")}
+
+_MISSING = object()
+
+
 def _numeric(value) -> bool:
     """Numbers or an array of them (not strings, not booleans, not None)."""
     try:
@@ -61,16 +77,52 @@ def _numeric(value) -> bool:
     return kind in "iuf"
 
 
+def _real_vector(value) -> tuple[np.ndarray | None, str | None]:
+    """``value`` as a 1-D array of real numbers the compiled conversion takes without loss (floats,
+    integers, also Python ints beyond int64, booleans), or None and what is wrong with it: complex
+    values (numpy would drop their imaginary parts), strings, other objects, another shape (a (1, n)
+    or (n, 1) array would be taken for a vector). Its size is not looked at."""
+    if isinstance(value, (str, bytes)) or value is None:
+        return None, f"{value!r}"
+    try:
+        a = np.asarray(value)
+    except Exception:  # noqa: BLE001 -- a sequence numpy cannot take (ragged, raising __len__, ...)
+        return None, f"{value!r}"
+    kind = a.dtype.kind
+    if kind == "c":
+        return None, "complex values (expected real numbers)"
+    if kind == "O":  # Python ints beyond int64 are fine; None, strings, complex, lists are not
+        if a.ndim == 1 and all(isinstance(x, (int, float, np.integer, np.floating)) and not isinstance(x, bool)
+                               for x in a):
+            return a, None
+        return None, f"{value!r}"
+    if kind not in "fiub":
+        return None, f"{value!r}"
+    if a.ndim != 1:
+        return None, f"shape {a.shape}"
+    return a, None
+
+
 def _problem(name: str, value, system) -> str | None:
-    """Why ``value`` cannot be the argument ``name`` (None if it could)."""
+    """Why ``value`` cannot be the argument ``name`` (None if it could): "bad", or what is wrong."""
     from ._core import Body, Data, Point
 
     nq = getattr(system, "nq", 0)
     if name in ("t", "load_factor"):
         return None if _numeric(value) and np.ndim(value) == 0 and np.isfinite(value) else "bad"
-    if name in ("q", "qd", "qdd", "y"):
-        n = 2 * nq if name == "y" else nq
-        return None if _numeric(value) and np.shape(value) == (n,) and np.all(np.isfinite(value)) else "bad"
+    if name in VECTORS:
+        n = VECTORS[name] * nq
+        a, problem = _real_vector(value)
+        if problem:
+            return problem + (f" (expected shape ({n},))" if problem.startswith("shape") else "")
+        if a.shape != (n,):
+            return f"shape {a.shape} (expected shape ({n},))"
+        try:
+            with np.errstate(over="ignore"):
+                finite = np.all(np.isfinite(a.astype(float)))
+        except (OverflowError, TypeError, ValueError):  # a Python int beyond the range of floats
+            finite = False
+        return None if finite else "NaN or inf"
     if name == "static":
         return None if isinstance(value, (bool, np.bool_)) else "bad"
     if name == "body":
@@ -100,9 +152,11 @@ def explain(function: str, parameters: tuple, args: tuple, kwargs: dict, system)
     given = dict(zip(parameters, args)) | kwargs
     nq = getattr(system, "nq", 0)
     for name in parameters:
-        if name in given and _problem(name, given[name], system):
+        problem = _problem(name, given[name], system) if name in given else None
+        if problem:
             expected = _EXPECTED[name].format(nq=nq, nq2=2 * nq)
-            return ValueError(f"{name}: expected {expected}, got {given[name]!r}"[:400])
+            got = repr(given[name]) if problem == "bad" else problem
+            return ValueError(f"{name}: expected {expected}, got {got}"[:400])
     missing = [p for p in parameters if p not in given]
     if missing:
         return TypeError(f"{function}() missing the arguments {missing}")
@@ -110,20 +164,73 @@ def explain(function: str, parameters: tuple, args: tuple, kwargs: dict, system)
     return ValueError(f"{parameters[0]}: expected {expected}, got {given!r}"[:400])
 
 
+def _refuse(function: str, parameters: tuple, name: str, value, args: tuple, kwargs: dict) -> ValueError:
+    """The ValueError for the argument ``name`` that the compiled conversion would take wrongly."""
+    return explain(function, parameters, (), {name: value}, args[0] if args else kwargs.get("system"))
+
+
 def guard(function: str, compiled, parameters: tuple, method: bool = True):
     """``compiled`` with its conversion failures explained (see ``explain``): a method of System
-    (``method``: the system is self), or a function whose first parameter is the system."""
+    (``method``: the system is self), or a function whose first parameter is the system.
 
-    # Booleans convert to 0 and 1 in the compiled call: refused for times and load factors.
-    numbers = [(k + (1 if method else 0), p) for k, p in enumerate(parameters) if p in ("t", "load_factor")]
+    What the compiled conversion would take wrongly is refused before the call: booleans for t and
+    load_factor (they convert to 0 and 1), numpy's complex scalars for them (their imaginary part
+    dropped), vectors of complex numbers and (1, n) or (n, 1) arrays for q, qd, qdd and y, anything
+    but True or False for ``static``, t left out of a method of ``OPTIONAL_T`` of a system with
+    prescribed coordinates, and the vector ``UNREAD`` would leave unchecked."""
+    offset = 1 if method else 0
+    # (position in args, name, kind): 0 a number, 1 a vector, 2 a flag
+    checks = [(k + offset, p, 0 if p in ("t", "load_factor") else 1 if p in VECTORS else 2)
+              for k, p in enumerate(parameters) if p in ("t", "load_factor", "static") or p in VECTORS]
+    t_default = function in OPTIONAL_T and method
+    t_at = parameters.index("t") + offset if t_default else -1
+    unread = UNREAD.get(function)
+    if unread:
+        unread_at = (parameters.index(unread[0]) + offset, unread[0], parameters.index(unread[1]) + offset, unread[1])
+    ndarray = np.ndarray
 
     @functools.wraps(compiled)
     def call(*args, **kwargs):
-        for k, p in numbers:
-            v = args[k] if k < len(args) else kwargs.get(p)
-            if isinstance(v, (bool, np.bool_)):
-                system = args[0] if args else kwargs.get("system")
-                raise explain(function, parameters, (), {p: v}, system)
+        n = len(args)
+        converted = None
+        for k, p, kind in checks:
+            v = args[k] if k < n else kwargs.get(p, _MISSING)
+            if kind == 1:
+                if v.__class__ is ndarray and v.ndim == 1 and v.dtype.kind in "fiu":
+                    continue  # the fast path
+                if v is _MISSING:
+                    continue
+                a, problem = _real_vector(v)
+                if problem is None:
+                    if a is not v and a.dtype.kind in "fiu":  # converted once here, not again by the call
+                        if converted is None:
+                            converted = list(args), dict(kwargs)
+                        if k < n:
+                            converted[0][k] = a
+                        else:
+                            converted[1][p] = a
+                    continue
+                if v is None or isinstance(v, (str, bytes, dict)):
+                    continue  # the compiled conversion refuses it; explain() names it
+                raise _refuse(function, parameters, p, v, args, kwargs)
+            elif kind == 0:
+                if v.__class__ is float or v is _MISSING:
+                    continue
+                if isinstance(v, (bool, np.bool_, np.complexfloating)):
+                    raise _refuse(function, parameters, p, v, args, kwargs)
+            elif not (v is True or v is False or v is _MISSING or isinstance(v, np.bool_)):
+                raise _refuse(function, parameters, p, v, args, kwargs)
+        if t_default and n <= t_at and "t" not in kwargs and args and args[0].np:
+            _checks.pose_time(args[0], None)  # raises: the drives make the answer depend on t
+        if unread:
+            k, p, j, flag = unread_at
+            f = args[j] if j < n else kwargs.get(flag, False)
+            if f is True or (isinstance(f, np.bool_) and f):
+                v = args[k] if k < n else kwargs.get(p, _MISSING)
+                if v is not _MISSING and _problem(p, v, args[0] if args else kwargs.get("system")):
+                    raise _refuse(function, parameters, p, v, args, kwargs)
+        if converted is not None:
+            args, kwargs = tuple(converted[0]), converted[1]
         try:
             return compiled(*args, **kwargs)
         except TypeError as e:
@@ -131,6 +238,15 @@ def guard(function: str, compiled, parameters: tuple, method: bool = True):
                 raise
             system = args[0] if args else kwargs.get("system")
             raise explain(function, parameters, args[1:] if method else args, kwargs, system) from None
+        except SimulationError:
+            # a numerical failure met before the compiled code checked every argument (a drive
+            # evaluated at a huge t before the size of qdd was looked at): name a bad argument instead
+            system = args[0] if args else kwargs.get("system")
+            given = dict(zip(parameters, args[1:] if method else args)) | kwargs
+            for name in parameters:
+                if name in VECTORS and name in given and _problem(name, given[name], system):
+                    raise _refuse(function, parameters, name, given[name], args, kwargs) from None
+            raise
 
     return call
 

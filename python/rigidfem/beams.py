@@ -29,6 +29,9 @@ from .frames import transform
 #: Deformation name -> joint coordinate of the sde (book order x, y, z, φ3, φ2, φ1).
 DEFORMATIONS = {"axial": "x", "shear_y": "y", "shear_z": "z", "torsion": "rx", "bend_y": "ry", "bend_z": "rz"}
 MODIFIED_DEFORMATIONS = ("torsion", "bend_y", "bend_z")
+#: The most sdes of one beam: each rfe is a body (about 1-2 kB in every workspace), so 10⁵ elements
+#: cost ~0.2 GB per workspace; far more would exhaust memory (or take minutes) before failing.
+MAX_ELEMENTS = 100_000
 
 _GAUSS = np.polynomial.legendre.leggauss(8)  # exact for polynomials of degree ≤ 15 on each piece
 
@@ -371,8 +374,8 @@ def add_beam(
     if isinstance(length, _core.Profile):
         flow, length = length, _flow_length(length, material, section, deform, formulation, linear, tip_mass)
     L = _checks.scalar(length, "length", positive=True)
-    if isinstance(elements, bool) or not isinstance(elements, (int, np.integer)) or elements < 1:
-        raise ValueError(f"elements: expected an integer number of sdes >= 1, got {elements!r}")
+    if isinstance(elements, bool) or not isinstance(elements, (int, np.integer)) or not 1 <= elements <= MAX_ELEMENTS:
+        raise ValueError(f"elements: expected an integer number of sdes in [1, {MAX_ELEMENTS}], got {elements!r}")
     m = int(elements)
     if formulation not in ("classical", "modified"):
         raise ValueError(f"formulation: expected 'classical' or 'modified', got {formulation!r}")

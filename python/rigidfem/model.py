@@ -58,7 +58,12 @@ class Model(_core._Model):
 
     def body(self, name: str) -> Body:
         """The handle of the body called ``name``."""
-        index = self._body_index(name)
+        if not isinstance(name, str):
+            raise ValueError(f"name: expected the name (str) of a body of this model or 'ground', got {name!r}")
+        try:
+            index = self._body_index(name)
+        except ValueError:
+            raise ValueError(f"name: expected the name of a body of this model or 'ground', got {name!r}") from None
         return Body() if index < 0 else self._handle(index)
 
     def _handle(self, index: int) -> Body:
@@ -129,6 +134,8 @@ class Model(_core._Model):
     def _coordinate(self, body: Body, coordinate: str | None) -> int:
         if not isinstance(body, Body) or body.index < 0 or not self._owns(body):
             raise ValueError(f"body: expected a body of this model, got {body!r}")
+        if coordinate is not None and not isinstance(coordinate, str):
+            raise ValueError(f"coordinate: expected None or a coordinate name such as 'x' or 'rz', got {coordinate!r}")
         return -1 if coordinate is None else self._coordinate_index(body.index, coordinate)
 
     def prescribe(self, body: Body, motion: Profile, coordinate: str | None = None) -> None:
@@ -271,7 +278,7 @@ class Model(_core._Model):
         section : Section, function of s, or list of m
             ``rigidfem.Section``, likewise (tapered beams).
         elements : int
-            m >= 1, the number of sdes (primary division).
+            1 <= m <= 100 000 (``rigidfem.beams.MAX_ELEMENTS``), the number of sdes (primary division).
         formulation : "classical" or "modified"
             Classical: rfes with up to 6 relative coordinates (axial, shear, torsion,
             bending); modified: spherical joints, 3 rotations at most.
@@ -323,6 +330,8 @@ class System(_core._System):
     """
 
     def __init__(self, model, algorithm: str = "recursive"):
+        if not isinstance(algorithm, str):
+            raise ValueError(f"algorithm: expected 'recursive' or 'lagrange', got {algorithm!r}")
         super().__init__(model, algorithm)
         self._model_id = model.id  # handles of other models are refused (_checks.same_model)
 

@@ -15,23 +15,24 @@ from . import _checks, _core
 
 def constant(value: float) -> _core.Profile:
     """q(t) = value (a locked coordinate)."""
-    return _core.constant_profile(value)
+    return _core.constant_profile(_checks.scalar(value, "value"))
 
 
 def polynomial(coefficients: Sequence[float]) -> _core.Profile:
     """q(t) = c0 + c1 t + c2 t² + ... (``coefficients`` = [c0, c1, ...])."""
-    return _core.polynomial_profile([float(c) for c in coefficients])
+    return _core.polynomial_profile(list(_checks.vector(coefficients, "coefficients")))
 
 
 def harmonic(amplitude: float, omega: float, phase: float = 0.0, offset: float = 0.0) -> _core.Profile:
     """q(t) = offset + amplitude · sin(omega t + phase); omega in rad/s."""
-    return _core.harmonic_profile(amplitude, omega, phase, offset)
+    return _core.harmonic_profile(_checks.scalar(amplitude, "amplitude"), _checks.scalar(omega, "omega"),
+                                  _checks.scalar(phase, "phase"), _checks.scalar(offset, "offset"))
 
 
 def spin_up(omega: float, duration: float) -> _core.Profile:
     """Kane's spin-up of a hub to the rate ``omega`` (rad/s) over ``duration`` T (s):
     θ = (Ω/T)[t²/2 + (T/2π)²(cos(2πt/T) − 1)] for t < T, θ = Ω(t − T/2) after."""
-    return _core.spin_up_profile(omega, duration)
+    return _core.spin_up_profile(_checks.scalar(omega, "omega"), _checks.scalar(duration, "duration"))
 
 
 def spline(t: Sequence[float], q: Sequence[float]) -> _core.Profile:
@@ -42,14 +43,31 @@ def spline(t: Sequence[float], q: Sequence[float]) -> _core.Profile:
 
 def function(f: Callable[[float], tuple[float, float, float]]) -> _core.Profile:
     """A Python function ``f(t) -> (q, qd, qdd)``. Slow path: Python is called at every
-    evaluation, under the GIL."""
+    evaluation, under the GIL.
+
+    ``f`` must return three finite real numbers: anything else (strings, None, NaN, inf, another
+    shape) raises ``rigidfem.ForceLawError`` naming the drive, what it returned and the time: a
+    ValueError (whose message starts with ``f:``) where a System method evaluates the drive, and a
+    ``SimulationError`` with ``time`` and ``cause``. Exceptions ``f`` raises propagate."""
     if not callable(f):
         raise ValueError(f"f: expected a callable f(t) -> (q, qd, qdd), got {f!r}")
+    name = getattr(f, "__qualname__", None) or repr(f)
 
     def checked(t):
         value = f(t)
-        if np.shape(value) != (3,):
-            raise ValueError(f"f: expected f(t) to return (q, qd, qdd), got {value!r} at t = {t}")
-        return tuple(float(v) for v in value)
+        try:
+            numbers = None if isinstance(value, (str, bytes)) or np.shape(value) != (3,) else \
+                tuple(_checks.scalar(v, "f") for v in value)
+        except ValueError:  # an entry that is not a finite real number
+            numbers = None
+        if numbers is None:
+            got = repr(value)
+            got = got if len(got) <= 120 else got[:117] + "..."
+            cause = f"the drive '{name}' returned {got}; expected three finite numbers (q, qd, qdd)"
+            error = _core.ForceLawError(f"f: expected the drive '{name}' to return three finite numbers (q, qd, qdd), "
+                                        f"got {got} at t = {t:.10g} s")
+            error.time, error.cause = float(t), cause
+            raise error
+        return numbers
 
     return _core.callback_profile(checked)

@@ -152,9 +152,11 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
     rtol, atol : float or (2 nq,) array
         Error control of adaptive methods, per component of y = [q, q̇] (m, rad; per s). With
         atol = 0 a component's tolerance is purely relative (an exactly zero component counts as
-        exact). SciPy's methods raise rtol to their floor 100 ε.
+        exact). SciPy's methods raise rtol to their floor 100 ε; scipy:Radau and scipy:BDF take one
+        rtol, the smallest given.
     first_step : float, optional
-        First step (s) of an adaptive run; estimated (Hairer's rule) by default.
+        First step (s) of an adaptive run (scipy: methods too); estimated (Hairer's rule) by
+        default. scipy: methods check dt, adaptive, beta, ... like the others but do not use them.
     stiffness_warning : bool
         dopri5 runs Hairer's stiffness test (h ρ > 3.25 over 15 accepted steps): its step is
         then bounded by stability, so it costs ~t ω_max/3.3 steps, and at loose tolerances
@@ -209,6 +211,9 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
     Ctrl-C in the main thread — in the C++ loop, in a Python drive or force law, or in a
     ``scipy:`` method — returns the partial result with a RuntimeWarning (``result.interrupted``).
     """
+    if not isinstance(system, _core._System):
+        got = type(system).__name__ if isinstance(system, _core._Model) else _checks._short(system)
+        raise ValueError(f"system: expected a compiled System (call model.compile()), got {got}")
     n = system.nq
     q0 = np.zeros(n) if q0 is None else _checks.array(q0, (n,), "q0")
     qd0 = np.zeros(n) if qd0 is None else _checks.array(qd0, (n,), "qd0")
@@ -217,22 +222,28 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
     if not t_end > t0:
         raise ValueError(f"t_end: expected a time after t0 = {t0} s, got {t_end}")
     t_eval = np.zeros(0) if t_eval is None else _checks.vector(t_eval, "t_eval")
+    if len(t_eval) and (t_eval[0] < t0 or t_eval[-1] > t_end or np.any(np.diff(t_eval) <= 0.0)):
+        raise ValueError(f"t_eval: expected increasing times within [t0, t_end] = [{t0:g}, {t_end:g}] s, got "
+                         f"{_checks._short(t_eval)}")
     if not isinstance(method, str):
         raise ValueError(f"method: expected a method name such as 'dopri5' (see rigidfem.simulate), got {method!r}")
     max_steps = _checks.integer(max_steps, "max_steps", minimum=1, maximum=2**62)
     max_step = _checks.step_limit(max_step, "max_step")
-    rtol, atol = _tolerance(rtol, "rtol", n), _tolerance(atol, "atol", n)
+    rtol, atol = _tolerance(rtol, "rtol", n, 1e-6), _tolerance(atol, "atol", n, 1e-9)
     if stop is not None and not callable(getattr(stop, "is_set", None)):
         raise ValueError(f"stop: expected None or a threading.Event (an object with is_set()), got {stop!r}")
     _check_closed(system, t0, q0, qd0)
     bar = _ProgressBar(t0, t_end) if progress else None
     try:
-        if method.startswith("scipy:"):
+        scipy = method.startswith("scipy:")
+        # scipy: methods check the options of the C++ ones too (they use only first_step of them)
+        opt = _options("dopri5" if scipy else method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, beta,
+                       gamma, alpha, rho_inf, newton_tol, newton_max_iterations, iteration_matrix)
+        if scipy:
+            first = None if first_step is None else opt.dt
             run = _run_scipy(system, method[6:], t0, t_end, q0, qd0, t_eval, rtol, atol, max_step, max_steps,
-                             _keep_going(bar, stop))
+                             _keep_going(bar, stop), first)
         else:
-            opt = _options(method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, beta, gamma, alpha,
-                           rho_inf, newton_tol, newton_max_iterations, iteration_matrix)
             run = _core._integrate(system, t0, t_end, q0, qd0, t_eval, opt, _keep_going(bar, stop))
     finally:
         if bar is not None:
@@ -304,20 +315,33 @@ def _keep_going(bar, stop):
     return keep_going
 
 
-def _tolerance(x, name, n) -> np.ndarray:
+def _tolerance(x, name, n, default) -> np.ndarray:
+    """One tolerance or 2 nq of them (an empty array when nq = 0: then ``default``, which no
+    component uses)."""
     try:
-        tol = np.atleast_1d(np.asarray(x, dtype=float))
-    except (TypeError, ValueError):
+        tol = np.atleast_1d(_checks.array(x, np.shape(x), name))  # real numbers (not complex, not strings)
+    except ValueError:
         tol = None
     if tol is None or tol.ndim != 1 or tol.size not in (1, 2 * n) or not np.all(np.isfinite(tol)) or np.any(tol < 0):
-        raise ValueError(f"{name}: expected a non-negative number or {2 * n} (2 nq) of them, got {x!r}")
-    return tol
+        raise ValueError(f"{name}: expected a non-negative number or {2 * n} (2 nq) of them, got {_checks._short(x)}")
+    return np.array([default]) if tol.size == 0 else tol
 
 
-def _run_scipy(system, name, t0, t_end, q0, qd0, t_eval, rtol, atol, max_step, max_steps, keep_going):
+class _NonFinite(Exception):
+    """The state or its derivative became NaN or inf in a scipy: run (at ``t``)."""
+
+    def __init__(self, t, cause):
+        super().__init__(cause)
+        self.t, self.cause = float(t), cause
+
+
+def _run_scipy(system, name, t0, t_end, q0, qd0, t_eval, rtol, atol, max_step, max_steps, keep_going,
+               first_step=None):
     """SciPy's step-by-step solvers (the OdeSolver classes behind solve_ivp) with the C++ rhs and
     Jacobian (analytic for recursive systems), stepped here so that max_steps, Ctrl-C and ``stop``
-    hold as in the C++ loop (Python per step: the slow path). Returns what _core._integrate does."""
+    hold as in the C++ loop (Python per step: the slow path). A state, rate or Jacobian that becomes
+    NaN or inf ends the run with a SimulationError at its time, as in the C++ loop. Returns what
+    _core._integrate does."""
     import time
 
     import scipy.integrate
@@ -329,36 +353,76 @@ def _run_scipy(system, name, t0, t_end, q0, qd0, t_eval, rtol, atol, max_step, m
     n = system.nq
     start = time.perf_counter()
     solver_class = getattr(scipy.integrate, name)
-    options = {"jac": system.jacobian} if name in ("Radau", "BDF", "LSODA") else {}
+
+    def rhs(t, y):
+        if not np.all(np.isfinite(y)):
+            raise _NonFinite(t, f"the state became NaN or inf (scipy {name})")
+        yd = system.rhs(t, y)
+        if not np.all(np.isfinite(yd)):
+            raise _NonFinite(t, f"the accelerations became NaN or inf (scipy {name})")
+        return yd
+
+    def jacobian(t, y):
+        if not np.all(np.isfinite(y)):
+            raise _NonFinite(t, f"the state became NaN or inf (scipy {name})")
+        J = system.jacobian(t, y)
+        if not np.all(np.isfinite(J)):
+            raise _NonFinite(t, f"the Jacobian of the rhs became NaN or inf (scipy {name})")
+        return J
+
+    options = {"jac": jacobian} if name in ("Radau", "BDF", "LSODA") else {}
+    if first_step is not None:
+        options["first_step"] = min(first_step, t_end - t0)
     rtol = np.maximum(rtol, 100 * np.finfo(float).eps)  # SciPy's floor, without its warning
-    solver = solver_class(system.rhs, t0, np.concatenate([q0, qd0]), t_end, rtol=rtol if rtol.size > 1 else rtol[0],
-                          atol=atol if atol.size > 1 else atol[0], max_step=max_step, **options)
-    ts, ys = ([t0], [solver.y.copy()]) if not len(t_eval) else ([], [])
-    ts, ys = _scipy_outputs(t_eval, t0, t0, None, solver.y, ts, ys)
-    steps, last_check, interrupted, failure = 0, start, False, None
+    if name in ("Radau", "BDF"):  # one rtol only (their Newton tolerance is a scalar): the strictest
+        rtol = np.min(rtol, keepdims=True)
+    y0 = np.concatenate([q0, qd0])
+    steps, last_check, interrupted, failure, solver = 0, start, False, None, None
+    ts, ys = ([t0], [y0]) if not len(t_eval) else ([], [])
     try:
-        while solver.status == "running":
-            if steps >= max_steps:
-                failure = _failure(solver.t, f"max_steps = {max_steps} reached (scipy {name})")
-                break
-            t_before = solver.t
-            message = solver.step()
-            if solver.status == "failed":
-                failure = _failure(solver.t, f"scipy {name} failed: {message}")
-                break
-            steps += 1
-            dense = solver.dense_output() if len(t_eval) else None
-            ts, ys = _scipy_outputs(t_eval, t_before, solver.t, dense, solver.y, ts, ys)
-            if keep_going is not None and time.perf_counter() - last_check > 0.05:
-                last_check = time.perf_counter()
-                if not keep_going(solver.t):
-                    interrupted = True
+        # overflows are reported as the SimulationError below, not as numpy's RuntimeWarnings
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):
+            solver = solver_class(rhs, t0, y0, t_end, rtol=rtol if rtol.size > 1 else rtol[0],
+                                  atol=atol if atol.size > 1 else atol[0], max_step=max_step, **options)
+            ts, ys = ([t0], [solver.y.copy()]) if not len(t_eval) else ([], [])
+            ts, ys = _scipy_outputs(t_eval, t0, t0, None, solver.y, ts, ys)
+            while solver.status == "running":
+                if steps >= max_steps:
+                    failure = _failure(solver.t, f"max_steps = {max_steps} reached (scipy {name})")
                     break
+                t_before = solver.t
+                message = solver.step()
+                if solver.status == "failed":
+                    failure = _failure(solver.t, f"scipy {name} failed: {message}")
+                    break
+                steps += 1
+                dense = solver.dense_output() if len(t_eval) else None
+                ts, ys = _scipy_outputs(t_eval, t_before, solver.t, dense, solver.y, ts, ys)
+                if keep_going is not None and time.perf_counter() - last_check > 0.05:
+                    last_check = time.perf_counter()
+                    if not keep_going(solver.t):
+                        interrupted = True
+                        break
     except KeyboardInterrupt:
         interrupted = True
+    except (_NonFinite, ValueError) as e:
+        # the state or SciPy's own numbers (its LU refuses the iteration matrix) overflowed: the inputs
+        # were checked, so this is a numerical failure, at the last accepted time
+        if isinstance(e, ValueError) and "infs or NaNs" not in str(e):
+            raise
+        last = solver.t if solver is not None else t0
+        if isinstance(e, _NonFinite) and np.isfinite(e.t):
+            failure = _failure(e.t, e.cause)
+        elif isinstance(e, _NonFinite) or not np.isfinite(getattr(solver, "h_abs", np.nan)):
+            failure = _failure(last, f"the step size became NaN or inf (scipy {name})" +
+                               (" (atol = 0 leaves it no error scale for a component at zero: give atol > 0)"
+                                if np.min(atol) == 0.0 else ""))
+        else:
+            failure = _failure(last, f"the iteration matrix overflowed (scipy {name}: {e})")
     y = np.array(ys).reshape(len(ys), 2 * n)
-    stats = {"steps": steps, "rejected_steps": -1, "rhs_evaluations": int(solver.nfev), "jacobians": int(solver.njev),
-             "factorizations": int(solver.nlu), "newton_iterations": -1, "wall_time": time.perf_counter() - start,
+    count = (lambda key: int(getattr(solver, key))) if solver is not None else (lambda key: 0)
+    stats = {"steps": steps, "rejected_steps": -1, "rhs_evaluations": count("nfev"), "jacobians": count("njev"),
+             "factorizations": count("nlu"), "newton_iterations": -1, "wall_time": time.perf_counter() - start,
              "stiff_at": float("nan")}
     return np.array(ts, dtype=float), y[:, :n].copy(), y[:, n:].copy(), stats, interrupted, failure
 
