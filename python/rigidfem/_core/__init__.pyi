@@ -17,7 +17,7 @@ class Profile:
     """
     A prescribed motion q(t) with its rates (see rigidfem.motion).
     """
-    def __call__(self, t: typing.SupportsFloat | typing.SupportsIndex) -> tuple[float, float, float]:
+    def __call__(self, t: typing.Any) -> tuple[float, float, float]:
         """
         (q, qd, qdd) at time t (s).
         """
@@ -35,7 +35,7 @@ class JointSpec:
     """
     def __init__(self, kind: str, coordinates: collections.abc.Sequence[str]) -> None:
         ...
-    def add_coupling(self, body: typing.SupportsInt | typing.SupportsIndex, slot: typing.SupportsInt | typing.SupportsIndex, G: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"]) -> None:
+    def add_coupling(self, body: typing.Any, slot: typing.Any, G: typing.Any) -> None:
         """
         Let coordinate `slot` of an earlier body (index) also move this linear joint, with generator G (4, 4)
         in this joint's frame: T = 1 + sum G q (used by the linear model of beams).
@@ -89,7 +89,7 @@ class Body:
         ...
     def __repr__(self) -> str:
         ...
-    def point(self, r: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> ...:
+    def point(self, r: typing.Any) -> ...:
         """
         The material point at r (m, body frame).
         """
@@ -114,7 +114,7 @@ class Point:
     A material point: body index and position r (m) in the body frame.
     """
     @typing.overload
-    def __init__(self, body: typing.SupportsInt | typing.SupportsIndex, r: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
+    def __init__(self, body: typing.Any, r: typing.Any) -> None:
         ...
     @typing.overload
     def __init__(self, body: Body) -> None:
@@ -563,15 +563,15 @@ class IntegratorOptions:
     @rtol.setter
     def rtol(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> None:
         ...
-def R1(phi1: typing.SupportsFloat | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
+def R1(phi1: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
     """
     Rotation matrix about x by phi1 (rad), (3, 3).
     """
-def R2(phi2: typing.SupportsFloat | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
+def R2(phi2: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
     """
     Rotation matrix about y by phi2 (rad), (3, 3).
     """
-def R3(phi3: typing.SupportsFloat | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
+def R3(phi3: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
     """
     Rotation matrix about z by phi3 (rad), (3, 3).
     """
@@ -585,17 +585,17 @@ def callback_profile(function: collections.abc.Callable[[float], tuple[typing.Su
     ...
 def constant_profile(value: typing.SupportsFloat | typing.SupportsIndex) -> Profile:
     ...
-def euler_zyx(phi3: typing.SupportsFloat | typing.SupportsIndex, phi2: typing.SupportsFloat | typing.SupportsIndex, phi1: typing.SupportsFloat | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
+def euler_zyx(phi3: typing.Any, phi2: typing.Any, phi1: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
     """
     R3(phi3) R2(phi2) R1(phi1), book eq. (2.7): yaw, pitch, roll in rad. (3, 3).
     """
 def harmonic_profile(amplitude: typing.SupportsFloat | typing.SupportsIndex, omega: typing.SupportsFloat | typing.SupportsIndex, phase: typing.SupportsFloat | typing.SupportsIndex, offset: typing.SupportsFloat | typing.SupportsIndex) -> Profile:
     ...
-def homogeneous(R: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 3]"], r: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
+def homogeneous(R: typing.Any, r: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
     """
     [[R, r], [0, 1]] (4, 4); r in m.
     """
-def inverse(T: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
+def inverse(T: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
     """
     Inverse of a homogeneous transform, [[R^T, -R^T r], [0, 1]] (4, 4).
     """
@@ -614,12 +614,12 @@ def joint_transform_second_derivative(coordinates: collections.abc.Sequence[str]
     """
 def polynomial_profile(coefficients: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> Profile:
     ...
-def pseudo_inertia(mass: typing.SupportsFloat | typing.SupportsIndex, com: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], inertia: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 3]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
+def pseudo_inertia(mass: typing.Any, com: typing.Any, inertia: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
     """
     Pseudo-inertia H = int r r^T dm (4, 4) of a body: mass (kg), centre of mass com (3,) m and
     inertia tensor (3, 3) about the centre of mass (kg m^2), all in the body frame.
     """
-def skew(w: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
+def skew(w: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
     """
     Skew-symmetric S(w) with S(w) x = w x x. (3, 3).
     """
