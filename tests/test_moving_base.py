@@ -47,8 +47,8 @@ def test_harmonics_rates_by_central_differences(t):
 
 def test_one_harmonic_and_default_phases():
     for t in (0.0, 0.3, 7.1):
-        np.testing.assert_allclose(motion.harmonics([0.3], [2.0], [0.5], 1.0)(t), motion.harmonic(0.3, 2.0, 0.5, 1.0)(t),
-                                   rtol=1e-15, atol=1e-15)
+        one = motion.harmonics([0.3], [2.0], [0.5], 1.0)
+        np.testing.assert_allclose(one(t), motion.harmonic(0.3, 2.0, 0.5, 1.0)(t), rtol=1e-15, atol=1e-15)
         np.testing.assert_allclose(motion.harmonics(A, W)(t), series(A, W, 0 * W, 0.0, t), rtol=1e-13, atol=1e-13)
     assert "harmonics(3 components" in repr(motion.harmonics(A, W))
 
@@ -153,7 +153,8 @@ def test_rao_phase_is_unwrapped_and_held_outside_the_table():
 def test_oscillator_and_constant_raos():
     rao = sea.RAO.oscillator(6.0, 0.1)
     wn = 2 * np.pi / 6.0
-    # ẍ + 2ζω_n ẋ + ω_n² x = ω_n² η: H(ω) = ω_n²/(ω_n² − ω² + 2iζω_nω), at resonance 1/(2ζ), lag π/2.
+    # ẍ + 2ζω_n ẋ + ω_n² x = ω_n² η: H(ω) = ω_n²/(ω_n² − ω² + 2iζω_nω);
+    # at resonance 1/(2ζ), lag π/2.
     H = rao([1e-6, wn, 10.0])
     assert H[0] == pytest.approx(1.0, abs=1e-6) and abs(H[1]) == pytest.approx(5.0)
     r = 10.0 / wn
@@ -179,7 +180,8 @@ def rot_zyx(psi, theta, phi):
 @pytest.mark.parametrize("engine", ENGINES)
 def test_six_dof_pose_ship_names_and_aliases(engine):
     dofs = {"surge": 0.5, "sway": motion.harmonic(0.2, 1.0), "heave": motion.harmonics(A, W, PH, C),
-            "yaw": motion.harmonic(0.3, 0.5), "pitch": motion.polynomial([0.05, 0.02]), "roll": motion.harmonic(0.1, 2.0)}
+            "yaw": motion.harmonic(0.3, 0.5), "pitch": motion.polynomial([0.05, 0.02]),
+            "roll": motion.harmonic(0.1, 2.0)}
     model = rf.Model()
     base = model.add_moving_base("deck", dofs, placement=rf.transform((1.0, 0, 2.0)))
     system = model.compile(engine)
