@@ -95,6 +95,8 @@ def test_components_discretise_the_spectrum():
     assert np.all((0 <= waves.phase) & (waves.phase < 2 * np.pi))
     assert waves.m0 == pytest.approx(hs**2 / 16, rel=0.005)  # measured 1.0011 hs²/16
     assert waves.hs == pytest.approx(4 * np.sqrt(waves.m0))
+    with pytest.raises(ValueError, match="read-only"):
+        waves.phase[0] = 1.0
 
 
 def test_same_seed_same_sea_other_seed_other_sea():

@@ -137,11 +137,11 @@ def _as_rao(rao, name: str) -> RAO:
         raise ValueError(f"{name}: expected an RAO or a non-negative gain, got {rao!r}") from None
 
 
-@dataclass(frozen=True)
+@dataclass(frozen=True, eq=False)
 class Waves:
     """Harmonic components of a sea state: η(t) = Σ_k a_k sin(ω_k t + φ_k) (m) with
     ``omega`` ω_k (rad/s), ``amplitude`` a_k (m) and ``phase`` φ_k (rad), 1-D arrays of one
-    length. ``jonswap_waves`` makes them from a spectrum."""
+    length (kept as read-only copies). ``jonswap_waves`` makes them from a spectrum."""
 
     omega: np.ndarray
     amplitude: np.ndarray
@@ -149,12 +149,12 @@ class Waves:
 
     def __post_init__(self):
         a = _checks.vector(self.amplitude, "amplitude", min_length=1)
-        for name in ("omega", "phase"):
-            values = _checks.vector(getattr(self, name), name)
+        for name in ("omega", "phase", "amplitude"):
+            values = np.array(_checks.vector(getattr(self, name), name))  # a copy, then read-only
             if values.size != a.size:
                 raise ValueError(f"{name}: expected {a.size} values (len(amplitude)), got {values.size}")
+            values.flags.writeable = False
             object.__setattr__(self, name, values)
-        object.__setattr__(self, "amplitude", a)
 
     @property
     def m0(self) -> float:
