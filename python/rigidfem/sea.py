@@ -84,8 +84,8 @@ class RAO:
         w = _finite(omega, "omega")
         try:
             H = np.asarray(self._h(w), dtype=complex)
-        except (TypeError, ValueError):
-            raise ValueError(f"rao: expected {self} to return complex numbers, got an error") from None
+        except (TypeError, ValueError) as error:
+            raise ValueError(f"rao: expected {self} to return complex numbers, got {error!r}") from error
         if H.shape != w.shape or not np.all(np.isfinite(H)):
             raise ValueError(f"rao: expected {self} to return finite values of shape {w.shape}, got {H!r}")
         return H
