@@ -82,6 +82,8 @@ void bind_profiles(py::module_& m) {
   m.def("polynomial_profile", &polynomial_profile, py::arg("coefficients"));
   m.def("harmonic_profile", &harmonic_profile, py::arg("amplitude"), py::arg("omega"), py::arg("phase"),
         py::arg("offset"));
+  m.def("harmonic_series_profile", &harmonic_series_profile, py::arg("amplitudes"), py::arg("omegas"),
+        py::arg("phases"), py::arg("offset"));
   m.def("spin_up_profile", &spin_up_profile, py::arg("omega"), py::arg("duration"));
   m.def("spline_profile", &spline_profile, py::arg("t"), py::arg("q"));
   m.def(

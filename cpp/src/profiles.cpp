@@ -59,6 +59,32 @@ class Harmonic final : public Profile {
   double a_, w_, ph_, off_;
 };
 
+class HarmonicSeries final : public Profile {
+ public:
+  HarmonicSeries(std::vector<double> a, std::vector<double> w, std::vector<double> ph, double off)
+      : a_(std::move(a)), w_(std::move(w)), ph_(std::move(ph)), off_(off) {}
+  MotionState at(double t) const override {
+    // q = c + Σ a_k sin(ω_k t + φ_k), q̇ = Σ a_k ω_k cos(ω_k t + φ_k), q̈ = −Σ a_k ω_k² sin(ω_k t + φ_k).
+    MotionState m{off_, 0.0, 0.0};
+    for (size_t k = 0; k < a_.size(); ++k) {
+      const double s = std::sin(w_[k] * t + ph_[k]), c = std::cos(w_[k] * t + ph_[k]);
+      m.q += a_[k] * s;
+      m.qd += a_[k] * w_[k] * c;
+      m.qdd -= a_[k] * w_[k] * w_[k] * s;
+    }
+    return m;
+  }
+  std::string describe() const override {
+    std::ostringstream o;
+    o << "harmonics(" << a_.size() << " components, offset=" << off_ << ")";
+    return o.str();
+  }
+
+ private:
+  std::vector<double> a_, w_, ph_;
+  double off_;
+};
+
 class SpinUp final : public Profile {
  public:
   SpinUp(double omega, double T) : W_(omega), T_(T) {}
@@ -156,6 +182,25 @@ ProfilePtr harmonic_profile(double amplitude, double omega, double phase, double
   require_finite(phase, "phase");
   require_finite(offset, "offset");
   return std::make_shared<Harmonic>(amplitude, omega, phase, offset);
+}
+
+ProfilePtr harmonic_series_profile(const std::vector<double>& amplitudes, const std::vector<double>& omegas,
+                                   const std::vector<double>& phases, double offset) {
+  const size_t n = amplitudes.size();
+  if (n == 0) throw std::invalid_argument("amplitudes: expected at least one amplitude, got none");
+  if (omegas.size() != n)
+    throw std::invalid_argument("omegas: expected " + std::to_string(n) + " values (len(amplitudes)), got " +
+                                std::to_string(omegas.size()));
+  if (phases.size() != n)
+    throw std::invalid_argument("phases: expected " + std::to_string(n) + " values (len(amplitudes)), got " +
+                                std::to_string(phases.size()));
+  for (size_t k = 0; k < n; ++k) {
+    require_finite(amplitudes[k], "amplitudes");
+    require_finite(omegas[k], "omegas");
+    require_finite(phases[k], "phases");
+  }
+  require_finite(offset, "offset");
+  return std::make_shared<HarmonicSeries>(amplitudes, omegas, phases, offset);
 }
 
 ProfilePtr spin_up_profile(double omega, double duration) {

@@ -34,6 +34,7 @@ from .joints import Joint
 from .materials import Material, Section
 from .frames import transform
 from .model import Model, System
+from . import sea  # noqa: E402 (rigidfem.sea: sea states for a moving base)
 from .simulation import Result, simulate
 
 __version__ = "0.1.0"
@@ -70,6 +71,7 @@ __all__ = [
     "rfe_parameters",
     "sde_parameters",
     "samples",
+    "sea",
     "simulate",
     "skew",
     "stages",

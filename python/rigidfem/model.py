@@ -10,7 +10,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from . import _checks, _contract, _core, force_elements, loops
+from . import _checks, _contract, _core, force_elements, joints, loops
 from ._core import Body, JointSpec, Point, Profile
 from .beams import add_beam
 from .frames import transform  # noqa: F401 (re-exported: rigidfem.model.transform)
@@ -28,6 +28,33 @@ def _inertia(inertia) -> np.ndarray:
             f"inertia: expected principal moments (3,) or a tensor (3, 3) in kg·m², got shape {np.shape(inertia)}"
         )
     return _checks.array(a, (3, 3), "inertia")
+
+
+# A moving base's degrees of freedom: ship names and the free joint's coordinates (ZYX angles:
+# yaw ψ = rz, pitch θ = ry, roll φ = rx), in the joint's order x, y, z, rz, ry, rx.
+BASE_DOFS = {"surge": "x", "sway": "y", "heave": "z", "yaw": "rz", "pitch": "ry", "roll": "rx"}
+
+
+def _base_profiles(motion) -> dict[str, Profile]:
+    """The six profiles of a moving base, by coordinate name ("x" ... "rx"), from ``motion``: a
+    dict of ship names or coordinate names to profiles or numbers; missing ones are held at 0."""
+    if motion is None:
+        motion = {}
+    if not isinstance(motion, dict):
+        raise ValueError(f"motion: expected a dict of degrees of freedom to profiles, got {motion!r}")
+    coordinate_of = {**BASE_DOFS, **{c: c for c in BASE_DOFS.values()}}
+    out: dict[str, Profile] = {}
+    for dof, value in motion.items():
+        if dof not in coordinate_of:
+            raise ValueError(f"motion: expected keys from {list(BASE_DOFS)} or {list(BASE_DOFS.values())}, "
+                             f"got {dof!r}")
+        c = coordinate_of[dof]
+        if c in out:
+            raise ValueError(f"motion: {dof!r} gives coordinate {c!r} a second motion")
+        if not isinstance(value, Profile):
+            value = _core.constant_profile(_checks.scalar(value, f"motion[{dof!r}]"))
+        out[c] = value
+    return {c: out[c] if c in out else _core.constant_profile(0.0) for c in BASE_DOFS.values()}
 
 
 def _scale(scale):
@@ -150,6 +177,39 @@ class Model(_core._Model):
             raise ValueError(f"motion: expected a profile from rigidfem.motion, got {motion!r}")
         k = self._coordinate(body, coordinate)
         self._prescribe(body.index, k, motion)
+
+    def add_moving_base(self, name: str, motion=None, *, mass: float = 1e-6, inertia=(1e-6, 1e-6, 1e-6),
+                        com=(0.0, 0.0, 0.0), placement=None) -> Body:
+        """Add a base body moving with a prescribed 6-DOF motion; returns its ``Body``.
+
+        The base hangs from the ground by ``Joint.free()``, T̃ = Trans(x, y, z) R3(ψ) R2(θ) R1(φ),
+        whose six coordinates are all prescribed, so the bodies added on it feel its motion as a
+        known base acceleration (both engines), and ``System.driving_forces`` reports the
+        forces (N) and torques (N·m) that drive it.
+
+        Parameters
+        ----------
+        name : str
+            The base body's name.
+        motion : dict
+            Degree of freedom -> ``rigidfem.motion`` profile (or a number: held constant). Keys are
+            ship names — ``"surge"`` x, ``"sway"`` y, ``"heave"`` z (m), ``"yaw"`` ψ = rz,
+            ``"pitch"`` θ = ry, ``"roll"`` φ = rx (rad; ZYX angles) — or the coordinate names
+            themselves. Missing ones are held at 0. ``rigidfem.sea.Waves.motion`` makes such a dict
+            from a sea state.
+        mass, inertia, com
+            The base's own mass (kg, positive; default 1e-6, negligible), inertia (kg·m²) and
+            centre of mass (m), as in ``add_body``; they only enter the driving forces.
+        placement : (4, 4) array, optional
+            Pose of the frame in which the motion is given (the base's rest pose), in the global
+            frame; identity by default.
+        """
+        profiles = _base_profiles(motion)
+        base = self.add_body(name, self.ground, joints.Joint.free(), mass=mass, inertia=inertia, com=com,
+                             placement=placement)
+        for coordinate, profile in profiles.items():
+            self.prescribe(base, profile, coordinate=coordinate)
+        return base
 
     def add_generalized_force(
         self, body: Body, force: float | Callable[[float, float, float], float], coordinate: str | None = None

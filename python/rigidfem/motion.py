@@ -29,6 +29,25 @@ def harmonic(amplitude: float, omega: float, phase: float = 0.0, offset: float =
                                   _checks.scalar(phase, "phase"), _checks.scalar(offset, "offset"))
 
 
+def harmonics(amplitudes: Sequence[float], omegas: Sequence[float], phases: Sequence[float] | None = None,
+              offset: float = 0.0) -> _core.Profile:
+    """q(t) = offset + Σ_k a_k sin(ω_k t + φ_k), a sum of harmonics with its exact rates
+    q̇ = Σ a_k ω_k cos(ω_k t + φ_k) and q̈ = −Σ a_k ω_k² sin(ω_k t + φ_k).
+
+    ``amplitudes`` a_k (units of the coordinate, m or rad), ``omegas`` ω_k (rad/s) and
+    ``phases`` φ_k (rad; zeros when omitted) are 1-D sequences of one length, at least one
+    component; ``offset`` c likewise in m or rad. A base motion per degree of freedom
+    (``Model.add_moving_base``) and a sea state's responses (``rigidfem.sea``) are such sums.
+    """
+    a = _checks.vector(amplitudes, "amplitudes", min_length=1)
+    w = _checks.vector(omegas, "omegas")
+    phi = np.zeros_like(a) if phases is None else _checks.vector(phases, "phases")
+    for values, name in ((w, "omegas"), (phi, "phases")):
+        if values.size != a.size:
+            raise ValueError(f"{name}: expected {a.size} values (len(amplitudes)), got {values.size}")
+    return _core.harmonic_series_profile(list(a), list(w), list(phi), _checks.scalar(offset, "offset"))
+
+
 def spin_up(omega: float, duration: float) -> _core.Profile:
     """Kane's spin-up of a hub to the rate ``omega`` (rad/s) over ``duration`` T (s):
     θ = (Ω/T)[t²/2 + (T/2π)²(cos(2πt/T) − 1)] for t < T, θ = Ω(t − T/2) after."""

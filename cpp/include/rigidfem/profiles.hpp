@@ -29,6 +29,10 @@ ProfilePtr constant_profile(double value);
 ProfilePtr polynomial_profile(const std::vector<double>& coefficients);
 /// q = offset + amplitude · sin(ω t + phase).
 ProfilePtr harmonic_profile(double amplitude, double omega, double phase, double offset);
+/// q = c + Σ_k a_k sin(ω_k t + φ_k): a sum of harmonics (a base motion, a sea state's response);
+/// q̇ and q̈ are its exact derivatives. ω_k in rad/s, φ_k in rad.
+ProfilePtr harmonic_series_profile(const std::vector<double>& amplitudes, const std::vector<double>& omegas,
+                                   const std::vector<double>& phases, double offset);
 /// Kane's spin-up of a hub (Kane, Ryan & Banerjee 1987):
 /// θ = (Ω/T)[t²/2 + (T/2π)²(cos(2πt/T) − 1)] for t < T, θ = Ω(t − T/2) after.
 ProfilePtr spin_up_profile(double omega, double duration);
