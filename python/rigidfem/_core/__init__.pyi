@@ -8,7 +8,7 @@ import numpy.typing
 import typing
 from . import stages
 from . import _bench
-__all__: list[str] = ['Body', 'Data', 'ForceLawError', 'IntegratorOptions', 'JointSpec', 'Point', 'Profile', 'R1', 'R2', 'R3', 'SimulationError', 'callback_profile', 'constant_profile', 'euler_zyx', 'harmonic_profile', 'homogeneous', 'inverse', 'joint_transform', 'joint_transform_derivative', 'joint_transform_second_derivative', 'polynomial_profile', 'pseudo_inertia', 'skew', 'spin_up_profile', 'spline_profile', 'stages']
+__all__: list[str] = ['Body', 'Data', 'ForceLawError', 'IntegratorOptions', 'JointSpec', 'Point', 'Profile', 'R1', 'R2', 'R3', 'SimulationError', 'callback_profile', 'constant_profile', 'euler_zyx', 'harmonic_profile', 'harmonic_series_profile', 'homogeneous', 'inverse', 'joint_transform', 'joint_transform_derivative', 'joint_transform_second_derivative', 'polynomial_profile', 'pseudo_inertia', 'skew', 'spin_up_profile', 'spline_profile', 'stages']
 class SimulationError(RuntimeError):
     """
     A numerical failure, a RuntimeError whose message names the time (s) and the cause: a singular mass or iteration matrix, a step size below the minimum, a NaN or inf state, Newton divergence in a step or a load step of the statics, max_steps, gimbal lock of ZYX Euler angles.
@@ -590,6 +590,8 @@ def euler_zyx(phi3: typing.Any, phi2: typing.Any, phi1: typing.Any) -> typing.An
     R3(phi3) R2(phi2) R1(phi1), book eq. (2.7): yaw, pitch, roll in rad. (3, 3).
     """
 def harmonic_profile(amplitude: typing.SupportsFloat | typing.SupportsIndex, omega: typing.SupportsFloat | typing.SupportsIndex, phase: typing.SupportsFloat | typing.SupportsIndex, offset: typing.SupportsFloat | typing.SupportsIndex) -> Profile:
+    ...
+def harmonic_series_profile(amplitudes: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], omegas: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], phases: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], offset: typing.SupportsFloat | typing.SupportsIndex) -> Profile:
     ...
 def homogeneous(R: typing.Any, r: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
     """
