@@ -94,10 +94,7 @@ PENDING = {
     # -- known and being fixed (the lead's list); at 66ee91f the fixed ones are out of this table:
     #    Material/Section strings, Point NaN offsets, prescribing twice, foreign handles, force laws
     #    returning non-numbers, statics/modal analysis of nq = 0 and their LinAlgErrors
-    "modal": "modal_analysis: damping_ratios inf for a damped mode of zero frequency (revolute + damper, no spring)",
     # -- found by this fuzzer (issue 10), not fixed yet
-    "huge_load_steps": "static_equilibrium(load_steps=10**12) is taken: a hang (analysis.py, being fixed "
-                       "separately)",
 }
 
 #: Violations that no input group can leave out (they come from what a run does), known and not fixed
@@ -291,6 +288,12 @@ def _finite(value, depth: int = 0) -> bool:
         return all(_finite(v, depth + 1) for v in value)
     fields = getattr(value, "__dataclass_fields__", None)
     if fields:
+        if "damping_ratios" in fields and "omega" in fields:  # Modes: ζ = inf is a damped mode of ω = 0
+            zeta, omega = np.asarray(value.damping_ratios), np.asarray(value.omega)
+            if not np.all(np.isfinite(zeta) | ((zeta == np.inf) & (omega == 0.0))):
+                return False
+            return all(_finite(getattr(value, f), depth + 1) for f in fields
+                       if f not in ("system", "history", "damping_ratios"))
         return all(_finite(getattr(value, f), depth + 1) for f in fields if f not in ("system", "history"))
     return True
 

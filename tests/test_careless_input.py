@@ -365,3 +365,11 @@ def test_a_bad_vector_is_named_even_when_a_drive_fails_first():
         s.inverse_dynamics_derivatives(1e300, np.zeros(1), np.zeros(1), np.zeros(1))
     with pytest.raises(ValueError, match=named("qdd")):
         s.inverse_dynamics_derivatives(1e300, np.zeros(1), np.zeros(1), np.zeros(2))
+
+
+def test_absurd_load_step_counts_are_refused_not_run():
+    """static_equilibrium(load_steps=10**12) was taken and ran for ever."""
+    model = rf.Model()
+    model.add_body("b", model.ground, rf.Joint.revolute("z", stiffness=1.0), 1.0, (1.0, 1.0, 1.0))
+    with pytest.raises(ValueError, match=r"^load_steps: expected an integer in \[1, 100000\], got 1000000000000"):
+        rf.static_equilibrium(model.compile(), load_steps=10**12)

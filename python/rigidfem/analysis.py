@@ -230,6 +230,10 @@ def _solve_tangent(K: np.ndarray, f: np.ndarray):
     return x / s if info == 0 else None
 
 
+#: The most load steps static_equilibrium takes (each is a Newton solve: more is a typo, not a study).
+MAX_LOAD_STEPS = 100_000
+
+
 def _integer_at_least_one(x, name: str) -> int:
     v = _checks.integer(x, name)
     if v < 1:
@@ -242,7 +246,7 @@ def static_equilibrium(system, q0=None, t: float = 0.0, load_steps: int = 10, to
     """Solve f(q) = 0 by Newton's method with load stepping.
 
     Gravity, point forces, torques and applied generalised forces are scaled together
-    by λ = 1/n, 2/n, ..., 1 (n = ``load_steps``); each step starts from the previous
+    by λ = 1/n, 2/n, ..., 1 (n = ``load_steps``, 1 to 100,000); each step starts from the previous
     one's solution (``q0``, m and rad, default 0, for the first). Prescribed coordinates
     are held at their values at time ``t`` (s), at rest. A step converges when the
     Newton correction satisfies max |Δq| ≤ tol · max(1, max |q|) (m and rad).
@@ -265,7 +269,7 @@ def static_equilibrium(system, q0=None, t: float = 0.0, load_steps: int = 10, to
     t = _checks.scalar(t, "t")
     n = system.nq
     q = np.zeros(n) if q0 is None else _checks.array(q0, (n,), "q0").copy()
-    steps = _integer_at_least_one(load_steps, "load_steps")
+    steps = _checks.integer(load_steps, "load_steps", minimum=1, maximum=MAX_LOAD_STEPS)
     tol = _checks.scalar(tol, "tol", positive=True)
     max_iterations = _integer_at_least_one(max_iterations, "max_iterations")
     if system.nl:
