@@ -373,3 +373,23 @@ def test_absurd_load_step_counts_are_refused_not_run():
     model.add_body("b", model.ground, rf.Joint.revolute("z", stiffness=1.0), 1.0, (1.0, 1.0, 1.0))
     with pytest.raises(ValueError, match=r"^load_steps: expected an integer in \[1, 100000\], got 1000000000000"):
         rf.static_equilibrium(model.compile(), load_steps=10**12)
+
+
+def test_stages_refuse_a_workspace_whose_set_state_raised():
+    """A drive overflowing at t = 1e300 raises in set_state after the free coordinates were written:
+    the stages on that workspace refuse it instead of computing NaN from a half-written state, and
+    a successful set_state makes it usable again."""
+    model = rf.Model()
+    hub = model.add_body("hub", model.ground, rf.Joint.revolute("z"), 1.0, (1.0, 1.0, 1.0))
+    arm = model.add_body("arm", hub, rf.Joint.revolute("y"), 1.0, (1.0, 1.0, 1.0))
+    model.prescribe(hub, rf.motion.polynomial([0.0, 0.0, 0.0, 1.0]))
+    system = model.compile()
+    data = system.make_data()
+    with pytest.raises(rf.SimulationError, match="drive of hub.rz returned NaN or inf"):
+        stages.set_state(system, data, 1e300, [0.1], [0.0])
+    for stage in (stages.kinematics, stages.generalized_forces, stages.mass_matrix):
+        with pytest.raises(ValueError, match="^data: expected a workspace with a state, got one whose last set_state"):
+            stage(system, data)
+    stages.set_state(system, data, 1.0, [0.1], [0.0])
+    stages.kinematics(system, data)
+    assert np.all(np.isfinite(data.T[arm.index]))

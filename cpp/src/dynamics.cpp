@@ -69,7 +69,7 @@ void dynamics_kinematics(const System& sys, Data& d) {
 }
 
 void generalized_forces(const System& sys, Data& d) {
-  check_data(sys, d);
+  check_state(sys, d);
   if (recursive(sys))
     rnea_forces(sys, d);
   else
@@ -77,7 +77,7 @@ void generalized_forces(const System& sys, Data& d) {
 }
 
 void mass_matrix(const System& sys, Data& d) {
-  check_data(sys, d);
+  check_state(sys, d);
   if (recursive(sys))
     crba(sys, d);
   else
@@ -85,7 +85,7 @@ void mass_matrix(const System& sys, Data& d) {
 }
 
 void accelerations(const System& sys, Data& d) {
-  check_data(sys, d);
+  check_state(sys, d);
   if (sys.nq == 0) return;
   check_gimbal_lock(sys, d);
   d.llt.compute(d.A);
@@ -96,7 +96,7 @@ void accelerations(const System& sys, Data& d) {
 }
 
 void driving_forces(const System& sys, Data& d) {
-  check_data(sys, d);
+  check_state(sys, d);
   if (sys.np == 0) return;
   set_accelerations(sys, d, d.qdd);
   if (recursive(sys)) {

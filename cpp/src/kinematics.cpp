@@ -13,6 +13,7 @@ void set_state(const System& sys, Data& d, double t, const Eigen::Ref<const VecX
   if (!std::isfinite(t)) throw std::invalid_argument("t: expected a finite time in s, got NaN or inf");
   check_vector(q, sys.nq, "q", "nq");
   check_vector(qd, sys.nq, "qd", "nq");
+  d.state_ok = false;  // until every drive has answered: bad input above leaves the old state
   d.t = t;
   for (int k = 0; k < sys.nq; ++k) {
     const int i = sys.free_coords[k];
@@ -30,6 +31,7 @@ void set_state(const System& sys, Data& d, double t, const Eigen::Ref<const VecX
     d.qdda(i) = m.qdd;
   }
   if (!sys.flows.empty()) update_flows(sys, d, false);
+  d.state_ok = true;
 }
 
 void set_static_state(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q) {
@@ -116,7 +118,7 @@ void set_accelerations(const System& sys, Data& d, const Eigen::Ref<const VecX>&
 }
 
 void kinematics(const System& sys, Data& d, bool rates) {
-  check_data(sys, d);
+  check_state(sys, d);
   static const Mat4 I4 = Mat4::Identity(), O4 = Mat4::Zero();
   Mat4 Tj, Tjd, Tjdd;
   for (int p = 0; p < sys.nbodies; ++p) {

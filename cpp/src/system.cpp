@@ -173,4 +173,11 @@ void check_data(const System& sys, const Data& d) {
         "data: expected a workspace made by this system's make_data(), got one of another system");
 }
 
+void check_state(const System& sys, const Data& d) {
+  check_data(sys, d);
+  if (!d.state_ok)
+    throw std::invalid_argument(
+        "data: expected a workspace with a state, got one whose last set_state raised (call set_state again)");
+}
+
 }  // namespace rigidfem

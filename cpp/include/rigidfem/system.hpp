@@ -151,10 +151,14 @@ struct Data {
   std::vector<Mat3> inertia;   // (nbodies) about the centre of mass, body axes
   VecX spring_scale;           // (nc) factor of each coordinate's stiffness and damping (L₀/L for sdes)
   std::vector<MotionState> flow;  // (nflows) L, v = L̇, v̇ at t (zero rates at rest)
+  bool state_ok = true;        // false after a set_state that raised (it leaves a half-written state)
 };
 
 /// Throws std::invalid_argument unless d is a workspace made for sys (a Data of another system
 /// would be written out of bounds).
 void check_data(const System& sys, const Data& d);
+/// check_data, and std::invalid_argument if the last set_state on d raised (the stages after it
+/// would compute from a half-written state). A fresh workspace holds the zero state.
+void check_state(const System& sys, const Data& d);
 
 }  // namespace rigidfem
