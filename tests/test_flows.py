@@ -193,3 +193,31 @@ def test_retraction_pumps_vibration_and_extrusion_damps_it():
         energy[name] = r.energy[:n].mean(), r.energy[-n:].mean()
     assert energy["retract"][1] > 1.5 * energy["retract"][0]
     assert energy["extrude"][1] < 0.8 * energy["extrude"][0]
+
+
+@pytest.mark.parametrize("L0, c", [(0.3, 2.0), (0.6, -2.0)], ids=["extrusion", "retraction"])
+def test_converges_to_the_continuum_at_second_order(L0, c):
+    """Extruded (or retracted) as L = L₀ + c t³ from the static shape at rest, the tip deflection
+    converges at second order in m to the continuum's, ρA (w_tt + 2v w_xt + v² w_xx + v̇ w_x)
+    − (N w_x)_x + EI w_xxxx = −ρA g with the axial force N = −ρA v̇ (L − x) of the accelerated
+    tape, solved independently by Galerkin in ξ = x/L (tests/extrusion_reference.py, converged to
+    5e-14 m). Gravity is scaled down (g/100) to keep the deflection, and so the RFEM's geometric
+    nonlinearity, small against the linear continuum."""
+    from extrusion_reference import solve
+
+    E, rho, b, h, g = 2.1e11, 7850.0, 0.02, 0.002, 0.0981
+    t = np.linspace(0.0, 0.5, 51)
+    ref = solve(E, b * h**3 / 12, rho, b * h, g, lambda s: L0 + c * s**3, lambda s: 3 * c * s**2,
+                lambda s: 6 * c * s, t_span=(0.0, 0.5), t_eval=t, modes=16, axial_inertia=True)
+    errors = []
+    for m in (4, 8, 16):
+        model = rf.Model(gravity=(0.0, 0.0, -g))
+        beam = model.add_beam("tape", model.ground, rf.motion.polynomial([L0, 0.0, 0.0, c]),
+                              rf.Material(E=E, rho=rho), rf.Section.rectangle(b, h), m, deform=("bend_y",))
+        s = model.compile()
+        r = rf.simulate(s, 0.5, method="dopri5", rtol=1e-9, atol=1e-13, q0=rf.static_equilibrium(s).q, t_eval=t,
+                        stiffness_warning=False)
+        errors.append(np.abs(beam.tip_positions(r)[:, 2] - ref.tip).max())
+    ratios = errors[0] / errors[1], errors[1] / errors[2]
+    assert 3.8 < ratios[0] < 4.2 and 3.8 < ratios[1] < 4.2, (errors, ratios)
+    assert errors[2] < 3e-3 * np.abs(ref.tip).max()
