@@ -93,3 +93,25 @@ def test_bad_rope_input():
     s = model.compile()
     with pytest.raises(rf.SimulationError, match="unstretched length of rope 'reeled' is l_u = -0.5 m"):
         s.forward_dynamics(1.5, [-1.0], [0.0])
+
+
+def test_a_rope_with_mass_is_the_hanging_chain():
+    """A rope with mass and sag is a beam with (almost) no bending stiffness: pinned at its top and
+    hanging under gravity, its frequencies converge at second order to the hanging chain's,
+    ω_n = (z_n/2) √(g/L) with z_n the zeros of J₀ (Bernoulli, Euler)."""
+    from scipy.special import jn_zeros
+
+    g, L = 9.81, 10.0
+    exact = jn_zeros(0, 3) / 2 * np.sqrt(g / L)
+    errors = []
+    for m in (10, 20, 40):
+        model = rf.Model(gravity=(0.0, 0.0, -g))
+        model.add_beam("rope", model.ground, L, rf.Material(E=1e3, rho=7850.0), rf.Section.rectangle(0.02, 0.02), m,
+                       deform=("bend_y",), joint=rf.Joint.revolute("y"),
+                       placement=rf.transform(euler_zyx=(0.0, np.pi / 2, 0.0)))  # hanging down
+        s = model.compile()
+        errors.append(np.abs(rf.modal_analysis(s, np.zeros(s.nq)).omega[:3] / exact - 1.0))
+    errors = np.array(errors)
+    ratios = errors[:-1] / errors[1:]
+    assert np.all(ratios > 3.4) and np.all(ratios < 4.3), ratios
+    assert errors[-1, 0] < 3e-5 and errors[-1, 2] < 3e-3
