@@ -23,6 +23,8 @@
 #      - PYTHONMALLOC=malloc: Python's objects come from the instrumented malloc too;
 #      - FUZZ_MEMORY_LIMIT=-1: the fuzz workers' address-space limit (RLIMIT_AS) would leave ASan
 #        no room for its shadow memory ("ERROR: Failed to mmap");
+#      - RIGIDFEM_CONTRACT_TIMEOUT=120 (unless set): the contract test's per-case hang limit, 15 s
+#        by default, is too short for the instrumented build (a case of 0.4 s took over 15 s);
 #      - Hypothesis without deadlines or too-slow health checks (everything runs 2-3x slower).
 #   4. A summary: ASan's reports (build/sanitize/reports/asan.<pid>) and UBSan's "runtime error"
 #      lines in the whole output (build/sanitize/output.log).
@@ -95,7 +97,8 @@ sanitized=(env
   "ASAN_OPTIONS=detect_leaks=0:allocator_may_return_null=1:log_path=$reports/asan${ASAN_OPTIONS:+:$ASAN_OPTIONS}"
   "UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1${UBSAN_OPTIONS:+:$UBSAN_OPTIONS}"
   "PYTHONMALLOC=malloc"
-  "FUZZ_MEMORY_LIMIT=-1")
+  "FUZZ_MEMORY_LIMIT=-1"
+  "RIGIDFEM_CONTRACT_TIMEOUT=${RIGIDFEM_CONTRACT_TIMEOUT:-120}")
 
 log="$root/build/sanitize/output.log"
 : > "$log"
