@@ -58,3 +58,15 @@ def pytest_collection_modifyitems(config, items):
     for item in items:
         if "slow" in item.keywords:
             item.add_marker(skip)
+
+
+def central_jacobians(s, t, q, qd, h=1e-6):
+    """(∂f/∂q, ∂f/∂q̇) of a system's generalized_forces at (t, q, q̇) by central differences."""
+    n = len(q)
+    Kq, Kqd = np.zeros((n, n)), np.zeros((n, n))
+    for j in range(n):
+        e = np.zeros(n)
+        e[j] = h
+        Kq[:, j] = (s.generalized_forces(t, q + e, qd) - s.generalized_forces(t, q - e, qd)) / (2 * h)
+        Kqd[:, j] = (s.generalized_forces(t, q, qd + e) - s.generalized_forces(t, q, qd - e)) / (2 * h)
+    return Kq, Kqd

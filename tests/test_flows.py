@@ -5,6 +5,7 @@ import numpy as np
 import pytest
 
 import rigidfem as rf
+from conftest import central_jacobians
 
 MATERIAL = rf.Material(E=2.1e9, rho=7850.0)
 WIDTH, HEIGHT = 0.02, 0.004
@@ -124,13 +125,7 @@ def test_tangents_are_exact_and_engines_agree():
     t, q, qd = 0.7, rng.uniform(-0.3, 0.3, rec.nq), rng.uniform(-2.0, 2.0, rec.nq)
     np.testing.assert_allclose(lag.forward_dynamics(t, q, qd), rec.forward_dynamics(t, q, qd), rtol=1e-9, atol=1e-8)
     Kq, Kqd = rec.force_jacobians(t, q, qd)
-    n, h = rec.nq, 1e-6
-    Fq, Fqd = np.zeros((n, n)), np.zeros((n, n))
-    for j in range(n):
-        e = np.zeros(n)
-        e[j] = h
-        Fq[:, j] = (rec.generalized_forces(t, q + e, qd) - rec.generalized_forces(t, q - e, qd)) / (2 * h)
-        Fqd[:, j] = (rec.generalized_forces(t, q, qd + e) - rec.generalized_forces(t, q, qd - e)) / (2 * h)
+    Fq, Fqd = central_jacobians(rec, t, q, qd)
     assert np.abs(Kq - Fq).max() < 1e-8 * np.abs(Fq).max()
     assert np.abs(Kqd - Fqd).max() < 1e-7 * np.abs(Fqd).max()
 

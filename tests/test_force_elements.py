@@ -6,6 +6,7 @@ import pytest
 import sympy as sp
 
 import rigidfem as rf
+from conftest import central_jacobians
 
 ENGINES = ("recursive", "lagrange")
 
@@ -65,17 +66,6 @@ def chain_with_elements(algorithm, law=False):
         model.add_cylinder(model.ground.point((-0.3, 0.2, 0.0)), c.point((0.0, 0.1, 0.0)),
                            rf.motion.harmonic(4.0, 2.0), damping=0.5)
     return model.compile(algorithm)
-
-
-def central_jacobians(s, t, q, qd, h=1e-6):
-    n = len(q)
-    Kq, Kqd = np.zeros((n, n)), np.zeros((n, n))
-    for j in range(n):
-        e = np.zeros(n)
-        e[j] = h
-        Kq[:, j] = (s.generalized_forces(t, q + e, qd) - s.generalized_forces(t, q - e, qd)) / (2 * h)
-        Kqd[:, j] = (s.generalized_forces(t, q, qd + e) - s.generalized_forces(t, q, qd - e)) / (2 * h)
-    return Kq, Kqd
 
 
 @pytest.mark.parametrize("law", [False, True])
