@@ -227,7 +227,23 @@ class ConstantSpeed(Motion):
         return self.L0 + self.speed * (t - self.t0), self.speed, 0.0
 
 
-class SmoothStroke(Motion):
+class _TripleMotion(Motion):
+    """A motion defined by ``__call__`` (t -> (L, v, v̇)); L, v and v̇ of arrays element-wise."""
+
+    def _part(self, t, k):
+        return np.vectorize(lambda s: self(s)[k])(t) if np.ndim(t) else self(t)[k]
+
+    def L(self, t):
+        return self._part(t, 0)
+
+    def v(self, t):
+        return self._part(t, 1)
+
+    def vdot(self, t):
+        return self._part(t, 2)
+
+
+class SmoothStroke(_TripleMotion):
     """L goes from L0 (t ≤ t0) to L1 (t ≥ t1) along the C³ septic smoothstep
     s(τ) = 35τ⁴ − 84τ⁵ + 70τ⁶ − 20τ⁷ (v, v̇, v̈ vanish at both ends); peak speed 35/16 (L1−L0)/(t1−t0)."""
 
@@ -243,17 +259,8 @@ class SmoothStroke(Motion):
         dds = tau**2 * (420 + tau * (-1680 + tau * (2100 - 840 * tau))) / self.T**2
         return self.L0 + d * s, d * ds, d * dds
 
-    def L(self, t):
-        return np.vectorize(lambda s: self(s)[0])(t) if np.ndim(t) else self(t)[0]
 
-    def v(self, t):
-        return np.vectorize(lambda s: self(s)[1])(t) if np.ndim(t) else self(t)[1]
-
-    def vdot(self, t):
-        return np.vectorize(lambda s: self(s)[2])(t) if np.ndim(t) else self(t)[2]
-
-
-class RampToSpeed(Motion):
+class RampToSpeed(_TripleMotion):
     """Starts at rest with length L0 at t0, reaches the speed v smoothly at t0 + t_ramp (speed profile
     v·s(τ), s the C³ septic smoothstep) and keeps it: L = L0 + v t_ramp (7τ⁵ − 14τ⁶ + 10τ⁷ − 5τ⁸/2)
     during the ramp, L0 + v t_ramp/2 + v (t − t0 − t_ramp) after it."""
@@ -272,15 +279,6 @@ class RampToSpeed(Motion):
         S = u**4 * (35 + u * (-84 + u * (70 - 20 * u)))
         dS = u**3 * (140 + u * (-420 + u * (420 - 140 * u)))
         return self.L0 + V * tr * iS, V * S, V * dS / tr
-
-    def L(self, t):
-        return np.vectorize(lambda s: self(s)[0])(t) if np.ndim(t) else self(t)[0]
-
-    def v(self, t):
-        return np.vectorize(lambda s: self(s)[1])(t) if np.ndim(t) else self(t)[1]
-
-    def vdot(self, t):
-        return np.vectorize(lambda s: self(s)[2])(t) if np.ndim(t) else self(t)[2]
 
 
 class CallableMotion(Motion):
