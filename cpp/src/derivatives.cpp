@@ -156,21 +156,16 @@ void tangent_column(const System& sys, const Data& d, const std::vector<BodyLoad
 std::pair<MatX, MatX> rnea_derivatives(const System& sys, Data& d) {
   spatial_kinematics(sys, d);
   rnea_pass(sys, d);
+  // The loads (their geometric term) and the states of the elements and flowing rfes whose forces
+  // change with the state.
   std::vector<BodyLoad> loads;
-  for (const Load& L : sys.loads) loads.push_back({L.body, L.follower, applied_load(d, L)});
+  for_each_body_load(sys, d, true, [&](int body, const AppliedLoad& a, bool follower) {
+    loads.push_back({body, follower, a});
+  });
   std::vector<ElementState> elements;
-  for (const ForceElement& E : sys.elements) {
-    elements.push_back(element_state(d, E, true));
-    const auto [on_b, on_a] = element_loads(elements.back());
-    if (E.body_b >= 0) loads.push_back({E.body_b, false, on_b});
-    if (E.body_a >= 0) loads.push_back({E.body_a, false, on_a});
-  }
-  const std::vector<FlowTerm> flows = flow_terms(sys, d, true);
-  for (const FlowTerm& f : flows) {
-    const auto [coriolis, turn] = flow_loads(f);
-    loads.push_back({f.body, false, coriolis});
-    loads.push_back({f.body, false, turn});
-  }
+  for (const ForceElement& E : sys.elements) elements.push_back(element_state(d, E, true));
+  std::vector<FlowTerm> flows;
+  for_each_flow_term(sys, d, true, [&](const FlowTerm& f) { flows.push_back(f); });
   MatX dq(sys.nq, sys.nq), dqd(sys.nq, sys.nq);
   Tangent w(sys);
   for (int j = 0; j < sys.nq; ++j) {

@@ -87,25 +87,18 @@ void update_flows(const System& sys, Data& d, bool at_rest) {
   }
 }
 
-std::vector<FlowTerm> flow_terms(const System& sys, const Data& d, bool spatial) {
-  std::vector<FlowTerm> terms;
-  for (std::size_t f = 0; f < sys.flows.size(); ++f) {
-    const Flow& F = sys.flows[f];
-    const MotionState& L = d.flow[f];
-    const double rhoA = d.mass[F.first] / (F.share(0) * L.q);
-    for (int k = 0; k <= F.elements; ++k) {
-      const int b = F.first + k, prev = k > 0 ? b - 1 : sys.parent[b];
-      const double slip = 1.0 - F.xi(k);
-      FlowTerm t{b, prev, d.mass[b], rhoA, L.qd * slip, L.qdd * slip, d.T[b].block<3, 1>(0, 0), Vec3::Zero(),
-                 angular_velocity(d, b, spatial), (d.T[b] * d.com[b].homogeneous()).head<3>(),
-                 d.T[b].block<3, 1>(0, 3)};
-      // The axis the material comes from: rfe k − 1's, or for rfe 0 the guide's (x of T_parent B_0).
-      t.e_prev = k > 0 ? Vec3(d.T[prev].block<3, 1>(0, 0))
-                       : Vec3((prev >= 0 ? d.T[prev] : Mat4::Identity()).topLeftCorner<3, 3>() * sys.B[b].block<3, 1>(0, 0));
-      terms.push_back(t);
-    }
-  }
-  return terms;
+FlowTerm flow_term(const System& sys, const Data& d, int flow, int k, bool spatial) {
+  const Flow& F = sys.flows[flow];
+  const MotionState& L = d.flow[flow];
+  const int b = F.first + k, prev = k > 0 ? b - 1 : sys.parent[b];
+  const double slip = 1.0 - F.xi(k);
+  // The axis the material comes from: rfe k − 1's, or for rfe 0 the guide's (x of T_parent B_0).
+  const Vec3 e_prev = k > 0 ? Vec3(d.T[prev].block<3, 1>(0, 0))
+                            : Vec3((prev >= 0 ? d.T[prev] : Mat4::Identity()).topLeftCorner<3, 3>() *
+                                   sys.B[b].block<3, 1>(0, 0));
+  return {b, prev, d.mass[b], d.mass[F.first] / (F.share(0) * L.q), L.qd * slip, L.qdd * slip,
+          d.T[b].block<3, 1>(0, 0), e_prev, angular_velocity(d, b, spatial),
+          (d.T[b] * d.com[b].homogeneous()).head<3>(), d.T[b].block<3, 1>(0, 3)};
 }
 
 std::pair<AppliedLoad, AppliedLoad> flow_loads(const FlowTerm& f) {

@@ -21,22 +21,12 @@ void load_composites(const System& sys, Data& d) {
   const Vec4 g(gl.x(), gl.y(), gl.z(), 0.0);
   // Gravity: V = −Σ m gᵀ r_C, so Q_i = g̃ᵀ U_i T_p H_p e₄ = tr(U_i (T_p H_p e₄) g̃ᵀ).
   for (int p = 0; p < sys.nbodies; ++p) d.Zbar[p].noalias() = (d.T[p] * d.H[p].col(3)) * g.transpose();
-  for (const Load& L : sys.loads) {
+  for_each_body_load(sys, d, false, [&](int body, const AppliedLoad& a, bool) {
     // Force F at point x: Q_i = F̃ᵀ U_i x = tr(U_i x F̃ᵀ); torque τ: tr(U_i [[−½S(τ), 0], [0, 0]]) = w_i · τ.
-    const AppliedLoad a = applied_load(d, L);
-    Mat4& Z = d.Zbar[L.body];
+    Mat4& Z = d.Zbar[body];
     Z.leftCols<3>() += Vec4(a.x.homogeneous()) * a.F.transpose();
     Z.topLeftCorner<3, 3>() -= 0.5 * skew(a.tau);
-  }
-  for (const FlowTerm& f : flow_terms(sys, d, false)) {
-    const auto [coriolis, turn] = flow_loads(f);
-    for (const AppliedLoad& a : {coriolis, turn}) d.Zbar[f.body].leftCols<3>() += Vec4(a.x.homogeneous()) * a.F.transpose();
-  }
-  for (const ForceElement& E : sys.elements) {
-    const auto [on_b, on_a] = element_loads(element_state(d, E, false));
-    for (const auto& [body, a] : {std::pair<int, const AppliedLoad&>{E.body_b, on_b}, {E.body_a, on_a}})
-      if (body >= 0) d.Zbar[body].leftCols<3>() += Vec4(a.x.homogeneous()) * a.F.transpose();
-  }
+  });
   accumulate_subtrees(sys, d.Zbar);
 }
 

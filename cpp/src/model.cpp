@@ -15,6 +15,17 @@ namespace {
 
 std::string num8(double x) { return num(x, 8); }
 
+// `item` named "<prefix><index>" if its name is empty; std::invalid_argument naming `name` if another
+// of `items` has its name already.
+template <class T>
+T with_unique_name(T item, const std::vector<T>& items, const char* prefix, const char* what) {
+  if (item.name.empty()) item.name = prefix + std::to_string(items.size());
+  for (const T& other : items)
+    if (other.name == item.name)
+      bad("name", std::string("a name not used by another ") + what, "'" + item.name + "'");
+  return item;
+}
+
 // The growth x_k(t) = κ (L(t) − L₀) of the distance between two rfe frames of a link of varying
 // length (flows.hpp), with its rates κ L̇ and κ L̈.
 class Growth final : public Profile {
@@ -270,11 +281,7 @@ int Model::add_loop(const Loop& loop) {
   }
   if (loop.kind == LoopKind::Distance && !loop.drive && !(loop.length > 0.0 && std::isfinite(loop.length)))
     bad("length", "a positive distance in m", num8(loop.length));
-  Loop named = loop;
-  if (named.name.empty()) named.name = "loop" + std::to_string(loops_.size());
-  for (const Loop& other : loops_)
-    if (other.name == named.name) bad("name", "a name not used by another loop", "'" + named.name + "'");
-  loops_.push_back(std::move(named));
+  loops_.push_back(with_unique_name(loop, loops_, "loop", "loop"));
   return static_cast<int>(loops_.size()) - 1;
 }
 
@@ -296,11 +303,7 @@ int Model::add_force_element(const ForceElement& element) {
     if (!(element.DA >= 0.0 && std::isfinite(element.DA))) bad("DA", "a finite axial damping DA >= 0 in N·s", num8(element.DA));
     if (!element.unstretched && !(element.length > 0.0)) bad("length", "a positive unstretched length in m", num8(element.length));
   }
-  ForceElement named = element;
-  if (named.name.empty()) named.name = "element" + std::to_string(elements_.size());
-  for (const ForceElement& other : elements_)
-    if (other.name == named.name) bad("name", "a name not used by another force element", "'" + named.name + "'");
-  elements_.push_back(std::move(named));
+  elements_.push_back(with_unique_name(element, elements_, "element", "force element"));
   return static_cast<int>(elements_.size()) - 1;
 }
 

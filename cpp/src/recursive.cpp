@@ -49,27 +49,11 @@ void spatial_kinematics(const System& sys, Data& d) {
                              R * d.inertia[p] * R.transpose());
     d.fext[p].setZero();
   }
-  for (const Load& L : sys.loads) {
+  for_each_body_load(sys, d, true, [&](int body, const AppliedLoad& a, bool) {
     // As a spatial force at the global origin: (x × F + τ, F).
-    const AppliedLoad a = applied_load(d, L);
-    d.fext[L.body].head<3>() += a.x.cross(a.F) + a.tau;
-    d.fext[L.body].tail<3>() += a.F;
-  }
-  for (const FlowTerm& f : flow_terms(sys, d, true)) {
-    const auto [coriolis, turn] = flow_loads(f);
-    for (const AppliedLoad& a : {coriolis, turn}) {
-      d.fext[f.body].head<3>() += a.x.cross(a.F);
-      d.fext[f.body].tail<3>() += a.F;
-    }
-  }
-  for (const ForceElement& E : sys.elements) {
-    const auto [on_b, on_a] = element_loads(element_state(d, E, true));
-    for (const auto& [body, a] : {std::pair<int, const AppliedLoad&>{E.body_b, on_b}, {E.body_a, on_a}}) {
-      if (body < 0) continue;
-      d.fext[body].head<3>() += a.x.cross(a.F);
-      d.fext[body].tail<3>() += a.F;
-    }
-  }
+    d.fext[body].head<3>() += a.x.cross(a.F) + a.tau;
+    d.fext[body].tail<3>() += a.F;
+  });
 }
 
 void rnea_pass(const System& sys, Data& d) {

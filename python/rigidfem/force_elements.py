@@ -32,7 +32,7 @@ from . import _checks
 from ._core import Body, Point, Profile
 
 
-def _point(model, where, name: str):
+def point_of(model, where, name: str):
     """(body index, point in that body's frame, m) of a Point, a Body (its origin) or the ground."""
     if isinstance(where, Body):
         if not model._owns(where):
@@ -62,8 +62,8 @@ def add_force_element(model, a, b, *, stiffness: float = 0.0, damping: float = 0
                       force=0.0, name: str | None = None) -> str:
     """The element added to ``model`` (see ``Model.add_spring_damper``, ``Model.add_cylinder``);
     returns its name ("element<k>" when ``name`` is None)."""
-    ia, ra = _point(model, a, "a")
-    ib, rb = _point(model, b, "b")
+    ia, ra = point_of(model, a, "a")
+    ib, rb = point_of(model, b, "b")
     stiffness = _checks.scalar(stiffness, "stiffness", nonnegative=True, unit="N/m")
     damping = _checks.scalar(damping, "damping", nonnegative=True, unit="N s/m")
     length = _checks.scalar(length, "length", nonnegative=True, unit="m")
@@ -74,8 +74,8 @@ def add_force_element(model, a, b, *, stiffness: float = 0.0, damping: float = 0
 
 def add_rope(model, a, b, *, EA: float, length, damping: float = 0.0, name: str | None = None) -> str:
     """A rope between ``a`` and ``b`` (see ``Model.add_rope``); returns its name."""
-    ia, ra = _point(model, a, "a")
-    ib, rb = _point(model, b, "b")
+    ia, ra = point_of(model, a, "a")
+    ib, rb = point_of(model, b, "b")
     EA = _checks.scalar(EA, "EA", positive=True, unit="N")
     DA = _checks.scalar(damping, "damping", nonnegative=True, unit="N s")
     if isinstance(length, Profile):

@@ -28,7 +28,8 @@ from __future__ import annotations
 import numpy as np
 
 from . import _checks
-from ._core import Body, Point, Profile
+from ._core import Point, Profile
+from .force_elements import point_of
 
 KINDS = ("revolute", "spherical", "universal", "prismatic", "cylindrical", "fixed", "distance")
 
@@ -36,16 +37,7 @@ KINDS = ("revolute", "spherical", "universal", "prismatic", "cylindrical", "fixe
 def _frame(model, where, frame, name: str):
     """(body index, 4x4 frame in that body) of a Body (its frame), a Point (the body's axes at the
     point) or the ground; ``frame`` (4, 4) in the body's frame replaces the default."""
-    if isinstance(where, Body):
-        if not model._owns(where):
-            raise ValueError(f"{name}: expected a Body or Point of this model, got {where!r}")
-        body, origin = where.index, np.zeros(3)
-    elif isinstance(where, Point):
-        if not -1 <= where.body < model.nbodies or where.model not in (0, model.id):
-            raise ValueError(f"{name}: expected a Body or Point of this model, got {where!r}")
-        body, origin = where.body, np.asarray(where.r, dtype=float)
-    else:
-        raise ValueError(f"{name}: expected a Body or Point of this model (or model.ground), got {where!r}")
+    body, origin = point_of(model, where, name)
     if frame is None:
         F = np.eye(4)
         F[:3, 3] = origin

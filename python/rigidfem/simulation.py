@@ -354,21 +354,19 @@ def _run_scipy(system, name, t0, t_end, q0, qd0, t_eval, rtol, atol, max_step, m
     start = time.perf_counter()
     solver_class = getattr(scipy.integrate, name)
 
-    def rhs(t, y):
-        if not np.all(np.isfinite(y)):
-            raise _NonFinite(t, f"the state became NaN or inf (scipy {name})")
-        yd = system.rhs(t, y)
-        if not np.all(np.isfinite(yd)):
-            raise _NonFinite(t, f"the accelerations became NaN or inf (scipy {name})")
-        return yd
+    def finite(evaluate, what):
+        """``evaluate`` of the C++ system, raising _NonFinite at t when its state or value is not finite."""
+        def checked(t, y):
+            if not np.all(np.isfinite(y)):
+                raise _NonFinite(t, f"the state became NaN or inf (scipy {name})")
+            value = evaluate(t, y)
+            if not np.all(np.isfinite(value)):
+                raise _NonFinite(t, f"the {what} became NaN or inf (scipy {name})")
+            return value
+        return checked
 
-    def jacobian(t, y):
-        if not np.all(np.isfinite(y)):
-            raise _NonFinite(t, f"the state became NaN or inf (scipy {name})")
-        J = system.jacobian(t, y)
-        if not np.all(np.isfinite(J)):
-            raise _NonFinite(t, f"the Jacobian of the rhs became NaN or inf (scipy {name})")
-        return J
+    rhs = finite(system.rhs, "accelerations")
+    jacobian = finite(system.jacobian, "Jacobian of the rhs")
 
     options = {"jac": jacobian} if name in ("Radau", "BDF", "LSODA") else {}
     if first_step is not None:

@@ -69,11 +69,35 @@ struct FlowTerm {
   double m, rhoA, alpha, beta;
   Vec3 e, e_prev, omega, xc, origin;
 };
-std::vector<FlowTerm> flow_terms(const System& sys, const Data& d, bool spatial);
+FlowTerm flow_term(const System& sys, const Data& d, int flow, int k, bool spatial);
+/// visit(term) for rfe k = 0..m of every link of varying length (no allocation: the per-step path).
+template <class Visit>
+void for_each_flow_term(const System& sys, const Data& d, bool spatial, Visit&& visit) {
+  for (int f = 0; f < static_cast<int>(sys.flows.size()); ++f)
+    for (int k = 0; k <= sys.flows[f].elements; ++k) visit(flow_term(sys, d, f, k, spatial));
+}
 /// The loads of the flowing material (inertia moved to the right-hand side): on rfe k
 /// −m (2 α ω × e + β e) at x_C (Coriolis and relative acceleration), and −ρA α² (e − e_prev)
 /// at its origin (the turn at the sde).
 std::pair<AppliedLoad, AppliedLoad> flow_loads(const FlowTerm& f);
+
+/// visit(body, load, follower) for every load on a body at the current state, the one list both
+/// formulations and the tangents read: the model's loads, the force elements' two point forces
+/// (none on the ground) and the loads of the flowing material. Velocities as in element_state.
+template <class Visit>
+void for_each_body_load(const System& sys, const Data& d, bool spatial, Visit&& visit) {
+  for (const Load& L : sys.loads) visit(L.body, applied_load(d, L), L.follower);
+  for (const ForceElement& E : sys.elements) {
+    const auto [on_b, on_a] = element_loads(element_state(d, E, spatial));
+    if (E.body_b >= 0) visit(E.body_b, on_b, false);
+    if (E.body_a >= 0) visit(E.body_a, on_a, false);
+  }
+  for_each_flow_term(sys, d, spatial, [&](const FlowTerm& f) {
+    const auto [coriolis, turn] = flow_loads(f);
+    visit(f.body, coriolis, false);
+    visit(f.body, turn, false);
+  });
+}
 
 /// Q_i of springs, dampers and applied generalised forces on coordinate i (all coordinates):
 /// −c_i (q_i − q_i⁰) − b_i q̇_i + λ (Q_i + Q_i(t, q_i, q̇_i)).
