@@ -6,7 +6,9 @@ Flexible Multibody Systems: Rigid Finite Element Method* (Springer 2006), with a
 C++ core. SI units throughout.
 """
 
-from . import motion, samples, stages, study
+import importlib
+
+from . import motion, plots, samples, stages, study
 from ._core import (
     R1,
     R2,
@@ -35,9 +37,21 @@ from .materials import Material, Section
 from .frames import transform
 from .model import Model, System
 from . import sea  # noqa: E402 (rigidfem.sea: sea states for a moving base)
-from .simulation import Result, simulate
+from .simulation import Result, load_npz, simulate
+from . import display, export  # noqa: E402 (notebook displays; tables, CSV and NumPy archives)
+from .sweep import sweep
 
 __version__ = "0.1.0"
+
+
+def __getattr__(name: str):
+    """``rigidfem.animation`` and ``rigidfem.animate`` on first use: they import
+    matplotlib.animation (about 0.1 s), which ``import rigidfem`` does without."""
+    if name in ("animation", "animate"):
+        animation = importlib.import_module(".animation", __name__)  # also sets rigidfem.animation
+        return animation if name == "animation" else animation.animate
+    raise AttributeError(f"module 'rigidfem' has no attribute {name!r}")
+
 
 __all__ = [
     "R1",
@@ -59,13 +73,19 @@ __all__ = [
     "Section",
     "SimulationError",
     "System",
+    "animate",
+    "animation",
+    "display",
     "euler_zyx",
+    "export",
     "homogeneous",
     "inverse",
+    "plots",
     "pseudo_inertia",
     "joint_transform",
     "joint_transform_derivative",
     "joint_transform_second_derivative",
+    "load_npz",
     "modal_analysis",
     "motion",
     "rfe_parameters",
@@ -77,5 +97,6 @@ __all__ = [
     "stages",
     "static_equilibrium",
     "study",
+    "sweep",
     "transform",
 ]

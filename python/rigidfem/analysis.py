@@ -31,8 +31,9 @@ import scipy.linalg
 import scipy.optimize
 from scipy.linalg import lapack
 
-from . import _checks
+from . import _checks, display, export
 from ._core import SimulationError
+from .persistence import Versioned
 
 _EPS = np.finfo(float).eps
 #: The tangent stiffness counts as singular when its reciprocal condition number, after symmetric
@@ -200,7 +201,7 @@ def _close_loops(system, q: np.ndarray, t: float, what: str) -> np.ndarray:
 # --------------------------------------------------------------------------- statics
 
 @dataclass
-class Equilibrium:
+class Equilibrium(Versioned):
     """Result of ``static_equilibrium``."""
 
     q: np.ndarray            #: (nq,) equilibrium coordinates, m and rad
@@ -387,7 +388,7 @@ def _constrained_statics(system, q: np.ndarray, t: float, steps: int, tol: float
 # --------------------------------------------------------------------------- modes
 
 @dataclass
-class Modes:
+class Modes(Versioned):
     """Result of ``modal_analysis``: one entry per mode (k = nq, or nq − rank G with loops), sorted
     by natural frequency."""
 
@@ -410,6 +411,19 @@ class Modes:
     basis: np.ndarray | None = field(default=None, repr=False)
     #: (nl,) the loops' multipliers λ (least squares of f + Gᵀλ = 0) in the geometric stiffness; empty without loops
     multipliers: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+
+    def _repr_html_(self) -> str:
+        """Notebook display: the frequency table (``rigidfem.display``)."""
+        return display.modes_html(self)
+
+    def table(self) -> list[dict]:
+        """The frequency table, one dict per mode: ``mode`` (1, 2, ...), ``omega (rad/s)``,
+        ``f (Hz)``, ``zeta`` (no pandas needed)."""
+        return export.modes_table(self)
+
+    def to_dataframe(self):
+        """``table()`` as a pandas DataFrame indexed by mode (ImportError without pandas)."""
+        return export.modes_dataframe(self)
 
 
 def _check_mass_matrix(M: np.ndarray, names, t: float, basis: np.ndarray | None = None) -> None:

@@ -10,10 +10,11 @@ from collections.abc import Callable
 
 import numpy as np
 
-from . import _checks, _contract, _core, force_elements, joints, loops
+from . import _checks, _contract, _core, display, force_elements, joints, loops, persistence
 from ._core import Body, JointSpec, Point, Profile
 from .beams import add_beam
 from .frames import transform  # noqa: F401 (re-exported: rigidfem.model.transform)
+from .persistence import recorded
 
 
 def _inertia(inertia) -> np.ndarray:
@@ -76,7 +77,26 @@ class Model(_core._Model):
     """
 
     def __init__(self, gravity=(0.0, 0.0, -9.81)):
-        super().__init__(np.zeros(3) if gravity is None else _checks.vec3(gravity, "gravity"))
+        g = np.zeros(3) if gravity is None else _checks.vec3(gravity, "gravity")
+        super().__init__(g)
+        self._gravity0, self._calls, self._building = np.array(g, dtype=float), [], False  # the recipe (pickling)
+
+    @property
+    def gravity(self) -> np.ndarray:
+        """Gravitational acceleration (3,) in m/s², global frame."""
+        return _core._Model.gravity.fget(self)
+
+    @gravity.setter
+    def gravity(self, g) -> None:
+        self._set_gravity(g)
+
+    @recorded
+    def _set_gravity(self, g) -> None:
+        _core._Model.gravity.fset(self, _checks.vec3(g, "gravity"))
+
+    def __reduce__(self):
+        """Pickled as its recipe (rigidfem.persistence): unpickling replays the builder calls."""
+        return _model_from_state, (persistence.model_state(self),)
 
     @property
     def ground(self) -> Body:
@@ -114,6 +134,7 @@ class Model(_core._Model):
             return self._body_index(parent)
         raise ValueError(f"parent: expected a Body handle or a body name, got {parent!r}")
 
+    @recorded
     def add_body(
         self,
         name: str,
@@ -165,6 +186,7 @@ class Model(_core._Model):
             raise ValueError(f"coordinate: expected None or a coordinate name such as 'x' or 'rz', got {coordinate!r}")
         return -1 if coordinate is None else self._coordinate_index(body.index, coordinate)
 
+    @recorded
     def prescribe(self, body: Body, motion: Profile, coordinate: str | None = None) -> None:
         """Drive a coordinate of ``body``'s joint by ``motion`` (``rigidfem.motion.*``).
 
@@ -178,6 +200,7 @@ class Model(_core._Model):
         k = self._coordinate(body, coordinate)
         self._prescribe(body.index, k, motion)
 
+    @recorded
     def add_moving_base(self, name: str, motion=None, *, mass: float = 1e-6, inertia=(1e-6, 1e-6, 1e-6),
                         com=(0.0, 0.0, 0.0), placement=None) -> Body:
         """Add a base body moving with a prescribed 6-DOF motion; returns its ``Body``.
@@ -211,6 +234,7 @@ class Model(_core._Model):
             self.prescribe(base, profile, coordinate=coordinate)
         return base
 
+    @recorded
     def add_generalized_force(
         self, body: Body, force: float | Callable[[float, float, float], float], coordinate: str | None = None
     ) -> None:
@@ -229,6 +253,7 @@ class Model(_core._Model):
         else:
             self._add_generalized_force(body.index, k, _checks.scalar(force, "force"), None)
 
+    @recorded
     def add_force(self, point, force, *, follower: bool = False, scale: Profile | None = None) -> None:
         """Apply a point force (N) at ``point`` (a ``Point`` or a ``Body``'s origin).
 
@@ -239,6 +264,7 @@ class Model(_core._Model):
         p = self._point(point)
         self._add_load(p.body, p.r, _checks.vec3(force, "force"), np.zeros(3), bool(follower), _scale(scale))
 
+    @recorded
     def add_torque(self, body: Body, torque, *, follower: bool = False, scale: Profile | None = None) -> None:
         """Apply a torque (N·m) on ``body``: global components, or body ones if ``follower``."""
         p = self._point(body)
@@ -253,6 +279,7 @@ class Model(_core._Model):
             raise ValueError(f"point: expected a Point or Body of this model, got {point!r}")
         return point
 
+    @recorded
     def add_loop_joint(self, kind: str, a, b, *, frame_a=None, frame_b=None, length: float | None = None,
                        name: str | None = None) -> str:
         """Close a kinematic loop: a joint of ``kind`` between ``a`` and ``b`` (book ch. 2.6).
@@ -280,6 +307,7 @@ class Model(_core._Model):
         """
         return loops.add_loop_joint(self, kind, a, b, frame_a=frame_a, frame_b=frame_b, length=length, name=name)
 
+    @recorded
     def add_actuator(self, a, b, length, *, name: str | None = None) -> str:
         """A linear actuator (hydraulic cylinder under position control) between the points ``a``
         and ``b`` (Point or Body): their distance is held at ``length`` (m), a number or a
@@ -287,6 +315,7 @@ class Model(_core._Model):
         loop's reaction, column 0 of ``System.loop_reactions``. Returns its name."""
         return loops.add_actuator(self, a, b, length, name=name)
 
+    @recorded
     def add_spring_damper(self, a, b, *, stiffness: float, length: float, damping: float = 0.0,
                           name: str | None = None) -> str:
         """A linear spring-damper between the points ``a`` and ``b`` (Point, Body or
@@ -298,6 +327,7 @@ class Model(_core._Model):
         return force_elements.add_force_element(self, a, b, stiffness=stiffness, damping=damping, length=length,
                                                 name=name)
 
+    @recorded
     def add_cylinder(self, a, b, force, *, damping: float = 0.0, name: str | None = None) -> str:
         """A hydraulic cylinder under force control between the points ``a`` and ``b``: it pushes
         them apart with ``force`` (N; negative pulls) — a number, a ``rigidfem.motion`` profile
@@ -307,6 +337,7 @@ class Model(_core._Model):
         default); ``System.element_states`` and ``Result.element_forces`` give its force."""
         return force_elements.add_force_element(self, a, b, damping=damping, force=force, name=name)
 
+    @recorded
     def add_rope(self, a, b, *, EA: float, length, damping: float = 0.0, name: str | None = None) -> str:
         """A massless rope between the points ``a`` and ``b`` (book ch. 7.1: a hoisting rope): it
         only pulls, with the tension T = (EA (l − l_u) + DA (l̇ − l̇_u))/l_u while positive, 0 when
@@ -316,6 +347,7 @@ class Model(_core._Model):
         force F = −T (N)."""
         return force_elements.add_rope(self, a, b, EA=EA, length=length, damping=damping, name=name)
 
+    @recorded
     def add_beam(self, name: str, parent, length, material, section, elements: int,
                  formulation: str = "modified", deform=None, linear: bool = False, joint=None, placement=None,
                  tip_mass: float = 0.0, tip_inertia=(0.0, 0.0, 0.0), tip_offset=(0.0, 0.0, 0.0)):
@@ -379,6 +411,10 @@ class Model(_core._Model):
         """
         return System(self, algorithm)
 
+    def _repr_html_(self) -> str:
+        """Notebook display: bodies, parents, joints, coordinates, beams, loops (``rigidfem.display``)."""
+        return display.model_html(self)
+
 
 class System(_core._System):
     """A compiled multibody system: the book's A(q) q̈ = f(q, q̇, t).
@@ -394,6 +430,13 @@ class System(_core._System):
             raise ValueError(f"algorithm: expected 'recursive' or 'lagrange', got {algorithm!r}")
         super().__init__(model, algorithm)
         self._model_id = model.id  # handles of other models are refused (_checks.same_model)
+        self._state = {"rigidfem_state": persistence.STATE_VERSION, "model": persistence.model_state(model),
+                       "algorithm": algorithm}
+
+    def __reduce__(self):
+        """Pickled as its model's recipe at compile time and the algorithm; compiled again when
+        unpickled (bitwise identical results in any process)."""
+        return _system_from_state, (self._state,)
 
     def position(self, point, q, t: float | None = None) -> np.ndarray:
         """Global position (3,) in m of a ``Point`` (or a ``Body``'s origin) of this system's model.
@@ -435,6 +478,22 @@ class System(_core._System):
     def __repr__(self) -> str:
         loops_ = f", {len(self.loop_names)} loops ({self.nl} constraints)" if self.nl else ""
         return f"<rigidfem System: {self.nbodies} bodies, nq={self.nq}, {self.np} prescribed{loops_}>"
+
+    def _repr_html_(self) -> str:
+        """Notebook display: bodies, parents, joints, coordinates, beams, loops (``rigidfem.display``)."""
+        return display.system_html(self)
+
+
+def _model_from_state(state: dict) -> Model:
+    """Unpickling: a Model made again from its recipe (``persistence.model_state``)."""
+    persistence.check_version(state, "Model")
+    return persistence.replay(Model(gravity=state["gravity"]), state)
+
+
+def _system_from_state(state: dict) -> System:
+    """Unpickling: a System compiled again from the recipe of its model at compile time."""
+    persistence.check_version(state, "System")
+    return _model_from_state(state["model"]).compile(state["algorithm"])
 
 
 _contract.guard_methods(System)

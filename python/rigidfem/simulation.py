@@ -36,14 +36,16 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _checks, _core
+from . import _checks, _core, display, export
+from ._progress import ProgressBar
+from .persistence import Versioned
 from ._core import Body, Point
 
 SCIPY_METHODS = ("Radau", "BDF", "LSODA", "RK45", "DOP853")
 
 
 @dataclass
-class Result:
+class Result(Versioned):
     """A simulation's output at the times ``t`` (s).
 
     ``q``, ``qd`` are (len(t), nq) in m, rad and per s; the other arrays are computed
@@ -128,6 +130,34 @@ class Result:
         return (f"<rigidfem Result {self.method}: {len(self.t)} outputs to t = {self.t[-1]:g} s, {s['steps']} steps "
                 f"({s['rejected_steps']} rejected), {s['rhs_evaluations']} rhs, {s['wall_time']:.3g} s"
                 f"{', interrupted' if self.interrupted else ''}>")
+
+    def _repr_html_(self) -> str:
+        """Notebook display: method, outputs, steps, rhs evaluations, wall time (``rigidfem.display``)."""
+        return display.result_html(self)
+
+    def to_dataframe(self, points=None):
+        """pandas DataFrame indexed by ``t`` (s): a column per coordinate (q, m or rad, named as in
+        ``system.coordinate_names``), ``<name>.dot`` per coordinate (q̇, m/s or rad/s) and, for
+        ``points={"tip": beam.tip}`` (Points or Bodies), ``tip.x``, ``tip.y``, ``tip.z`` (global
+        position, m). ImportError when pandas is not installed (``to_csv`` needs none)."""
+        return export.to_dataframe(self, points)
+
+    def to_csv(self, path, points=None):
+        """Write the table of ``to_dataframe`` as CSV with a header line ``t,<columns>`` (numpy only;
+        17 significant digits). Returns ``path``."""
+        return export.to_csv(self, path, points)
+
+    def to_npz(self, path):
+        """Save t, q, qd, coordinate_names, method, stats and interrupted in a NumPy archive;
+        ``rigidfem.load_npz(path, system)`` reads it back. Returns ``path``."""
+        return export.to_npz(self, path)
+
+
+def load_npz(path, system=None) -> Result:
+    """The Result saved by ``Result.to_npz``. Give the ``system`` it was computed with (its
+    coordinate names must match; ValueError otherwise) to use the outputs that need it: positions,
+    energies, ``to_dataframe``."""
+    return Result(system, **export.read_npz(path, system))
 
 
 def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = None, rtol=1e-6,
@@ -233,7 +263,7 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
     if stop is not None and not callable(getattr(stop, "is_set", None)):
         raise ValueError(f"stop: expected None or a threading.Event (an object with is_set()), got {stop!r}")
     _check_closed(system, t0, q0, qd0)
-    bar = _ProgressBar(t0, t_end) if progress else None
+    bar = ProgressBar(t_end - t0, "s", "simulate") if progress else None
     try:
         scipy = method.startswith("scipy:")
         # scipy: methods check the options of the C++ ones too (they use only first_step of them)
@@ -242,9 +272,9 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
         if scipy:
             first = None if first_step is None else opt.dt
             run = _run_scipy(system, method[6:], t0, t_end, q0, qd0, t_eval, rtol, atol, max_step, max_steps,
-                             _keep_going(bar, stop), first)
+                             _keep_going(bar, stop, t0), first)
         else:
-            run = _core._integrate(system, t0, t_end, q0, qd0, t_eval, opt, _keep_going(bar, stop))
+            run = _core._integrate(system, t0, t_end, q0, qd0, t_eval, opt, _keep_going(bar, stop, t0))
     finally:
         if bar is not None:
             bar.close()
@@ -301,7 +331,7 @@ def _options(method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, 
     return opt
 
 
-def _keep_going(bar, stop):
+def _keep_going(bar, stop, t0):
     """The monitor of a run, called about every 0.05 s with t: updates the progress bar, and
     returns False once ``stop`` is set. None when there is nothing to do."""
     if bar is None and stop is None:
@@ -309,7 +339,7 @@ def _keep_going(bar, stop):
 
     def keep_going(t):
         if bar is not None:
-            bar(t)
+            bar.update(t - t0)
         return stop is None or not stop.is_set()
 
     return keep_going
@@ -444,32 +474,3 @@ def _scipy_outputs(t_eval, t_before, t_after, dense, y_after, ts, ys):
 def _failure(t, cause):
     """(message, time, cause) of a failed run, as _core._integrate reports it."""
     return f"at t = {t:.10g} s: {cause}", float(t), cause
-
-
-class _ProgressBar:
-    """tqdm when installed, otherwise a line on stderr; updated from the C++ loop's monitor."""
-
-    def __init__(self, t0, t_end):
-        self.t0, self.t_end = t0, t_end
-        try:
-            from tqdm.auto import tqdm
-
-            self.bar = tqdm(total=t_end - t0, unit="s", desc="simulate")
-        except ImportError:
-            self.bar = None
-
-    def __call__(self, t):
-        if self.bar is not None:
-            self.bar.update(t - self.t0 - self.bar.n)
-        else:
-            import sys
-
-            print(f"\rsimulate: t = {t:.4g} of {self.t_end:g} s", end="", file=sys.stderr, flush=True)
-
-    def close(self):
-        if self.bar is not None:
-            self.bar.close()
-        else:
-            import sys
-
-            print(file=sys.stderr)

@@ -1,0 +1,99 @@
+"""Export of results: tables (pandas DataFrame, CSV), NumPy archives, the modes' frequency table.
+
+Column names of a Result's table (``Result.to_dataframe``, ``Result.to_csv``):
+
+- ``t``: time, s (the DataFrame's index; the first CSV column);
+- one column per coordinate, named as in ``System.coordinate_names`` (``"link.rz"``): q, m or rad;
+- ``<name>.dot`` per coordinate: q̇, m/s or rad/s;
+- for ``points={"tip": beam.tip}``: ``tip.x``, ``tip.y``, ``tip.z``, the global position in m.
+
+The modes' table (``Modes.table``, ``Modes.to_dataframe``) has the columns ``mode`` (1, 2, ...),
+``omega (rad/s)``, ``f (Hz)`` and ``zeta`` (the modal damping ratio, dimensionless).
+"""
+
+from __future__ import annotations
+
+import json
+from collections.abc import Mapping
+
+import numpy as np
+
+#: Suffix of the velocity columns: "<coordinate name>.dot" holds q̇ (m/s or rad/s).
+RATE = ".dot"
+MODE_COLUMNS = ("mode", "omega (rad/s)", "f (Hz)", "zeta")
+
+
+def _pandas(what: str):
+    try:
+        import pandas
+    except ImportError:
+        raise ImportError(f"{what} needs pandas: pip install pandas (or use to_csv / table(), which do not)") from None
+    return pandas
+
+
+def result_columns(result, points=None) -> tuple[list[str], np.ndarray]:
+    """(names, values (len(t), ncolumns)) of a Result's table without the time column: q, q̇ and
+    the positions (m) of ``points`` (a dict name -> Point or Body)."""
+    if points is None:
+        points = {}
+    if not isinstance(points, Mapping) or not all(isinstance(k, str) for k in points):
+        raise ValueError(f"points: expected None or a dict of column names (str) to Points or Bodies, e.g. "
+                         f"{{'tip': beam.tip}}, got {points!r}")
+    names = list(result.system.coordinate_names)
+    columns = names + [n + RATE for n in names]
+    blocks = [result.q, result.qd]
+    for key, point in points.items():
+        columns += [f"{key}.{axis}" for axis in "xyz"]
+        blocks.append(result.position(point))  # checks the point (ValueError naming it)
+    return columns, np.hstack(blocks).reshape(len(result.t), len(columns))
+
+
+def to_dataframe(result, points=None):
+    """pandas DataFrame indexed by t (s); columns as in this module's docstring."""
+    pandas = _pandas("Result.to_dataframe")
+    columns, values = result_columns(result, points)
+    return pandas.DataFrame(values, index=pandas.Index(result.t, name="t"), columns=columns)
+
+
+def to_csv(result, path, points=None):
+    """CSV with a header line "t,<columns>" and one row per output time, 17 significant digits
+    (floats read back exactly); no pandas needed. Returns the path."""
+    columns, values = result_columns(result, points)
+    for name in columns:
+        if "," in name or '"' in name:
+            raise ValueError(f"points: expected column names without ',' or '\"' for CSV, got {name!r}")
+    np.savetxt(path, np.column_stack([result.t, values]), delimiter=",", fmt="%.17g",
+               header=",".join(["t", *columns]), comments="")
+    return path
+
+
+def to_npz(result, path):
+    """NumPy archive with t (s), q, qd (m, rad; per s), coordinate_names, method and stats (JSON)."""
+    np.savez(path, t=result.t, q=result.q, qd=result.qd, coordinate_names=np.array(result.system.coordinate_names,
+             dtype=str), method=np.array(result.method), stats=np.array(json.dumps(result.stats)),
+             interrupted=np.array(result.interrupted))
+    return path
+
+
+def read_npz(path, system=None) -> dict:
+    """The fields of the Result saved by ``to_npz`` (``rigidfem.load_npz`` builds it), checking
+    that ``system`` (if given) has the coordinate names saved."""
+    with np.load(path, allow_pickle=False) as f:
+        names = [str(n) for n in f["coordinate_names"]]
+        if system is not None and list(system.coordinate_names) != names:
+            raise ValueError(f"system: expected a System with the coordinates {names} saved in {path}, got "
+                             f"{list(system.coordinate_names)}")
+        return {"t": f["t"], "q": f["q"], "qd": f["qd"], "stats": json.loads(str(f["stats"])),
+                "method": str(f["method"]), "interrupted": bool(f["interrupted"])}
+
+
+def modes_table(modes) -> list[dict]:
+    """One dict per mode with the keys ``MODE_COLUMNS``: k (from 1), ω (rad/s), f (Hz), ζ."""
+    return [dict(zip(MODE_COLUMNS, (k + 1, float(w), float(f), float(z))))
+            for k, (w, f, z) in enumerate(zip(modes.omega, modes.frequencies_hz, modes.damping_ratios))]
+
+
+def modes_dataframe(modes):
+    """``modes_table`` as a pandas DataFrame indexed by mode."""
+    pandas = _pandas("Modes.to_dataframe")
+    return pandas.DataFrame(modes_table(modes), columns=list(MODE_COLUMNS)).set_index("mode")
