@@ -143,7 +143,29 @@ void bind_model(py::module_& m) {
           },
           py::arg("body"), py::arg("slot"), py::arg("G"),
           "Let coordinate `slot` of an earlier body (index) also move this linear joint, with generator G (4, 4)\n"
-          "in this joint's frame: T = 1 + sum G q (used by the linear model of beams).");
+          "in this joint's frame: T = 1 + sum G q (used by the linear model of beams).")
+      .def(py::pickle(
+          [](const Joint& j) {
+            std::vector<std::string> coordinates;
+            for (Axis a : j.axes) coordinates.push_back(axis_name(a));
+            py::list coupled;
+            for (const auto& c : j.coupled) coupled.append(py::make_tuple(c.body, c.slot, c.G));
+            return py::make_tuple(j.kind, coordinates, j.stiffness, j.rest, j.damping, j.linear, coupled);
+          },
+          [](const py::tuple& s) {
+            std::vector<Axis> axes;
+            for (const auto& c : s[1].cast<std::vector<std::string>>()) axes.push_back(parse_coordinate(c, "coordinates"));
+            Joint j = Joint::make(s[0].cast<std::string>(), axes);
+            j.stiffness = s[2].cast<std::vector<double>>();
+            j.rest = s[3].cast<std::vector<double>>();
+            j.damping = s[4].cast<std::vector<double>>();
+            j.linear = s[5].cast<bool>();
+            for (const auto& c : s[6].cast<py::list>()) {
+              const auto t = c.cast<py::tuple>();
+              j.coupled.push_back({t[0].cast<int>(), t[1].cast<int>(), t[2].cast<Mat4>()});
+            }
+            return j;
+          }));
 
   py::class_<Body>(m, "Body", "Handle of a body of a Model (index -1 is the ground).")
       .def(py::init<>(), "The ground.")
@@ -160,7 +182,11 @@ void bind_model(py::module_& m) {
           },
           py::arg("r"), "The material point at r (m, body frame).")
       .def_property_readonly("origin", [](const Body& b) { return Point(b); }, "The point at the body frame's origin.")
-      .def("__repr__", [](const Body& b) { return "<rigidfem Body '" + b.name + "' #" + std::to_string(b.index) + ">"; });
+      .def("__repr__", [](const Body& b) { return "<rigidfem Body '" + b.name + "' #" + std::to_string(b.index) + ">"; })
+      .def(py::pickle([](const Body& b) { return py::make_tuple(b.index, b.name, b.model); },
+                      [](const py::tuple& s) {
+                        return Body{s[0].cast<int>(), s[1].cast<std::string>(), s[2].cast<std::uint64_t>()};
+                      }));
 
   py::class_<Point>(m, "Point", "A material point: body index and position r (m) in the body frame.")
       .def(py::init([](const py::object& body, const py::object& r) {
@@ -175,7 +201,11 @@ void bind_model(py::module_& m) {
       .def("__repr__", [](const Point& p) {
         return "<rigidfem Point on body #" + std::to_string(p.body) + " at r = (" + num(p.r.x()) + ", " + num(p.r.y()) +
                ", " + num(p.r.z()) + ") m>";
-      });
+      })
+      .def(py::pickle([](const Point& p) { return py::make_tuple(p.body, p.r, p.model); },
+                      [](const py::tuple& s) {
+                        return Point(s[0].cast<int>(), s[1].cast<Vec3>(), s[2].cast<std::uint64_t>());
+                      }));
   py::implicitly_convertible<Body, Point>();
 
   m.def(
@@ -304,6 +334,7 @@ void bind_model(py::module_& m) {
           },
           py::arg("index"))
       .def_property_readonly("id", &Model::id, "Unique id of this model, carried by its Body and Point handles.")
+      .def("_adopt_id", &Model::adopt_id, py::arg("id"), "Takes the id of the model this one copies (unpickling).")
       .def("_coordinate_index", &Model::coordinate_index, py::arg("body"), py::arg("coordinate"))
       .def_property("gravity", &Model::gravity, &Model::set_gravity, "Gravitational acceleration (m/s^2), global.")
       .def_property_readonly("nbodies", [](const Model& model) { return model.bodies().size(); })

@@ -67,7 +67,8 @@ void bind_transforms(py::module_& m) {
 }
 
 void bind_profiles(py::module_& m) {
-  py::class_<Profile, ProfilePtr>(m, "Profile", "A prescribed motion q(t) with its rates (see rigidfem.motion).")
+  py::class_<Profile, ProfilePtr>(m, "Profile", "A prescribed motion q(t) with its rates (see rigidfem.motion).",
+                                  py::dynamic_attr())
       .def(
           "__call__",
           [](const Profile& p, const py::object& time) {
@@ -77,7 +78,25 @@ void bind_profiles(py::module_& m) {
             return py::make_tuple(s.q, s.qd, s.qdd);
           },
           py::arg("t"), "(q, qd, qdd) at time t (s).")
-      .def("__repr__", [](const Profile& p) { return "<rigidfem motion " + p.describe() + ">"; });
+      .def("__repr__", [](const Profile& p) { return "<rigidfem motion " + p.describe() + ">"; })
+      .def(
+          "__reduce__",
+          [](const py::object& self) -> py::tuple {
+            // Pickled as its maker and the maker's arguments (or, for rigidfem.motion.function, the
+            // Python function it keeps as `function`), so that it unpickles bit for bit.
+            const ProfileRecipe r = self.cast<const Profile&>().recipe();
+            if (r.maker.empty()) {
+              if (py::hasattr(self, "function"))
+                return py::make_tuple(py::module_::import("rigidfem.motion").attr("function"),
+                                      py::make_tuple(self.attr("function")));
+              throw py::type_error("cannot pickle the profile " + self.cast<const Profile&>().describe() +
+                                   ": it is internal to a model (pickle the Model instead)");
+            }
+            py::tuple arguments(r.arguments.size());
+            for (size_t k = 0; k < r.arguments.size(); ++k)
+              arguments[k] = std::visit([](const auto& a) { return py::cast(a); }, r.arguments[k]);
+            return py::make_tuple(py::module_::import("rigidfem._core").attr(r.maker.c_str()), arguments);
+          });
   m.def("constant_profile", &constant_profile, py::arg("value"));
   m.def("polynomial_profile", &polynomial_profile, py::arg("coefficients"));
   m.def("harmonic_profile", &harmonic_profile, py::arg("amplitude"), py::arg("omega"), py::arg("phase"),

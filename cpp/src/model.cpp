@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <atomic>
 #include <cmath>
+#include <random>
 #include <sstream>
 #include <stdexcept>
 #include <tuple>
@@ -101,9 +102,18 @@ Mat4 pseudo_inertia(double mass, const Vec3& com, const Mat3& inertia) {
 }
 
 Model::Model(const Vec3& gravity) {
-  static std::atomic<std::uint64_t> models{0};
-  id_ = ++models;
+  // Ids count up from a random 64-bit start drawn once per process, so that a model unpickled in
+  // another process (which keeps its id, and its handles with it) meets no other model's id there.
+  static std::atomic<std::uint64_t> models{(std::uint64_t{std::random_device{}()} << 32) ^ std::random_device{}()};
+  do id_ = ++models;
+  while (id_ == 0);  // 0 marks a handle of unknown origin
   set_gravity(gravity);
+}
+
+void Model::adopt_id(std::uint64_t id) {
+  if (!bodies_.empty()) bad("id", "an id adopted before the first body is added", "a model with bodies");
+  if (id == 0) bad("id", "a nonzero model id", "0");
+  id_ = id;
 }
 
 void Model::set_gravity(const Vec3& g) {

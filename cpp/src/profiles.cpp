@@ -18,6 +18,7 @@ class Constant final : public Profile {
   explicit Constant(double v) : v_(v) {}
   MotionState at(double) const override { return {v_, 0.0, 0.0}; }
   std::string describe() const override { return "constant(" + std::to_string(v_) + ")"; }
+  ProfileRecipe recipe() const override { return {"constant_profile", {v_}}; }
 
  private:
   double v_;
@@ -37,6 +38,7 @@ class Polynomial final : public Profile {
     return s;
   }
   std::string describe() const override { return "polynomial(degree " + std::to_string(c_.size() - 1) + ")"; }
+  ProfileRecipe recipe() const override { return {"polynomial_profile", {c_}}; }
 
  private:
   std::vector<double> c_;
@@ -54,6 +56,8 @@ class Harmonic final : public Profile {
     o << "harmonic(amplitude=" << a_ << ", omega=" << w_ << ")";
     return o.str();
   }
+
+  ProfileRecipe recipe() const override { return {"harmonic_profile", {a_, w_, ph_, off_}}; }
 
  private:
   double a_, w_, ph_, off_;
@@ -80,6 +84,8 @@ class HarmonicSeries final : public Profile {
     return o.str();
   }
 
+  ProfileRecipe recipe() const override { return {"harmonic_series_profile", {a_, w_, ph_, off_}}; }
+
  private:
   std::vector<double> a_, w_, ph_;
   double off_;
@@ -101,6 +107,8 @@ class SpinUp final : public Profile {
     o << "spin_up(omega=" << W_ << " rad/s, duration=" << T_ << " s)";
     return o.str();
   }
+
+  ProfileRecipe recipe() const override { return {"spin_up_profile", {W_, T_}}; }
 
  private:
   double W_, T_;
@@ -141,6 +149,7 @@ class Spline final : public Profile {
     return segment(std::min(std::max(after, size_t{1}), n - 1) - 1, t);
   }
   std::string describe() const override { return "spline(" + std::to_string(t_.size()) + " points)"; }
+  ProfileRecipe recipe() const override { return {"spline_profile", {t_, q_}}; }
 
  private:
   MotionState segment(size_t k, double t) const {

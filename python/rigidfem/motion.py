@@ -89,4 +89,6 @@ def function(f: Callable[[float], tuple[float, float, float]]) -> _core.Profile:
             raise error
         return numbers
 
-    return _core.callback_profile(checked)
+    profile = _core.callback_profile(checked)
+    profile.function = f  # pickled as rigidfem.motion.function(f): f must pickle (a module-level function)
+    return profile

@@ -24,6 +24,7 @@ import numpy as np
 from . import samples
 from ._core import Body, Point
 from .analysis import modal_analysis, static_equilibrium
+from .persistence import Versioned
 from .materials import Material, Section
 from .model import Model
 from .simulation import simulate
@@ -105,7 +106,7 @@ class scenes:
 
 
 @dataclass
-class Table:
+class Table(Versioned):
     """Rows of a study (dicts), printable, savable as CSV and plottable."""
 
     rows: list = field(default_factory=list)

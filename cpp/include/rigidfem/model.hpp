@@ -153,6 +153,8 @@ class Model {
   const std::vector<ForceElement>& force_elements() const { return elements_; }
   /// Unique among the Models of this process (never 0): the `model` of the handles it makes.
   std::uint64_t id() const { return id_; }
+  /// Takes the id of the model this one is a copy of (unpickling), before any body is added.
+  void adopt_id(std::uint64_t id);
   int body_index(const std::string& name) const;  ///< −1 for "ground"; throws if unknown
   int coordinate_index(int body, const std::string& coordinate) const;
   /// "body.rz": the name of coordinate `coordinate` (−1: the only one) of a body's joint.

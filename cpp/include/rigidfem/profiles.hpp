@@ -5,6 +5,7 @@
 #include <functional>
 #include <memory>
 #include <string>
+#include <variant>
 #include <vector>
 
 namespace rigidfem {
@@ -14,11 +15,20 @@ struct MotionState {
   double q = 0.0, qd = 0.0, qdd = 0.0;
 };
 
+/// How a profile was made: the name of its maker below (e.g. "harmonic_profile") and the maker's
+/// arguments, enough to make it again bit for bit (pickling). Empty maker: not remakeable (a
+/// Python function, an internal profile).
+struct ProfileRecipe {
+  std::string maker;
+  std::vector<std::variant<double, std::vector<double>>> arguments;
+};
+
 class Profile {
  public:
   virtual ~Profile() = default;
   virtual MotionState at(double t) const = 0;
   virtual std::string describe() const = 0;
+  virtual ProfileRecipe recipe() const { return {}; }
 };
 
 using ProfilePtr = std::shared_ptr<Profile>;  // profiles are immutable: only const methods
