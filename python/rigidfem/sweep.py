@@ -1,0 +1,245 @@
+"""``rf.sweep``: a study over a grid or a list of cases, on threads, processes or a Dask cluster.
+
+A sweep calls a user function once per case, ``function(**case)``; the function builds a model
+(or takes a shared compiled System), runs it and returns what to keep. The results come back as
+one table row per case, in the order of the cases, whatever order the workers finish in.
+
+Executors: threads by default (``rf.simulate`` releases the GIL for its C++ loop, and a compiled
+System is immutable, so one System may be shared by every thread); "processes" (a process pool of
+this machine); any ``concurrent.futures.Executor`` (e.g. mpi4py's ``MPIPoolExecutor``); or a
+Dask distributed ``Client``, so that the same call runs on a laptop's ``LocalCluster`` and on a
+cluster. Arguments and results travel by pickle to processes and Dask workers: Models, Systems,
+Results and Modes pickle (``rigidfem.persistence``).
+"""
+
+from __future__ import annotations
+
+import concurrent.futures
+import inspect
+import itertools
+import os
+import time
+from collections.abc import Callable, Mapping, Sequence
+
+import numpy as np
+
+from ._progress import ProgressBar
+from .study import Table
+
+#: Columns a sweep adds to the parameters and the function's values.
+ERROR, WALL_TIME, SEED = "error", "wall_time_s", "seed"
+
+
+def grid_cases(grid: Mapping[str, Sequence]) -> list[dict]:
+    """The Cartesian product of ``grid`` (name -> values) as a list of cases, the last name varying
+    fastest: ``grid_cases({"a": [1, 2], "b": [3, 4]})`` gives a=1,b=3; a=1,b=4; a=2,b=3; a=2,b=4."""
+    if not isinstance(grid, Mapping) or not grid:
+        raise ValueError(f"grid: expected a non-empty dict of parameter names to sequences of values, got {grid!r}")
+    names = list(grid)
+    values = []
+    for name in names:
+        v = grid[name]
+        if isinstance(v, (str, bytes)) or not isinstance(v, (Sequence, np.ndarray)) or len(v) == 0:
+            raise ValueError(f"grid[{name!r}]: expected a non-empty sequence of values, got {v!r}")
+        values.append(list(v))
+    return [dict(zip(names, combination)) for combination in itertools.product(*values)]
+
+
+def _cases(cases, grid) -> list[dict]:
+    if (cases is None) == (grid is None):
+        raise ValueError("cases, grid: expected exactly one of them (a list of dicts, or a dict of sequences)")
+    if grid is not None:
+        return grid_cases(grid)
+    if isinstance(cases, Mapping) or not isinstance(cases, Sequence) or isinstance(cases, (str, bytes)):
+        raise ValueError(f"cases: expected a list of dicts of parameters, got {cases!r}")
+    for k, case in enumerate(cases):
+        if not isinstance(case, Mapping) or not all(isinstance(name, str) for name in case):
+            raise ValueError(f"cases[{k}]: expected a dict of parameter names (str) to values, got {case!r}")
+    return [dict(case) for case in cases]
+
+
+def _seeds(seed, n: int) -> list[int]:
+    """One independent seed per case from numpy's SeedSequence(seed).spawn(n): the case's stream does
+    not depend on the executor nor on the other cases."""
+    if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0):
+        raise ValueError(f"seed: expected None or a non-negative integer, got {seed!r}")
+    return [int(child.generate_state(1, np.uint64)[0] >> np.uint64(1))
+            for child in np.random.SeedSequence(seed).spawn(n)]
+
+
+def _takes_seed(function) -> bool:
+    try:
+        return "seed" in inspect.signature(function).parameters
+    except (TypeError, ValueError):  # a builtin without a signature
+        return False
+
+
+def run_case(function, case: dict, seed: int | None, record_errors: bool):
+    """One case in a worker: (value, error, wall time in s). ``error`` is "Type: message" when the
+    function raised and errors are recorded, else None."""
+    start = time.perf_counter()
+    try:
+        value = function(**case) if seed is None else function(**case, seed=seed)
+        error = None
+    except Exception as e:  # noqa: BLE001 (a failing case is reported in its row)
+        if not record_errors:
+            raise
+        value, error = None, f"{type(e).__name__}: {e}"
+    return value, error, time.perf_counter() - start
+
+
+def _is_dask_client(executor) -> bool:
+    return type(executor).__module__.split(".")[0] == "distributed" and hasattr(executor, "gather")
+
+
+def _resolve_executor(executor, workers):
+    """(executor, whether this call owns it and must shut it down)."""
+    if workers is not None and (isinstance(workers, bool) or not isinstance(workers, (int, np.integer))
+                                or workers < 1):
+        raise ValueError(f"workers: expected None or a positive integer, got {workers!r}")
+    if executor == "serial":
+        return None, False
+    if executor == "threads":
+        return concurrent.futures.ThreadPoolExecutor(workers or os.cpu_count() or 1), True
+    if executor == "processes":
+        return concurrent.futures.ProcessPoolExecutor(workers or os.cpu_count() or 1), True
+    if isinstance(executor, concurrent.futures.Executor) or _is_dask_client(executor):
+        if workers is not None:
+            raise ValueError("workers: expected None with an executor or a Dask Client (they have their own workers)")
+        return executor, False
+    raise ValueError(f"executor: expected 'threads', 'processes', 'serial', a concurrent.futures.Executor or a "
+                     f"dask.distributed.Client, got {executor!r}")
+
+
+def _submit_all(executor, function, cases, seeds, record_errors) -> list:
+    """Futures of every case, in the order of the cases."""
+    if _is_dask_client(executor):
+        return [executor.submit(run_case, function, case, seed, record_errors, pure=False)
+                for case, seed in zip(cases, seeds)]
+    return [executor.submit(run_case, function, case, seed, record_errors) for case, seed in zip(cases, seeds)]
+
+
+def _as_completed(executor, futures):
+    if _is_dask_client(executor):
+        from distributed import as_completed
+
+        return as_completed(futures)
+    return concurrent.futures.as_completed(futures)
+
+
+def _outcomes(function, cases, seeds, executor, record_errors, bar) -> list:
+    """(value, error, wall time) per case, in the order of the cases."""
+    if executor is None:
+        out = []
+        for case, seed in zip(cases, seeds):
+            out.append(run_case(function, case, seed, record_errors))
+            if bar is not None:
+                bar.update(len(out))
+        return out
+    futures = _submit_all(executor, function, cases, seeds, record_errors)
+    for done, _ in enumerate(_as_completed(executor, futures), start=1):
+        if bar is not None:
+            bar.update(done)
+    return [f.result() for f in futures]
+
+
+def _row(case: dict, seed, value, error, wall_time) -> dict:
+    row = dict(case)
+    if seed is not None:
+        row[SEED] = seed
+    if isinstance(value, Mapping):
+        row.update(value)
+    elif error is None:
+        row["result"] = value
+    row[ERROR], row[WALL_TIME] = error, wall_time
+    return row
+
+
+def _columns(rows: list[dict]) -> list[str]:
+    """Columns in order of first appearance, the error and wall time last."""
+    names = dict.fromkeys(name for row in rows for name in row if name not in (ERROR, WALL_TIME))
+    return [*names, ERROR, WALL_TIME]
+
+
+def _table(rows: list[dict], as_frame):
+    columns = _columns(rows)
+    if as_frame is None:
+        try:
+            import pandas  # noqa: F401
+        except ImportError:
+            as_frame = False
+        else:
+            as_frame = True
+    if not as_frame:
+        return Table([{c: row.get(c) for c in columns} for row in rows], tuple(columns))
+    try:
+        import pandas as pd
+    except ImportError:
+        raise ValueError("as_frame: expected None or False without pandas installed (pip install pandas), "
+                         "got True") from None
+    return pd.DataFrame.from_records(rows, columns=columns)
+
+
+def sweep(function: Callable, cases: Sequence[Mapping] | None = None, *, grid: Mapping[str, Sequence] | None = None,
+          executor="threads", workers: int | None = None, seed: int | None = None, progress: bool = False,
+          errors: str = "record", as_frame: bool | None = None):
+    """Run ``function(**case)`` for every case and gather what it returns in a table.
+
+    Parameters
+    ----------
+    function : callable
+        ``function(**parameters)`` builds a model (or uses a compiled System it shares), runs it
+        and returns what to keep: a dict of named values (a column each; numbers, arrays or any
+        object) or a single value (column ``"result"``). If it has a parameter ``seed``, each case
+        gets its own integer seed (for ``np.random.default_rng(seed)``), drawn from ``seed`` below.
+    cases : list of dicts, optional
+        The parameters of each case, e.g. ``[{"omega": 4.0}, {"omega": 6.0}]``.
+    grid : dict of sequences, optional
+        Instead of ``cases``: every combination (``grid_cases``), the last name varying fastest.
+    executor : str, Executor or dask.distributed.Client
+        ``"threads"`` (default: a thread pool; the C++ integrators run without the GIL),
+        ``"processes"`` (a process pool; the function and its arguments must pickle),
+        ``"serial"``, any ``concurrent.futures.Executor`` (e.g. ``mpi4py.futures.MPIPoolExecutor``),
+        or a Dask ``Client`` (``pip install "rigidfem[dask]"``; Dask pickles with cloudpickle, so
+        functions defined in a notebook travel too).
+    workers : int, optional
+        Threads or processes of a pool made here (default: the number of cores).
+    seed : int, optional
+        Root of the per-case seeds (numpy ``SeedSequence(seed).spawn``): the same seed gives every
+        case the same stream on any executor. None: fresh entropy, still one stream per case.
+    progress : bool
+        A progress bar (tqdm when installed, else a line on stderr) counting finished cases.
+    errors : "record" or "raise"
+        "record" (default): a case whose function raises gets its row with ``error`` = "Type:
+        message" and no values, the others go on; "raise": the first failure propagates.
+    as_frame : bool, optional
+        None (default): a pandas DataFrame when pandas is installed, else a ``rigidfem.study.Table``
+        of records; True/False force one.
+
+    Returns
+    -------
+    pandas.DataFrame or rigidfem.study.Table
+        One row per case in the order of the cases: the parameters, ``seed`` (when the function
+        takes one), the returned values, ``error`` (None when it ran) and ``wall_time_s`` (s,
+        the case's own time in its worker).
+    """
+    if not callable(function):
+        raise ValueError(f"function: expected a callable function(**parameters), got {function!r}")
+    if errors not in ("record", "raise"):
+        raise ValueError(f"errors: expected 'record' or 'raise', got {errors!r}")
+    if as_frame not in (None, True, False):
+        raise ValueError(f"as_frame: expected None, True or False, got {as_frame!r}")
+    cases = _cases(cases, grid)
+    draw = _takes_seed(function) and not any(SEED in case for case in cases)  # else cases give their own
+    seeds = _seeds(seed, len(cases)) if draw else [None] * len(cases)
+    pool, owned = _resolve_executor(executor, workers)
+    bar = ProgressBar(len(cases), "cases", "sweep") if progress else None
+    try:
+        outcomes = _outcomes(function, cases, seeds, pool, errors == "record", bar)
+    finally:
+        if bar is not None:
+            bar.close()
+        if owned:
+            pool.shutdown(wait=True, cancel_futures=True)
+    rows = [_row(case, s, *outcome) for case, s, outcome in zip(cases, seeds, outcomes)]
+    return _table(rows, as_frame)
