@@ -234,7 +234,7 @@ def test_save_writes_a_gif_with_one_image_per_frame(pendulum, tmp_path):
 
 # --- bad input ------------------------------------------------------------------------------------
 
-def test_bad_input_names_the_argument_and_the_expected_values(pendulum, kane, cantilever, monkeypatch):
+def test_bad_input_names_the_argument_and_the_expected_values(pendulum, kane, cantilever):
     system, res, h = pendulum
     with pytest.raises(ValueError, match=r"which: expected coordinate names from \['link1.rz', 'link1.ry'.*'nope'"):
         plots.coordinates(res, "nope")

@@ -192,18 +192,21 @@ class Skeleton:
         self.points: list[Point] = []      # on bodies: placed by the kinematics
         self.fixed: dict[int, np.ndarray] = {}  # row -> global position of joints on the ground
         self.links: list[list[int]] = []   # per body, the rows of its polyline
-        self.triads: list[tuple[int, int]] = []  # per body with a triad, the rows of its origin and x axis' unit point
+        self.triads: list[tuple[int, int]] = []  # per triad, the rows of the origin and the x axis' unit point
         for i, body in enumerate(bodies):
             if i in hidden:
                 continue
-            p, r_joint = system.parent[i], np.asarray(system.placements[i])[:3, 3]
-            joint = [self._fixed(r_joint)] if p < 0 else [self._add(bodies[p].origin), self._add(bodies[p].point(r_joint))]
+            joint = self._joint(bodies, i)
             origin = self._add(body.origin)
             self.links.append(joint + [origin, self._add(body.point(system.centres_of_mass[i]))])
             if not _is_rfe(names[i]):
-                self.triads.append((origin, self._add(body.point((1.0, 0.0, 0.0)))))
-                self._add(body.point((0.0, 1.0, 0.0)))
-                self._add(body.point((0.0, 0.0, 1.0)))
+                axes = [self._add(body.point(e)) for e in np.eye(3)]  # unit points along x, y, z
+                self.triads.append((origin, axes[0]))
+
+    def _joint(self, bodies: list[Body], i: int) -> list[int]:
+        """The rows of body i's parent origin and joint frame (only the joint frame on the ground)."""
+        p, r = self.system.parent[i], np.asarray(self.system.placements[i])[:3, 3]
+        return [self._fixed(r)] if p < 0 else [self._add(bodies[p].origin), self._add(bodies[p].point(r))]
 
     @property
     def rows(self) -> int:
