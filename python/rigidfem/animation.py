@@ -91,7 +91,7 @@ def animate(result, *, plane: str | None = None, beams=(), trails=(), frames: in
     shape = plots.ShapeArtists(ax, plane, len(skeleton.beams), [b.name for b in skeleton.beams])
     lines = [shape.line(color=f"C{k + 1}", lw=1.0, label=f"trail {k}") for k in range(len(paths))]
     clock = (ax.text2D if plane is None else ax.text)(0.02, 0.95, "", transform=ax.transAxes)
-    plots.set_limits(ax, np.vstack([p.points() for p in poses] + paths), plane)
+    plots.set_limits(ax, np.vstack([p.points() for p in poses] + paths)[:, list(shape.columns)])
 
     def update(k: int) -> list:
         for line, path in zip(lines, paths):

@@ -318,17 +318,25 @@ def set_line(line, X: np.ndarray, columns) -> None:
         line.set_data(*coords)
 
 
-def set_limits(ax, X: np.ndarray, plane) -> None:
-    """Equal-aspect limits around the points X (k, 3) with a 5 % margin: a cube in 3D."""
-    columns = PLANES[plane] if plane else (0, 1, 2)
-    lo, hi = np.min(X[:, columns], axis=0), np.max(X[:, columns], axis=0)
-    half = 0.55 * _extent(X[:, columns]) if len(X) else 0.5
+def set_limits(ax, X: np.ndarray) -> None:
+    """Equal-aspect limits around the points X (k, 2) of 2D Axes or (k, 3) of 3D ones, with a 5 %
+    margin: a square, or a cube in 3D."""
+    X = X[np.all(np.isfinite(X), axis=1)]
+    lo, hi = (np.min(X, axis=0), np.max(X, axis=0)) if len(X) else (np.zeros(X.shape[1]),) * 2
+    half = 0.55 * _extent(X)
     for axis, centre in zip("xyz", 0.5 * (lo + hi)):
         getattr(ax, f"set_{axis}lim")(centre - half, centre + half)
-    if plane:
+    if X.shape[1] == 2:
         ax.set_aspect("equal", adjustable="box")
     else:
         ax.set_box_aspect((1, 1, 1))
+
+
+def drawn(ax) -> np.ndarray:
+    """The vertices of all the lines in ``ax``, (k, 2) or (k, 3) in 3D, NaN rows included."""
+    three = ax.name == "3d"
+    rows = [np.column_stack(line.get_data_3d()) if three else line.get_xydata() for line in ax.get_lines()]
+    return np.vstack(rows) if rows else np.zeros((0, 3 if three else 2))
 
 
 def shape(system, q, t: float | None = None, *, ax=None, plane: str | None = None, beams=(),
@@ -350,7 +358,7 @@ def shape(system, q, t: float | None = None, *, ax=None, plane: str | None = Non
     pose = skeleton.pose(q, t, frame_size)
     ax = _shape_axes(ax, plane)
     ShapeArtists(ax, plane, len(skeleton.beams), [b.name for b in skeleton.beams]).set(pose)
-    set_limits(ax, pose.points(), plane)
+    set_limits(ax, drawn(ax))  # all shapes drawn into ax: several states can share it
     return ax
 
 
@@ -363,7 +371,7 @@ def modes(system, modes, which=(0, 1, 2), *, scale: float | None = None, t: floa
     q + scale·φ_i, titled "mode i: f Hz" (``modes.frequencies_hz``).
 
     ``scale`` (m or rad per unit of the shape, whose largest entry is 1) defaults, per mode, to
-    the one that moves the drawn points by at most 15 % of the drawing's extent. ``t`` (s) as
+    the one that moves the drawn points by at most 10 % of the drawing's extent. ``t`` (s) as
     in ``shape``; ``plane`` and ``beams`` as in ``shape``. ``ax``: a sequence of Axes, one per
     mode (a new figure with one row of them by default). Returns the list of Axes.
     """
@@ -385,7 +393,7 @@ def modes(system, modes, which=(0, 1, 2), *, scale: float | None = None, t: floa
         names = [b.name for b in skeleton.beams]
         ShapeArtists(a, plane, len(names), [f"_{n} reference" for n in names], color="0.7", alpha=0.8).set(reference)
         ShapeArtists(a, plane, len(names), names).set(deformed)
-        set_limits(a, np.vstack([reference.points(), deformed.points()]), plane)
+        set_limits(a, drawn(a))
         a.set_title(f"mode {i + 1}: {modes.frequencies_hz[i]:.4g} Hz")
     return ax
 
@@ -399,11 +407,11 @@ def _mode_indices(which, n: int) -> list[int]:
 
 
 def _mode_scale(skeleton: Skeleton, q, phi, t, size: float) -> float:
-    """The scale s that moves the drawn points of the pose at q + s φ by 15 % of its extent
+    """The scale s that moves the drawn points of the pose at q + s φ by 10 % of its extent
     (from the linearised motion)."""
     base = skeleton.pose(q, t, size)
     eps = 1e-6
     moved = skeleton.pose(q + eps * phi, t, size)
     a, b = base.points(), moved.points()
     rate = np.max(np.linalg.norm(b - a, axis=1)) / eps if len(a) == len(b) and len(a) else 0.0
-    return 0.15 * _extent(a) / rate if rate > 0 else 1.0
+    return 0.1 * _extent(a) / rate if rate > 0 else 1.0
