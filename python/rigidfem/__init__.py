@@ -39,6 +39,7 @@ from .model import Model, System
 from . import sea  # noqa: E402 (rigidfem.sea: sea states for a moving base)
 from .simulation import Result, load_npz, simulate
 from . import display, export  # noqa: E402 (notebook displays; tables, CSV and NumPy archives)
+from .linearize import NotAnEquilibriumWarning, linearize  # noqa: E402 (rigidfem.linearize: the function)
 from .sweep import sweep
 
 __version__ = "0.1.0"
@@ -66,6 +67,7 @@ __all__ = [
     "Material",
     "ForceLawError",
     "Model",
+    "NotAnEquilibriumWarning",
     "Modes",
     "Point",
     "Profile",
@@ -85,6 +87,7 @@ __all__ = [
     "joint_transform",
     "joint_transform_derivative",
     "joint_transform_second_derivative",
+    "linearize",
     "load_npz",
     "modal_analysis",
     "motion",

@@ -564,10 +564,10 @@ def modal_analysis(system, q=None, qd=None, t: float = 0.0) -> Modes:
     return Modes(omega[order], omega[order] / (2 * np.pi), zeta[order], shapes, lam[order], q, M, K, C)
 
 
-def _constrained_modes(system, q: np.ndarray, qd: np.ndarray, t: float, M: np.ndarray, K: np.ndarray,
-                       C: np.ndarray, tol: float = 1e-8) -> Modes:
-    """``modal_analysis`` of a closed chain: the modes of NᵀMN, NᵀK_tN, NᵀCN (N: null space of G)."""
-    what = "modal analysis"
+def _loop_tangent(system, q: np.ndarray, qd: np.ndarray, t: float, K: np.ndarray, what: str, tol: float = 1e-8):
+    """(constraints G split by its SVD, K_t = K − ∂(Gᵀλ)/∂q (nq, nq), λ (nl,)) of a closed chain at
+    (q, q̇): λ the least squares of f + Gᵀλ = 0. ValueError naming q or qd when they do not close the
+    loops (to ``tol``: m, or cosines)."""
     g, gd, G = system.loop_constraints(t, q, qd)
     _require_finite(t, what, **{"loop Jacobian G": G, "g(q)": g, "ġ": gd})
     for name, v in (("q", g), ("qd", gd)):
@@ -582,6 +582,14 @@ def _constrained_modes(system, q: np.ndarray, qd: np.ndarray, t: float, M: np.nd
     lam = c.multipliers(-f)
     Kt = K + _constraint_stiffness(system, t, q, lam)
     _require_finite(t, what, **{"geometric stiffness of the loops": Kt})
+    return c, Kt, lam
+
+
+def _constrained_modes(system, q: np.ndarray, qd: np.ndarray, t: float, M: np.ndarray, K: np.ndarray,
+                       C: np.ndarray, tol: float = 1e-8) -> Modes:
+    """``modal_analysis`` of a closed chain: the modes of NᵀMN, NᵀK_tN, NᵀCN (N: null space of G)."""
+    what = "modal analysis"
+    c, Kt, lam = _loop_tangent(system, q, qd, t, K, what, tol)
     N = c.N
     k = N.shape[1]
     if k == 0:  # the loops leave nothing free
