@@ -73,11 +73,11 @@ def test_coordinates_default_to_the_first_six_and_rates_carry_their_units(pendul
     ax = plots.coordinates(res, quantity="qd")
     assert len(ax.get_lines()) == system.nq == 6
     np.testing.assert_array_equal(ax.get_lines()[5].get_ydata(), res.qd[:, 5])
-    assert ax.get_lines()[5].get_label() == "link2.rx (rad/s)" and "rad/s" in ax.get_ylabel()
+    assert ax.get_lines()[5].get_label() == "link2.rx (rad/s)" and ax.get_ylabel() == "q̇ (rad/s)"
     model, _ = rf.samples.spring_mass()
     res = rf.simulate(model.compile(), 0.1, q0=[0.01], t_eval=np.linspace(0, 0.1, 5))
     ax = plots.coordinates(res, "block.x", quantity="qdd")
-    assert ax.get_lines()[0].get_label() == "block.x (m/s²)" and ax.get_ylabel() == "acceleration of qdd (m/s²)"
+    assert ax.get_lines()[0].get_label() == "block.x (m/s²)" and ax.get_ylabel() == "q̈ (m/s²)"
     np.testing.assert_array_equal(ax.get_lines()[0].get_ydata(), res.qdd[:, 0])
 
 
@@ -157,6 +157,18 @@ def test_bodies_are_drawn_as_their_frames_and_links(pendulum):
                                        system.position(h["link2"].point(system.centres_of_mass[1]), q)], atol=1e-14)
     lo, hi = (np.array([getattr(ax, f"get_{c}lim")() for c in "xyz"]).T)
     np.testing.assert_allclose(hi - lo, (hi - lo)[0])  # equal aspect: a cube
+
+
+def test_segments_join_their_two_points(pendulum):
+    system, res, h = pendulum
+    anchor = rf.Body().point((0.5, 0.2, 0.0))  # on the ground
+    q = res.q[30]
+    ax = plots.shape(system, q, segments=[(anchor, h["tip"]), (h["link1"], h["link2"].point((0.1, 0, 0)))])
+    X = np.column_stack(lines_by_label(ax)["_segments"].get_data_3d())
+    np.testing.assert_allclose(X[[0, 1, 3, 4]], [(0.5, 0.2, 0.0), system.position(h["tip"], q),
+                                                 system.transform(h["link1"], q)[:3, 3],
+                                                 system.position(h["link2"].point((0.1, 0, 0)), q)], atol=1e-14)
+    assert np.all(np.isnan(X[[2, 5]]))
 
 
 def test_plane_shape_has_equal_aspect_and_rfes_without_triads(kane):
@@ -266,6 +278,10 @@ def test_bad_input_names_the_argument_and_the_expected_values(pendulum, kane, ca
         plots.shape(system, res.q[0], ax=plt.figure().add_subplot())
     with pytest.raises(ValueError, match="beams: expected Beam handles"):
         plots.shape(system, res.q[0], beams=[h["link1"]])
+    with pytest.raises(ValueError, match=r"segments: expected pairs \(a, b\) of Point or Body"):
+        plots.shape(system, res.q[0], segments=[h["tip"]])
+    with pytest.raises(ValueError, match="frame_size: expected a positive number in m"):
+        plots.shape(system, res.q[0], frame_size=-1.0)
     kane_system, kane_res, _ = kane
     with pytest.raises(ValueError, match="t: required"):
         plots.shape(kane_system, kane_res.q[0])

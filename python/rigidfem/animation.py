@@ -48,7 +48,7 @@ def frame_indices(t: np.ndarray, frames: int | None = None, fps: float | None = 
     return np.where(np.abs(t[left] - wanted) <= np.abs(t[right] - wanted), left, right)
 
 
-def animate(result, *, plane: str | None = None, beams=(), trails=(), frames: int | None = None,
+def animate(result, *, plane: str | None = None, beams=(), segments=(), trails=(), frames: int | None = None,
             fps: float | None = None, interval: float | None = None, frame_size: float | None = None,
             ax=None) -> Animation:
     """Animate ``result`` (a ``rigidfem.Result``).
@@ -59,6 +59,8 @@ def animate(result, *, plane: str | None = None, beams=(), trails=(), frames: in
         3D axes (None) or the projection on a plane, as in ``rigidfem.plots.shape``.
     beams : Beam or sequence of Beam
         Drawn as their deformed centre lines (``plots.shape``).
+    segments : sequence of (a, b) pairs of Point or Body
+        Straight lines between points: ropes, cylinders, springs (``plots.shape``).
     trails : sequence of Point or Body
         Points whose paths are drawn from the start up to the current frame (e.g. ``[beam.tip]``).
     frames : int, optional
@@ -80,15 +82,13 @@ def animate(result, *, plane: str | None = None, beams=(), trails=(), frames: in
     indices = frame_indices(t, frames, fps)
     interval = _real_time(t[indices]) if interval is None else _checks.scalar(interval, "interval", positive=True,
                                                                              unit="ms")
-    skeleton = plots.Skeleton(result.system, beams)
-    first = skeleton.pose(result.q[indices[0]], t[indices[0]])
-    size = 0.08 * plots._extent(first.points()) if frame_size is None else \
-        _checks.scalar(frame_size, "frame_size", positive=True, unit="m")
-    poses = [skeleton.pose(result.q[i], t[i], size) for i in indices]
+    skeleton = plots.Skeleton(result.system, beams, segments)
+    first = skeleton.pose(result.q[indices[0]], t[indices[0]], frame_size)
+    poses = [skeleton.pose(result.q[i], t[i], first.frame_size) for i in indices]
     paths = [result.position(p) for p in _points(trails)]
 
     ax = plots._shape_axes(ax, plane)
-    shape = plots.ShapeArtists(ax, plane, len(skeleton.beams), [b.name for b in skeleton.beams])
+    shape = plots.ShapeArtists(ax, plane, [b.name for b in skeleton.beams])
     lines = [shape.line(color=f"C{k + 1}", lw=1.0, label=f"trail {k}") for k in range(len(paths))]
     clock = (ax.text2D if plane is None else ax.text)(0.02, 0.95, "", transform=ax.transAxes)
     plots.set_limits(ax, np.vstack([p.points() for p in poses] + paths)[:, list(shape.columns)])

@@ -24,7 +24,7 @@ from .beams import Beam
 
 PLANES = {"xy": (0, 1), "xz": (0, 2), "yz": (1, 2)}
 ANGULAR = ("rx", "ry", "rz")
-QUANTITIES = {"q": ("", ""), "qd": ("/s", "rate of "), "qdd": ("/s²", "acceleration of ")}
+QUANTITIES = {"q": ("q", ""), "qd": ("q̇", "/s"), "qdd": ("q̈", "/s²")}  #: symbol, unit per s^k
 ENERGIES = {"kinetic": "kinetic_energy", "gravity": "gravity_energy", "elastic": "elastic_energy",
             "total": "energy"}
 
@@ -97,7 +97,8 @@ def coordinates(result, which=None, *, quantity: str = "q", ax=None):
         Coordinates (m, rad), their rates (m/s, rad/s) or accelerations (m/s², rad/s²).
     ax : matplotlib Axes, optional
 
-    Returns the Axes: one line per coordinate, labelled "name (unit)", x = ``result.t``.
+    Returns the Axes: one line per coordinate, labelled "name (unit)", x = ``result.t``; the
+    y axis "q (rad)", "q̇ (m/s, rad/s)", ...
     """
     if quantity not in QUANTITIES:
         raise ValueError(f"quantity: expected one of {list(QUANTITIES)}, got {quantity!r}")
@@ -105,11 +106,11 @@ def coordinates(result, which=None, *, quantity: str = "q", ax=None):
     if not names:
         raise ValueError("result: expected a system with free coordinates, got one with nq = 0")
     k = _select(names, which, "which", "coordinate names", 6)
-    per, prefix = QUANTITIES[quantity]
+    symbol, per = QUANTITIES[quantity]
     units = [unit(names[i]) + per for i in k]
     values = getattr(result, quantity)[:, k]
     labels = [f"{names[i]} ({u})" for i, u in zip(k, units)]
-    return _history(ax, result.t, values, labels, f"{prefix}{quantity} ({_units(units)})")
+    return _history(ax, result.t, values, labels, f"{symbol} ({_units(units)})")
 
 
 def position(result, point, components: str = "xyz", *, frame: Body | None = None, ax=None, label: str = ""):
@@ -155,17 +156,24 @@ def driving_forces(result, which=None, *, ax=None):
 class Pose:
     """What ``shape`` draws of one state, global coordinates (m); NaN rows separate polylines.
 
-    ``links`` (n, 3): per body, parent origin → joint → origin → centre of mass; ``triads``
-    (3, n, 3): each body's x, y, z axes from its origin, ``frame_size`` long; ``beams``: a
-    centre line (m + 2, 3) per beam."""
+    ``links`` (n, 3): per body, parent origin → joint → origin → centre of mass; ``segments``
+    (n, 3): the straight lines between pairs of points; ``triads``: three arrays (n, 3), each
+    body's x, y and z axes from its origin, ``frame_size`` (m) long; ``beams``: a centre line
+    (m + 2, 3) per beam."""
 
     links: np.ndarray
-    triads: np.ndarray
+    segments: np.ndarray
+    triads: list[np.ndarray]
     beams: list[np.ndarray]
+    frame_size: float
+
+    def lines(self) -> list[np.ndarray]:
+        """The polylines in the order ``ShapeArtists`` draws them."""
+        return [self.links, self.segments, *self.triads, *self.beams]
 
     def points(self) -> np.ndarray:
         """All the finite points drawn, (k, 3)."""
-        X = np.vstack([self.links, *self.triads, *self.beams])
+        X = np.vstack(self.lines())
         return X[np.all(np.isfinite(X), axis=1)]
 
 
@@ -181,9 +189,10 @@ class Skeleton:
 
     Every body gets a link (parent origin → joint frame → body origin → centre of mass) and,
     unless it is an rfe, a triad of its axes; the rfes of the ``beams`` are drawn by their centre
-    lines instead (``Beam.centerline``), other rfes by their links."""
+    lines instead (``Beam.centerline``), other rfes by their links. ``segments``: pairs of points
+    (Point or Body; on the ground too) joined by straight lines: ropes, cylinders, springs."""
 
-    def __init__(self, system, beams=()):
+    def __init__(self, system, beams=(), segments=()):
         self.system = system
         self.beams = _beams(beams, system)
         hidden = {b.index for beam in self.beams for b in beam.rfes[1:]}
@@ -202,6 +211,7 @@ class Skeleton:
             if not _is_rfe(names[i]):
                 axes = [self._add(body.point(e)) for e in np.eye(3)]  # unit points along x, y, z
                 self.triads.append((origin, axes[0]))
+        self.segments = [[self._point(a), self._point(b)] for a, b in _pairs(segments, system)]
 
     def _joint(self, bodies: list[Body], i: int) -> list[int]:
         """The rows of body i's parent origin and joint frame (only the joint frame on the ground)."""
@@ -211,6 +221,11 @@ class Skeleton:
     @property
     def rows(self) -> int:
         return len(self.points) + len(self.fixed)
+
+    def _point(self, point) -> int:
+        """The row of a Point or a Body's origin; fixed on the ground."""
+        point = point.origin if isinstance(point, Body) else point
+        return self._fixed(np.asarray(point.r, dtype=float)) if point.body < 0 else self._add(point)
 
     def _add(self, point: Point) -> int:
         self.points.append(point)
@@ -225,19 +240,21 @@ class Skeleton:
         """The points at the state ``q`` (m, rad) and time ``t`` (s; required with drives).
         ``frame_size``: the triads' length in m; default 8 % of the shape's extent."""
         t = _checks.pose_time(self.system, t)
+        if frame_size is not None:
+            frame_size = _checks.scalar(frame_size, "frame_size", positive=True, unit="m")
         X = np.empty((self.rows, 3))
         on_bodies = np.setdiff1d(np.arange(self.rows), list(self.fixed))
         if self.points:
             X[on_bodies] = self.system._positions(self.points, q, t)
         for row, r in self.fixed.items():
             X[row] = r
-        links = _polylines([X[k] for k in self.links])
+        links, segments = _polylines([X[k] for k in self.links]), _polylines([X[k] for k in self.segments])
         beams = [beam.centerline(self.system, q, t) for beam in self.beams]
         if frame_size is None:
-            frame_size = 0.08 * _extent(np.vstack([links, *beams]))
+            frame_size = 0.08 * _extent(np.vstack([links, segments, *beams]))
         triads = [_polylines([[X[o], X[o] + frame_size * (X[x + a] - X[o])] for o, x in self.triads])
                   for a in range(3)]
-        return Pose(links, triads, beams)
+        return Pose(links, segments, triads, beams, frame_size)
 
 
 def _polylines(lines) -> np.ndarray:
@@ -262,6 +279,16 @@ def _beams(beams, system) -> list[Beam]:
     return beams
 
 
+def _pairs(segments, system) -> list[tuple]:
+    pairs = list(segments)
+    for pair in pairs:
+        if not (isinstance(pair, tuple) and len(pair) == 2 and all(isinstance(p, (Point, Body)) for p in pair)):
+            raise ValueError(f"segments: expected pairs (a, b) of Point or Body handles, got {pair!r}")
+        for p in pair:
+            _checks.same_model(p, system, "segments")
+    return pairs
+
+
 def _plane(plane):
     if plane is not None and plane not in PLANES:
         raise ValueError(f"plane: expected None (3D) or one of {list(PLANES)}, got {plane!r}")
@@ -282,16 +309,18 @@ def _shape_axes(ax, plane):
 
 class ShapeArtists:
     """The lines that draw a ``Pose`` in the Axes ``ax`` (3D for plane=None, else the projection
-    on ``plane``): links (grey), triads (red x, green y, blue z) and one line per beam."""
+    on ``plane``): links (grey), segments (brown), triads (red x, green y, blue z) and one line per
+    beam, labelled with ``beam_names``; ``color`` and ``alpha`` override the style of all."""
 
-    def __init__(self, ax, plane, nbeams: int, beam_names=(), color=None, alpha: float = 1.0):
+    def __init__(self, ax, plane, beam_names, color=None, alpha: float = 1.0):
         self.ax, self.columns = ax, PLANES[plane] if plane else (0, 1, 2)
         line = self.line
         self.links = line(label="_links", color=color or "0.35", lw=1.2, marker="o", ms=2.5, alpha=alpha)
+        self.segments = line(label="_segments", color=color or "tab:brown", lw=1.2, alpha=alpha)
         self.triads = [line(label=f"_{c} axes", color=color or k, lw=1.0, alpha=alpha)
                        for c, k in zip("xyz", ("tab:red", "tab:green", "tab:blue"))]
-        names = list(beam_names) or [f"beam {k}" for k in range(nbeams)]
-        self.beams = [line(label=name, color=color or "tab:blue", lw=2.0, alpha=alpha) for name in names]
+        self.beams = [line(label=name, color=color or "tab:blue", lw=2.0, alpha=alpha) for name in beam_names]
+        self.all = [self.links, self.segments, *self.triads, *self.beams]  # in the order of Pose.lines
 
     def line(self, **style):
         """A new, empty line in the Axes with the matplotlib ``style``."""
@@ -300,13 +329,9 @@ class ShapeArtists:
 
     def set(self, pose: Pose) -> list:
         """Show ``pose``; returns the changed artists."""
-        for artist, X in zip(self.all, [pose.links, *pose.triads, *pose.beams]):
+        for artist, X in zip(self.all, pose.lines(), strict=True):
             set_line(artist, X, self.columns)
         return self.all
-
-    @property
-    def all(self) -> list:
-        return [self.links, *self.triads, *self.beams]
 
 
 def set_line(line, X: np.ndarray, columns) -> None:
@@ -339,7 +364,7 @@ def drawn(ax) -> np.ndarray:
     return np.vstack(rows) if rows else np.zeros((0, 3 if three else 2))
 
 
-def shape(system, q, t: float | None = None, *, ax=None, plane: str | None = None, beams=(),
+def shape(system, q, t: float | None = None, *, ax=None, plane: str | None = None, beams=(), segments=(),
           frame_size: float | None = None):
     """Draw ``system`` at the state ``q`` (m, rad) and time ``t`` (s; required when the system
     has drives, as for ``System.position``).
@@ -349,16 +374,19 @@ def shape(system, q, t: float | None = None, *, ax=None, plane: str | None = Non
     origin through its joint frame to its origin and centre of mass. Beams given in ``beams``
     (Beam handles, or one) are drawn as their deformed centre lines (``Beam.centerline``,
     labelled with the beam's name) instead of their rfes; the rfes of other beams as links only.
+    ``segments``: pairs (a, b) of Points or Bodies (on the ground too) drawn as straight lines —
+    ropes, cylinders, springs, which the System does not place.
 
     ``plane``: None for 3D axes, or "xy", "xz", "yz" for the projection on that plane. Equal
-    aspect, axes labelled "x (m)", ... Returns the Axes.
+    aspect around everything drawn into the Axes (several states can share them), axes labelled
+    "x (m)", ... Returns the Axes.
     """
     plane = _plane(plane)
-    skeleton = Skeleton(system, beams)
+    skeleton = Skeleton(system, beams, segments)
     pose = skeleton.pose(q, t, frame_size)
     ax = _shape_axes(ax, plane)
-    ShapeArtists(ax, plane, len(skeleton.beams), [b.name for b in skeleton.beams]).set(pose)
-    set_limits(ax, drawn(ax))  # all shapes drawn into ax: several states can share it
+    ShapeArtists(ax, plane, [b.name for b in skeleton.beams]).set(pose)
+    set_limits(ax, drawn(ax))
     return ax
 
 
@@ -384,15 +412,14 @@ def modes(system, modes, which=(0, 1, 2), *, scale: float | None = None, t: floa
         raise ValueError(f"ax: expected {len(k)} Axes (one per mode in which), got {len(ax)}")
     skeleton = Skeleton(system, beams)
     reference = skeleton.pose(modes.q, t)
-    size = 0.08 * _extent(reference.points())
+    names = [b.name for b in skeleton.beams]
     for a, i in zip(ax, k):
         phi = modes.shapes[:, i]
-        s = _mode_scale(skeleton, modes.q, phi, t, size) if scale is None else _checks.scalar(scale, "scale")
-        deformed = skeleton.pose(modes.q + s * phi, t, size)
+        s = _mode_scale(skeleton, modes.q, reference, phi, t) if scale is None else _checks.scalar(scale, "scale")
+        deformed = skeleton.pose(modes.q + s * phi, t, reference.frame_size)
         _shape_axes(a, plane)
-        names = [b.name for b in skeleton.beams]
-        ShapeArtists(a, plane, len(names), [f"_{n} reference" for n in names], color="0.7", alpha=0.8).set(reference)
-        ShapeArtists(a, plane, len(names), names).set(deformed)
+        ShapeArtists(a, plane, [f"_{n} reference" for n in names], color="0.7", alpha=0.8).set(reference)
+        ShapeArtists(a, plane, names).set(deformed)
         set_limits(a, drawn(a))
         a.set_title(f"mode {i + 1}: {modes.frequencies_hz[i]:.4g} Hz")
     return ax
@@ -406,12 +433,11 @@ def _mode_indices(which, n: int) -> list[int]:
     return [int(i) for i in items]
 
 
-def _mode_scale(skeleton: Skeleton, q, phi, t, size: float) -> float:
-    """The scale s that moves the drawn points of the pose at q + s φ by 10 % of its extent
-    (from the linearised motion)."""
-    base = skeleton.pose(q, t, size)
+def _mode_scale(skeleton: Skeleton, q: np.ndarray, reference: Pose, phi: np.ndarray, t) -> float:
+    """The scale s that moves the drawn points of the ``reference`` pose at q by 10 % of its
+    extent at q + s φ (from the linearised motion)."""
     eps = 1e-6
-    moved = skeleton.pose(q + eps * phi, t, size)
-    a, b = base.points(), moved.points()
-    rate = np.max(np.linalg.norm(b - a, axis=1)) / eps if len(a) == len(b) and len(a) else 0.0
+    moved = skeleton.pose(q + eps * phi, t, reference.frame_size)
+    a, b = reference.points(), moved.points()
+    rate = np.max(np.linalg.norm(b - a, axis=1)) / eps if len(a) else 0.0
     return 0.1 * _extent(a) / rate if rate > 0 else 1.0
