@@ -8,6 +8,7 @@ import sys
 from pathlib import Path
 
 import numpy as np
+import pytest
 
 sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
 
@@ -38,3 +39,16 @@ def test_runner_writes_and_prints_the_scaling_tables(tmp_path, capsys):
             assert [int(r["m"]) for r in csv.DictReader(f)] == list(scaling.QUICK_ELEMENTS)
     out = capsys.readouterr().out
     assert "machine:" in out and "| m | nq | recursive_s |" in out and "| m | nq | spring_s_per_step |" in out
+
+
+@pytest.mark.filterwarnings("ignore")  # a LocalCluster's start-up notices (ports, dashboards)
+def test_sweep_scaling_table():
+    """The sweep benchmark's structure: four executors, all giving the serial results (asserted
+    inside), speed-up 1 for serial."""
+    pytest.importorskip("distributed")
+    from benchmarks import sweep
+
+    table = sweep.scaling(spins=(4.0, 6.0), elements=4, rounds=1, tiny=10)
+    assert [r["executor"] for r in table.rows][0] == "serial (1 thread)" and len(table.rows) == 4
+    assert table.rows[0]["speed_up"] == 1.0 and all(r["wall_time_s"] > 0 for r in table.rows)
+    assert table.rows[-1]["startup_s"] > 0
