@@ -39,6 +39,8 @@ def result_columns(result, points=None) -> tuple[list[str], np.ndarray]:
     if not isinstance(points, Mapping) or not all(isinstance(k, str) for k in points):
         raise ValueError(f"points: expected None or a dict of column names (str) to Points or Bodies, e.g. "
                          f"{{'tip': beam.tip}}, got {points!r}")
+    if result.system is None:
+        raise ValueError("result: expected a Result with its system; load it with rigidfem.load_npz(path, system)")
     names = list(result.system.coordinate_names)
     columns = names + [n + RATE for n in names]
     blocks = [result.q, result.qd]
