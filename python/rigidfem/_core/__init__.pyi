@@ -21,6 +21,8 @@ class Profile:
         """
         (q, qd, qdd) at time t (s).
         """
+    def __reduce__(self) -> tuple:
+        ...
     def __repr__(self) -> str:
         ...
 class ForceLawError(SimulationError, ValueError):
@@ -33,7 +35,11 @@ class JointSpec:
     """
     Active coordinates of a joint with their springs and dampers.
     """
+    def __getstate__(self) -> tuple[str, list[str], list[float], list[float], list[float], bool, list]:
+        ...
     def __init__(self, kind: str, coordinates: collections.abc.Sequence[str]) -> None:
+        ...
+    def __setstate__(self, arg0: tuple) -> None:
         ...
     def add_coupling(self, body: typing.Any, slot: typing.Any, G: typing.Any) -> None:
         """
@@ -79,6 +85,8 @@ class Body:
     """
     Handle of a body of a Model (index -1 is the ground).
     """
+    def __getstate__(self) -> tuple[int, str, int]:
+        ...
     @typing.overload
     def __init__(self) -> None:
         """
@@ -88,6 +96,8 @@ class Body:
     def __init__(self, index: typing.SupportsInt | typing.SupportsIndex, name: str, model: typing.SupportsInt | typing.SupportsIndex = 0) -> None:
         ...
     def __repr__(self) -> str:
+        ...
+    def __setstate__(self, arg0: tuple) -> None:
         ...
     def point(self, r: typing.Any) -> ...:
         """
@@ -113,6 +123,8 @@ class Point:
     """
     A material point: body index and position r (m) in the body frame.
     """
+    def __getstate__(self) -> tuple[int, typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"], int]:
+        ...
     @typing.overload
     def __init__(self, body: typing.Any, r: typing.Any) -> None:
         ...
@@ -120,6 +132,8 @@ class Point:
     def __init__(self, body: Body) -> None:
         ...
     def __repr__(self) -> str:
+        ...
+    def __setstate__(self, arg0: tuple) -> None:
         ...
     @property
     def body(self) -> int:
@@ -154,6 +168,10 @@ class _Model:
         ...
     def _add_rope(self, name: str, a: typing.SupportsInt | typing.SupportsIndex, point_a: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], b: typing.SupportsInt | typing.SupportsIndex, point_b: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], EA: typing.SupportsFloat | typing.SupportsIndex, DA: typing.SupportsFloat | typing.SupportsIndex, length: typing.SupportsFloat | typing.SupportsIndex, unstretched: Profile) -> str:
         ...
+    def _adopt_id(self, id: typing.SupportsInt | typing.SupportsIndex) -> None:
+        """
+        Takes the id of the model this one copies (unpickling).
+        """
     def _body_index(self, name: str) -> int:
         ...
     def _body_name(self, index: typing.SupportsInt | typing.SupportsIndex) -> str:
