@@ -1,4 +1,4 @@
-"""``python -m benchmarks {scaling,peers,scale,loops,sweep} [--quick] [--output DIR]``, from the root of a checkout."""
+"""``python -m benchmarks {scaling,peers,scale,loops,implicit_step,sweep} [--quick] [--output DIR]``, from the root of a checkout."""
 
 from __future__ import annotations
 
@@ -12,6 +12,7 @@ COMMANDS = {
     "peers": "rigidfem against Pinocchio and MuJoCo (needs: pip install pin mujoco)",
     "scale": "hidden costs at scale: Python calls against C++, outputs, building long beams",
     "loops": "closed loops: cost per step against n and the number of constraint rows, against a dense solve",
+    "implicit_step": "where a generalised-alpha step's time goes on Kane's beam (m = 10 ... 1000): floor and parts",
     "sweep": "rf.sweep on 1 and 2 threads, 2 processes and a 2-worker Dask LocalCluster (needs dask[distributed])",
 }
 

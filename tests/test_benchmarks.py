@@ -52,3 +52,15 @@ def test_sweep_scaling_table():
     assert [r["executor"] for r in table.rows][0] == "serial (1 thread)" and len(table.rows) == 4
     assert table.rows[0]["speed_up"] == 1.0 and all(r["wall_time_s"] > 0 for r in table.rows)
     assert table.rows[-1]["startup_s"] > 0
+
+
+def test_implicit_step_breakdown_table():
+    """The implicit-step breakdown's structure: the parts are positive and the step costs at least
+    about its floor (one residual and one solve per Newton iteration)."""
+    from benchmarks import implicit_step
+
+    table = implicit_step.step_breakdown(elements=(10,), t_end=0.5)
+    row = table.rows[0]
+    assert row["nq"] == 10 and row["iterations_per_step"] >= 1
+    assert all(row[k] > 0 for k in ("residual_s", "lu_solve_s", "tangent_s", "lu_factor_s", "floor_s"))
+    assert row["step_over_floor"] > 0.5
