@@ -127,7 +127,8 @@ class Result(Versioned):
 
     def __repr__(self) -> str:
         s = self.stats
-        return (f"<rigidfem Result {self.method}: {len(self.t)} outputs to t = {self.t[-1]:g} s, {s['steps']} steps "
+        chosen = f" ({s['method']})" if "method" in s else ""
+        return (f"<rigidfem Result {self.method}{chosen}: {len(self.t)} outputs to t = {self.t[-1]:g} s, {s['steps']} steps "
                 f"({s['rejected_steps']} rejected), {s['rhs_evaluations']} rhs, {s['wall_time']:.3g} s"
                 f"{', interrupted' if self.interrupted else ''}>")
 
@@ -160,7 +161,7 @@ def load_npz(path, system=None) -> Result:
     return Result(system, **export.read_npz(path, system))
 
 
-def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = None, rtol=1e-6,
+def simulate(system, t_end: float, method: str = "auto", dt: float | None = None, rtol=1e-6,
              atol=1e-9, t_eval=None, q0=None, qd0=None, t0: float = 0.0, progress: bool = False,
              first_step: float | None = None, stiffness_warning: bool = True,
              max_steps: int = 1_000_000, max_step: float = np.inf, adaptive: bool | None = None, beta: float = 0.25,
@@ -279,13 +280,15 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
         if bar is not None:
             bar.close()
     t, q, qd, stats, interrupted, failure = run
+    if method == "auto":
+        stats["method"] = _auto_choice(stats, opt.stiff_method)
     result = Result(system, t, q, qd, stats, method, interrupted)
     if failure is not None:
         message, time, cause = failure
         error = _core.SimulationError(message)
         error.result, error.time, error.cause = result, time, cause
         raise error
-    if stiffness_warning and np.isfinite(stats.get("stiff_at", np.nan)):
+    if stiffness_warning and method != "auto" and np.isfinite(stats.get("stiff_at", np.nan)):
         warnings.warn(f"{method}: the problem is stiff from t = {stats['stiff_at']:.6g} s on (h rho > 3.25): the step is "
                       "bounded by stability, the cost grows with the highest frequency and loose tolerances leave "
                       "errors in the stiff modes; an implicit method (generalized_alpha, newmark, scipy:Radau) is "
@@ -309,6 +312,20 @@ def _check_closed(system, t0, q0, qd0, tol=1e-8):
                              "system.assemble(q0, qd0, t0) finds the nearest ones")
 
 
+#: The implicit method ``method="auto"`` hands over to when dopri5 finds the problem stiff.
+AUTO_STIFF_METHOD = "generalized_alpha"
+
+
+def _auto_choice(stats: dict, stiff_method: str) -> str:
+    """What ``auto`` ran, for ``Result.stats["method"]``: "dopri5", or the hand-over."""
+    switched, trials = stats.get("switched_at", np.nan), stats.get("auto_trials", 0)
+    lost = trials - (1 if np.isfinite(switched) else 0)
+    tried = f"; {lost} trial{'s' * (lost != 1)} of {stiff_method} lost" if lost else ""
+    if not np.isfinite(switched):
+        return f"dopri5{tried}"
+    return f"dopri5, then {stiff_method} from t = {switched:.6g} s{tried}"
+
+
 def _options(method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, beta, gamma, alpha, rho_inf,
              newton_tol, newton_max_iterations, iteration_matrix):
     """The C++ integrator's options, each checked and converted."""
@@ -328,6 +345,10 @@ def _options(method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, 
     if not isinstance(iteration_matrix, str):
         raise ValueError(f"iteration_matrix: expected 'auto', 'tangent' or 'spring', got {iteration_matrix!r}")
     opt.iteration_matrix = iteration_matrix
+    if method == "auto":
+        if adaptive is False:
+            raise ValueError("adaptive: expected None or True with method 'auto' (it controls its steps), got False")
+        opt.stiff_method = AUTO_STIFF_METHOD
     return opt
 
 
