@@ -17,6 +17,20 @@ def integrate(system, t_end, q0, qd0, *, rtol=1e-12, atol=1e-12, t_eval=None, ev
     return sol
 
 
+DOUBLE_PENDULUM_Y0 = np.array([1.0, 0.5, 0.0, 0.0])
+
+
+@pytest.fixture(scope="module")
+def pendulum2():
+    """Planar double pendulum released from (1, 0.5) rad; reference by SciPy's DOP853 at 1e-13."""
+    import rigidfem as rf
+
+    model, _ = rf.samples.double_pendulum()
+    system = model.compile()
+    y0 = DOUBLE_PENDULUM_Y0
+    return system, integrate(system, 1.0, y0[:2], y0[2:], rtol=1e-13, atol=1e-13)
+
+
 @pytest.fixture
 def rng():
     return np.random.default_rng(20261121)

@@ -14,16 +14,7 @@ from scipy.integrate import solve_ivp
 
 import rigidfem as rf
 
-Y0 = np.array([1.0, 0.5, 0.0, 0.0])
-
-
-@pytest.fixture(scope="module")
-def pendulum2():
-    """Planar double pendulum released from (1, 0.5) rad; reference by SciPy's DOP853 at 1e-13."""
-    model, _ = rf.samples.double_pendulum()
-    system = model.compile()
-    sol = solve_ivp(system.rhs, (0, 1.0), Y0, method="DOP853", rtol=1e-13, atol=1e-13, dense_output=True)
-    return system, sol
+from conftest import DOUBLE_PENDULUM_Y0 as Y0  # the pendulum2 fixture's initial state
 
 
 @pytest.mark.parametrize("method,dts,order,kw", [

@@ -81,7 +81,8 @@ LAYERS = [
 ]
 RANK = {name: k for k, layer in enumerate(LAYERS) for name in layer}
 # Sources named after their family rather than a header.
-RANK.update({"integrate": RANK["stepper"], "runge_kutta": RANK["stepper"], "newmark": RANK["stepper"]})
+RANK.update({"integrate": RANK["stepper"], "runge_kutta": RANK["stepper"], "newmark": RANK["stepper"],
+             "implicit_rk": RANK["stepper"]})
 
 
 def _cpp_includes(path: Path) -> set:

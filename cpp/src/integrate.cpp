@@ -26,6 +26,7 @@ const MethodInfo methods[] = {
     {Method::HHT, "hht", 2, true, false, make_newmark},
     {Method::GeneralizedAlpha, "generalized_alpha", 2, true, false, make_newmark},
     {Method::ImplicitSpring, "implicit_spring", 2, true, false, make_newmark},
+    {Method::Esdirk43, "esdirk43", 4, true, true, make_implicit_rk},
     {Method::Auto, "auto", 5, true, true, make_runge_kutta},  // dopri5 and its stiff method (AutoChoice)
 };
 
@@ -141,7 +142,10 @@ void check_options(const System& sys, double t0, double t_end, const VecX& q0, c
   check_vector(qd0, sys.nq, "qd0", "nq");
   if (!m.error_estimate && o.adaptive == 1)
     throw std::invalid_argument(std::string("adaptive: the method '") + m.name +
-                                "' has no error estimate; use dopri5, rkf45 or the Newmark family");
+                                "' has no error estimate; use dopri5, rkf45, esdirk43 or the Newmark family");
+  if (m.make == make_implicit_rk && sys.nl > 0)
+    throw std::invalid_argument(std::string("method: '") + m.name + "' does not integrate loop closures (the system has " +
+                                std::to_string(sys.nl) + " constraint rows); use generalized_alpha or dopri5");
   if (!is_adaptive(o) && !(o.dt > 0.0 && std::isfinite(o.dt)))
     throw std::invalid_argument(std::string("dt: expected a positive step in s for the fixed-step method '") + m.name +
                                 "', got " + num(o.dt));
@@ -270,6 +274,7 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
   double h = o.dt > 0.0 ? std::min(o.dt, span) : stepper->initial_step(span, tol, o.max_step);
 
   double t = t0;
+  double err_prev = 1.0;  // the error estimate of the last accepted step (PI control)
   bool rejected_last = false;
   int stiff_steps = 0, nonstiff_steps = 0;  // Hairer's stiffness test (h ρ, dopri5)
   while (t < t_end) {
@@ -296,10 +301,15 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
       continue;
     }
     if (adaptive) {
-      // h_new = h · min(growth, max(0.2, 0.9 err^(−1/k))); no growth right after a rejection
-      // where the method asks so, and h kept for small gains where it reuses a matrix.
+      // h_new = h · min(growth, max(0.2, 0.9 err^(−β₁/k) err_prev^(β₂/k))), the elementary controller
+      // after a rejection; no growth right after a rejection where the method asks so, and h kept
+      // for small gains where it reuses a matrix.
       const double growth = control.hold_after_reject && rejected_last ? 1.0 : control.growth;
-      double factor = std::min(growth, std::max(0.2, 0.9 * std::pow(std::max(err, 1e-10), -1.0 / control.k)));
+      const double e = std::max(err, 1e-10);
+      const double pi = rejected_last || !(err <= 1.0)
+                            ? std::pow(e, -1.0 / control.k)
+                            : std::pow(e, -control.beta1 / control.k) * std::pow(err_prev, control.beta2 / control.k);
+      double factor = std::min(growth, std::max(0.2, 0.9 * pi));
       if (factor >= 1.0 && factor < control.keep_below) factor = 1.0;
       if (!(err <= 1.0)) {
         if (!std::isfinite(err) && hs < 1e-300) step_failure(t, hs, "the error estimate is NaN or inf");
@@ -309,6 +319,7 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
         continue;
       }
       rejected_last = false;
+      err_prev = e;
       h = hs * factor;
       if (stepper->h_rho() > 3.25) {
         nonstiff_steps = 0;

@@ -15,6 +15,10 @@ name                   scheme                                                   
 ``"generalized_alpha"`` Chung–Hulbert generalised-α with ρ∞, Newton                ``dt`` or adaptive
 ``"implicit_spring"``  generalised-α whose Newton matrix is                       ``dt`` or adaptive
                        M + diag(γ′h b + β′h² c), O(n) per iteration (ABA)
+``"esdirk43"``         ESDIRK4(3)6L[2]SA (Kennedy & Carpenter 2003): order 4,     ``rtol``/``atol``
+                       L-stable, stiffly accurate, embedded order 3, PI control;  or ``dt``
+                       5 implicit stages, each a Newton solve for its q̈ with
+                       M + γh C + (γh)² K (γ = ¼), dense output quintic Hermite
 ``"scipy:Radau"`` …    SciPy's solvers (Radau, BDF, LSODA, RK45, DOP853) with the  ``rtol``/``atol``
                        C++ ``rhs`` and ``jacobian`` (Python per step: the slow path)
 =====================  =========================================================  ===========
@@ -26,6 +30,16 @@ analytic for the default recursive engine, by central differences for
 ``compile(algorithm="lagrange")``. ``implicit_spring`` keeps only its diagonal
 springs c and dampers b. ``adaptive=True`` controls their step by the local error
 estimate h²(β − 1/6)(a_{n+1} − a_n).
+
+``esdirk43`` writes each stage for the second-order system: with the stage's unknown
+acceleration A_i, V_i = v̂_i + γh A_i and Q_i = q̂_i + γh V_i (v̂_i, q̂_i from the earlier
+stages), and Newton solves M(Q_i) A_i = f(Q_i, V_i, t_i) with M + γh C + (γh)² K (the exact
+tangent, kept over stages and steps while Newton contracts fast and refactorised when h changes)
+or, with ``iteration_matrix="spring"``, the O(n) matrix of ``implicit_spring``. Its error is
+controlled on y = [q, q̇]: on a flexible beam give ``atol`` well below ``rtol`` × the size of the
+sde angles (e.g. ``atol = 1e-3 rtol``), since a tip moves by the sum of many small angles times
+their lever arms (with atol = rtol the tip's error on Kane's beam is ~60× rtol times the
+tip deflection, with atol = 1e-3 rtol ~0.2×). Systems with loop closures are refused (ValueError).
 """
 
 from __future__ import annotations
@@ -173,7 +187,7 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
     ----------
     method : str
         See the module docstring: "euler", "symplectic_euler", "rk4", "dopri5", "rkf45",
-        "newmark", "hht", "generalized_alpha", "implicit_spring", or "scipy:Radau", "scipy:BDF",
+        "newmark", "hht", "generalized_alpha", "implicit_spring", "esdirk43", or "scipy:Radau", "scipy:BDF",
         "scipy:LSODA", "scipy:RK45", "scipy:DOP853". "implicit_spring" is generalised-α (``rho_inf``)
         whose Newton matrix holds only the coordinates' springs and dampers,
         M + diag(γ'h b + β'h² c): the articulated-body algorithm solves it in O(n), so a stiff beam
@@ -203,17 +217,19 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
         Limits: a run that needs more steps (accepted and rejected) raises SimulationError, which
         carries the partial result.
     adaptive : bool, optional
-        Step-size control: on by default for dopri5 and rkf45 (``False`` runs them at the
-        fixed step ``dt``), off by default for the Newmark family (``True`` switches on its
+        Step-size control: on by default for dopri5, rkf45 and esdirk43 (``False`` runs them at
+        the fixed step ``dt``), off by default for the Newmark family (``True`` switches on its
         local error estimate).
     beta, gamma, alpha, rho_inf
         Newmark's β, γ; HHT's α ∈ [−1/3, 0]; generalised-α's spectral radius ρ∞ ∈ [0, 1].
     newton_tol, newton_max_iterations
-        Newton stops when the increments of q and q̇ fall below newton_tol (1 + |q|).
+        Newton stops when the increments of q and q̇ fall below newton_tol (1 + |q|); adaptive
+        esdirk43 runs stop it at 0.03 of the error weights instead (newton_tol is for fixed steps).
     iteration_matrix : str
-        Newton matrix of the Newmark family: "tangent" (the exact tangent
-        M + γ'h ∂r/∂q̇ + β'h² ∂r/∂q, analytic for recursive systems, dense LU), "spring" (the
-        O(n) matrix of "implicit_spring") or "auto" (spring for implicit_spring, else tangent).
+        Newton matrix of the Newmark family and esdirk43: "tangent" (the exact tangent
+        M + γ'h ∂r/∂q̇ + β'h² ∂r/∂q, analytic for recursive systems, dense LU; γh and (γh)² for
+        esdirk43), "spring" (the O(n) matrix of "implicit_spring") or "auto" (spring for
+        implicit_spring, else tangent).
     stop : threading.Event, optional
         Checked about every 0.05 s of wall time: once set, the run stops and returns its partial
         result (with a RuntimeWarning). The way to stop a run in a worker thread, which Ctrl-C

@@ -26,17 +26,19 @@ enum class Method {
   HHT,               ///< Hilber–Hughes–Taylor α
   GeneralizedAlpha,  ///< Chung–Hulbert generalised-α with ρ∞
   ImplicitSpring,    ///< generalised-α with the O(n) Newton matrix M + diag(γ'h b + β'h² c)
+  Esdirk43,          ///< ESDIRK4(3)6L[2]SA (Kennedy & Carpenter), order 4, L-stable, adaptive
   /// dopri5 while it is the faster, `stiff_method` (adaptive) while that is: where dopri5's steps look
-  /// bounded by stability, the stiff method runs a timed trial and keeps the run if it advances faster.
+  /// bounded by stability, the stiff method runs a trial and keeps the run if it does less work per simulated second.
   Auto,
 };
 /// The method called `name` ("dopri5", ...); std::invalid_argument listing the methods otherwise.
 Method parse_method(const std::string& name);
 const char* method_name(Method method);
 
-/// The Newmark family's Newton matrix: Tangent, M + γ'h ∂r/∂q̇ + β'h² ∂r/∂q (analytic for recursive
-/// systems, factorised densely); Spring, M + diag(γ'h b + β'h² c) (the sde springs and dampers as
-/// armature of the articulated-body algorithm: O(n)); Auto, Spring for implicit_spring, else Tangent.
+/// The implicit methods' Newton matrix: Tangent, M + γ'h ∂r/∂q̇ + β'h² ∂r/∂q (analytic for recursive
+/// systems, factorised densely; γh and (γh)² for the ESDIRK's stages); Spring, M + diag(γ'h b + β'h² c)
+/// (the sde springs and dampers as armature of the articulated-body algorithm: O(n)); Auto, Spring
+/// for implicit_spring, else Tangent.
 enum class IterationMatrix { Auto, Tangent, Spring };
 IterationMatrix parse_iteration_matrix(const std::string& name);
 const char* iteration_matrix_name(IterationMatrix matrix);

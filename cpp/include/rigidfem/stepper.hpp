@@ -30,12 +30,15 @@ VecX hermite(double theta, double h, const VecX& y0, const VecX& f0, const VecX&
 [[noreturn]] void step_failure(double t, double h, const std::string& cause);
 
 /// Step-size control of a method whose local error estimate is O(h^k):
-/// h_new = h · min(growth, max(0.2, 0.9 err^(−1/k))).
+/// h_new = h · min(growth, max(0.2, 0.9 err^(−β₁/k) err_prev^(β₂/k))), err_prev the estimate of the
+/// last accepted step: the elementary controller (β₁ = 1, β₂ = 0) or a PI controller (Gustafsson:
+/// β₁ = 0.7, β₂ = 0.4), the elementary one after a rejection.
 struct StepControl {
   int k;
   double growth;           ///< largest growth after an accepted step
   bool hold_after_reject;  ///< no growth on the step after a rejection
   double keep_below;       ///< factors in [1, keep_below) keep h (and an iteration matrix with it)
+  double beta1 = 1.0, beta2 = 0.0;  ///< the exponents of the PI controller
 };
 
 class Stepper {
@@ -63,9 +66,11 @@ class Stepper {
   virtual StepControl control() const = 0;
 };
 
-/// The explicit Runge–Kutta family (runge_kutta.cpp) and the Newmark family (newmark.cpp).
+/// The explicit Runge–Kutta family (runge_kutta.cpp), the Newmark family (newmark.cpp) and the
+/// implicit Runge–Kutta methods of high order (implicit_rk.cpp).
 std::unique_ptr<Stepper> make_runge_kutta(const System& sys, const IntegratorOptions& o, IntegratorStats& stats);
 std::unique_ptr<Stepper> make_newmark(const System& sys, const IntegratorOptions& o, IntegratorStats& stats);
+std::unique_ptr<Stepper> make_implicit_rk(const System& sys, const IntegratorOptions& o, IntegratorStats& stats);
 
 /// A row of the method table.
 struct MethodInfo {
