@@ -109,6 +109,7 @@ class Esdirk final : public Stepper {
     // e = h Σ (b_i − b̂_i) [V_i, A_i]
     e_.head(n_) = h * (V_ * Eigen::Map<const VecX>(T::e, T::s));
     e_.tail(n_) = h * (A_ * Eigen::Map<const VecX>(T::e, T::s));
+    if (!spring_) filter_error(T::gamma * h);
     err = error_norm(e_, y_, y1_, tol->atol, tol->rtol);
     return true;
   }
@@ -133,6 +134,17 @@ class Esdirk final : public Stepper {
   StepControl control() const override { return {4, 5.0, true, 1.2, 0.7, 0.4}; }
 
  private:
+  /// Shampine's filter of the error estimate, ê = (I − γh J)⁻¹ e with J the Jacobian of y' = (q̇, q̈):
+  /// the embedded method is not L-stable, so e carries the stiff modes' components at full size
+  /// although the step damps them; the filter scales a mode of frequency ω by about 1/(γhω)² and
+  /// leaves the accurate ones. With J = [[0, 1], [−M⁻¹K, −M⁻¹C]]:
+  /// (M + γhC + (γh)²K) ê_v = M e_v − γh K e_q, ê_q = e_q + γh ê_v (S is factorised already).
+  void filter_error(double gh) {
+    rhs_ = M_ * e_.tail(n_) - gh * (K_ * e_.head(n_));
+    e_.tail(n_) = lu_.solve(rhs_);
+    e_.head(n_) += gh * e_.tail(n_);
+  }
+
   /// The stages of the step t → t + h from (q_, v_, a_); false when a Newton iteration fails.
   bool stages(double t, double h, const Tolerances* tol) {
     const double gh = T::gamma * h;
@@ -275,7 +287,7 @@ class Esdirk final : public Stepper {
   bool spring_;
   VecX q_, v_, a_;     // (nq) the current state and its acceleration
   VecX qp_, vp_, ap_;  // (nq) the same at the start of the last accepted step (dense output)
-  VecX Q_, qhat_, vhat_, r_, dA_, armature_;  // (nq) the stage being solved
+  VecX Q_, qhat_, vhat_, r_, dA_, armature_, rhs_;  // (nq) the stage being solved; the filter's right side
   MatX V_, A_;                                // (nq, s) the stages' velocities and accelerations
   VecX y_, y1_, e_, dy_, sc_;                 // (2 nq) y_n, y_{n+1}, error, increments, error weights
   MatX K_, C_, M_, S_;                        // (nq, nq) the tangent's parts and S

@@ -329,7 +329,7 @@ def _check_closed(system, t0, q0, qd0, tol=1e-8):
 
 
 #: The implicit method ``method="auto"`` hands over to when dopri5 finds the problem stiff.
-AUTO_STIFF_METHOD = "generalized_alpha"
+AUTO_STIFF_METHOD = "esdirk43"
 
 
 def _auto_choice(stats: dict, stiff_method: str) -> str:
