@@ -107,7 +107,20 @@ def test_closed_chain_runs_and_stays_closed():
     q0, _ = system.assemble([0.4, -1.9, 4.6])
     result = rf.simulate(system, 2.0, q0=q0, t_eval=np.linspace(0, 2, 21))
     g = [np.abs(system.loop_constraints(t, q, np.zeros(3))[0]).max() for t, q in zip(result.t, result.q)]
-    assert max(g) < 1e-10 and "method" in result.stats
+    assert max(g) < 1e-10 and result.stats["method"] == "dopri5 (a closed chain)"
+    dopri = rf.simulate(system, 2.0, method="dopri5", q0=q0, t_eval=np.linspace(0, 2, 21))
+    assert np.array_equal(result.q, dopri.q)
+
+
+def test_no_free_coordinate():
+    """Every coordinate prescribed (nq = 0): the default method runs the drives (it crashed once on
+    the empty tolerance vector)."""
+    model = rf.Model()
+    body = model.add_body("a", model.ground, rf.Joint.revolute("z"), mass=1.0, inertia=(1, 1, 1))
+    model.prescribe(body, rf.motion.harmonic(1.0, 2.0))
+    result = rf.simulate(model.compile(), 1.0, t_eval=[0.0, 0.5, 1.0], rtol=0.1)
+    assert result.q.shape == (3, 0) and result.driving_forces.shape == (3, 1)
+    assert result.driving_forces[1, 0] == pytest.approx(-1.0 * 4.0 * np.sin(1.0), rel=1e-12)  # I θ̈, θ = sin 2t
 
 
 def test_bad_options():

@@ -266,7 +266,9 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
                          o.rtol.size() == 1 ? VecX::Constant(2 * n, o.rtol(0)) : o.rtol};
   // auto runs dopri5 at rtol <= 1e-3 (atol scaled alike): looser, its error control lets the stiff
   // modes of a beam go unstable (measured: the classical cantilever at rtol = 1e-2 ... 1e-1).
-  const double tighten = o.method == Method::Auto ? std::min(1.0, AutoChoice::loosest_explicit / asked.rtol.maxCoeff()) : 1.0;
+  const double loosest = asked.rtol.size() ? asked.rtol.maxCoeff() : 0.0;  // nq = 0: no tolerance to tighten
+  const double tighten = o.method == Method::Auto && loosest > AutoChoice::loosest_explicit
+                             ? AutoChoice::loosest_explicit / loosest : 1.0;
   const Tolerances explicit_tol{tighten * asked.atol, tighten * asked.rtol};
   const bool adaptive = is_adaptive(o);
   const double span = t_end - t0, grid = std::min(o.dt, o.max_step), near_end = t_end - 1e-12 * span;
