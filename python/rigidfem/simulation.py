@@ -19,6 +19,10 @@ name                   scheme                                                   
                        L-stable, stiffly accurate, embedded order 3, PI control;  or ``dt``
                        5 implicit stages, each a Newton solve for its q̈ with
                        M + γh C + (γh)² K (γ = ¼), dense output quintic Hermite
+``"radau5"``           Radau IIA, 3 stages, order 5, L-stable, stiffly accurate;  ``rtol``/``atol``
+                       simplified Newton on all stages in the transformed         or ``dt``
+                       real/complex form (exact tangent only), Hairer's filtered
+                       estimate, PI control, dense output quintic Hermite
 ``"scipy:Radau"`` …    SciPy's solvers (Radau, BDF, LSODA, RK45, DOP853) with the  ``rtol``/``atol``
                        C++ ``rhs`` and ``jacobian`` (Python per step: the slow path)
 =====================  =========================================================  ===========
@@ -39,7 +43,15 @@ or, with ``iteration_matrix="spring"``, the O(n) matrix of ``implicit_spring``. 
 controlled on y = [q, q̇]: on a flexible beam give ``atol`` well below ``rtol`` × the size of the
 sde angles (e.g. ``atol = 1e-3 rtol``), since a tip moves by the sum of many small angles times
 their lever arms (with atol = rtol the tip's error on Kane's beam is ~60× rtol times the
-tip deflection, with atol = 1e-3 rtol ~0.2×). Systems with loop closures are refused (ValueError).
+tip deflection, with atol = 1e-3 rtol ~0.2×).
+
+``radau5`` solves its three stages together: the stage accelerations A (nq, 3) give
+V = q̇_n 1ᵀ + h A aᵀ and Q = q_n 1ᵀ + h V aᵀ, Newton's matrix I⊗M + h a⊗C + h² a²⊗K splits, by
+the eigenvectors of the Butcher matrix a, into one real and one complex block of the form
+M + g C + g² K. Its error estimate (of order 3, Hairer & Wanner IV.8) is held to Hairer's
+rtol' = 0.1 rtol^(2/3) (atol scaled alike), as in radau5.f, since it bounds an order-5 solution
+from far above. Both methods: output at ``t_eval`` by the quintic Hermite interpolant of q through
+(q, q̇, q̈) at both ends of each step; systems with loop closures are refused (ValueError).
 """
 
 from __future__ import annotations
@@ -186,7 +198,8 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
     ----------
     method : str
         See the module docstring: "euler", "symplectic_euler", "rk4", "dopri5", "rkf45",
-        "newmark", "hht", "generalized_alpha", "implicit_spring", "esdirk43", or "scipy:Radau", "scipy:BDF",
+        "newmark", "hht", "generalized_alpha", "implicit_spring", "esdirk43", "radau5", or "scipy:Radau",
+        "scipy:BDF",
         "scipy:LSODA", "scipy:RK45", "scipy:DOP853". "implicit_spring" is generalised-α (``rho_inf``)
         whose Newton matrix holds only the coordinates' springs and dampers,
         M + diag(γ'h b + β'h² c): the articulated-body algorithm solves it in O(n), so a stiff beam
@@ -216,19 +229,20 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
         Limits: a run that needs more steps (accepted and rejected) raises SimulationError, which
         carries the partial result.
     adaptive : bool, optional
-        Step-size control: on by default for dopri5, rkf45 and esdirk43 (``False`` runs them at
+        Step-size control: on by default for dopri5, rkf45, esdirk43 and radau5 (``False`` runs them at
         the fixed step ``dt``), off by default for the Newmark family (``True`` switches on its
         local error estimate).
     beta, gamma, alpha, rho_inf
         Newmark's β, γ; HHT's α ∈ [−1/3, 0]; generalised-α's spectral radius ρ∞ ∈ [0, 1].
     newton_tol, newton_max_iterations
         Newton stops when the increments of q and q̇ fall below newton_tol (1 + |q|); adaptive
-        esdirk43 runs stop it at 0.03 of the error weights instead (newton_tol is for fixed steps).
+        esdirk43 and radau5 runs stop it at 0.03 of the error weights instead (newton_tol is for
+        their fixed steps).
     iteration_matrix : str
         Newton matrix of the Newmark family and esdirk43: "tangent" (the exact tangent
         M + γ'h ∂r/∂q̇ + β'h² ∂r/∂q, analytic for recursive systems, dense LU; γh and (γh)² for
         esdirk43), "spring" (the O(n) matrix of "implicit_spring") or "auto" (spring for
-        implicit_spring, else tangent).
+        implicit_spring, else tangent). radau5 takes the tangent only.
     stop : threading.Event, optional
         Checked about every 0.05 s of wall time: once set, the run stops and returns its partial
         result (with a RuntimeWarning). The way to stop a run in a worker thread, which Ctrl-C
