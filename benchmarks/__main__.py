@@ -1,4 +1,4 @@
-"""``python -m benchmarks {scaling,peers,scale,loops,sweep} [--quick] [--output DIR]``, from the root of a checkout."""
+"""``python -m benchmarks {scaling,peers,scale,loops,sweep,orders} [--quick] [--output DIR]``, from the root of a checkout."""
 
 from __future__ import annotations
 
@@ -13,6 +13,7 @@ COMMANDS = {
     "scale": "hidden costs at scale: Python calls against C++, outputs, building long beams",
     "loops": "closed loops: cost per step against n and the number of constraint rows, against a dense solve",
     "sweep": "rf.sweep on 1 and 2 threads, 2 processes and a 2-worker Dask LocalCluster (needs dask[distributed])",
+    "orders": "speed against error on Kane's beam: esdirk43, radau5, generalised-α and dopri5",
 }
 
 

@@ -52,3 +52,15 @@ def test_sweep_scaling_table():
     assert [r["executor"] for r in table.rows][0] == "serial (1 thread)" and len(table.rows) == 4
     assert table.rows[0]["speed_up"] == 1.0 and all(r["wall_time_s"] > 0 for r in table.rows)
     assert table.rows[-1]["startup_s"] > 0
+
+
+def test_orders_study_table():
+    """The high-order study's structure on a 4-element beam: every method reaches 1e-4 m, and the
+    summary keeps the least time per method and target."""
+    from benchmarks import orders
+
+    sweep, summary = orders.study(elements=(4,), quick=True, repeats=0)
+    assert {r["method"] for r in sweep.rows} == {"esdirk43", "esdirk43 (spring)", "radau5", "dopri5",
+                                                 "generalized_alpha"}
+    assert all(np.isfinite(r["tip_error_rms_m"]) and r["wall_time_s"] > 0 for r in sweep.rows)
+    assert len(summary.rows) == 5 and all(r["time_s_to_0.0001"] != "-" for r in summary.rows)

@@ -277,8 +277,9 @@ class Esdirk final : public ImplicitRk {
 
   /// e = h Σ (b_i − b̂_i) [V_i, A_i]
   double estimate(double, double h, const Tolerances& tol) override {
-    e_.head(n_) = h * (V_ * Eigen::Map<const VecX>(T::e, T::s));
-    e_.tail(n_) = h * (A_ * Eigen::Map<const VecX>(T::e, T::s));
+    const Eigen::Map<const VecX> e(T::e, T::s);
+    e_.head(n_).noalias() = h * (V_ * e);
+    e_.tail(n_).noalias() = h * (A_ * e);
     return error_norm(e_, y_, y1_, tol.atol, tol.rtol);
   }
 
@@ -355,7 +356,7 @@ class Esdirk final : public ImplicitRk {
 struct RadauTableau {
   static constexpr int s = 3;
   Eigen::Matrix3d a;
-  Eigen::Vector3d c, dd;       // dd: the estimate's weights on the stage increments (Hairer's DD/h)
+  Eigen::Vector3d c, dd;       // dd: the estimate's weights on the stage increments (Y_i − y_n)/h
   Eigen::Matrix3cd P, Pinv;    // a = P diag(d) P⁻¹
   Eigen::Vector3cd d;          // d(0) real, d(2) = conj d(1), Im d(1) > 0
   RadauTableau() {
@@ -386,7 +387,8 @@ class Radau5 final : public ImplicitRk {
  public:
   Radau5(const System& sys, const IntegratorOptions& o, IntegratorStats& stats)
       : ImplicitRk(sys, o, stats), A_(n_, 3), V_(n_, 3), Q_(n_, 3), R_(n_, 3), D_(n_, 3), dV_(n_, 3), dQ_(n_, 3),
-        Aprev_(n_, 3), Rt_(n_, 3), Dt_(n_, 3), x_(n_), xs_(n_), b1_(n_), b2_(n_), qx_(n_), vx_(n_), Sr_(n_, n_),
+        Aprev_(n_, 3), Rt_(n_, 3), Dt_(n_, 3), z_(n_), zs_(n_), x_(n_), xs_(n_), b1_(n_), b2_(n_), qx_(n_), vx_(n_),
+        Sr_(n_, n_),
         Sc_(n_, n_), lur_(n_), luc_(n_) {}
 
  private:
@@ -407,9 +409,13 @@ class Radau5 final : public ImplicitRk {
       x_ = Rt_.col(0).real();
       xs_.noalias() = lur_.solve(x_);
       Dt_.col(0) = xs_.cast<cplx>();
-      Dt_.col(1) = luc_.solve(Rt_.col(1));
-      Dt_.col(2) = Dt_.col(1).conjugate();
-      D_.noalias() = -(Dt_ * tab_.P.transpose()).real();
+      z_ = Rt_.col(1);
+      zs_.noalias() = luc_.solve(z_);
+      Dt_.col(1) = zs_;
+      Dt_.col(2) = zs_.conjugate();
+      // ΔA = −Re(ΔÃ Pᵀ), with ΔÃ holding S_k⁻¹ R̃_k
+      D_.noalias() = Dt_.imag() * tab_.P.imag().transpose();
+      D_.noalias() -= Dt_.real() * tab_.P.real().transpose();
       ++stats_.newton_iterations;
       if (!D_.allFinite()) return false;
       A_ += D_;
@@ -483,8 +489,11 @@ class Radau5 final : public ImplicitRk {
   double estimate(double t, double h, const Tolerances& tol) override {
     const bool refine = !have_previous_ || rejected_;
     rejected_ = true;  // until accepted
-    b1_.noalias() = v_ + (Q_.colwise() - q_) * (tab_.dd / h);
-    b2_.noalias() = a_ + (V_.colwise() - v_) * (tab_.dd / h);
+    b1_ = v_, b2_ = a_;
+    for (int i = 0; i < 3; ++i) {
+      b1_ += (tab_.dd(i) / h) * (Q_.col(i) - q_);
+      b2_ += (tab_.dd(i) / h) * (V_.col(i) - v_);
+    }
     double err = filtered_error(h, tol);
     if (refine && err > 1.0) {
       // b with f(y_n + x) = [q̇_n + x_q̇, q̈(t, q_n + x_q, q̇_n + x_q̇)]
@@ -526,6 +535,7 @@ class Radau5 final : public ImplicitRk {
   Tolerances tol_;  // the tolerances the estimate is held to (controlled)
   MatX A_, V_, Q_, R_, D_, dV_, dQ_, Aprev_;  // (nq, 3) stages, residuals, increments, last step's A
   MatXc Rt_, Dt_;                             // (nq, 3) transformed residuals and increments
+  Eigen::VectorXcd z_, zs_;                   // (nq) the complex block's right-hand side and solution
   VecX x_, xs_, b1_, b2_, qx_, vx_;           // (nq) the error estimate's
   MatX Sr_;
   MatXc Sc_;
