@@ -214,3 +214,13 @@ def test_loops_are_refused(method):
     system = model.compile()
     with pytest.raises(ValueError, match="loop"):
         rf.simulate(system, 1.0, method=method)
+
+
+@pytest.mark.parametrize("method", METHODS)
+def test_nothing_to_solve(method):
+    """Every coordinate prescribed (nq = 0): one step over the span, outputs at t_eval."""
+    model, h = rf.samples.pendulum()
+    model.prescribe(h["link"], rf.motion.harmonic(1.0, 2.0))
+    system = model.compile()
+    r = rf.simulate(system, 1.0, method=method, t_eval=[0.5, 1.0])
+    assert r.q.shape == (2, 0) and r.stats["steps"] == 1

@@ -71,6 +71,15 @@ void hermite5(double theta, double h, const VecX& q0, const VecX& v0, const VecX
               (-12 * t2 + 28 * t3 - 15 * t4) * v1 + (h * (1.5 * t2 - 4 * t3 + 2.5 * t4)) * a1;
 }
 
+/// q̈(t0 + θh) of the quintic Hermite interpolant of hermite5 (a cubic in θ), into a.
+void acceleration_hermite5(double t, double h, const VecX& q0, const VecX& v0, const VecX& a0, const VecX& q1,
+                           const VecX& v1, const VecX& a1, Eigen::Ref<VecX> a) {
+  const double t2 = t * t, t3 = t2 * t;
+  a = ((-60 * t + 180 * t2 - 120 * t3) / (h * h)) * (q0 - q1) + ((-36 * t + 96 * t2 - 60 * t3) / h) * v0 +
+      (1 - 9 * t + 18 * t2 - 10 * t3) * a0 + ((-24 * t + 84 * t2 - 60 * t3) / h) * v1 +
+      (3 * t - 12 * t2 + 10 * t3) * a1;
+}
+
 /// What the implicit Runge–Kutta methods share: the state (q, q̇, q̈) at both ends of the last step
 /// (dense output), the stage residual, the tangent at the step's start, Newton's convergence test
 /// and the error weights. Every work array is allocated by the constructors.
@@ -90,6 +99,7 @@ class ImplicitRk : public Stepper {
 
   /// Hairer's first guess 0.01 ‖y‖/‖ẏ‖ in the error weights (1e-6 s when either is negligible).
   double initial_step(double span, const Tolerances& tol, double max_step) override {
+    if (n_ == 0) return std::min(span, max_step);  // nothing moves
     dy_ << v_, a_;
     sc_ = tol.atol.array() + tol.rtol.array() * y_.cwiseAbs().array();
     const double d0 = scaled_rms(y_, sc_), d1 = scaled_rms(dy_, sc_);
@@ -283,11 +293,22 @@ class Esdirk final : public ImplicitRk {
     return error_norm(e_, y_, y1_, tol.atol, tol.rtol);
   }
 
-  /// The first iterate of A_i: the line through the two stages before it, in c (the previous
-  /// stage's acceleration for the first implicit stage).
+  /// The first iterate of A_i: for the first implicit stage, the last step's interpolant continued
+  /// (q̈_n on the first step); then the line through the two stages before it, in c. (Continuing the
+  /// last step for every stage measured worse on Kane's beam, +20 % Newton iterations; for the
+  /// first stage only, 8-18 % fewer than q̈_n.)
   void predict(int i) {
+    if (i == 1 && have_previous_) {
+      acceleration_hermite5(1.0 + T::c[i] * h_ / h_previous_, h_previous_, qp_, vp_, ap_, q_, v_, a_, A_.col(i));
+      return;
+    }
     A_.col(i) = A_.col(i - 1);
     if (i >= 2) A_.col(i) += ((T::c[i] - T::c[i - 1]) / (T::c[i - 1] - T::c[i - 2])) * (A_.col(i - 1) - A_.col(i - 2));
+  }
+
+  void accepted() override {
+    h_previous_ = h_;
+    have_previous_ = true;
   }
 
   /// Stage i: A_i solving r(A_i) = M(Q_i) A_i − f(Q_i, V_i, t_i) = 0 by A_i ← A_i − S⁻¹ r, with
@@ -348,6 +369,8 @@ class Esdirk final : public ImplicitRk {
   MatX S_;                                // (nq, nq)
   Eigen::PartialPivLU<MatX> lu_;
   double gh_ = 0.0;  // γh of the factorised S
+  double h_previous_ = 1.0;  // the last accepted step
+  bool have_previous_ = false;
 };
 
 /// Radau IIA of order 5 (Ehle; Hairer & Wanner IV.5, IV.8): c = ((4 − √6)/10, (4 + √6)/10, 1),
