@@ -104,13 +104,14 @@ def _tip_rms_error(result, h, tip_ref):
 @pytest.mark.parametrize("rtol", [1e-4, 1e-6, 1e-8])
 def test_tolerance_delivered_on_kanes_beam(kane10, method, rtol):
     """The tip's RMS error (m) within 10× rtol times the tip's deflection (about 2 m) when atol is
-    well below the sde angles (atol = 1e-3 rtol); the hub is a prescribed drive, evaluated at the
-    stage times."""
+    well below the sde angles (atol = 1e-3 rtol), and not wastefully far below it (measured:
+    0.01-0.1× for esdirk43, 0.006-0.009× for radau5); the hub is a prescribed drive, evaluated at
+    the stage times."""
     system, h, t, tip_ref = kane10
     scale = np.max(np.abs(tip_ref[:, 1]))
     r = rf.simulate(system, 20.0, method=method, rtol=rtol, atol=1e-3 * rtol, t_eval=t)
     error = _tip_rms_error(r, h, tip_ref)
-    assert error < 10 * rtol * scale, (error, rtol * scale)
+    assert 1e-3 * rtol * scale < error < 10 * rtol * scale, (error, rtol * scale)
     s = r.stats
     assert s["jacobians"] >= 1 and s["factorizations"] >= s["jacobians"]
     stages_per_iteration = {"esdirk43": 1, "radau5": 3}[method]  # radau5 iterates on its 3 stages at once

@@ -41,9 +41,10 @@ stages), and Newton solves M(Q_i) A_i = f(Q_i, V_i, t_i) with M + γh C + (γh)�
 tangent, kept over stages and steps while Newton contracts fast and refactorised when h changes)
 or, with ``iteration_matrix="spring"``, the O(n) matrix of ``implicit_spring``. Its error is
 controlled on y = [q, q̇]: on a flexible beam give ``atol`` well below ``rtol`` × the size of the
-sde angles (e.g. ``atol = 1e-3 rtol``), since a tip moves by the sum of many small angles times
-their lever arms (with atol = rtol the tip's error on Kane's beam is ~60× rtol times the
-tip deflection, with atol = 1e-3 rtol ~0.2×).
+sde angles (e.g. ``atol = 1e-3 rtol``, the defaults' ratio), since a tip moves by the sum of many
+small angles times their lever arms. Measured on Kane's beam (m = 10 and 20, 20 s, rtol = 1e-4,
+1e-6, 1e-8), the tip's RMS error over rtol × the tip's deflection: esdirk43 0.01–0.13 and radau5
+0.006–0.02 with atol = 1e-3 rtol, but 10–110 and 4–80 with atol = rtol.
 
 ``radau5`` solves its three stages together: the stage accelerations A (nq, 3) give
 V = q̇_n 1ᵀ + h A aᵀ and Q = q_n 1ᵀ + h V aᵀ, Newton's matrix I⊗M + h a⊗C + h² a²⊗K splits, by
