@@ -24,6 +24,7 @@
 #include <complex>
 #include <limits>
 
+#include "rigidfem/constraints.hpp"
 #include "rigidfem/dynamics.hpp"
 #include "rigidfem/errors.hpp"
 #include "rigidfem/kinematics.hpp"
@@ -260,7 +261,14 @@ class Esdirk final : public ImplicitRk {
  public:
   Esdirk(const System& sys, const IntegratorOptions& o, IntegratorStats& stats)
       : ImplicitRk(sys, o, stats), spring_(o.iteration_matrix == IterationMatrix::Spring), Q_(n_), qhat_(n_),
-        vhat_(n_), dA_(n_), armature_(n_), V_(n_, T::s), A_(n_, T::s), e_(2 * n_), S_(n_, n_), lu_(n_) {}
+        vhat_(n_), dA_(n_), armature_(n_), V_(n_, T::s), A_(n_, T::s), e_(2 * n_), S_(n_, n_), lu_(n_),
+        lambda_(VecX::Zero(sys.nl)) {}
+
+  /// With loops, the multipliers λ of the initial state too.
+  void start(double t0, const VecX& q0, const VecX& qd0) override {
+    ImplicitRk::start(t0, q0, qd0);
+    if (sys_.nl > 0) lambda_ = d_.lambda;
+  }
 
  private:
   bool uses_tangent() const override { return !spring_; }
@@ -321,7 +329,9 @@ class Esdirk final : public ImplicitRk {
       V = vhat_ + gh * A;
       Q_ = qhat_ + gh * V;
       residual(ti, Q_, V, A);
+      if (sys_.nl > 0) G_ = free_jacobian(sys_, d_), r_.noalias() -= G_.transpose() * lambda_;
       correction(gh);
+      if (sys_.nl > 0) close_loops_correction();
       ++stats_.newton_iterations;
       if (!dA_.allFinite()) return false;
       A += dA_;
@@ -332,6 +342,28 @@ class Esdirk final : public ImplicitRk {
     V = vhat_ + gh * A;
     Q_ = qhat_ + gh * V;
     return true;
+  }
+
+  /// Loops, index 1 at each stage: r = M A − f − Gᵀλ and G A = γ, whose Newton step
+  /// [S −Gᵀ; G 0] [ΔA; Δλ] = −[r; G A − γ] is taken by its Schur complement: dA_ = −S⁻¹ r on entry,
+  /// Y = S⁻¹ Gᵀ by nl solves with the iteration matrix, (G Y) Δλ = (γ − G A) − G dA_ (d.gamma holds
+  /// γ − G A when d.qdda holds A), then dA_ += Y Δλ and λ += Δλ. The state is projected onto the
+  /// loops after each step (project).
+  void close_loops_correction() {
+    const MatX Y = spring_ ? solve_armature(sys_, d_, G_.transpose()) : MatX(lu_.solve(G_.transpose()));
+    const VecX dl = least_norm(G_ * Y, d_.gamma - G_ * dA_);
+    dA_ += Y * dl;
+    lambda_ += dl;
+  }
+
+  /// Loops: (q, q̇) onto the constraint manifold at t after each accepted step (closure residual
+  /// <= 1e-12), and q̈, λ by the constrained forward dynamics there (the next step's first stage).
+  void project(double t) override {
+    project_onto_loops(sys_, d_, t, q_, v_, 1e-12, 10);
+    ++stats_.rhs_evaluations;
+    a_ = forward_dynamics(sys_, d_, t, q_, v_);
+    lambda_ = d_.lambda;
+    y_ << q_, v_;
   }
 
   /// dA_ = −S⁻¹ r_: the factorised tangent, or the O(n) spring matrix at the iterate.
@@ -371,6 +403,8 @@ class Esdirk final : public ImplicitRk {
   double gh_ = 0.0;  // γh of the factorised S
   double h_previous_ = 1.0;  // the last accepted step
   bool have_previous_ = false;
+  MatX G_;       // (nl, nq) the loops' Jacobian at the iterate
+  VecX lambda_;  // (nl) their multipliers at the stage being solved
 };
 
 /// Radau IIA of order 5 (Ehle; Hairer & Wanner IV.5, IV.8): c = ((4 − √6)/10, (4 + √6)/10, 1),

@@ -143,9 +143,9 @@ void check_options(const System& sys, double t0, double t_end, const VecX& q0, c
   if (!m.error_estimate && o.adaptive == 1)
     throw std::invalid_argument(std::string("adaptive: the method '") + m.name +
                                 "' has no error estimate; use dopri5, rkf45, esdirk43, radau5 or the Newmark family");
-  if (m.make == make_implicit_rk && sys.nl > 0)
-    throw std::invalid_argument(std::string("method: '") + m.name + "' does not integrate loop closures (the system has " +
-                                std::to_string(sys.nl) + " constraint rows); use generalized_alpha or dopri5");
+  if (o.method == Method::Radau5 && sys.nl > 0)
+    throw std::invalid_argument("method: 'radau5' does not integrate loop closures (the system has " +
+                                std::to_string(sys.nl) + " constraint rows); use esdirk43, generalized_alpha or dopri5");
   if (o.method == Method::Radau5 && o.iteration_matrix == IterationMatrix::Spring)
     throw std::invalid_argument("iteration_matrix: radau5 takes the exact tangent ('auto' or 'tangent'), got 'spring' "
                                 "(its complex block has no O(n) form); use esdirk43 for the spring matrix");

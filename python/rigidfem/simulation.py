@@ -52,7 +52,10 @@ the eigenvectors of the Butcher matrix a, into one real and one complex block of
 M + g C + g² K. Its error estimate (of order 3, Hairer & Wanner IV.8) is held to Hairer's
 rtol' = 0.1 rtol^(2/3) (atol scaled alike), as in radau5.f, since it bounds an order-5 solution
 from far above. Both methods: output at ``t_eval`` by the quintic Hermite interpolant of q through
-(q, q̇, q̈) at both ends of each step; systems with loop closures are refused (ValueError).
+(q, q̇, q̈) at both ends of each step. Loop closures: ``esdirk43`` holds them at the acceleration
+level in each stage (M A − f − Gᵀλ = 0 with G A = γ, by the Schur complement as in the Newmark
+family) and projects each step's end onto them, like the explicit methods; ``radau5`` refuses them
+(ValueError).
 """
 
 from __future__ import annotations
@@ -266,7 +269,9 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
     Systems with loop closures (``Model.add_loop_joint``, ``add_actuator``): q0 and qd0 must close
     every loop (``System.assemble`` finds them); explicit methods project every accepted step back
     onto the loops (closure residual <= 1e-12), the Newmark family solves the index-3 equations
-    (Arnold & Brüls: the constraints hold at every step to Newton's tolerance). ``scipy:`` methods
+    (Arnold & Brüls: the constraints hold at every step to Newton's tolerance), esdirk43 holds them
+    at the acceleration level in its stages and projects like the explicit methods, radau5 refuses
+    them. ``scipy:`` methods
     integrate the constrained accelerations without projection (their residual drifts).
 
     Ctrl-C in the main thread — in the C++ loop, in a Python drive or force law, or in a
