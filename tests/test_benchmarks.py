@@ -54,6 +54,43 @@ def test_sweep_scaling_table():
     assert table.rows[-1]["startup_s"] > 0
 
 
+def test_implicit_step_breakdown_table():
+    """The implicit-step breakdown's structure: the parts are positive and the step costs at least
+    about its floor (one residual and one solve per Newton iteration)."""
+    from benchmarks import implicit_step
+
+    table = implicit_step.step_breakdown(elements=(10,), t_end=0.5)
+    row = table.rows[0]
+    assert row["nq"] == 10 and row["iterations_per_step"] >= 1
+    assert all(row[k] > 0 for k in ("residual_s", "lu_solve_s", "tangent_s", "lu_factor_s", "floor_s"))
+    assert row["step_over_floor"] > 0.5
+
+
+def test_kane_peers_models_agree():
+    """Kane's spin-up beam (m = 4, 20 s) rebuilt in Exudyn and MuJoCo: their tip histories in
+    the hub frame agree with rigidfem's within 1e-6 m (RK4 at a quarter of its stability
+    limit, flywheel hub) and 2e-5 m (Exudyn's generalised-α at h = 1.56 ms, constraint hub:
+    its own O(h²) error, ~5e-6 m); the benchmark's forward kinematics is rigidfem's."""
+    pytest.importorskip("exudyn")
+    pytest.importorskip("mujoco")
+    from benchmarks import kane_peers as kp
+    from rigidfem import simulate
+
+    scene = kp.kane(4)
+    r = simulate(scene.system, kp.T_END, method="dopri5", rtol=1e-10, atol=1e-12, t_eval=scene.t_eval)
+    assert np.array_equal(kp.RigidfemKane(scene).run("dopri5", "rtol", 1e-10), r.q)
+    tip = kp.tip_in_hub(scene, r.q)
+    assert np.allclose(r.position(scene.tip, frame=scene.hub), tip, rtol=0, atol=1e-12)
+    assert np.max(np.abs(tip[:, 1])) > 0.5  # the beam does deflect
+    h = kp._divide(0.25 * 2.785 / scene.omega_max)
+    exudyn, mujoco = kp.ExudynKane(scene), kp.MujocoKane(scene)
+    for name, q, tol in [("Exudyn RK44", exudyn.run("RK44", "dt", h), 1e-6),
+                         ("Exudyn GeneralizedAlpha", exudyn.run("GeneralizedAlpha", "dt", kp.INTERVAL / 64), 2e-5),
+                         ("MuJoCo RK4", mujoco.run("RK4", "dt", h), 1e-6)]:
+        error = np.max(np.linalg.norm(kp.tip_in_hub(scene, q) - tip, axis=1))
+        assert error < tol, f"{name}: tip differs from rigidfem's by {error:.3g} m"
+
+
 def test_orders_study_table():
     """The high-order study's structure on a 4-element beam: every method reaches 1e-4 m, and the
     summary keeps the least time per method and target."""

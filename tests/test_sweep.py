@@ -151,6 +151,8 @@ def test_bad_input(kwargs, match):
         rf.sweep(noisy, [{"scale": 1.0}], seed=-1)
     with pytest.raises(ValueError, match="function"):
         rf.sweep("pendulum", grid=GRID)
+    with pytest.raises(ValueError, match="pickles"):
+        rf.sweep(lambda length: length, grid=GRID, executor="processes")
 
 
 @pytest.mark.filterwarnings("ignore")  # a LocalCluster's start-up notices (ports, dashboards)

@@ -35,7 +35,10 @@ void bind_integrators(py::module_& m) {
       .def_readwrite("newton_max_iterations", &IntegratorOptions::newton_max_iterations)
       .def_property(
           "iteration_matrix", [](const IntegratorOptions& o) { return iteration_matrix_name(o.iteration_matrix); },
-          [](IntegratorOptions& o, const std::string& name) { o.iteration_matrix = parse_iteration_matrix(name); });
+          [](IntegratorOptions& o, const std::string& name) { o.iteration_matrix = parse_iteration_matrix(name); })
+      .def_property(
+          "stiff_method", [](const IntegratorOptions& o) { return method_name(o.stiff_method); },
+          [](IntegratorOptions& o, const std::string& name) { o.stiff_method = parse_method(name); });
 
   m.def(
       "_integrate",
@@ -80,6 +83,8 @@ void bind_integrators(py::module_& m) {
         stats["newton_iterations"] = st.newton_iterations;
         stats["wall_time"] = st.wall_time;
         stats["stiff_at"] = st.stiff_at;
+        stats["switched_at"] = st.switched_at;
+        stats["auto_trials"] = st.auto_trials;
         return py::make_tuple(VecX(Eigen::Map<const VecX>(tr.t.data(), tr.t.size())), stack(tr.q, s.nq),
                               stack(tr.qd, s.nq), stats, tr.interrupted, failure);
       },

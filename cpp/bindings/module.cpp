@@ -143,4 +143,14 @@ PYBIND11_MODULE(_core, m) {
       },
       py::arg("system"), py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("calls"),
       "Seconds per forward-dynamics call, timed in C++ on one workspace after a warm-up call.");
+  bench.def(
+      "implicit_step_parts_seconds",
+      [](const rigidfem::System& s, double t, const rigidfem::VecX& q, const rigidfem::VecX& qd,
+         const rigidfem::VecX& qdd, int calls) {
+        py::gil_scoped_release release;
+        return rigidfem::implicit_step_parts_seconds(s, t, q, qd, qdd, calls);
+      },
+      py::arg("system"), py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("calls"),
+      "Seconds per call of the parts of an implicit step (residual, tangent, LU factor and solve, the O(n)\n"
+      "armature factor and solve), timed in C++.");
 }

@@ -261,7 +261,7 @@ class Esdirk final : public ImplicitRk {
  public:
   Esdirk(const System& sys, const IntegratorOptions& o, IntegratorStats& stats)
       : ImplicitRk(sys, o, stats), spring_(o.iteration_matrix == IterationMatrix::Spring), Q_(n_), qhat_(n_),
-        vhat_(n_), dA_(n_), armature_(n_), V_(n_, T::s), A_(n_, T::s), e_(2 * n_), S_(n_, n_), lu_(n_),
+        vhat_(n_), dA_(n_), armature_(n_), rhs_(n_), V_(n_, T::s), A_(n_, T::s), e_(2 * n_), S_(n_, n_), lu_(n_),
         lambda_(VecX::Zero(sys.nl)) {}
 
   /// With loops, the multipliers λ of the initial state too.
@@ -271,6 +271,18 @@ class Esdirk final : public ImplicitRk {
   }
 
  private:
+  /// Shampine's filter of the error estimate, ê = (I − γh J)⁻¹ e with J the Jacobian of y' = (q̇, q̈):
+  /// the embedded method is not L-stable, so e carries the stiff modes' components at full size
+  /// although the step damps them; the filter scales a mode of frequency ω by about 1/(γhω)² and
+  /// leaves the accurate ones. With J = [[0, 1], [−M⁻¹K, −M⁻¹C]]:
+  /// (M + γhC + (γh)²K) ê_v = M e_v − γh K e_q, ê_q = e_q + γh ê_v (S is factorised already).
+  void filter_error(double gh) {
+    rhs_.noalias() = M_ * e_.tail(n_);
+    rhs_.noalias() -= gh * (K_ * e_.head(n_));
+    e_.tail(n_).noalias() = lu_.solve(rhs_);
+    e_.head(n_) += gh * e_.tail(n_);
+  }
+
   bool uses_tangent() const override { return !spring_; }
 
   bool solve(double t, double h, const Tolerances* tol) override {
@@ -293,11 +305,12 @@ class Esdirk final : public ImplicitRk {
     return true;
   }
 
-  /// e = h Σ (b_i − b̂_i) [V_i, A_i]
+  /// e = h Σ (b_i − b̂_i) [V_i, A_i], filtered with the tangent (filter_error).
   double estimate(double, double h, const Tolerances& tol) override {
     const Eigen::Map<const VecX> e(T::e, T::s);
     e_.head(n_).noalias() = h * (V_ * e);
     e_.tail(n_).noalias() = h * (A_ * e);
+    if (!spring_) filter_error(T::gamma * h);
     return error_norm(e_, y_, y1_, tol.atol, tol.rtol);
   }
 
@@ -395,7 +408,7 @@ class Esdirk final : public ImplicitRk {
   }
 
   bool spring_;
-  VecX Q_, qhat_, vhat_, dA_, armature_;  // (nq) the stage being solved
+  VecX Q_, qhat_, vhat_, dA_, armature_, rhs_;  // (nq) the stage being solved; the filter's right side
   MatX V_, A_;                            // (nq, s) the stages' velocities and accelerations
   VecX e_;                                // (2 nq) the error estimate
   MatX S_;                                // (nq, nq)

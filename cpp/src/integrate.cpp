@@ -28,6 +28,7 @@ const MethodInfo methods[] = {
     {Method::ImplicitSpring, "implicit_spring", 2, true, false, make_newmark},
     {Method::Esdirk43, "esdirk43", 4, true, true, make_implicit_rk},
     {Method::Radau5, "radau5", 5, true, true, make_implicit_rk},
+    {Method::Auto, "auto", 5, true, true, make_runge_kutta},  // dopri5 and its stiff method (AutoChoice)
 };
 
 const char* iteration_matrices[] = {"auto", "tangent", "spring"};
@@ -169,10 +170,91 @@ void check_options(const System& sys, double t0, double t_end, const VecX& q0, c
   if ((o.method == Method::GeneralizedAlpha || o.method == Method::ImplicitSpring) &&
       !(o.rho_inf >= 0.0 && o.rho_inf <= 1.0))
     throw std::invalid_argument("rho_inf: expected a value in [0, 1], got " + num(o.rho_inf));
+  const Method stiff = o.stiff_method;
+  if (o.method == Method::Auto && (!method_info(stiff).error_estimate || stiff == Method::Dopri5 ||
+                                   stiff == Method::RKF45 || stiff == Method::Auto))
+    throw std::invalid_argument(std::string("stiff_method: expected an implicit method with an error estimate, got '") +
+                                method_name(stiff) + "'");
   for (Eigen::Index k = 0; k < t_eval.size(); ++k)
     if (!(t_eval(k) >= t0 && t_eval(k) <= t_end) || (k > 0 && !(t_eval(k) > t_eval(k - 1))))
       throw std::invalid_argument("t_eval: expected increasing times within [t0, t_end]");
 }
+
+/// method="auto": dopri5 while it is the faster, its stiff method (adaptive) while that is. dopri5 runs
+/// in windows of `window` accepted steps; a window that looks stiff — a fifth of its steps near the
+/// stability boundary (h ρ > 2) or a sixth as many rejections as steps — starts a trial of the stiff
+/// method from the state reached. After `ramp` steps to grow its step, the trial is measured over
+/// `window` steps: if it advances in simulated time per unit of work at least `margin` times as fast
+/// as dopri5 did in its last window, it keeps the run; otherwise dopri5 takes over again and the next trial waits twice
+/// as many windows. Work is counted, not timed, so the choice is the same on every run and machine:
+/// one unit per right-hand side (or residual) evaluation, nq per tangent (the analytic derivatives
+/// cost about nq evaluations) and max(1, (nq/50)²) per dense factorisation (one for the O(n) one).
+class AutoChoice {
+ public:
+  static constexpr int window = 30, ramp = 8;
+  static constexpr double margin = 1.25;  // a near tie goes to dopri5, whose error control is the surer
+  static constexpr double loosest_explicit = 1e-3;  // dopri5's rtol at most (run() tightens looser ones)
+  AutoChoice(const IntegratorOptions& o, int nq) : o_(o), nq_(nq) {}
+
+  /// After an accepted step: true when the run should change method (then call switched()).
+  bool after_step(double t, double h_rho, const IntegratorStats& stats) {
+    if (!stiff_running_) {
+      if (h_rho > 2.0) ++near_boundary_;
+      if (++steps_ < window) return false;
+      rate_ = (t - t_mark_) / std::max(work(stats) - work_mark_, 1.0);
+      const bool stiffish = near_boundary_ * 5 >= window || (stats.rejected - rejected_mark_) * 6 >= window;
+      const bool trial = stiffish && ++windows_since_trial_ >= backoff_;
+      mark(t, stats);
+      return trial;
+    }
+    if (kept_) return false;
+    ++steps_;
+    if (steps_ == ramp) mark(t, stats);
+    if (steps_ < ramp + window) return false;
+    const bool faster = (t - t_mark_) / std::max(work(stats) - work_mark_, 1.0) >= margin * rate_;
+    kept_ = faster;
+    if (!faster) backoff_ *= 2;
+    return !faster;
+  }
+  /// The options of the method the run changes to, at time t.
+  IntegratorOptions switched(double t, double h, IntegratorStats& stats) {
+    stiff_running_ = !stiff_running_;
+    IntegratorOptions next = o_;
+    next.adaptive = 1;
+    next.method = stiff_running_ ? o_.stiff_method : Method::Dopri5;
+    if (stiff_running_) {
+      ++stats.auto_trials;
+      h_explicit_ = h;
+    }
+    stats.switched_at = stiff_running_ ? t : std::numeric_limits<double>::quiet_NaN();
+    windows_since_trial_ = 0;
+    spring_ = next.method == Method::ImplicitSpring || next.iteration_matrix == IterationMatrix::Spring;
+    mark(t, stats);
+    return next;
+  }
+  /// The step to continue dopri5 with after a lost trial.
+  double explicit_step() const { return h_explicit_; }
+  bool stiff_running() const { return stiff_running_; }
+
+ private:
+  /// The work done so far, in right-hand-side evaluations (see the class comment).
+  double work(const IntegratorStats& s) const {
+    const double factorization = spring_ ? 1.0 : std::max(1.0, (nq_ / 50.0) * (nq_ / 50.0));
+    return static_cast<double>(s.rhs_evaluations) + nq_ * static_cast<double>(s.jacobians) +
+           factorization * static_cast<double>(s.factorizations);
+  }
+  void mark(double t, const IntegratorStats& stats) {
+    t_mark_ = t, work_mark_ = work(stats), rejected_mark_ = stats.rejected;
+    steps_ = 0, near_boundary_ = 0;
+  }
+  IntegratorOptions o_;
+  int nq_;
+  bool stiff_running_ = false, kept_ = false, spring_ = false;
+  // The first window holds dopri5's start from a small step: not a rate to race against.
+  int steps_ = 0, near_boundary_ = 0, windows_since_trial_ = -1, backoff_ = 1;
+  long rejected_mark_ = 0;
+  double t_mark_ = 0.0, work_mark_ = 0.0, rate_ = 0.0, h_explicit_ = 0.0;
+};
 
 /// The one loop, into traj: attempt a step, control its size by the error estimate (adaptive runs)
 /// or keep to the grid t0 + k·dt (fixed steps), record the outputs it covers, ask the monitor; the
@@ -184,16 +266,24 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
   IntegratorStats& stats = traj.stats;
   Recorder out(sys, traj, t_eval);
   const int n = sys.nq;
-  const Tolerances tol{o.atol.size() == 1 ? VecX::Constant(2 * n, o.atol(0)) : o.atol,
-                       o.rtol.size() == 1 ? VecX::Constant(2 * n, o.rtol(0)) : o.rtol};
+  const Tolerances asked{o.atol.size() == 1 ? VecX::Constant(2 * n, o.atol(0)) : o.atol,
+                         o.rtol.size() == 1 ? VecX::Constant(2 * n, o.rtol(0)) : o.rtol};
+  // auto runs dopri5 at rtol <= 1e-3 (atol scaled alike): looser, its error control lets the stiff
+  // modes of a beam go unstable (measured: the classical cantilever at rtol = 1e-2 ... 1e-1).
+  const double loosest = asked.rtol.size() ? asked.rtol.maxCoeff() : 0.0;  // nq = 0: no tolerance to tighten
+  const double tighten = o.method == Method::Auto && loosest > AutoChoice::loosest_explicit
+                             ? AutoChoice::loosest_explicit / loosest : 1.0;
+  const Tolerances explicit_tol{tighten * asked.atol, tighten * asked.rtol};
   const bool adaptive = is_adaptive(o);
   const double span = t_end - t0, grid = std::min(o.dt, o.max_step), near_end = t_end - 1e-12 * span;
 
-  const std::unique_ptr<Stepper> stepper = method_info(o.method).make(sys, o, stats);
-  const StepControl control = stepper->control();
+  AutoChoice choice(o, n);
+  std::unique_ptr<Stepper> stepper = method_info(o.method).make(sys, o, stats);
+  StepControl control = stepper->control();
   stepper->start(t0, q0, qd0);
   out.start(t0, stepper->state());
-  double h = o.dt > 0.0 ? std::min(o.dt, span) : stepper->initial_step(span, tol, o.max_step);
+  const Tolerances* tol = o.method == Method::Auto ? &explicit_tol : &asked;
+  double h = o.dt > 0.0 ? std::min(o.dt, span) : stepper->initial_step(span, *tol, o.max_step);
 
   double t = t0;
   double err_prev = 1.0;  // the error estimate of the last accepted step (PI control)
@@ -216,7 +306,7 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
     if (hs < 16.0 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t)))
       step_failure(t, hs, "the step size fell below the minimum: the problem is too stiff or singular for this method");
     double err = 0.0;
-    if (!stepper->attempt(t, hs, adaptive ? &tol : nullptr, err)) {
+    if (!stepper->attempt(t, hs, adaptive ? tol : nullptr, err)) {
       if (!adaptive) step_failure(t, hs, "Newton iterations did not converge; reduce dt");
       ++stats.rejected;
       h = 0.25 * hs;
@@ -257,6 +347,17 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
     const VecX& y = stepper->state();
     out.step(t, y, *stepper);
     last_q = y.head(n);
+    if (o.method == Method::Auto && choice.after_step(t, stepper->h_rho(), stats)) {
+      // Change method: the other goes on from the state reached (its own controller grows its step).
+      const VecX q1 = y.head(n), qd1 = y.tail(n);
+      const IntegratorOptions next = choice.switched(t, h, stats);
+      stepper = method_info(next.method).make(sys, next, stats);
+      stepper->start(t, q1, qd1);
+      control = stepper->control();
+      if (!choice.stiff_running()) h = choice.explicit_step();
+      tol = choice.stiff_running() ? &asked : &explicit_tol;
+      rejected_last = false;
+    }
     // Ask the monitor about every 0.05 s; false means stop (e.g. Ctrl-C).
     if (monitor && Clock::now() - last_check >= std::chrono::milliseconds(50)) {
       last_check = Clock::now();

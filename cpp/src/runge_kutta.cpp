@@ -212,7 +212,7 @@ class RungeKutta final : public Stepper {
 }  // namespace
 
 std::unique_ptr<Stepper> make_runge_kutta(const System& sys, const IntegratorOptions& o, IntegratorStats& stats) {
-  return std::make_unique<RungeKutta>(sys, o.method, stats);
+  return std::make_unique<RungeKutta>(sys, o.method == Method::Auto ? Method::Dopri5 : o.method, stats);
 }
 
 }  // namespace rigidfem

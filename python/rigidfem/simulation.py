@@ -23,6 +23,8 @@ name                   scheme                                                   
                        simplified Newton on all stages in the transformed         or ``dt``
                        real/complex form (exact tangent only), Hairer's filtered
                        estimate, PI control, dense output quintic Hermite
+``"auto"`` (default)   dopri5, handing over to esdirk43 where a counted trial finds  ``rtol``/``atol``
+                       it cheaper (stiff problems); the choice in ``stats["method"]``
 ``"scipy:Radau"`` …    SciPy's solvers (Radau, BDF, LSODA, RK45, DOP853) with the  ``rtol``/``atol``
                        C++ ``rhs`` and ``jacobian`` (Python per step: the slow path)
 =====================  =========================================================  ===========
@@ -43,8 +45,8 @@ or, with ``iteration_matrix="spring"``, the O(n) matrix of ``implicit_spring``. 
 controlled on y = [q, q̇]: on a flexible beam give ``atol`` well below ``rtol`` × the size of the
 sde angles (e.g. ``atol = 1e-3 rtol``, the defaults' ratio), since a tip moves by the sum of many
 small angles times their lever arms. Measured on Kane's beam (m = 10 and 20, 20 s, rtol = 1e-4,
-1e-6, 1e-8), the tip's RMS error over rtol × the tip's deflection: esdirk43 0.01–0.13 and radau5
-0.006–0.02 with atol = 1e-3 rtol, but 10–110 and 4–80 with atol = rtol.
+1e-6, 1e-8), the tip's RMS error over rtol × the tip's deflection: esdirk43 0.02–0.26 and radau5
+0.006–0.02 with atol = 1e-3 rtol, but 15–170 and 4–80 with atol = rtol.
 
 ``radau5`` solves its three stages together: the stage accelerations A (nq, 3) give
 V = q̇_n 1ᵀ + h A aᵀ and Q = q_n 1ᵀ + h V aᵀ, Newton's matrix I⊗M + h a⊗C + h² a²⊗K splits, by
@@ -157,7 +159,8 @@ class Result(Versioned):
 
     def __repr__(self) -> str:
         s = self.stats
-        return (f"<rigidfem Result {self.method}: {len(self.t)} outputs to t = {self.t[-1]:g} s, {s['steps']} steps "
+        chosen = f" ({s['method']})" if "method" in s else ""
+        return (f"<rigidfem Result {self.method}{chosen}: {len(self.t)} outputs to t = {self.t[-1]:g} s, {s['steps']} steps "
                 f"({s['rejected_steps']} rejected), {s['rhs_evaluations']} rhs, {s['wall_time']:.3g} s"
                 f"{', interrupted' if self.interrupted else ''}>")
 
@@ -190,7 +193,7 @@ def load_npz(path, system=None) -> Result:
     return Result(system, **export.read_npz(path, system))
 
 
-def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = None, rtol=1e-6,
+def simulate(system, t_end: float, method: str = "auto", dt: float | None = None, rtol=1e-6,
              atol=1e-9, t_eval=None, q0=None, qd0=None, t0: float = 0.0, progress: bool = False,
              first_step: float | None = None, stiffness_warning: bool = True,
              max_steps: int = 1_000_000, max_step: float = np.inf, adaptive: bool | None = None, beta: float = 0.25,
@@ -201,7 +204,18 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
     Parameters
     ----------
     method : str
-        See the module docstring: "euler", "symplectic_euler", "rk4", "dopri5", "rkf45",
+        "auto" (default): dopri5 while it is the cheaper, esdirk43 where it is not. dopri5 runs in
+        windows of 30 accepted steps (at rtol <= 1e-3: looser, its error control lets the stiff
+        modes of a beam go unstable); a window that looks bounded by stability (a fifth of its
+        steps at h ρ > 2, or a sixth as many rejections) starts a trial of esdirk43 from the state
+        reached, which keeps the run if it advances 1.25 times as far per unit of work — counted,
+        not timed (right-hand sides, nq per tangent, (nq/50)² per dense factorisation), so the
+        choice is the same on every machine and thread — else dopri5 goes on and the next trial
+        waits twice as long. ``stats["method"]`` says what ran ("dopri5", or "dopri5, then
+        esdirk43 from t = ... s"), ``stats["switched_at"]`` and ``stats["auto_trials"]`` the details.
+        A closed chain runs dopri5 alone (dopri5 warns when it finds the chain stiff:
+        generalized_alpha at a fixed dt, or esdirk43, is then the choice).
+        Otherwise see the module docstring: "euler", "symplectic_euler", "rk4", "dopri5", "rkf45",
         "newmark", "hht", "generalized_alpha", "implicit_spring", "esdirk43", "radau5", or "scipy:Radau",
         "scipy:BDF",
         "scipy:LSODA", "scipy:RK45", "scipy:DOP853". "implicit_spring" is generalised-α (``rho_inf``)
@@ -303,8 +317,11 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
     try:
         scipy = method.startswith("scipy:")
         # scipy: methods check the options of the C++ ones too (they use only first_step of them)
-        opt = _options("dopri5" if scipy else method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, beta,
-                       gamma, alpha, rho_inf, newton_tol, newton_max_iterations, iteration_matrix)
+        # auto on a closed chain: dopri5 alone (its hand-over to esdirk43 is not tried on loops, and the
+        # adaptive Newmark family's error estimate does not bound the error)
+        looped_auto = method == "auto" and system.nl > 0
+        opt = _options("dopri5" if scipy or looped_auto else method, dt, first_step, rtol, atol, max_step, max_steps,
+                       adaptive, beta, gamma, alpha, rho_inf, newton_tol, newton_max_iterations, iteration_matrix)
         if scipy:
             first = None if first_step is None else opt.dt
             run = _run_scipy(system, method[6:], t0, t_end, q0, qd0, t_eval, rtol, atol, max_step, max_steps,
@@ -315,13 +332,15 @@ def simulate(system, t_end: float, method: str = "dopri5", dt: float | None = No
         if bar is not None:
             bar.close()
     t, q, qd, stats, interrupted, failure = run
+    if method == "auto":
+        stats["method"] = "dopri5 (a closed chain)" if looped_auto else _auto_choice(stats, opt.stiff_method)
     result = Result(system, t, q, qd, stats, method, interrupted)
     if failure is not None:
         message, time, cause = failure
         error = _core.SimulationError(message)
         error.result, error.time, error.cause = result, time, cause
         raise error
-    if stiffness_warning and np.isfinite(stats.get("stiff_at", np.nan)):
+    if stiffness_warning and (method != "auto" or looped_auto) and np.isfinite(stats.get("stiff_at", np.nan)):
         warnings.warn(f"{method}: the problem is stiff from t = {stats['stiff_at']:.6g} s on (h rho > 3.25): the step is "
                       "bounded by stability, the cost grows with the highest frequency and loose tolerances leave "
                       "errors in the stiff modes; an implicit method (generalized_alpha, newmark, scipy:Radau) is "
@@ -345,6 +364,20 @@ def _check_closed(system, t0, q0, qd0, tol=1e-8):
                              "system.assemble(q0, qd0, t0) finds the nearest ones")
 
 
+#: The implicit method ``method="auto"`` hands over to when dopri5 finds the problem stiff.
+AUTO_STIFF_METHOD = "esdirk43"
+
+
+def _auto_choice(stats: dict, stiff_method: str) -> str:
+    """What ``auto`` ran, for ``Result.stats["method"]``: "dopri5", or the hand-over."""
+    switched, trials = stats.get("switched_at", np.nan), stats.get("auto_trials", 0)
+    lost = trials - (1 if np.isfinite(switched) else 0)
+    tried = f"; {lost} trial{'s' * (lost != 1)} of {stiff_method} lost" if lost else ""
+    if not np.isfinite(switched):
+        return f"dopri5{tried}"
+    return f"dopri5, then {stiff_method} from t = {switched:.6g} s{tried}"
+
+
 def _options(method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, beta, gamma, alpha, rho_inf,
              newton_tol, newton_max_iterations, iteration_matrix):
     """The C++ integrator's options, each checked and converted."""
@@ -364,6 +397,10 @@ def _options(method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, 
     if not isinstance(iteration_matrix, str):
         raise ValueError(f"iteration_matrix: expected 'auto', 'tangent' or 'spring', got {iteration_matrix!r}")
     opt.iteration_matrix = iteration_matrix
+    if method == "auto":
+        if adaptive is False:
+            raise ValueError("adaptive: expected None or True with method 'auto' (it controls its steps), got False")
+        opt.stiff_method = AUTO_STIFF_METHOD
     return opt
 
 

@@ -147,6 +147,27 @@ class Table(Versioned):
             rows.append(row)
         return Table(rows, ("scene", "method", *(f"time_s_to_{t:g}" for t in thresholds), "smallest_error"))
 
+    def auto_against_best(self, thresholds=(1e-4, 1e-6), error: str = "tip_error_rms_m") -> Table:
+        """Per scene and threshold: the cheapest run of ``method="auto"`` reaching it against the
+        cheapest run of any other method (the best, with its name), their ratio, and the error
+        ``auto`` delivered at rtol = threshold (``delivered_at_rtol``, "-" if not run)."""
+        rows = []
+        for scene in dict.fromkeys(r["scene"] for r in self.rows):
+            runs = [r for r in self.rows if r["scene"] == scene]
+            auto = [r for r in runs if r["method"] == "auto"]
+            others = [r for r in runs if r["method"] != "auto"]
+            for tol in thresholds:
+                a, b = cheapest(auto, error, "wall_time_s", tol), cheapest(others, error, "wall_time_s", tol)
+                at = [r[error] for r in auto if r["setting"] == "rtol" and r["value"] == tol]
+                rows.append({"scene": scene, "error_at_most": tol,
+                             "best": f"{b['method']} ({b['setting']} {b['value']:g})" if b else "-",
+                             "best_time_s": b["wall_time_s"] if b else "-",
+                             "auto_time_s": a["wall_time_s"] if a else "-",
+                             "auto_over_best": a["wall_time_s"] / b["wall_time_s"] if a and b else "-",
+                             "delivered_at_rtol": at[0] if at else "-"})
+        return Table(rows, ("scene", "error_at_most", "best", "best_time_s", "auto_time_s", "auto_over_best",
+                            "delivered_at_rtol"))
+
     def to_markdown(self) -> str:
         lines = ["| " + " | ".join(self.columns) + " |", "|" + "---|" * len(self.columns)]
         lines += ["| " + " | ".join(_fmt(r.get(c)) for c in self.columns) + " |" for r in self.rows]
@@ -293,7 +314,9 @@ def discretisation_error(elements=(5, 10, 20, 40, 80), modes: int = 3) -> Table:
 def standard_methods(quick: bool = False):
     """The integrators and settings of the benchmark."""
     r = [1e-4, 1e-6, 1e-8] if quick else [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9]
-    return [("dopri5", "rtol", r), ("rkf45", "rtol", r[:-1]), ("generalized_alpha", "rtol", r[:3], {"adaptive": True})]
+    loose = [1e-1, 1e-2] if quick else [1e-1, 3e-2, 1e-2]
+    return [("auto", "rtol", loose + r), ("dopri5", "rtol", r), ("rkf45", "rtol", r[:-1]),
+            ("generalized_alpha", "rtol", r[:3], {"adaptive": True})]
 
 
 def bench(output_dir="bench", quick: bool = False) -> Table:
@@ -317,11 +340,13 @@ def bench(output_dir="bench", quick: bool = False) -> Table:
             ("generalized_alpha", "dt", [1e-3, 5e-4] if quick else [1e-3, 5e-4, 2.5e-4, 1.25e-4]),
             ("implicit_spring", "dt", [1e-3, 5e-4] if quick else [1e-3, 5e-4, 2.5e-4, 1.25e-4])]),
         (scenes.stiff_cantilever(4 if quick else m), [
+            ("auto", "rtol", [1e-1, 1e-2, 1e-4, 1e-6] if quick else [1e-1, 3e-2, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8]),
             ("dopri5", "rtol", [1e-4, 1e-6] if quick else [1e-4, 1e-6, 1e-8]),
             ("rk4", "dt", [1e-6] if quick else [2e-6, 1e-6, 5e-7]),
             ("generalized_alpha", "dt", [1e-3, 5e-4] if quick else [2e-3, 1e-3, 5e-4, 2.5e-4, 1.25e-4]),
             ("implicit_spring", "dt", [1e-3, 5e-4] if quick else [2e-3, 1e-3, 5e-4, 2.5e-4, 1.25e-4])]),
         (scenes.cantilever("classical", m), [
+            ("auto", "rtol", [1e-1, 1e-2, 1e-4, 1e-6] if quick else [1e-1, 3e-2, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8]),
             ("dopri5", "rtol", [1e-4, 1e-6] if quick else [1e-4, 1e-6, 1e-8]),
             ("newmark", "dt", [1e-3, 5e-4] if quick else [1e-3, 5e-4, 2.5e-4, 1.25e-4]),
             ("generalized_alpha", "dt", [1e-3, 5e-4] if quick else [1e-3, 5e-4, 2.5e-4, 1.25e-4])]),
@@ -353,5 +378,7 @@ def bench(output_dir="bench", quick: bool = False) -> Table:
     print(table)
     print("\nLeast wall time (s) to reach a tip RMS error (m):")
     print(table.summary().to_markdown())
+    print("\nmethod='auto' against the best method for each error (least wall time, s):")
+    print(table.auto_against_best().to_markdown())
     print(disc.to_markdown())
     return table

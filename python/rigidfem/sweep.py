@@ -18,6 +18,7 @@ import concurrent.futures
 import inspect
 import itertools
 import os
+import pickle
 import time
 from collections.abc import Callable, Mapping, Sequence
 
@@ -86,6 +87,16 @@ def run_case(function, case: dict, seed: int | None, record_errors: bool):
             raise
         value, error = None, f"{type(e).__name__}: {e}"
     return value, error, time.perf_counter() - start
+
+
+def _check_pickles(function) -> None:
+    """A process pool sends the function by pickle: say so before the pool fails on it."""
+    try:
+        pickle.dumps(function)
+    except (pickle.PicklingError, AttributeError, TypeError) as e:
+        raise ValueError(f"function: expected a function that pickles for executor='processes' (defined at module "
+                         f"level; lambdas and closures do not), got {function!r} ({e}); threads or a Dask Client "
+                         f"(cloudpickle) take it") from None
 
 
 def _is_dask_client(executor) -> bool:
@@ -230,6 +241,8 @@ def sweep(function: Callable, cases: Sequence[Mapping] | None = None, *, grid: M
     if as_frame not in (None, True, False):
         raise ValueError(f"as_frame: expected None, True or False, got {as_frame!r}")
     cases = _cases(cases, grid)
+    if executor == "processes":
+        _check_pickles(function)
     draw = _takes_seed(function) and not any(SEED in case for case in cases)  # else cases give their own
     seeds = _seeds(seed, len(cases)) if draw else [None] * len(cases)
     pool, owned = _resolve_executor(executor, workers)

@@ -28,6 +28,9 @@ enum class Method {
   ImplicitSpring,    ///< generalised-α with the O(n) Newton matrix M + diag(γ'h b + β'h² c)
   Esdirk43,          ///< ESDIRK4(3)6L[2]SA (Kennedy & Carpenter), order 4, L-stable, adaptive
   Radau5,            ///< Radau IIA, 3 stages, order 5, L-stable, adaptive
+  /// dopri5 while it is the faster, `stiff_method` (adaptive) while that is: where dopri5's steps look
+  /// bounded by stability, the stiff method runs a trial and keeps the run if it does less work per simulated second.
+  Auto,
 };
 /// The method called `name` ("dopri5", ...); std::invalid_argument listing the methods otherwise.
 Method parse_method(const std::string& name);
@@ -57,6 +60,7 @@ struct IntegratorOptions {
   double newton_tol = 1e-10;        ///< Newton: increments below newton_tol (1 + |q|), relative for adaptive runs
   int newton_max_iterations = 10;
   IterationMatrix iteration_matrix = IterationMatrix::Auto;
+  Method stiff_method = Method::GeneralizedAlpha;  ///< auto: the implicit method it hands over to
 };
 
 struct IntegratorStats {
@@ -65,6 +69,9 @@ struct IntegratorStats {
   /// dopri5 only: first time (s) Hairer's stiffness test fired (h ρ > 3.25 over 15 accepted
   /// steps: the step is bounded by stability, not accuracy), NaN if never.
   double stiff_at = std::numeric_limits<double>::quiet_NaN();
+  /// auto: the time (s) its stiff method took over for the rest of the run, NaN if the run ended on dopri5.
+  double switched_at = std::numeric_limits<double>::quiet_NaN();
+  long auto_trials = 0;  ///< auto: trials of its stiff method (a lost trial returns to dopri5)
 };
 
 /// States at the output times (every accepted step when no output times are given).

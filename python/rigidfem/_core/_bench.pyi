@@ -6,8 +6,13 @@ import numpy
 import numpy.typing
 import rigidfem._core
 import typing
-__all__: list[str] = ['forward_dynamics_seconds']
+__all__: list[str] = ['forward_dynamics_seconds', 'implicit_step_parts_seconds']
 def forward_dynamics_seconds(system: rigidfem._core._System, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], calls: typing.SupportsInt | typing.SupportsIndex) -> float:
     """
     Seconds per forward-dynamics call, timed in C++ on one workspace after a warm-up call.
+    """
+def implicit_step_parts_seconds(system: rigidfem._core._System, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], qd: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], qdd: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], calls: typing.SupportsInt | typing.SupportsIndex) -> dict[str, float]:
+    """
+    Seconds per call of the parts of an implicit step (residual, tangent, LU factor and solve, the O(n)
+    armature factor and solve), timed in C++.
     """

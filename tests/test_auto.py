@@ -1,0 +1,128 @@
+"""method="auto" (the default): dopri5 on non-stiff problems (bit for bit), its stiff method where a
+counted trial finds it faster, the choice reported in Result.stats and repr, deterministic (work is
+counted, not timed), and the delivered error against independent references."""
+
+import concurrent.futures
+
+import numpy as np
+import pytest
+
+import rigidfem as rf
+from rigidfem import samples
+from rigidfem.simulation import AUTO_STIFF_METHOD
+
+
+def pendulum():
+    model = rf.Model(gravity=(0.0, -9.81, 0.0))
+    model.add_body("rod", model.ground, rf.Joint.revolute("z"), mass=1.0, inertia=(1e-3, 0.08, 0.08),
+                   com=(0.5, 0.0, 0.0))
+    return model.compile()
+
+
+def spring_chain(n=8, k=1e6, m=1.0):
+    """n masses in a row joined by springs k (prismatic joints, each relative to the last): the
+    stiff modes reach 2√(k/m) = 2000 rad/s, the slow one (gravity along the chain) hangs."""
+    model = rf.Model(gravity=(0.0, 0.0, -9.81))
+    parent = model.ground
+    for i in range(n):
+        parent = model.add_body(f"m{i}", parent, rf.Joint.prismatic("z", stiffness=k), mass=m, inertia=(1, 1, 1))
+    return model.compile()
+
+
+def test_non_stiff_runs_dopri5_bit_for_bit():
+    system = pendulum()
+    auto = rf.simulate(system, 5.0, q0=[1.0], rtol=1e-8, atol=1e-10)
+    dopri = rf.simulate(system, 5.0, method="dopri5", q0=[1.0], rtol=1e-8, atol=1e-10)
+    assert auto.stats["method"] == "dopri5" and auto.stats["auto_trials"] == 0
+    assert np.array_equal(auto.q, dopri.q) and np.array_equal(auto.t, dopri.t)
+    assert "auto (dopri5)" in repr(auto) and auto.method == "auto"
+
+
+def test_stiff_hands_over_and_is_cheaper_than_dopri5():
+    """Kane's beam (m = 10): stiff for dopri5 (its step held at ~3.3/ω_max); auto hands over early,
+    does far less work than dopri5 at the same tolerance and meets a tight reference to the
+    tolerance's order."""
+    model, h = samples.kane_beam(omega=6.0, duration=15.0, elements=10)
+    system = model.compile()
+    t_eval = np.linspace(0, 20, 201)
+    ref = rf.simulate(system, 20.0, method="dopri5", rtol=1e-11, atol=1e-13, t_eval=t_eval, stiffness_warning=False)
+    tip = lambda r: r.position(h["beam"].tip, frame=h["hub"])  # noqa: E731
+    auto = rf.simulate(system, 20.0, rtol=1e-5, atol=1e-7, t_eval=t_eval)
+    dopri = rf.simulate(system, 20.0, method="dopri5", rtol=1e-5, atol=1e-7, t_eval=t_eval, stiffness_warning=False)
+    assert auto.stats["method"].startswith(f"dopri5, then {AUTO_STIFF_METHOD} from t = ")
+    assert 0.0 < auto.stats["switched_at"] < 1.0
+    assert auto.stats["rhs_evaluations"] < 0.5 * dopri.stats["rhs_evaluations"]
+    error = np.abs(tip(auto) - tip(ref)).max()
+    assert error < 1e-2, error  # the tip moves 2 m: a relative error below 1 %
+
+
+def test_choice_is_deterministic_across_threads():
+    model, _ = samples.kane_beam(omega=6.0, duration=15.0, elements=8)
+    system = model.compile()
+
+    def run(_):
+        return rf.simulate(system, 5.0, rtol=1e-4, t_eval=np.linspace(0, 5, 11))
+
+    serial = [run(k) for k in range(2)]
+    with concurrent.futures.ThreadPoolExecutor(2) as pool:
+        threaded = list(pool.map(run, range(4)))
+    for r in threaded + serial[1:]:
+        assert np.array_equal(r.q, serial[0].q) and r.stats["method"] == serial[0].stats["method"]
+
+
+def test_stiff_spring_chain_against_the_modal_solution():
+    """Linear: the exact solution is the modal superposition of x'' = −K x + g (computed here with
+    numpy's eigh); auto hands over and stays within the tolerance's order."""
+    n, k = 6, 1e6
+    system = spring_chain(n, k)
+    # Coordinates: each mass's offset from the previous one; K of the relative coordinates via the
+    # absolute positions z = L x (L lower-triangular ones): M z'' = −K_abs z + m g.
+    L = np.tril(np.ones((n, n)))
+    K_abs = k * (np.diag(np.r_[np.full(n - 1, 2.0), 1.0]) - np.diag(np.ones(n - 1), 1) - np.diag(np.ones(n - 1), -1))
+    x0 = np.linspace(1e-3, -1e-3, n)
+    z0 = L @ x0
+    z_static = np.linalg.solve(K_abs, np.full(n, -9.81))
+    w2, V = np.linalg.eigh(K_abs)
+    t = np.linspace(0.0, 0.05, 51)
+    modal = V.T @ (z0 - z_static)
+    z = z_static[:, None] + V @ (modal[:, None] * np.cos(np.sqrt(w2)[:, None] * t[None, :]))
+    x_exact = np.linalg.solve(L, z).T
+    result = rf.simulate(system, 0.05, q0=x0, t_eval=t, rtol=1e-6, atol=1e-9)
+    assert result.stats["method"] != "dopri5"
+    assert np.abs(result.q - x_exact).max() < 1e-3 * np.abs(x0).max()
+
+
+def test_closed_chain_runs_and_stays_closed():
+    model = rf.Model(gravity=(0, -9.81, 0))
+
+    def rod(L):
+        return dict(mass=1.0, inertia=(1e-4, L * L / 12, L * L / 12), com=(L / 2, 0, 0))
+
+    crank = model.add_body("crank", model.ground, rf.Joint.revolute("z", stiffness=15.0, rest=1.2), **rod(0.3))
+    coupler = model.add_body("coupler", crank, rf.Joint.revolute("z"), **rod(0.8), placement=rf.transform((0.3, 0, 0)))
+    rocker = model.add_body("rocker", model.ground, rf.Joint.revolute("z"), **rod(0.6),
+                            placement=rf.transform((0.7, 0, 0)))
+    model.add_loop_joint("revolute", coupler.point((0.8, 0, 0)), rocker.point((0.6, 0, 0)))
+    system = model.compile()
+    q0, _ = system.assemble([0.4, -1.9, 4.6])
+    result = rf.simulate(system, 2.0, q0=q0, t_eval=np.linspace(0, 2, 21))
+    g = [np.abs(system.loop_constraints(t, q, np.zeros(3))[0]).max() for t, q in zip(result.t, result.q)]
+    assert max(g) < 1e-10 and result.stats["method"] == "dopri5 (a closed chain)"
+    dopri = rf.simulate(system, 2.0, method="dopri5", q0=q0, t_eval=np.linspace(0, 2, 21))
+    assert np.array_equal(result.q, dopri.q)
+
+
+def test_no_free_coordinate():
+    """Every coordinate prescribed (nq = 0): the default method runs the drives (it crashed once on
+    the empty tolerance vector)."""
+    model = rf.Model()
+    body = model.add_body("a", model.ground, rf.Joint.revolute("z"), mass=1.0, inertia=(1, 1, 1))
+    model.prescribe(body, rf.motion.harmonic(1.0, 2.0))
+    result = rf.simulate(model.compile(), 1.0, t_eval=[0.0, 0.5, 1.0], rtol=0.1)
+    assert result.q.shape == (3, 0) and result.driving_forces.shape == (3, 1)
+    assert result.driving_forces[1, 0] == pytest.approx(-1.0 * 4.0 * np.sin(1.0), rel=1e-12)  # I θ̈, θ = sin 2t
+
+
+def test_bad_options():
+    with pytest.raises(ValueError, match="adaptive"):
+        rf.simulate(pendulum(), 1.0, method="auto", adaptive=False)
