@@ -973,7 +973,8 @@ def load_corpus(directory: Path = CORPUS) -> list[tuple[Path, dict]]:
 AXES = ("x", "y", "z")
 ROT = {"x": "rx", "y": "ry", "z": "rz"}
 METHODS = ("euler", "symplectic_euler", "rk4", "dopri5", "rkf45", "newmark", "hht", "generalized_alpha",
-           "implicit_spring", "scipy:Radau", "scipy:BDF", "scipy:LSODA", "scipy:RK45", "scipy:DOP853")
+           "implicit_spring", "esdirk43", "radau5", "scipy:Radau", "scipy:BDF", "scipy:LSODA", "scipy:RK45",
+           "scipy:DOP853")
 FIXED_STEP = ("euler", "symplectic_euler", "rk4", "newmark", "hht", "generalized_alpha", "implicit_spring")
 
 #: System methods: parameter lists ("t?" is t with a default, required when the system has drives).
@@ -1713,6 +1714,8 @@ class Gen:
                             kw[key]["soft"] = 1
                     else:
                         kw[key] = A(self.choice(good))
+                        if key == "iteration_matrix" and method == "radau5" and kw[key]["e"] == "'spring'":
+                            kw[key] = A("'spring'", bad=True, names=("iteration_matrix",))  # tangent only
             if kw.get("beta", {}).get("e") == "0.3025" and "gamma" not in kw:
                 kw["gamma"] = A("0.6")
             if kw.get("gamma", {}).get("e") == "0.6" and ("beta" not in kw or kw["beta"].get("e") == "0.25"):

@@ -89,3 +89,15 @@ def test_kane_peers_models_agree():
                          ("MuJoCo RK4", mujoco.run("RK4", "dt", h), 1e-6)]:
         error = np.max(np.linalg.norm(kp.tip_in_hub(scene, q) - tip, axis=1))
         assert error < tol, f"{name}: tip differs from rigidfem's by {error:.3g} m"
+
+
+def test_orders_study_table():
+    """The high-order study's structure on a 4-element beam: every method reaches 1e-4 m, and the
+    summary keeps the least time per method and target."""
+    from benchmarks import orders
+
+    sweep, summary = orders.study(elements=(4,), quick=True, repeats=0)
+    assert {r["method"] for r in sweep.rows} == {"esdirk43", "esdirk43 (spring)", "radau5", "dopri5",
+                                                 "generalized_alpha"}
+    assert all(np.isfinite(r["tip_error_rms_m"]) and r["wall_time_s"] > 0 for r in sweep.rows)
+    assert len(summary.rows) == 5 and all(r["time_s_to_0.0001"] != "-" for r in summary.rows)

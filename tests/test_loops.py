@@ -53,7 +53,7 @@ def closed_q(t1):
 
 
 @pytest.mark.parametrize("algorithm", ["recursive", "lagrange"])
-@pytest.mark.parametrize("method", ["dopri5", "generalized_alpha", "implicit_spring"])
+@pytest.mark.parametrize("method", ["dopri5", "generalized_alpha", "implicit_spring", "esdirk43"])
 def test_driven_four_bar_follows_the_closed_form_and_the_power_balance(algorithm, method):
     """Crank driven at θ1 = 0.4 + 2t + t²: rocker and coupler angles against the closed form at every
     output, closure residual ≤ 1e-12, and the crank torque against τ θ̇1 = dE/dt (E: kinetic +

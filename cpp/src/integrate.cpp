@@ -27,6 +27,7 @@ const MethodInfo methods[] = {
     {Method::GeneralizedAlpha, "generalized_alpha", 2, true, false, make_newmark},
     {Method::ImplicitSpring, "implicit_spring", 2, true, false, make_newmark},
     {Method::Esdirk43, "esdirk43", 4, true, true, make_implicit_rk},
+    {Method::Radau5, "radau5", 5, true, true, make_implicit_rk},
     {Method::Auto, "auto", 5, true, true, make_runge_kutta},  // dopri5 and its stiff method (AutoChoice)
 };
 
@@ -142,10 +143,13 @@ void check_options(const System& sys, double t0, double t_end, const VecX& q0, c
   check_vector(qd0, sys.nq, "qd0", "nq");
   if (!m.error_estimate && o.adaptive == 1)
     throw std::invalid_argument(std::string("adaptive: the method '") + m.name +
-                                "' has no error estimate; use dopri5, rkf45, esdirk43 or the Newmark family");
-  if (m.make == make_implicit_rk && sys.nl > 0)
-    throw std::invalid_argument(std::string("method: '") + m.name + "' does not integrate loop closures (the system has " +
-                                std::to_string(sys.nl) + " constraint rows); use generalized_alpha or dopri5");
+                                "' has no error estimate; use dopri5, rkf45, esdirk43, radau5 or the Newmark family");
+  if (o.method == Method::Radau5 && sys.nl > 0)
+    throw std::invalid_argument("method: 'radau5' does not integrate loop closures (the system has " +
+                                std::to_string(sys.nl) + " constraint rows); use esdirk43, generalized_alpha or dopri5");
+  if (o.method == Method::Radau5 && o.iteration_matrix == IterationMatrix::Spring)
+    throw std::invalid_argument("iteration_matrix: radau5 takes the exact tangent ('auto' or 'tangent'), got 'spring' "
+                                "(its complex block has no O(n) form); use esdirk43 for the spring matrix");
   if (!is_adaptive(o) && !(o.dt > 0.0 && std::isfinite(o.dt)))
     throw std::invalid_argument(std::string("dt: expected a positive step in s for the fixed-step method '") + m.name +
                                 "', got " + num(o.dt));
