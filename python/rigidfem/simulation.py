@@ -213,8 +213,7 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
         choice is the same on every machine and thread — else dopri5 goes on and the next trial
         waits twice as long. ``stats["method"]`` says what ran ("dopri5", or "dopri5, then
         esdirk43 from t = ... s"), ``stats["switched_at"]`` and ``stats["auto_trials"]`` the details.
-        A closed chain runs dopri5 alone (dopri5 warns when it finds the chain stiff:
-        generalized_alpha at a fixed dt, or esdirk43, is then the choice).
+        Closed chains too (both methods project each step onto the loops).
         Otherwise see the module docstring: "euler", "symplectic_euler", "rk4", "dopri5", "rkf45",
         "newmark", "hht", "generalized_alpha", "implicit_spring", "esdirk43", "radau5", or "scipy:Radau",
         "scipy:BDF",
@@ -317,11 +316,8 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
     try:
         scipy = method.startswith("scipy:")
         # scipy: methods check the options of the C++ ones too (they use only first_step of them)
-        # auto on a closed chain: dopri5 alone (its hand-over to esdirk43 is not tried on loops, and the
-        # adaptive Newmark family's error estimate does not bound the error)
-        looped_auto = method == "auto" and system.nl > 0
-        opt = _options("dopri5" if scipy or looped_auto else method, dt, first_step, rtol, atol, max_step, max_steps,
-                       adaptive, beta, gamma, alpha, rho_inf, newton_tol, newton_max_iterations, iteration_matrix)
+        opt = _options("dopri5" if scipy else method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, beta,
+                       gamma, alpha, rho_inf, newton_tol, newton_max_iterations, iteration_matrix)
         if scipy:
             first = None if first_step is None else opt.dt
             run = _run_scipy(system, method[6:], t0, t_end, q0, qd0, t_eval, rtol, atol, max_step, max_steps,
@@ -333,14 +329,14 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
             bar.close()
     t, q, qd, stats, interrupted, failure = run
     if method == "auto":
-        stats["method"] = "dopri5 (a closed chain)" if looped_auto else _auto_choice(stats, opt.stiff_method)
+        stats["method"] = _auto_choice(stats, opt.stiff_method)
     result = Result(system, t, q, qd, stats, method, interrupted)
     if failure is not None:
         message, time, cause = failure
         error = _core.SimulationError(message)
         error.result, error.time, error.cause = result, time, cause
         raise error
-    if stiffness_warning and (method != "auto" or looped_auto) and np.isfinite(stats.get("stiff_at", np.nan)):
+    if stiffness_warning and method != "auto" and np.isfinite(stats.get("stiff_at", np.nan)):
         warnings.warn(f"{method}: the problem is stiff from t = {stats['stiff_at']:.6g} s on (h rho > 3.25): the step is "
                       "bounded by stability, the cost grows with the highest frequency and loose tolerances leave "
                       "errors in the stiff modes; an implicit method (generalized_alpha, newmark, scipy:Radau) is "
