@@ -315,7 +315,8 @@ def standard_methods(quick: bool = False):
     """The integrators and settings of the benchmark."""
     r = [1e-4, 1e-6, 1e-8] if quick else [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9]
     loose = [1e-1, 1e-2] if quick else [1e-1, 3e-2, 1e-2]
-    return [("auto", "rtol", loose + r), ("dopri5", "rtol", r), ("rkf45", "rtol", r[:-1]),
+    return [("auto", "rtol", loose + r), ("esdirk43", "rtol", loose + r[:-2]), ("radau5", "rtol", loose + r[:-2]),
+            ("dopri5", "rtol", r), ("rkf45", "rtol", r[:-1]),
             ("generalized_alpha", "rtol", r[:3], {"adaptive": True})]
 
 
@@ -341,12 +342,16 @@ def bench(output_dir="bench", quick: bool = False) -> Table:
             ("implicit_spring", "dt", [1e-3, 5e-4] if quick else [1e-3, 5e-4, 2.5e-4, 1.25e-4])]),
         (scenes.stiff_cantilever(4 if quick else m), [
             ("auto", "rtol", [1e-1, 1e-2, 1e-4, 1e-6] if quick else [1e-1, 3e-2, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8]),
+            ("esdirk43", "rtol", [1e-1, 1e-2, 1e-4] if quick else [1e-1, 3e-2, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6]),
+            ("radau5", "rtol", [1e-1, 1e-2, 1e-4] if quick else [1e-1, 3e-2, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6]),
             ("dopri5", "rtol", [1e-4, 1e-6] if quick else [1e-4, 1e-6, 1e-8]),
             ("rk4", "dt", [1e-6] if quick else [2e-6, 1e-6, 5e-7]),
             ("generalized_alpha", "dt", [1e-3, 5e-4] if quick else [2e-3, 1e-3, 5e-4, 2.5e-4, 1.25e-4]),
             ("implicit_spring", "dt", [1e-3, 5e-4] if quick else [2e-3, 1e-3, 5e-4, 2.5e-4, 1.25e-4])]),
         (scenes.cantilever("classical", m), [
             ("auto", "rtol", [1e-1, 1e-2, 1e-4, 1e-6] if quick else [1e-1, 3e-2, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8]),
+            ("esdirk43", "rtol", [1e-1, 1e-2, 1e-4] if quick else [1e-1, 3e-2, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6]),
+            ("radau5", "rtol", [1e-1, 1e-2, 1e-4] if quick else [1e-1, 3e-2, 1e-2, 1e-3, 1e-4, 1e-5, 1e-6]),
             ("dopri5", "rtol", [1e-4, 1e-6] if quick else [1e-4, 1e-6, 1e-8]),
             ("newmark", "dt", [1e-3, 5e-4] if quick else [1e-3, 5e-4, 2.5e-4, 1.25e-4]),
             ("generalized_alpha", "dt", [1e-3, 5e-4] if quick else [1e-3, 5e-4, 2.5e-4, 1.25e-4])]),
