@@ -505,6 +505,7 @@ class IntegratorOptions:
     """
     iteration_matrix: str
     method: str
+    stiff_method: str
     def __init__(self) -> None:
         ...
     @property
