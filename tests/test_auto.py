@@ -107,9 +107,9 @@ def test_closed_chain_runs_and_stays_closed():
     q0, _ = system.assemble([0.4, -1.9, 4.6])
     result = rf.simulate(system, 2.0, q0=q0, t_eval=np.linspace(0, 2, 21))
     g = [np.abs(system.loop_constraints(t, q, np.zeros(3))[0]).max() for t, q in zip(result.t, result.q)]
-    assert max(g) < 1e-10 and result.stats["method"] == "dopri5"
-    dopri = rf.simulate(system, 2.0, method="dopri5", q0=q0, t_eval=np.linspace(0, 2, 21))
-    assert np.array_equal(result.q, dopri.q)
+    assert max(g) < 1e-10 and result.stats["method"].startswith("dopri5")
+    tight = rf.simulate(system, 2.0, method="dopri5", q0=q0, t_eval=np.linspace(0, 2, 21), rtol=1e-11, atol=1e-13)
+    assert np.abs(result.q - tight.q).max() < 100 * 1e-6 * np.abs(tight.q).max()
 
 
 def test_stiff_closed_chain_hands_over_and_stays_closed():

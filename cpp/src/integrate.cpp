@@ -191,7 +191,7 @@ void check_options(const System& sys, double t0, double t_end, const VecX& q0, c
 /// cost about nq evaluations) and max(1, (nq/50)²) per dense factorisation (one for the O(n) one).
 class AutoChoice {
  public:
-  static constexpr int window = 30, ramp = 8;
+  static constexpr int window = 20, ramp = 6;
   static constexpr double margin = 1.25;  // a near tie goes to dopri5, whose error control is the surer
   static constexpr double loosest_explicit = 1e-3;  // dopri5's rtol at most (run() tightens looser ones)
   AutoChoice(const IntegratorOptions& o, int nq) : o_(o), nq_(nq) {}
@@ -250,7 +250,7 @@ class AutoChoice {
   IntegratorOptions o_;
   int nq_;
   bool stiff_running_ = false, kept_ = false, spring_ = false;
-  // The first window holds dopri5's start from a small step: not a rate to race against.
+  // The first window holds dopri5's start from its first step (rejections, a low rate): no trial after it.
   int steps_ = 0, near_boundary_ = 0, windows_since_trial_ = -1, backoff_ = 1;
   long rejected_mark_ = 0;
   double t_mark_ = 0.0, work_mark_ = 0.0, rate_ = 0.0, h_explicit_ = 0.0;

@@ -205,7 +205,7 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
     ----------
     method : str
         "auto" (default): dopri5 while it is the cheaper, esdirk43 where it is not. dopri5 runs in
-        windows of 30 accepted steps (at rtol <= 1e-3: looser, its error control lets the stiff
+        windows of 20 accepted steps (at rtol <= 1e-3: looser, its error control lets the stiff
         modes of a beam go unstable); a window that looks bounded by stability (a fifth of its
         steps at h ρ > 2, or a sixth as many rejections) starts a trial of esdirk43 from the state
         reached, which keeps the run if it advances 1.25 times as far per unit of work — counted,
