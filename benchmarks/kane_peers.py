@@ -494,7 +494,8 @@ VERIFY_COLUMNS = ("m", "code", "reference", "self_check_max_m", "vs_rigidfem_max
 
 
 def settings(scene: Kane, quick: bool = False) -> dict:
-    """code -> [(method, setting, values)], coarse to fine. Explicit steps start at each
+    """code -> [(method, setting, values)], coarse to fine; rigidfem's radau5 when this build
+    has it. Fixed steps divide the output interval, ~√2 apart. Explicit steps start at each
     method's stability limit (ω_max h ≤ 2 for symplectic/semi-implicit Euler, Verlet and
     implicitfast, whose joint springs are explicit; 2.785 for RK4)."""
     w = scene.omega_max
