@@ -92,19 +92,25 @@ def test_stiff_spring_chain_against_the_modal_solution():
     assert np.abs(result.q - x_exact).max() < 1e-3 * np.abs(x0).max()
 
 
-def test_closed_chain_runs_and_stays_closed():
+def four_bar(crank_spring: dict, guess):
+    """A four-bar (crank 0.3 m, coupler 0.8 m, rocker 0.6 m, ground 0.7 m) under gravity, the crank's
+    joint with ``crank_spring``; the system and q0 closing the loop nearest ``guess``."""
     model = rf.Model(gravity=(0, -9.81, 0))
 
     def rod(L):
         return dict(mass=1.0, inertia=(1e-4, L * L / 12, L * L / 12), com=(L / 2, 0, 0))
 
-    crank = model.add_body("crank", model.ground, rf.Joint.revolute("z", stiffness=15.0, rest=1.2), **rod(0.3))
+    crank = model.add_body("crank", model.ground, rf.Joint.revolute("z", **crank_spring), **rod(0.3))
     coupler = model.add_body("coupler", crank, rf.Joint.revolute("z"), **rod(0.8), placement=rf.transform((0.3, 0, 0)))
     rocker = model.add_body("rocker", model.ground, rf.Joint.revolute("z"), **rod(0.6),
                             placement=rf.transform((0.7, 0, 0)))
     model.add_loop_joint("revolute", coupler.point((0.8, 0, 0)), rocker.point((0.6, 0, 0)))
     system = model.compile()
-    q0, _ = system.assemble([0.4, -1.9, 4.6])
+    return system, system.assemble(guess)[0]
+
+
+def test_closed_chain_runs_and_stays_closed():
+    system, q0 = four_bar(dict(stiffness=15.0, rest=1.2), [0.4, -1.9, 4.6])
     result = rf.simulate(system, 2.0, q0=q0, t_eval=np.linspace(0, 2, 21))
     g = [np.abs(system.loop_constraints(t, q, np.zeros(3))[0]).max() for t, q in zip(result.t, result.q)]
     assert max(g) < 1e-10 and result.stats["method"].startswith("dopri5")
@@ -115,19 +121,7 @@ def test_closed_chain_runs_and_stays_closed():
 def test_stiff_closed_chain_hands_over_and_stays_closed():
     """A four-bar whose crank spring (1e6 N·m/rad) makes it stiff: auto hands over to esdirk43, which
     projects every step onto the loop; its state stays within 20 rtol of a tight dopri5 run."""
-    model = rf.Model(gravity=(0, -9.81, 0))
-
-    def rod(L):
-        return dict(mass=1.0, inertia=(1e-4, L * L / 12, L * L / 12), com=(L / 2, 0, 0))
-
-    crank = model.add_body("crank", model.ground, rf.Joint.revolute("z", stiffness=1e6, rest=1.2, damping=1.0),
-                           **rod(0.3))
-    coupler = model.add_body("coupler", crank, rf.Joint.revolute("z"), **rod(0.8), placement=rf.transform((0.3, 0, 0)))
-    rocker = model.add_body("rocker", model.ground, rf.Joint.revolute("z"), **rod(0.6),
-                            placement=rf.transform((0.7, 0, 0)))
-    model.add_loop_joint("revolute", coupler.point((0.8, 0, 0)), rocker.point((0.6, 0, 0)))
-    system = model.compile()
-    q0, _ = system.assemble([1.25, -1.9, 4.6])
+    system, q0 = four_bar(dict(stiffness=1e6, rest=1.2, damping=1.0), [1.25, -1.9, 4.6])
     t = np.linspace(0, 0.2, 11)
     auto = rf.simulate(system, 0.2, q0=q0, t_eval=t, rtol=1e-6, atol=1e-9)
     ref = rf.simulate(system, 0.2, method="dopri5", q0=q0, t_eval=t, rtol=1e-9, atol=1e-12, stiffness_warning=False)
