@@ -101,3 +101,21 @@ def test_orders_study_table():
                                                  "generalized_alpha"}
     assert all(np.isfinite(r["tip_error_rms_m"]) and r["wall_time_s"] > 0 for r in sweep.rows)
     assert len(summary.rows) == 5 and all(r["time_s_to_0.0001"] != "-" for r in summary.rows)
+
+
+def test_tolerance_study_quick(tmp_path, capsys):
+    """The tolerance benchmark's quick run (m = 10, 2 tolerances, 3 methods, one fixed step): the
+    table's columns, a finite error and delivered/asked per run, and the fixed-step table."""
+    from benchmarks import tolerance
+
+    tables = tolerance.run(tmp_path, quick=True)
+    table, fixed = tables["tolerance"], tables["tolerance_fixed_steps"]
+    assert table.columns[:7] == ("method", "rtol", "tip_error_rms_m", "delivered_over_asked", "warned", "steps",
+                                 "rejected_steps") and "wall_time_s" in table.columns
+    methods, rtols, *_ = tolerance.settings(quick=True)
+    assert [(r["method"], r["rtol"]) for r in table.rows] == [(m, r) for m in methods for r in rtols]
+    assert all(np.isfinite(r["tip_error_rms_m"]) and np.isfinite(r["delivered_over_asked"])
+               and r["delivered_over_asked"] > 0 and r["steps"] > 0 for r in table.rows)
+    assert all(r["warned"] in ("no", "warning") for r in table.rows)
+    assert [r["method"] for r in fixed.rows] == ["implicit_spring"] and fixed.rows[0]["finished"] in ("yes", "no")
+    assert (tmp_path / "tolerance.csv").exists() and "| method | rtol | tip_error_rms_m |" in capsys.readouterr().out
