@@ -74,6 +74,7 @@ LAYERS = [
     {"joint_motion", "loops", "force_elements", "flows"},
     {"model"},
     {"system"},
+    {"arms"},                                  # internal variables of the state (system level)
     {"kinematics", "constraints"},
     {"lagrange", "recursive", "derivatives"},  # the formulations
     {"dynamics"},                              # the only place that chooses one

@@ -94,6 +94,15 @@ void bind_dynamics(py::module_& m) {
       .def_readonly("np", &System::np, "Number of prescribed (driven) coordinates.")
       .def_readonly("nc", &System::nc, "Number of all joint coordinates, nq + np.")
       .def_readonly("nbodies", &System::nbodies)
+      .def_readonly("nz", &System::nz, "Number of Maxwell arms: internal variables s (their forces, N or N·m).")
+      .def_property_readonly(
+          "arms",
+          [](const System& s) {
+            RowMatX table(s.nz, 3);
+            for (int j = 0; j < s.nz; ++j) table.row(j) << s.arms[j].q, s.arms[j].stiffness, s.arms[j].tau;
+            return table;
+          },
+          "The Maxwell arms (nz, 3): free coordinate index, stiffness k (N/m or N·m/rad), relaxation time tau (s).")
       .def_readonly("body_names", &System::body_names)
       .def_readonly("parent", &System::parent, "Parent index of every body (-1: ground), parent[p] < p.")
       .def_readonly("gravity", &System::gravity, "Gravitational acceleration (m/s^2), global.")

@@ -33,6 +33,7 @@ void bind_integrators(py::module_& m) {
       .def_readwrite("rho_inf", &IntegratorOptions::rho_inf)
       .def_readwrite("newton_tol", &IntegratorOptions::newton_tol)
       .def_readwrite("newton_max_iterations", &IntegratorOptions::newton_max_iterations)
+      .def_readwrite("s0", &IntegratorOptions::s0, "(nz) the Maxwell arms' initial forces (N or N·m); empty: zero")
       .def_property(
           "iteration_matrix", [](const IntegratorOptions& o) { return iteration_matrix_name(o.iteration_matrix); },
           [](IntegratorOptions& o, const std::string& name) { o.iteration_matrix = parse_iteration_matrix(name); })
@@ -86,7 +87,7 @@ void bind_integrators(py::module_& m) {
         stats["switched_at"] = st.switched_at;
         stats["auto_trials"] = st.auto_trials;
         return py::make_tuple(VecX(Eigen::Map<const VecX>(tr.t.data(), tr.t.size())), stack(tr.q, s.nq),
-                              stack(tr.qd, s.nq), stats, tr.interrupted, failure);
+                              stack(tr.qd, s.nq), stats, tr.interrupted, failure, stack(tr.s, s.nz));
       },
       py::arg("system"), py::arg("t0"), py::arg("t_end"), py::arg("q0"), py::arg("qd0"), py::arg("t_eval"),
       py::arg("options"), py::arg("keep_going"));
@@ -94,11 +95,11 @@ void bind_integrators(py::module_& m) {
   m.def(
       "_evaluate_outputs",
       [](const System& s, const Eigen::Ref<const VecX>& t, const Eigen::Ref<const RowMatX>& Q,
-         const Eigen::Ref<const RowMatX>& QD) {
-        StateOutputs o = evaluate_outputs(s, t, Q, QD);
-        return py::make_tuple(o.qdd, o.tau, o.kinetic, o.gravity, o.elastic);
+         const Eigen::Ref<const RowMatX>& QD, const Eigen::Ref<const RowMatX>& S) {
+        StateOutputs o = evaluate_outputs(s, t, Q, QD, S);
+        return py::make_tuple(o.qdd, o.tau, o.kinetic, o.gravity, o.elastic, o.power);
       },
-      py::arg("system"), py::arg("t"), py::arg("q"), py::arg("qd"));
+      py::arg("system"), py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("s"));
   m.def(
       "_point_positions",
       [](const System& s, int body, const Vec3& r, int frame, const Eigen::Ref<const VecX>& t,

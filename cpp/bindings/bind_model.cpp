@@ -269,6 +269,17 @@ void bind_model(py::module_& m) {
           },
           py::arg("body"), py::arg("coordinate"), py::arg("value"), py::arg("law"))
       .def(
+          "_add_maxwell_arms",
+          [](Model& model, const std::vector<int>& bodies, const std::vector<int>& coordinates,
+             const std::vector<double>& stiffness, const std::vector<double>& tau) {
+            const std::size_t n = bodies.size();
+            if (coordinates.size() != n || stiffness.size() != n || tau.size() != n)
+              bad("arms", "bodies, coordinates, stiffness and tau of one length", "other lengths");
+            for (std::size_t k = 0; k < n; ++k) model.add_maxwell_arm(bodies[k], coordinates[k], {stiffness[k], tau[k]});
+          },
+          py::arg("bodies"), py::arg("coordinates"), py::arg("stiffness"), py::arg("tau"),
+          "Adds Maxwell arms (k in N/m or N·m/rad, tau in s) on joint coordinates (-1: the joint's only one).")
+      .def(
           "_add_load",
           [](Model& model, int body, const Vec3& point, const Vec3& force, const Vec3& torque, bool follower,
              ProfilePtr scale) { model.add_load({body, point, force, torque, follower, std::move(scale)}); },

@@ -15,6 +15,10 @@
 // last stage is the step's end, (q, q̇, q̈)_{n+1} = (Q_s, V_s, A_s), and the first stage of the next
 // step (A_1 = q̈_n).
 //
+// The Maxwell arms' forces s (arms.hpp) are stages too: S_i = ŝ_i + γh (k V_i − S_i/τ) gives
+// S_i = (ŝ_i + γh k V_i)/(1 + γh/τ) in closed form, so the stage residual holds them and Newton's matrix
+// their stiffness (γh)² k/(1 + γh/τ); radau5 refuses them (its stages are coupled).
+//
 // Radau IIA (3 stages, order 5): all stages at once, V = q̇_n 1ᵀ + h A aᵀ, Q = q_n 1ᵀ + h V aᵀ
 // (columns the stages, a the Butcher matrix), so Newton's matrix is I⊗M + h a⊗C + h² a²⊗K; with
 // a = P D P⁻¹ it falls apart into one real block M + h d₁ C + (h d₁)² K and one complex block
@@ -24,6 +28,7 @@
 #include <complex>
 #include <limits>
 
+#include "rigidfem/arms.hpp"
 #include "rigidfem/constraints.hpp"
 #include "rigidfem/dynamics.hpp"
 #include "rigidfem/errors.hpp"
@@ -91,11 +96,14 @@ class ImplicitRk : public Stepper {
         q_(n_), v_(n_), a_(n_), qp_(n_), vp_(n_), ap_(n_), q1_(n_), v1_(n_), a1_(n_), r_(n_), y_(2 * n_),
         y1_(2 * n_), dy_(2 * n_), sc_(2 * n_), K_(n_, n_), C_(n_, n_), M_(n_, n_) {}
 
-  /// The initial acceleration, q̈_0 = M⁻¹ f at (t0, q0, q̇0).
-  void start(double t0, const VecX& q0, const VecX& qd0) override {
+  /// The initial acceleration, q̈_0 = M⁻¹ f at (t0, q0, q̇0, s0).
+  void start(double t0, const VecX& y0) override {
     ++stats_.rhs_evaluations;
-    q_ = q0, v_ = qd0, a_ = forward_dynamics(sys_, d_, t0, q0, qd0);
+    q_ = y0.head(n_), v_ = y0.segment(n_, n_), s_ = y0.tail(sys_.nz);
+    set_arm_forces(sys_, d_, s_);
+    a_ = forward_dynamics(sys_, d_, t0, q_, v_);
     y_ << q_, v_;
+    ys_ = y0;
   }
 
   /// Hairer's first guess 0.01 ‖y‖/‖ẏ‖ in the error weights (1e-6 s when either is negligible).
@@ -130,20 +138,25 @@ class ImplicitRk : public Stepper {
   }
 
   void accept() override {
-    qp_ = q_, vp_ = v_, ap_ = a_;
-    q_ = q1_, v_ = v1_, a_ = a1_;
+    qp_ = q_, vp_ = v_, ap_ = a_, sp_ = s_;
+    q_ = q1_, v_ = v1_, a_ = a1_, s_ = s1_;
     y_ = y1_;
+    ys_ << y_, s_;
     jacobian_fresh_ = false;
     if (slow_) jacobian_valid_ = false;  // Newton contracted slowly: a new tangent for the next step
     accepted();
   }
 
-  const VecX& state() const override { return y_; }
+  const VecX& state() const override { return ys_; }
 
+  /// [q, q̇] by the quintic Hermite interpolant, s by the cubic one through s and ṡ at both ends.
   VecX dense(double t) const override {
-    VecX y;
+    VecX y, out(2 * n_ + sys_.nz), sdp(sys_.nz), sd(sys_.nz);
     hermite5((t - t_) / h_, h_, qp_, vp_, ap_, q_, v_, a_, y);
-    return y;
+    arm_rates(sys_, vp_, sp_, sdp);
+    arm_rates(sys_, v_, s_, sd);
+    out << y, hermite((t - t_) / h_, h_, sp_, sdp, s_, sd);
+    return out;
   }
 
   /// Both estimates are O(h⁴); PI control (Gustafsson): h_new = h · 0.9 err^(−0.7/4) err_prev^(0.4/4),
@@ -248,6 +261,8 @@ class ImplicitRk : public Stepper {
   VecX q1_, v1_, a1_;  // (nq) the attempted step's end
   VecX r_;             // (nq) the residual of the last stage evaluated
   VecX y_, y1_, dy_, sc_;  // (2 nq) y_n, y_{n+1}, scratch, error weights atol + rtol |y_n|
+  VecX s_, sp_, s1_;       // (nz) the Maxwell arms' forces: now, at the last step's start, the attempted step's end
+  VecX ys_;                // (2 nq + nz) the state [q, q̇, s]
   MatX K_, C_, M_;         // (nq, nq) the tangent's parts
   bool jacobian_valid_ = false, jacobian_fresh_ = false, slow_ = false;
   double eta_ = 1.0;          // Newton's η of the last converged stage
@@ -261,12 +276,13 @@ class Esdirk final : public ImplicitRk {
  public:
   Esdirk(const System& sys, const IntegratorOptions& o, IntegratorStats& stats)
       : ImplicitRk(sys, o, stats), spring_(o.iteration_matrix == IterationMatrix::Spring), Q_(n_), qhat_(n_),
-        vhat_(n_), dA_(n_), armature_(n_), rhs_(n_), V_(n_, T::s), A_(n_, T::s), e_(2 * n_), S_(n_, n_), lu_(n_),
+        vhat_(n_), dA_(n_), armature_(n_), rhs_(n_), V_(n_, T::s), A_(n_, T::s), Sd_(sys.nz, T::s),
+        shat_(sys.nz), S_arm_(sys.nz), e_(2 * n_), S_(n_, n_), lu_(n_),
         lambda_(VecX::Zero(sys.nl)) {}
 
   /// With loops, the multipliers λ of the initial state too.
-  void start(double t0, const VecX& q0, const VecX& qd0) override {
-    ImplicitRk::start(t0, q0, qd0);
+  void start(double t0, const VecX& y0) override {
+    ImplicitRk::start(t0, y0);
     if (sys_.nl > 0) lambda_ = d_.lambda;
   }
 
@@ -290,6 +306,7 @@ class Esdirk final : public ImplicitRk {
     if (!spring_ && (tangent(t) || gh != gh_)) factor(t, gh);
     slow_ = false;
     V_.col(0) = v_, A_.col(0) = a_;
+    arm_rates(sys_, v_, s_, Sd_.col(0));
     for (int i = 1; i < T::s; ++i) {
       // v̂_i = q̇_n + h Σ_{j<i} a_ij A_j, q̂_i = q_n + h Σ_{j<i} a_ij V_j
       vhat_ = v_, qhat_ = q_;
@@ -298,11 +315,33 @@ class Esdirk final : public ImplicitRk {
         vhat_ += (h * T::a[i][j]) * A_.col(j);
         qhat_ += (h * T::a[i][j]) * V_.col(j);
       }
+      // ŝ_i = s_n + h Σ_{j<i} a_ij Ṡ_j
+      shat_ = s_;
+      for (int j = 0; j < i; ++j)
+        if (T::a[i][j] != 0.0) shat_ += (h * T::a[i][j]) * Sd_.col(j);
       predict(i);
       if (!newton(t + T::c[i] * h, gh, tol, i)) return false;
     }
-    q1_ = Q_, v1_ = V_.col(T::s - 1), a1_ = A_.col(T::s - 1);
+    q1_ = Q_, v1_ = V_.col(T::s - 1), a1_ = A_.col(T::s - 1), s1_ = S_arm_;
     return true;
+  }
+
+  /// The stage's arm forces S_i = (ŝ_i + γh k V_i)/(1 + γh/τ) into S_arm_ and d_, and (rates) Ṡ_i.
+  void stage_arms(double gh, const Eigen::Ref<const VecX>& V, int i, bool rates) {
+    if (sys_.nz == 0) return;
+    S_arm_.resize(sys_.nz);
+    for (int j = 0; j < sys_.nz; ++j) {
+      const Arm& a = sys_.arms[j];
+      S_arm_(j) = (shat_(j) + gh * a.stiffness * V(a.q)) / (1.0 + gh / a.tau);
+    }
+    set_arm_forces(sys_, d_, S_arm_);
+    if (rates) arm_rates(sys_, V, S_arm_, Sd_.col(i));
+  }
+
+  /// (γh)² Σ k/(1 + γh/τ) on each coordinate with arms: their part of ∂r/∂A_i.
+  void arm_matrix(double gh) {
+    arm_diag_.setZero(n_);
+    for (const Arm& a : sys_.arms) arm_diag_(a.q) += gh * gh * a.stiffness / (1.0 + gh / a.tau);
   }
 
   /// e = h Σ (b_i − b̂_i) [V_i, A_i], filtered with the tangent (filter_error).
@@ -341,6 +380,7 @@ class Esdirk final : public ImplicitRk {
     for (int it = 0;; ++it) {
       V = vhat_ + gh * A;
       Q_ = qhat_ + gh * V;
+      stage_arms(gh, V, i, false);
       residual(ti, Q_, V, A);
       if (sys_.nl > 0) G_ = free_jacobian(sys_, d_), r_.noalias() -= G_.transpose() * lambda_;
       correction(gh);
@@ -354,6 +394,7 @@ class Esdirk final : public ImplicitRk {
     }
     V = vhat_ + gh * A;
     Q_ = qhat_ + gh * V;
+    stage_arms(gh, V, i, true);
     return true;
   }
 
@@ -374,9 +415,11 @@ class Esdirk final : public ImplicitRk {
   void project(double t) override {
     project_onto_loops(sys_, d_, t, q_, v_, 1e-12, 10);
     ++stats_.rhs_evaluations;
+    set_arm_forces(sys_, d_, s_);
     a_ = forward_dynamics(sys_, d_, t, q_, v_);
     lambda_ = d_.lambda;
     y_ << q_, v_;
+    ys_ << y_, s_;
   }
 
   /// dA_ = −S⁻¹ r_: the factorised tangent, or the O(n) spring matrix at the iterate.
@@ -392,6 +435,7 @@ class Esdirk final : public ImplicitRk {
       const Coordinate& c = sys_.coords[i];
       armature_(k) = d_.spring_scale(i) * (gh * c.damping + gh * gh * c.stiffness);
     }
+    if (sys_.nz > 0) arm_matrix(gh), armature_ += arm_diag_;
     ++stats_.factorizations;
     factor_armature(sys_, d_, armature_);  // at the state residual() left in d_
     dA_ = -r_;
@@ -401,6 +445,7 @@ class Esdirk final : public ImplicitRk {
   /// S = M + γh C + (γh)² K.
   void factor(double t, double gh) {
     S_ = M_ + gh * C_ + (gh * gh) * K_;
+    if (sys_.nz > 0) arm_matrix(gh), S_.diagonal() += arm_diag_;
     lu_.compute(S_);
     ++stats_.factorizations;
     gh_ = gh;
@@ -410,6 +455,8 @@ class Esdirk final : public ImplicitRk {
   bool spring_;
   VecX Q_, qhat_, vhat_, dA_, armature_, rhs_;  // (nq) the stage being solved; the filter's right side
   MatX V_, A_;                            // (nq, s) the stages' velocities and accelerations
+  MatX Sd_;                               // (nz, s) the stages' arm rates Ṡ_i
+  VecX shat_, S_arm_, arm_diag_;          // (nz) ŝ_i and S_i of the stage being solved; (nq) their matrix part
   VecX e_;                                // (2 nq) the error estimate
   MatX S_;                                // (nq, nq)
   Eigen::PartialPivLU<MatX> lu_;

@@ -99,7 +99,8 @@ class Recorder {
   void push(double t, const VecX& y) {
     traj_.t.push_back(t);
     traj_.q.push_back(y.head(nq_));
-    traj_.qd.push_back(y.tail(nq_));
+    traj_.qd.push_back(y.segment(nq_, nq_));
+    traj_.s.push_back(y.tail(sys_.nz));
     if (d_) project_onto_loops(sys_, *d_, t, traj_.q.back(), traj_.qd.back(), 1e-12, 10);
   }
   void start(double t0, const VecX& y0) {
@@ -144,6 +145,11 @@ void check_options(const System& sys, double t0, double t_end, const VecX& q0, c
   if (!m.error_estimate && o.adaptive == 1)
     throw std::invalid_argument(std::string("adaptive: the method '") + m.name +
                                 "' has no error estimate; use dopri5, rkf45, esdirk43, radau5 or the Newmark family");
+  if ((o.method == Method::Radau5 || (o.method == Method::Auto && o.stiff_method == Method::Radau5)) && sys.nz > 0)
+    throw std::invalid_argument("method: 'radau5' does not integrate Maxwell arms (the system has " +
+                                std::to_string(sys.nz) + " arm forces as internal variables); use esdirk43, "
+                                "generalized_alpha or dopri5");
+  if (o.s0.size() != 0) check_vector(o.s0, sys.nz, "s0", "nz (the Maxwell arms' forces, N or N·m)");
   if (o.method == Method::Radau5 && sys.nl > 0)
     throw std::invalid_argument("method: 'radau5' does not integrate loop closures (the system has " +
                                 std::to_string(sys.nl) + " constraint rows); use esdirk43, generalized_alpha or dopri5");
@@ -280,7 +286,9 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
   AutoChoice choice(o, n);
   std::unique_ptr<Stepper> stepper = method_info(o.method).make(sys, o, stats);
   StepControl control = stepper->control();
-  stepper->start(t0, q0, qd0);
+  VecX y0(2 * n + sys.nz);
+  y0 << q0, qd0, (o.s0.size() ? o.s0 : VecX::Zero(sys.nz));
+  stepper->start(t0, y0);
   out.start(t0, stepper->state());
   const Tolerances* tol = o.method == Method::Auto ? &explicit_tol : &asked;
   double h = o.dt > 0.0 ? std::min(o.dt, span) : stepper->initial_step(span, *tol, o.max_step);
@@ -349,10 +357,10 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
     last_q = y.head(n);
     if (o.method == Method::Auto && choice.after_step(t, stepper->h_rho(), stats)) {
       // Change method: the other goes on from the state reached (its own controller grows its step).
-      const VecX q1 = y.head(n), qd1 = y.tail(n);
+      const VecX y1 = y;
       const IntegratorOptions next = choice.switched(t, h, stats);
       stepper = method_info(next.method).make(sys, next, stats);
-      stepper->start(t, q1, qd1);
+      stepper->start(t, y1);
       control = stepper->control();
       if (!choice.stiff_running()) h = choice.explicit_step();
       tol = choice.stiff_running() ? &asked : &explicit_tol;

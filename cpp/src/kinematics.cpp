@@ -212,7 +212,8 @@ double passive_force(const System& sys, const Data& d, int i) {
   const Coordinate& c = sys.coords[i];
   double applied = c.force;
   if (c.force_law) applied += c.force_law(d.t, d.qa(i), d.qda(i));
-  return -d.spring_scale(i) * (c.stiffness * (d.qa(i) - c.rest) + c.damping * d.qda(i)) + d.load_factor * applied;
+  return -d.spring_scale(i) * (c.stiffness * (d.qa(i) - c.rest) + c.damping * d.qda(i)) - d.arm_force(i) +
+         d.load_factor * applied;
 }
 
 namespace {

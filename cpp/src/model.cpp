@@ -257,6 +257,9 @@ void Model::prescribe(int body, int coordinate, ProfilePtr motion) {
   if (coords_[body][k].drive)
     bad("coordinate", "a coordinate not prescribed yet (each takes one motion)",
         "'" + coordinate_name(body, k) + "', prescribed already");
+  if (!coords_[body][k].arms.empty())
+    bad("coordinate", "a coordinate without Maxwell arms (their forces are states of the free motion)",
+        "'" + coordinate_name(body, k) + "', which has " + std::to_string(coords_[body][k].arms.size()));
   coords_[body][k].drive = std::move(motion);
 }
 
@@ -269,6 +272,17 @@ void Model::add_generalized_force(int body, int coordinate, double value, ForceL
     if (c.force_law) bad("force", "at most one force law per coordinate", "a second one");
     c.force_law = std::move(law);
   }
+}
+
+void Model::add_maxwell_arm(int body, int coordinate, const MaxwellArm& arm) {
+  const int k = resolve_coordinate(body, coordinate);
+  if (!(arm.stiffness > 0.0) || !std::isfinite(arm.stiffness))
+    bad("stiffness", "a positive finite arm stiffness (N/m or N·m/rad)", num8(arm.stiffness));
+  if (!(arm.tau > 0.0) || !std::isfinite(arm.tau)) bad("tau", "a positive finite relaxation time in s", num8(arm.tau));
+  if (coords_[body][k].drive)
+    bad("coordinate", "a free coordinate (an arm's force is a state of the free motion)",
+        "'" + coordinate_name(body, k) + "', prescribed");
+  coords_[body][k].arms.push_back(arm);
 }
 
 void Model::add_load(const Load& load) {
@@ -327,7 +341,8 @@ void Model::add_flow(Flow flow) {
   for (int k = 1; k <= flow.elements; ++k) {
     const int b = flow.first + k;
     const Joint& j = bodies_[b].joint;
-    if (bodies_[b].parent != b - 1 || j.linear || j.axes.empty() || j.axes[0] != Axis::X || coords_[b][0].drive)
+    if (bodies_[b].parent != b - 1 || j.linear || j.axes.empty() || j.axes[0] != Axis::X || coords_[b][0].drive ||
+        !coords_[b][0].arms.empty())
       bad("beam", "a chain of rfes whose sde joints start with a free x coordinate (built by add_beam)",
           "body '" + bodies_[b].name + "'");
   }

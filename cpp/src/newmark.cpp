@@ -4,11 +4,14 @@
 //   (1 − α_m) a_{n+1} + α_m a_n = (1 − α_f) q̈_{n+1} + α_f q̈_n,
 //   q_{n+1} = q_n + h q̇_n + h² [(½ − β) a_n + β a_{n+1}],
 //   q̇_{n+1} = q̇_n + h [(1 − γ) a_n + γ a_{n+1}].
+// The Maxwell arms' forces s (arms.hpp) advance exactly for q linear over the step (arm_step), so
+// f(q_{n+1}, ...) holds s_{n+1}(q_{n+1}) and Newton's K the arms' stiffness k (1 − e^{−h/τ})/(h/τ).
 // Newmark: α_m = α_f = 0; HHT-α: α_m = 0, α_f = −α; generalised-α from ρ∞ (Chung & Hulbert).
 #include <algorithm>
 #include <cmath>
 #include <limits>
 
+#include "rigidfem/arms.hpp"
 #include "rigidfem/constraints.hpp"
 #include "rigidfem/dynamics.hpp"
 #include "rigidfem/errors.hpp"
@@ -21,6 +24,7 @@ namespace {
 
 struct NewmarkState {
   VecX q, v, qdd, a, lambda;  // lambda (nl): the loops' multipliers at the same time
+  VecX s;                     // (nz) the Maxwell arms' forces
 };
 
 class NewmarkFamily final : public Stepper {
@@ -33,7 +37,8 @@ class NewmarkFamily final : public Stepper {
         max_it_(o.newton_max_iterations),
         spring_(o.iteration_matrix == IterationMatrix::Spring ||
                 (o.iteration_matrix == IterationMatrix::Auto && o.method == Method::ImplicitSpring)),
-        armature_(sys.nq) {
+        armature_(sys.nq),
+        arm_stiffness_(VecX::Zero(sys.nq)) {
     if (o.method == Method::Newmark) {
       am_ = af_ = 0.0;
       beta_ = o.beta;
@@ -53,12 +58,14 @@ class NewmarkFamily final : public Stepper {
   }
 
   /// M q̈ = f at (t, q, q̇): the initial state's acceleration, a_0 = q̈_0.
-  void start(double t0, const VecX& q0, const VecX& qd0) override {
+  void start(double t0, const VecX& y0) override {
     ++stats_.rhs_evaluations;
+    const int n = sys_.nq;
+    const VecX q0 = y0.head(n), qd0 = y0.segment(n, n), s0 = y0.tail(sys_.nz);
+    set_arm_forces(sys_, d_, s0);
     const VecX qdd = forward_dynamics(sys_, d_, t0, q0, qd0);
-    s_ = {q0, qd0, qdd, qdd, d_.lambda};
-    y_.resize(2 * sys_.nq);
-    y_ << q0, qd0;
+    s_ = {q0, qd0, qdd, qdd, d_.lambda, s0};
+    y_ = y0;
   }
 
   double initial_step(double span, const Tolerances&, double max_step) override {
@@ -83,16 +90,26 @@ class NewmarkFamily final : public Stepper {
 
   void accept() override {
     const int n = sys_.nq;
-    ya_.resize(2 * n), fa_.resize(2 * n), fb_.resize(2 * n);
+    ya_.resize(2 * n), fa_.resize(2 * n), yb_.resize(2 * n), fb_.resize(2 * n);
     ya_ << s_.q, s_.v;
     fa_ << s_.v, s_.qdd;
-    y_ << s1_.q, s1_.v;
+    yb_ << s1_.q, s1_.v;
     fb_ << s1_.v, s1_.qdd;
+    y_ << yb_, s1_.s;
+    sa_ = s_.s;
     s_ = s1_;
   }
 
   const VecX& state() const override { return y_; }
-  VecX dense(double t) const override { return hermite((t - t_) / h_step_, h_step_, ya_, fa_, y_, fb_); }
+  /// [q, q̇] by cubic Hermite interpolation, s by arm_step along it.
+  VecX dense(double t) const override {
+    const int n = sys_.nq;
+    VecX y(2 * n + sys_.nz), s;
+    y.head(2 * n) = hermite((t - t_) / h_step_, h_step_, ya_, fa_, yb_, fb_);
+    arm_step(sys_, t - t_, sa_, ya_.head(n), y.head(n), s);
+    y.tail(sys_.nz) = s;
+    return y;
+  }
   StepControl control() const override { return {3, 5.0, false, 1.25}; }
 
  private:
@@ -101,6 +118,7 @@ class NewmarkFamily final : public Stepper {
     const NewmarkState& s = s_;
     NewmarkState& s1 = s1_;
     const double bp = beta_ * (1.0 - af_) / (1.0 - am_), gp = gamma_ * (1.0 - af_) / (1.0 - am_);
+    arm_step_stiffness(sys_, h, arm_stiffness_);
     // Attempts: the kept iteration matrix; a fresh one (if it was old); Newton proper, the
     // tangent rebuilt at every iterate (spring: its matrix is always fresh, one attempt).
     for (int attempt = 0; attempt < 3; ++attempt) {
@@ -148,11 +166,13 @@ class NewmarkFamily final : public Stepper {
     s1.a = ((1.0 - af_) * s1.qdd + af_ * s.qdd - am_ * s.a) / (1.0 - am_);
     s1.q = s.q + h * s.v + (h * h) * ((0.5 - beta_) * s.a + beta_ * s1.a);
     s1.v = s.v + h * ((1.0 - gamma_) * s.a + gamma_ * s1.a);
+    arm_step(sys_, h, s.s, s.q, s1.q, s1.s);
   }
 
   /// r = M(q) q̈ − f(q, q̇, t) − Gᵀλ at the iterate (inverse dynamics: O(n) for recursive
   /// systems; with loops, g and G are left in d_ for close_loops_correction).
   VecX residual(double t, const NewmarkState& s1) {
+    set_arm_forces(sys_, d_, s1.s);
     set_state(sys_, d_, t, s1.q, s1.v);
     set_accelerations(sys_, d_, s1.qdd);
     dynamics_kinematics(sys_, d_);
@@ -187,6 +207,7 @@ class NewmarkFamily final : public Stepper {
       ++stats_.jacobians;
       ++stats_.factorizations;
       if (!analytic_derivatives(sys_)) stats_.rhs_evaluations += 4 * sys_.nq;  // the central differences
+      drdq.diagonal() += arm_stiffness_;
       lu_.compute(d_.A + (gp * h) * drdqd + (bp * h * h) * drdq);
       // The reciprocal condition number, not the determinant, which under- or overflows for large n.
       if (!(lu_.rcond() > 1e-15))
@@ -206,7 +227,7 @@ class NewmarkFamily final : public Stepper {
     for (int k = 0; k < sys_.nq; ++k) {
       const int i = sys_.free_coords[k];
       const Coordinate& c = sys_.coords[i];
-      armature_(k) = d_.spring_scale(i) * (gp * h * c.damping + bp * h * h * c.stiffness);
+      armature_(k) = d_.spring_scale(i) * (gp * h * c.damping + bp * h * h * c.stiffness) + bp * h * h * arm_stiffness_(k);
     }
     ++stats_.factorizations;
     factor_armature(sys_, d_, armature_);  // residual() left the state of the iterate in d_
@@ -222,13 +243,15 @@ class NewmarkFamily final : public Stepper {
   int max_it_;
   bool spring_;
   VecX armature_;
+  VecX arm_stiffness_;  // (nq) ∂s_{n+1}/∂q_{n+1} of the arms over the step (arm_step_stiffness)
   double am_ = 0, af_ = 0, beta_ = 0.25, gamma_ = 0.5;
   Eigen::PartialPivLU<MatX> lu_;
   bool valid_ = false, fresh_ = false, full_newton_ = false;
   double h_ = 0.0;                   // step of the kept tangent
   NewmarkState s_, s1_;              // the current state and the attempted step
   double t_ = 0.0, h_step_ = 1.0;    // the last attempted step
-  VecX y_, ya_, fa_, fb_;            // [q, q̇] after and before it, and [q̇, q̈] before and after
+  VecX y_;                           // [q, q̇, s] after it
+  VecX ya_, fa_, yb_, fb_, sa_;      // [q, q̇] and [q̇, q̈] before and after it, s before it
 };
 
 }  // namespace

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "rigidfem/arms.hpp"
 #include "rigidfem/dynamics.hpp"
 #include "rigidfem/kinematics.hpp"
 
@@ -116,18 +117,23 @@ MatX element_force_history(const System& sys, const Eigen::Ref<const VecX>& t, c
 }
 
 StateOutputs evaluate_outputs(const System& sys, const Eigen::Ref<const VecX>& t, const Eigen::Ref<const RowMatX>& Q,
-                              const Eigen::Ref<const RowMatX>& QD) {
+                              const Eigen::Ref<const RowMatX>& QD, const Eigen::Ref<const RowMatX>& S) {
   const Eigen::Index N = t.size();
   if (Q.rows() != N || QD.rows() != N || Q.cols() != sys.nq || QD.cols() != sys.nq)
     throw std::invalid_argument("q, qd: expected (len(t), nq) arrays");
-  StateOutputs out{MatX(N, sys.nq), MatX(N, sys.np), VecX(N), VecX(N), VecX(N)};
+  if (S.rows() != N || S.cols() != sys.nz) throw std::invalid_argument("s: expected a (len(t), nz) array");
+  StateOutputs out{MatX(N, sys.nq), MatX(N, sys.np), VecX(N), VecX(N), VecX(N), VecX(N)};
   Data d(sys);
+  VecX s(sys.nz);
   for (Eigen::Index k = 0; k < N; ++k) {
+    s = S.row(k).transpose();
+    set_arm_forces(sys, d, s);
     set_state(sys, d, t(k), Q.row(k).transpose(), QD.row(k).transpose());
     kinematics(sys, d);  // with rates: the kinetic energy needs Ṫ
     out.kinetic(k) = kinetic_energy(sys, d);
     out.gravity(k) = gravity_energy(sys, d);
-    out.elastic(k) = elastic_energy(sys, d);
+    out.elastic(k) = elastic_energy(sys, d) + arm_energy(sys, s);
+    out.power(k) = dissipated_power(sys, d) + arm_power(sys, s);
     forward_dynamics(sys, d, t(k), Q.row(k).transpose(), QD.row(k).transpose());
     out.qdd.row(k) = d.qdd.transpose();
     driving_forces(sys, d);

@@ -3,6 +3,7 @@
 #include <cmath>
 #include <vector>
 
+#include "rigidfem/arms.hpp"
 #include "rigidfem/dynamics.hpp"
 #include "rigidfem/errors.hpp"
 #include "rigidfem/stepper.hpp"
@@ -11,25 +12,29 @@ namespace rigidfem {
 
 namespace {
 
-/// y = [q, q̇] as a first-order system ẏ = [q̇, q̈(t, q, q̇)], counting evaluations.
+/// y = [q, q̇, s] as a first-order system ẏ = [q̇, q̈(t, q, q̇, s), ṡ(q̇, s)] (s the Maxwell arms'
+/// forces, arms.hpp), counting evaluations.
 class FirstOrder {
  public:
   FirstOrder(const System& sys, IntegratorStats& stats) : sys_(sys), d_(sys), stats_(stats) {}
   void eval(double t, const VecX& y, VecX& ydot) {
     if (!y.allFinite()) throw SimulationError(t, "the state became NaN or inf: the step was unstable");
     ++stats_.rhs_evaluations;
-    const int n = sys_.nq;
-    ydot.resize(2 * n);
-    ydot.head(n) = y.tail(n);
-    ydot.tail(n) = forward_dynamics(sys_, d_, t, y.head(n), y.tail(n));
+    const int n = sys_.nq, nz = sys_.nz;
+    ydot.resize(2 * n + nz);
+    ydot.head(n) = y.segment(n, n);
+    set_arm_forces(sys_, d_, y.tail(nz));
+    ydot.segment(n, n) = forward_dynamics(sys_, d_, t, y.head(n), y.segment(n, n));
+    arm_rates(sys_, y.segment(n, n), y.tail(nz), ydot.tail(nz));
   }
-  /// y onto the loops' constraint manifold at t (closure residual <= 1e-12).
+  /// [q, q̇] of y onto the loops' constraint manifold at t (closure residual <= 1e-12).
   void project(double t, VecX& y) {
     const int n = sys_.nq;
-    VecX q = y.head(n), qd = y.tail(n);
+    VecX q = y.head(n), qd = y.segment(n, n);
     project_onto_loops(sys_, d_, t, q, qd, 1e-12, 10);
-    y << q, qd;
+    y.head(n) = q, y.segment(n, n) = qd;
   }
+  int controlled() const { return 2 * sys_.nq; }  ///< the error is controlled on y's first 2 nq: [q, q̇]
 
  private:
   const System& sys_;
@@ -100,10 +105,9 @@ class RungeKutta final : public Stepper {
       : ode_(sys, stats), tab_(tableau(method)), k_(tab_.b.size()), dopri_(method == Method::Dopri5),
         symplectic_(method == Method::SymplecticEuler) {}
 
-  void start(double t0, const VecX& q0, const VecX& qd0) override {
+  void start(double t0, const VecX& y0) override {
     t_start_ = t0;
-    y_.resize(q0.size() + qd0.size());
-    y_ << q0, qd0;
+    y_ = y0;
     ode_.eval(t0, y_, f_);
   }
 
@@ -111,13 +115,14 @@ class RungeKutta final : public Stepper {
   double initial_step(double span, const Tolerances& tol, double max_step) override {
     if (y_.size() == 0) return std::min(span, max_step);
     const int p = tab_.order;
-    const VecX sc = tol.atol.array() + tol.rtol.array() * y_.cwiseAbs().array();
-    const double d0 = scaled_rms(y_, sc), d1 = scaled_rms(f_, sc);
+    const int m = ode_.controlled();
+    const VecX sc = tol.atol.array() + tol.rtol.array() * y_.head(m).cwiseAbs().array();
+    const double d0 = scaled_rms(y_.head(m), sc), d1 = scaled_rms(f_.head(m), sc);
     double h0 = (d0 < 1e-5 || d1 < 1e-5) ? 1e-6 : 0.01 * d0 / d1;
     h0 = std::min({h0, max_step, span});
     VecX f1;
     ode_.eval(t_start_ + h0, y_ + h0 * f_, f1);
-    const double d2 = scaled_rms(f1 - f_, sc) / h0;
+    const double d2 = scaled_rms(f1.head(m) - f_.head(m), sc) / h0;
     const double dm = std::max(d1, d2);
     // dm is infinite when a component with zero weight (atol = 0, starting at zero) moves: start small.
     const double h1 = dm <= 1e-15         ? std::max(1e-6, 1e-3 * h0)
@@ -130,11 +135,10 @@ class RungeKutta final : public Stepper {
     t0_ = t, h_ = h, y0_ = y_, f0_ = f_;
     err = 0.0;
     if (symplectic_) {
-      // q̇_{n+1} = q̇_n + h q̈(t_n, q_n, q̇_n), then q_{n+1} = q_n + h q̇_{n+1}.
-      const int n = static_cast<int>(y0_.size()) / 2;
-      y1_ = y0_;
-      y1_.tail(n) += h * f0_.tail(n);
-      y1_.head(n) += h * y1_.tail(n);
+      // q̇_{n+1} = q̇_n + h q̈(t_n, q_n, q̇_n), then q_{n+1} = q_n + h q̇_{n+1} (and s by Euler).
+      const int n = ode_.controlled() / 2;
+      y1_ = y0_ + h * f0_;
+      y1_.head(n) = y0_.head(n) + h * y1_.segment(n, n);
       ode_.eval(t + h, y1_, f1_);
       return true;
     }
@@ -173,7 +177,8 @@ class RungeKutta final : public Stepper {
     VecX e = VecX::Zero(y0_.size());
     for (int i = 0; i < s; ++i)
       if (tab_.e[i] != 0.0) e += (h * tab_.e[i]) * k_[i];
-    err = error_norm(e, y0_, y1_, tol->atol, tol->rtol);
+    const int m = ode_.controlled();
+    err = error_norm(e.head(m), y0_.head(m), y1_.head(m), tol->atol, tol->rtol);
     return true;
   }
 

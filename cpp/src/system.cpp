@@ -64,10 +64,12 @@ std::shared_ptr<const System> Model::compile(Algorithm algorithm) const {
         c.free_index = static_cast<int>(s.free_coords.size());
         s.free_coords.push_back(index);
       }
+      for (const MaxwellArm& a : coords_[p][k].arms) s.arms.push_back({index, c.free_index, a.stiffness, a.tau});
       s.coords.push_back(std::move(c));
     }
     s.coord_start.push_back(static_cast<int>(s.coords.size()));
   }
+  s.nz = static_cast<int>(s.arms.size());
   // Uses: own coordinates with their elementary generators, then the coupled ones.
   for (int p = 0; p < s.nbodies; ++p) {
     s.use_start.push_back(static_cast<int>(s.use_coord.size()));
@@ -134,6 +136,7 @@ Data::Data(const System& s)
       f(VecX::Zero(s.nq)),
       qdd(VecX::Zero(s.nq)),
       tau(VecX::Zero(s.np)),
+      arm_force(VecX::Zero(s.nc)),
       g(VecX::Zero(s.nl)),
       gd(VecX::Zero(s.nl)),
       gamma(VecX::Zero(s.nl)),

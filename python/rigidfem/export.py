@@ -70,8 +70,9 @@ def to_csv(result, path, points=None):
 
 
 def to_npz(result, path):
-    """NumPy archive with t (s), q, qd (m, rad; per s), coordinate_names, method and stats (JSON)."""
-    np.savez(path, t=result.t, q=result.q, qd=result.qd, coordinate_names=np.array(result.system.coordinate_names,
+    """NumPy archive with t (s), q, qd (m, rad; per s), arm_forces (N or N·m), coordinate_names, method and
+    stats (JSON)."""
+    np.savez(path, t=result.t, q=result.q, qd=result.qd, arm_forces=result.arm_forces, coordinate_names=np.array(result.system.coordinate_names,
              dtype=str), method=np.array(result.method), stats=np.array(json.dumps(result.stats)),
              interrupted=np.array(result.interrupted))
     return path
@@ -86,7 +87,8 @@ def read_npz(path, system=None) -> dict:
             raise ValueError(f"system: expected a System with the coordinates {names} saved in {path}, got "
                              f"{list(system.coordinate_names)}")
         return {"t": f["t"], "q": f["q"], "qd": f["qd"], "stats": json.loads(str(f["stats"])),
-                "method": str(f["method"]), "interrupted": bool(f["interrupted"])}
+                "method": str(f["method"]), "interrupted": bool(f["interrupted"]),
+                "arm_forces": f["arm_forces"] if "arm_forces" in f.files else None}
 
 
 def modes_table(modes) -> list[dict]:

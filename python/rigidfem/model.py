@@ -254,6 +254,24 @@ class Model(_core._Model):
             self._add_generalized_force(body.index, k, _checks.scalar(force, "force"), None)
 
     @recorded
+    def add_maxwell_arm(self, body: Body, stiffness: float, tau: float, coordinate: str | None = None) -> None:
+        """Add a Maxwell arm — a spring ``stiffness`` k (N/m or N·m/rad) in series with a dashpot k τ
+        (``tau``: the relaxation time, s) — on a free joint coordinate of ``body``, in parallel with
+        its spring and damper: the standard linear solid (Zener) with one arm, a generalised Maxwell
+        model (Prony series) with several.
+
+        The arm's force s (N or N·m) is an internal variable of the state, ṡ = k q̇ − s/τ, acting as
+        Q = −s on the coordinate; it stores s²/(2k) and dissipates s²/(kτ). A mode of the joint's
+        stiffness c with one arm has its eigenvalues at the roots of (1 + λτ)(m λ² + c) + k τ λ = 0.
+        ``rigidfem.simulate`` integrates s (initial value ``s0``, zero by default) and returns it
+        as ``Result.arm_forces``; ``rigidfem.Material(prony=...)`` puts arms in every sde of a beam.
+        """
+        k = self._coordinate(body, coordinate)
+        stiffness = _checks.scalar(stiffness, "stiffness", positive=True, unit="N/m or N·m/rad (arm stiffness)")
+        tau = _checks.scalar(tau, "tau", positive=True, unit="s (relaxation time)")
+        self._add_maxwell_arms([body.index], [k], [stiffness], [tau])
+
+    @recorded
     def add_force(self, point, force, *, follower: bool = False, scale: Profile | None = None) -> None:
         """Apply a point force (N) at ``point`` (a ``Point`` or a ``Body``'s origin).
 

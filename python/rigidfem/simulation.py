@@ -80,10 +80,12 @@ SCIPY_METHODS = ("Radau", "BDF", "LSODA", "RK45", "DOP853")
 class Result(Versioned):
     """A simulation's output at the times ``t`` (s).
 
-    ``q``, ``qd`` are (len(t), nq) in m, rad and per s; the other arrays are computed
-    from them on first use: ``qdd`` (len(t), nq), ``driving_forces`` (len(t), np; N or
-    N·m), energies (len(t),; J). ``stats`` holds steps, rejected_steps, rhs_evaluations,
-    jacobians, factorizations, newton_iterations and wall_time (s).
+    ``q``, ``qd`` are (len(t), nq) in m, rad and per s; ``arm_forces`` (len(t), nz) the forces s
+    of the Maxwell arms (N or N·m; the viscoelastic sde laws, ``system.arms``), zero columns
+    without arms. The other arrays are computed from them on first use: ``qdd`` (len(t), nq),
+    ``driving_forces`` (len(t), np; N or N·m), energies (len(t),; J; the elastic energy holds the
+    arms' Σ s²/(2k)) and ``dissipated_power`` (len(t),; W). ``stats`` holds steps, rejected_steps,
+    rhs_evaluations, jacobians, factorizations, newton_iterations and wall_time (s).
     """
 
     system: object = field(repr=False)
@@ -93,10 +95,15 @@ class Result(Versioned):
     stats: dict
     method: str
     interrupted: bool = False
+    arm_forces: np.ndarray = None
+
+    def __post_init__(self):
+        if self.arm_forces is None:
+            self.arm_forces = np.zeros((len(self.t), 0 if self.system is None else self.system.nz))
 
     @functools.cached_property
     def _outputs(self):
-        return _core._evaluate_outputs(self.system, self.t, self.q, self.qd)
+        return _core._evaluate_outputs(self.system, self.t, self.q, self.qd, self.arm_forces)
 
     @property
     def qdd(self) -> np.ndarray:
@@ -127,6 +134,12 @@ class Result(Versioned):
     def energy(self) -> np.ndarray:
         """Kinetic + gravity + elastic energy (J)."""
         return self._outputs[2] + self._outputs[3] + self._outputs[4]
+
+    @property
+    def dissipated_power(self) -> np.ndarray:
+        """Power (W) dissipated by the dampers (Σ b q̇², force elements' c l̇², ropes) and the Maxwell
+        arms (Σ s²/(k τ)): its integral over t closes the energy balance with ``energy``."""
+        return self._outputs[5]
 
     @functools.cached_property
     def loop_reactions(self) -> np.ndarray:
@@ -198,7 +211,7 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
              first_step: float | None = None, stiffness_warning: bool = True,
              max_steps: int = 1_000_000, max_step: float = np.inf, adaptive: bool | None = None, beta: float = 0.25,
              gamma: float = 0.5, alpha: float = -0.05, rho_inf: float = 0.8, newton_tol: float = 1e-10,
-             newton_max_iterations: int = 10, iteration_matrix: str = "auto", stop=None) -> Result:
+             newton_max_iterations: int = 10, iteration_matrix: str = "auto", stop=None, s0=None) -> Result:
     """Integrate ``system`` from ``t0`` to ``t_end`` (s) in C++ (no Python per step).
 
     Parameters
@@ -264,6 +277,13 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
         Checked about every 0.05 s of wall time: once set, the run stops and returns its partial
         result (with a RuntimeWarning). The way to stop a run in a worker thread, which Ctrl-C
         does not reach (Python delivers signals to the main thread only).
+    s0 : (nz,) array, optional
+        Initial forces (N or N·m) of the Maxwell arms (``system.arms``: the Zener and Prony sde
+        laws of ``rigidfem.Material``); zero (relaxed) by default. Every C++ method integrates them
+        with the state except radau5 (ValueError; scipy: methods too): the explicit ones carry
+        them in y = [q, q̇, s], the Newmark family advances them exactly for q linear over each
+        step (s ← e^{−h/τ} s + k (1 − e^{−h/τ})/(h/τ) Δq), esdirk43 as stages. Errors are
+        controlled on [q, q̇].
 
     Returns
     -------
@@ -312,6 +332,11 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
     if stop is not None and not callable(getattr(stop, "is_set", None)):
         raise ValueError(f"stop: expected None or a threading.Event (an object with is_set()), got {stop!r}")
     _check_closed(system, t0, q0, qd0)
+    nz = system.nz
+    s0 = np.zeros(nz) if s0 is None else _checks.array(s0, (nz,), "s0")
+    if nz and method.startswith("scipy:"):
+        raise ValueError(f"method: expected a C++ method for a system with Maxwell arms ({nz} arm forces as internal "
+                         f"variables), got {method!r}; use 'auto', 'esdirk43', 'generalized_alpha' or 'dopri5'")
     bar = ProgressBar(t_end - t0, "s", "simulate") if progress else None
     try:
         scipy = method.startswith("scipy:")
@@ -323,14 +348,16 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
             run = _run_scipy(system, method[6:], t0, t_end, q0, qd0, t_eval, rtol, atol, max_step, max_steps,
                              _keep_going(bar, stop, t0), first)
         else:
+            opt.s0 = s0
             run = _core._integrate(system, t0, t_end, q0, qd0, t_eval, opt, _keep_going(bar, stop, t0))
     finally:
         if bar is not None:
             bar.close()
-    t, q, qd, stats, interrupted, failure = run
+    t, q, qd, stats, interrupted, failure, *arms = run
+    arms = arms[0] if arms else np.zeros((len(t), 0))
     if method == "auto":
         stats["method"] = _auto_choice(stats, opt.stiff_method)
-    result = Result(system, t, q, qd, stats, method, interrupted)
+    result = Result(system, t, q, qd, stats, method, interrupted, arms)
     if failure is not None:
         message, time, cause = failure
         error = _core.SimulationError(message)

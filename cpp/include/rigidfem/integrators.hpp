@@ -61,6 +61,7 @@ struct IntegratorOptions {
   int newton_max_iterations = 10;
   IterationMatrix iteration_matrix = IterationMatrix::Auto;
   Method stiff_method = Method::GeneralizedAlpha;  ///< auto: the implicit method it hands over to
+  VecX s0;  ///< (nz) the Maxwell arms' initial forces (N or N·m, arms.hpp); empty: relaxed, zero
 };
 
 struct IntegratorStats {
@@ -78,6 +79,7 @@ struct IntegratorStats {
 struct Trajectory {
   std::vector<double> t;
   std::vector<VecX> q, qd;  // (len t) x (nq)
+  std::vector<VecX> s;      // (len t) x (nz) the Maxwell arms' forces; empty without arms
   IntegratorStats stats;
   bool interrupted = false;  ///< the monitor asked to stop: the trajectory ends early
   /// The exception that ended the run early — a SimulationError (numerical failure, max_steps),

@@ -100,7 +100,7 @@ void for_each_body_load(const System& sys, const Data& d, bool spatial, Visit&& 
 }
 
 /// Q_i of springs, dampers and applied generalised forces on coordinate i (all coordinates):
-/// −c_i (q_i − q_i⁰) − b_i q̇_i + λ (Q_i + Q_i(t, q_i, q̇_i)).
+/// −c_i (q_i − q_i⁰) − b_i q̇_i − Σ s (its Maxwell arms, d.arm_force) + λ (Q_i + Q_i(t, q_i, q̇_i)).
 double passive_force(const System& sys, const Data& d, int i);
 
 /// SimulationError if a ZYX joint sits at pitch ±π/2, where its mass matrix is singular.

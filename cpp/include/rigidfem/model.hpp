@@ -103,11 +103,22 @@ struct BodySpec {
   Mat3 inertia = Mat3::Zero();  ///< about the centre of mass, body axes (kg·m²)
 };
 
+/// A Maxwell arm on a joint coordinate (the viscoelastic sde laws: Zener, Prony series): a spring
+/// k in series with a dashpot k τ, in parallel with the coordinate's own spring and damper. Its
+/// force s (N or N·m, > 0 resisting q − q⁰) is an internal variable of the state,
+///   ṡ = k q̇ − s / τ,   Q = −s on the coordinate,
+/// storing s² / (2k) and dissipating s² / (k τ).
+struct MaxwellArm {
+  double stiffness = 0.0;  ///< k, N/m or N·m/rad
+  double tau = 0.0;        ///< τ, s: the arm's relaxation time
+};
+
 /// What the user says about one joint coordinate beyond its spring and damper.
 struct CoordinateSpec {
   ProfilePtr drive;         ///< prescribed motion, or null
   double force = 0.0;       ///< constant applied generalised force (N or N·m)
   ForceLaw force_law;       ///< or a law Q(t, q, q̇) of the coordinate itself
+  std::vector<MaxwellArm> arms;  ///< Maxwell arms (free coordinates only: compile checks)
 };
 
 /// Pseudo-inertia H = ∫ r rᵀ dm (4x4, body frame) of a body of mass m, centre of
@@ -133,6 +144,8 @@ class Model {
   void prescribe(int body, int coordinate, ProfilePtr motion);
   /// Adds a constant generalised force, or a law Q(t, q, q̇), on one joint coordinate.
   void add_generalized_force(int body, int coordinate, double value, ForceLaw law);
+  /// Adds a Maxwell arm (stiffness k > 0, relaxation time τ > 0) on one joint coordinate.
+  void add_maxwell_arm(int body, int coordinate, const MaxwellArm& arm);
   void add_load(const Load& load);
   /// Closes a loop (loops.hpp); returns its index. Checks the bodies, frames, length and name
   /// (an empty name becomes "loop<index>").

@@ -43,14 +43,15 @@ MatX element_states(const System& sys, Data& d, double t, const Eigen::Ref<const
 MatX element_force_history(const System& sys, const Eigen::Ref<const VecX>& t, const Eigen::Ref<const RowMatX>& Q,
                            const Eigen::Ref<const RowMatX>& QD);
 
-/// Quantities at a batch of states (t_k, q_k, q̇_k), rows k: accelerations, driving
-/// forces and energies (J). Used for simulation results.
+/// Quantities at a batch of states (t_k, q_k, q̇_k, s_k), rows k (S: the Maxwell arms' forces, (N, nz),
+/// or (N, 0) without arms): accelerations, driving forces, energies (J; elastic with the arms'
+/// Σ s²/(2k)) and the dissipated power (W; with the arms' Σ s²/(kτ)). Used for simulation results.
 struct StateOutputs {
-  MatX qdd, tau;                   // (N, nq), (N, np)
-  VecX kinetic, gravity, elastic;  // (N)
+  MatX qdd, tau;                          // (N, nq), (N, np)
+  VecX kinetic, gravity, elastic, power;  // (N)
 };
 StateOutputs evaluate_outputs(const System& sys, const Eigen::Ref<const VecX>& t, const Eigen::Ref<const RowMatX>& Q,
-                              const Eigen::Ref<const RowMatX>& QD);
+                              const Eigen::Ref<const RowMatX>& QD, const Eigen::Ref<const RowMatX>& S);
 /// Global positions (N, 3) of the point r (body frame) of `body` at (t_k, q_k), expressed in
 /// the frame of body `frame` (−1: global): one positions-only kinematics pass per sample.
 MatX point_positions(const System& sys, int body, const Vec3& r, int frame, const Eigen::Ref<const VecX>& t,

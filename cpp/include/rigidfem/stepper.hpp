@@ -44,8 +44,9 @@ struct StepControl {
 class Stepper {
  public:
   virtual ~Stepper() = default;
-  /// Takes the initial state (t0, q0, q̇0) and evaluates what the method needs there.
-  virtual void start(double t0, const VecX& q0, const VecX& qd0) = 0;
+  /// Takes the initial state y0 = [q0, q̇0, s0] (2 nq + nz, s the Maxwell arms' forces: arms.hpp) at t0
+  /// and evaluates what the method needs there.
+  virtual void start(double t0, const VecX& y0) = 0;
   /// A first step (s) for an adaptive run given no dt.
   virtual double initial_step(double span, const Tolerances& tol, double max_step) = 0;
   /// Attempts the step t → t + h from the current state; false if it could not be computed (Newton
@@ -54,9 +55,9 @@ class Stepper {
   virtual bool attempt(double t, double h, const Tolerances* tol, double& err) = 0;
   /// Makes the attempted step the current state.
   virtual void accept() = 0;
-  /// The current state y = [q, q̇] (2 nq).
+  /// The current state y = [q, q̇, s] (2 nq + nz); errors are controlled on [q, q̇].
   virtual const VecX& state() const = 0;
-  /// y at a time t within the last accepted step (dense output).
+  /// y (2 nq + nz) at a time t within the last accepted step (dense output).
   virtual VecX dense(double t) const = 0;
   /// Systems with loops: moves the current state onto the constraint manifold at t (explicit
   /// methods, whose steps drift off it); the Newmark family satisfies g(q) = 0 in every step.

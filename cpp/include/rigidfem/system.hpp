@@ -27,6 +27,12 @@ struct Coordinate {
   std::string name;        ///< "body.rz"
 };
 
+/// A compiled Maxwell arm (model.hpp): its coordinate (index in coords and in q), k and τ.
+struct Arm {
+  int coord = -1, q = -1;
+  double stiffness = 0.0, tau = 0.0;  ///< k (N/m or N·m/rad), τ (s)
+};
+
 /// How the equations of motion are evaluated.
 enum class Algorithm { Lagrange, Recursive };
 
@@ -77,6 +83,8 @@ class System : public std::enable_shared_from_this<System> {
   int nl = 0;                           ///< constraint rows (multipliers λ)
   std::vector<Flow> flows;              // links of varying length (flows.hpp)
   std::vector<ForceElement> elements;   // force elements between two bodies (force_elements.hpp)
+  std::vector<Arm> arms;                // (nz) Maxwell arms, in coordinate order (arms.hpp)
+  int nz = 0;                           ///< internal variables: the arms' forces s
 
   std::vector<std::string> coordinate_names() const;  ///< (nq)
   std::vector<std::string> prescribed_names() const;  ///< (np)
@@ -128,6 +136,7 @@ struct Data {
   VecX f;                      // (nq) right-hand side: loads − velocity terms − springs − dampers
   VecX qdd;                    // (nq)
   VecX tau;                    // (np) driving forces of the prescribed coordinates
+  VecX arm_force;              // (nc) input: Σ s of each coordinate's Maxwell arms (zero: relaxed; arms.hpp)
   Eigen::LLT<MatX> llt;
   // Loop closures (constraints.hpp):
   VecX g, gd, gamma;           // (nl) g(q, t), ġ, and γ with G q̈ = γ

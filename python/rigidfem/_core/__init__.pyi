@@ -166,6 +166,10 @@ class _Model:
         ...
     def _add_loop(self, name: str, kind: str, a: typing.SupportsInt | typing.SupportsIndex, frame_a: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"], b: typing.SupportsInt | typing.SupportsIndex, frame_b: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"], length: typing.SupportsFloat | typing.SupportsIndex, drive: Profile) -> str:
         ...
+    def _add_maxwell_arms(self, bodies: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], coordinates: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], stiffness: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], tau: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
+        """
+        Adds Maxwell arms (k in N/m or N·m/rad, tau in s) on joint coordinates (-1: the joint's only one).
+        """
     def _add_rope(self, name: str, a: typing.SupportsInt | typing.SupportsIndex, point_a: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], b: typing.SupportsInt | typing.SupportsIndex, point_b: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], EA: typing.SupportsFloat | typing.SupportsIndex, DA: typing.SupportsFloat | typing.SupportsIndex, length: typing.SupportsFloat | typing.SupportsIndex, unstretched: Profile) -> str:
         ...
     def _adopt_id(self, id: typing.SupportsInt | typing.SupportsIndex) -> None:
@@ -325,6 +329,11 @@ class _System:
         'recursive' (O(n): RNEA, CRBA, ABA) or 'lagrange' (the book's formulation; always for linear joints).
         """
     @property
+    def arms(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        """
+        The Maxwell arms (nz, 3): free coordinate index, stiffness k (N/m or N·m/rad), relaxation time tau (s).
+        """
+    @property
     def body_names(self) -> list[str]:
         ...
     @property
@@ -394,6 +403,11 @@ class _System:
     def nq(self) -> int:
         """
         Number of free joint coordinates (the unknowns).
+        """
+    @property
+    def nz(self) -> int:
+        """
+        Number of Maxwell arms: internal variables s (their forces, N or N·m).
         """
     @property
     def parent(self) -> list[int]:
@@ -582,6 +596,14 @@ class IntegratorOptions:
     @rtol.setter
     def rtol(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> None:
         ...
+    @property
+    def s0(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        (nz) the Maxwell arms' initial forces (N or N·m); empty: zero
+        """
+    @s0.setter
+    def s0(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> None:
+        ...
 def R1(phi1: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
     """
     Rotation matrix about x by phi1 (rad), (3, 3).
@@ -594,9 +616,9 @@ def R3(phi3: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64]
     """
     Rotation matrix about z by phi3 (rad), (3, 3).
     """
-def _evaluate_outputs(system: _System, t: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]]:
+def _evaluate_outputs(system: _System, t: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"], s: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]]:
     ...
-def _integrate(system: _System, t0: typing.SupportsFloat | typing.SupportsIndex, t_end: typing.SupportsFloat | typing.SupportsIndex, q0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], qd0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], t_eval: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], options: IntegratorOptions, keep_going: typing.Any) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], dict, bool, typing.Any]:
+def _integrate(system: _System, t0: typing.SupportsFloat | typing.SupportsIndex, t_end: typing.SupportsFloat | typing.SupportsIndex, q0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], qd0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], t_eval: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], options: IntegratorOptions, keep_going: typing.Any) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], dict, bool, typing.Any, typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]]:
     ...
 def _point_positions(system: _System, body: typing.SupportsInt | typing.SupportsIndex, r: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], frame: typing.SupportsInt | typing.SupportsIndex, t: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
     ...
