@@ -26,6 +26,8 @@ from __future__ import annotations
 
 from dataclasses import dataclass, field
 
+import warnings
+
 import numpy as np
 import scipy.linalg
 import scipy.optimize
@@ -546,6 +548,11 @@ def modal_analysis(system, q=None, qd=None, t: float = 0.0) -> Modes:
     if n == 0:
         e = np.zeros((0, 0))
         return Modes(np.zeros(0), np.zeros(0), np.zeros(0), e, np.zeros(0, complex), q, e, e.copy(), e.copy())
+    if system.nz:
+        warnings.warn(f"rigidfem.modal_analysis: the system's {system.nz} Maxwell arms (Zener/Prony sde laws) are left "
+                      "out: K and C are those of the relaxed structure (E = E_inf); rigidfem.linearize keeps the arms' "
+                      "forces as states (the eigenvalues of its A are the viscoelastic modes')", UserWarning,
+                      stacklevel=2)
     M = system.mass_matrix(q, t)
     dfdq, dfdqd = system.force_jacobians(t, q, qd)
     K, C = -dfdq, -dfdqd

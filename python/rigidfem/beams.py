@@ -387,6 +387,7 @@ def add_beam(
                              f"got {d!r}")
     if len(set(deform)) != len(deform):
         raise ValueError(f"deform: expected each deformation at most once, got {deform}")
+    prony, mat_E = _prony(material, flow)
     mat = Property.of(material, Material, "material", L, m)
     sec = Property.of(section, Section, "section", L, m)
     tip_m = _checks.scalar(tip_mass, "tip_mass", nonnegative=True)
@@ -439,6 +440,7 @@ def add_beam(
                 np.ascontiguousarray(sde.stiffness[:, columns]).reshape(m, len(columns)),
                 np.ascontiguousarray(sde.damping[:, columns]).reshape(m, len(columns)),
                 placements.reshape(m, 16), rfe.mass[1:], rfe.com[1:], rfe.inertia[1:].reshape(m, 9))]
+        _add_arms(model, bodies[1:], template.coordinates, sde.stiffness[:, columns], prony, mat_E)
         if flow is not None:
             model._add_flow(flow, root.index, m)
     except BaseException:
@@ -446,6 +448,34 @@ def add_beam(
         raise
     return Beam(name, L, m, formulation, tuple(deform), bool(linear), bodies, frames, _Rows(rfe, m + 1),
                 _Rows(sde, m), flow)
+
+
+def _prony(material, flow) -> tuple:
+    """The Prony terms and E of a viscoelastic beam's material: one Material only (a varying one,
+    a list or a function of s, has none), and no varying length."""
+    if isinstance(material, Material):
+        if material.prony and flow is not None:
+            raise ValueError("material: expected a Material without prony terms for a beam of varying length "
+                             "(Maxwell arms on its flowing sdes are not supported), got one with "
+                             f"{len(material.prony)}")
+        return material.prony, material.E
+    pieces = material if isinstance(material, (list, tuple)) else (material(0.0),) if callable(material) else ()
+    if any(isinstance(v, Material) and v.prony for v in pieces):
+        raise ValueError("material: expected one Material for a viscoelastic (prony) beam, got a list per segment or a "
+                         "function of s (varying Maxwell arms are not supported)")
+    return (), 1.0
+
+
+def _add_arms(model, sdes, coordinates, stiffness, prony, E) -> None:
+    """One Maxwell arm per Prony term (E_j, τ_j) on every sde coordinate of stiffness c > 0:
+    k = (E_j/E) c, τ_j (``Model.add_maxwell_arm``)."""
+    if not prony:
+        return
+    c = np.asarray(stiffness).reshape(len(sdes), len(coordinates))
+    body, slot = np.nonzero(c > 0.0)
+    for E_j, tau in prony:
+        model._add_maxwell_arms([sdes[b].index for b in body], [int(k) for k in slot],
+                                list(E_j / E * c[body, slot]), [tau] * len(body))
 
 
 def _flow_length(profile, material, section, deform, formulation, linear, tip_mass) -> float:

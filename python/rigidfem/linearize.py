@@ -23,6 +23,14 @@ C_r = −Nᵀ∂f/∂q̇ N: exact about an equilibrium at rest (the rates of G a
 
 ``rigidfem.linearize`` is the function (the package imports it over this module's name); import
 the module's other names with ``from rigidfem.linearize import NotAnEquilibriumWarning``.
+
+Maxwell arms (``System.nz`` > 0: the Zener and Prony sde laws) add their forces s to the state,
+x = (δq, δq̇, s) (2 nq + nz), about relaxed arms (s = 0, the only value at rest):
+
+    ṡ = K_a Eᵀ δq̇ − T⁻¹ s,   δq̈ = ... − M⁻¹ E s,
+
+E (nq, nz) the arms' incidence (E_ij = 1 when arm j acts on q_i), K_a = diag(k), T = diag(τ)
+(closed chains: Eᵀ N and Nᵀ E).
 """
 
 from __future__ import annotations
@@ -84,7 +92,7 @@ def linearize(system, q, qd=None, t: float = 0.0, inputs=(), outputs=None, dt: f
     -------
     scipy.signal.StateSpace
         With the attributes ``state_names`` (coordinate names, then ``<name>.dot``; with loops
-        ``y[k]``, ``y[k].dot``), ``input_names``, ``output_names``, ``y0`` (the outputs at the
+        ``y[k]``, ``y[k].dot``; then ``<name>.arm<j>`` for the Maxwell arms' forces), ``input_names``, ``output_names``, ``y0`` (the outputs at the
         operating point), ``basis`` (N (nq, k) for closed chains, else None) and ``q``, ``qd``, ``t``.
         ``ss.to_discrete(dt)`` discretises it again (the names stay valid but are not carried).
 
@@ -110,14 +118,37 @@ def linearize(system, q, qd=None, t: float = 0.0, inputs=(), outputs=None, dt: f
         A = np.block([[np.zeros((n, n)), np.eye(n)], [dqdd_dq, dqdd_dqd]])
         B = np.vstack([np.zeros((n, Q.shape[1])), np.linalg.solve(M, Q)])
         N, C, states = None, np.hstack([Cq, Cv]), list(system.coordinate_names)
+    states = states + [s + RATE for s in states]
+    if system.nz:
+        A, B, C, states = _with_arms(system, M, N, A, B, C, states)
     _require_finite(t, "linearize", A=A, B=B, C=C)
     _warn_unless_equilibrium(system, q, qd, t, M)  # after the loops' check: q closes them
     D = np.zeros((C.shape[0], B.shape[1]))
     ss = scipy.signal.StateSpace(A, B, C, D) if dt is None else \
         scipy.signal.StateSpace(*scipy.signal.cont2discrete((A, B, C, D), dt, method="zoh")[:4], dt=dt)
-    ss.state_names, ss.input_names, ss.output_names = states + [s + RATE for s in states], in_names, out_names
+    ss.state_names, ss.input_names, ss.output_names = states, in_names, out_names
     ss.y0, ss.basis, ss.q, ss.qd, ss.t = y0, N, q, qd, t
     return ss
+
+
+def _with_arms(system, M, N, A, B, C, states):
+    """(A, B, C, state names) with the Maxwell arms' forces s appended to the state (module docstring)."""
+    arms = system.arms
+    n, nz, k = system.nq, len(arms), A.shape[0] // 2
+    coordinate, stiffness, tau = arms[:, 0].astype(int), arms[:, 1], arms[:, 2]
+    E = np.zeros((n, nz))
+    E[coordinate, np.arange(nz)] = 1.0
+    if N is None:
+        force, rate = np.linalg.solve(M, E), E.T  # δq̈ −= M⁻¹ E s,  ṡ = K_a Eᵀ δq̇ − s/τ
+    else:
+        Mr = N.T @ M @ N
+        force, rate = np.linalg.solve(0.5 * (Mr + Mr.T), N.T @ E), E.T @ N
+    A = np.block([[A, np.vstack([np.zeros((k, nz)), -force])],
+                  [np.hstack([np.zeros((nz, k)), stiffness[:, None] * rate]), -np.diag(1.0 / tau)]])
+    names = system.coordinate_names
+    arm_names = [f"{names[i]}.arm{j}" for j, i in enumerate(coordinate)]
+    return (A, np.vstack([B, np.zeros((nz, B.shape[1]))]), np.hstack([C, np.zeros((C.shape[0], nz))]),
+            states + arm_names)
 
 
 def _reduced(system, q, qd, t, M, Q, Cq, Cv):
