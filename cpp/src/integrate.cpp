@@ -273,13 +273,13 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
   Recorder out(sys, traj, t_eval);
   const int n = sys.nq;
   const Tolerances asked{o.atol.size() == 1 ? VecX::Constant(2 * n, o.atol(0)) : o.atol,
-                         o.rtol.size() == 1 ? VecX::Constant(2 * n, o.rtol(0)) : o.rtol};
+                         o.rtol.size() == 1 ? VecX::Constant(2 * n, o.rtol(0)) : o.rtol, t_end - t0};
   // auto runs dopri5 at rtol <= 1e-3 (atol scaled alike): looser, its error control lets the stiff
   // modes of a beam go unstable (measured: the classical cantilever at rtol = 1e-2 ... 1e-1).
   const double loosest = asked.rtol.size() ? asked.rtol.maxCoeff() : 0.0;  // nq = 0: no tolerance to tighten
   const double tighten = o.method == Method::Auto && loosest > AutoChoice::loosest_explicit
                              ? AutoChoice::loosest_explicit / loosest : 1.0;
-  const Tolerances explicit_tol{tighten * asked.atol, tighten * asked.rtol};
+  const Tolerances explicit_tol{tighten * asked.atol, tighten * asked.rtol, asked.span};
   const bool adaptive = is_adaptive(o);
   const double span = t_end - t0, grid = std::min(o.dt, o.max_step), near_end = t_end - 1e-12 * span;
 
@@ -315,7 +315,10 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
       step_failure(t, hs, "the step size fell below the minimum: the problem is too stiff or singular for this method");
     double err = 0.0;
     if (!stepper->attempt(t, hs, adaptive ? tol : nullptr, err)) {
-      if (!adaptive) step_failure(t, hs, "Newton iterations did not converge; reduce dt");
+      if (!adaptive)
+        step_failure(t, hs, "Newton iterations did not converge in newton_max_iterations = " +
+                                std::to_string(o.newton_max_iterations) + " (with a fresh tangent too); reduce dt "
+                                "or raise newton_max_iterations");
       ++stats.rejected;
       h = 0.25 * hs;
       continue;
@@ -341,7 +344,7 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
       rejected_last = false;
       err_prev = e;
       h = hs * factor;
-      if (stepper->h_rho() > 3.25) {
+      if (stepper->h_rho() > control.stiff_limit) {
         nonstiff_steps = 0;
         if (++stiff_steps == 15 && std::isnan(stats.stiff_at)) stats.stiff_at = t1;
       } else if (++nonstiff_steps == 6) {
@@ -377,12 +380,14 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
   }
 }
 
-/// What the last accepted state says about a failure: a fixed step beyond the method's stability
-/// limit (the state grew by orders of magnitude), or Euler angles near gimbal lock.
+/// What the last accepted state says about a failure: a fixed step beyond an explicit method's
+/// stability limit (the state grew by orders of magnitude beyond max(|q0|, 1e-6): m, rad; the implicit
+/// ones are unconditionally stable and say why Newton failed), or Euler angles near gimbal lock.
 SimulationError explained(const SimulationError& e, const System& sys, const VecX& q0, const VecX& last_q,
                           const IntegratorOptions& o) {
-  const double growth = max_abs(last_q) / std::max(max_abs(q0), 1e-300);
-  if (!is_adaptive(o) && (growth > 1e3 || !last_q.allFinite()))
+  const double growth = max_abs(last_q) / std::max(max_abs(q0), 1e-6);
+  const bool explicit_method = method_info(o.method).make == make_runge_kutta;
+  if (!is_adaptive(o) && explicit_method && (growth > 1e3 || !last_q.allFinite()))
     return SimulationError(e.time, "the fixed step dt = " + num(o.dt) + " s is probably beyond the stability limit of " +
                                        std::string(method_name(o.method)) + " for this problem: the state grew " +
                                        num(growth) + " times, then " + e.cause);

@@ -103,7 +103,7 @@ class RungeKutta final : public Stepper {
  public:
   RungeKutta(const System& sys, Method method, IntegratorStats& stats)
       : ode_(sys, stats), tab_(tableau(method)), k_(tab_.b.size()), dopri_(method == Method::Dopri5),
-        symplectic_(method == Method::SymplecticEuler) {}
+        rkf_(method == Method::RKF45), symplectic_(method == Method::SymplecticEuler) {}
 
   void start(double t0, const VecX& y0) override {
     t_start_ = t0;
@@ -152,6 +152,7 @@ class RungeKutta final : public Stepper {
         if (tab_.a[i][j] != 0.0) yi += (h * tab_.a[i][j]) * k_[j];
       ode_.eval(t + tab_.c[i] * h, yi, k_[i]);
       if (dopri_ && i == 5) y_stage6_ = yi;
+      if (rkf_ && i == 4) y_stage_ = yi;
     }
     // y1 = y0 + h Σ b_i k_i
     y1_ = y0_;
@@ -161,10 +162,16 @@ class RungeKutta final : public Stepper {
       f1_ = k_[s - 1];
     else
       ode_.eval(t + h, y1_, f1_);
+    // Hairer's estimate of h ρ (ρ the dominant eigenvalue) from two evaluations at t + h: dopri5's
+    // stages 6 and 7, rkf45's stage 5 (c₅ = 1) and f(t + h, y1).
+    if (dopri_ || rkf_) {
+      const VecX& ya = dopri_ ? y_stage6_ : y_stage_;
+      const VecX& ka = dopri_ ? k_[5] : k_[4];
+      const VecX& kb = dopri_ ? k_[6] : f1_;
+      const double den = (y1_ - ya).squaredNorm();
+      h_rho_ = den > 0.0 ? h * std::sqrt((kb - ka).squaredNorm() / den) : 0.0;
+    }
     if (dopri_) {
-      // Hairer's estimate of h ρ (ρ the dominant eigenvalue) from stages 6 and 7, both at t + h.
-      const double den = (y1_ - y_stage6_).squaredNorm();
-      h_rho_ = den > 0.0 ? h * std::sqrt((k_[6] - k_[5]).squaredNorm() / den) : 0.0;
       // Shampine's continuous extension of order 4 (as in Hairer's dopri5).
       static const double d[7] = {-12715105075.0 / 11282082432.0, 0.0, 87487479700.0 / 32700410799.0,
                                   -10690763975.0 / 1880347072.0, 701980252875.0 / 199316789632.0,
@@ -202,16 +209,19 @@ class RungeKutta final : public Stepper {
   }
 
   double h_rho() const override { return h_rho_; }
-  StepControl control() const override { return {std::min(tab_.order, 5), 10.0, true, 1.0}; }
+  /// rkf45's stability boundary on the negative real axis is at h ρ = 3.02 (dopri5's 3.31).
+  StepControl control() const override {
+    return {std::min(tab_.order, 5), 10.0, true, 1.0, 1.0, 0.0, rkf_ ? 2.95 : 3.25};
+  }
 
  private:
   FirstOrder ode_;
   const Tableau& tab_;
   std::vector<VecX> k_;
-  bool dopri_, symplectic_;
+  bool dopri_, rkf_, symplectic_;
   double t_start_ = 0, t0_ = 0, h_ = 1, h_rho_ = 0;
   VecX y_, f_;                             // the current state and ẏ there
-  VecX y0_, y1_, f0_, f1_, rcont5_, y_stage6_;  // the last attempted step
+  VecX y0_, y1_, f0_, f1_, rcont5_, y_stage6_, y_stage_;  // the last attempted step
 };
 
 }  // namespace

@@ -14,8 +14,10 @@
 namespace rigidfem {
 
 /// Error weights per component of y = [q, q̇] (2 nq each): sc_i = atol_i + rtol_i max(|y0_i|, |y1_i|).
+/// span: the run's length t_end − t0 (s), for the methods that control the error per unit step.
 struct Tolerances {
   VecX atol, rtol;
+  double span = 0.0;
 };
 /// RMS of v_i / sc_i, with 0/0 counted as 0 (an exactly zero component under a pure relative
 /// tolerance); 0 for an empty vector (nq = 0).
@@ -39,6 +41,9 @@ struct StepControl {
   bool hold_after_reject;  ///< no growth on the step after a rejection
   double keep_below;       ///< factors in [1, keep_below) keep h (and an iteration matrix with it)
   double beta1 = 1.0, beta2 = 0.0;  ///< the exponents of the PI controller
+  /// Hairer's stiffness test: h ρ above this (just inside the method's stability boundary on the
+  /// negative real axis) over 15 accepted steps means the step is bounded by stability.
+  double stiff_limit = 3.25;
 };
 
 class Stepper {
@@ -62,7 +67,8 @@ class Stepper {
   /// Systems with loops: moves the current state onto the constraint manifold at t (explicit
   /// methods, whose steps drift off it); the Newmark family satisfies g(q) = 0 in every step.
   virtual void project(double /*t*/) {}
-  /// h ρ of the last attempted step (ρ the dominant eigenvalue) where the method estimates it, else 0.
+  /// h ρ of the last attempted step (ρ the dominant eigenvalue) where the method estimates it (dopri5,
+  /// rkf45: from two stages at t + h), else 0.
   virtual double h_rho() const { return 0.0; }
   virtual StepControl control() const = 0;
 };
