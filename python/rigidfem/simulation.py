@@ -226,12 +226,17 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
         "auto" (default): dopri5 while it is the cheaper, esdirk43 where it is not. dopri5 runs in
         windows of 20 accepted steps (at rtol <= 1e-3: looser, its error control lets the stiff
         modes of a beam go unstable); a window that looks bounded by stability (a fifth of its
-        steps at h ρ > 2, or a sixth as many rejections) starts a trial of esdirk43 from the state
-        reached, which keeps the run if it advances 1.25 times as far per unit of work — counted,
-        not timed (right-hand sides, nq per tangent, (nq/50)² per dense factorisation), so the
-        choice is the same on every machine and thread — else dopri5 goes on and the next trial
-        waits twice as long. ``stats["method"]`` says what ran ("dopri5", or "dopri5, then
-        esdirk43 from t = ... s"), ``stats["switched_at"]`` and ``stats["auto_trials"]`` the details.
+        steps at h ρ > 2, or a sixth as many rejections; in the first window only the former)
+        starts a trial of esdirk43 from the state reached, which keeps the run if it advances 1.25
+        times as far per unit of work — counted, not timed (right-hand sides, nq per tangent,
+        (nq/50)² per dense factorisation), so the choice is the same on every machine and thread —
+        else dopri5 goes on and the next trial waits twice as long. A first trial within 100 steps
+        and a tenth of the run starts esdirk43 from the initial state instead (dopri5 was a probe:
+        its state at the stability boundary carries errors in the stiff modes that an undamped
+        beam keeps ringing) and is measured against the probe over the same interval.
+        ``stats["method"]`` says what ran ("dopri5", "esdirk43 from the start (...)", or "dopri5,
+        then esdirk43 from t = ... s"), ``stats["switched_at"]`` and ``stats["auto_trials"]`` the
+        details.
         Closed chains too (both methods project each step onto the loops).
         Otherwise see the module docstring: "euler", "symplectic_euler", "rk4", "dopri5", "rkf45",
         "newmark", "hht", "generalized_alpha", "implicit_spring", "esdirk43", "radau5", or "scipy:Radau",
@@ -364,7 +369,7 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
     t, q, qd, stats, interrupted, failure, *arms = run
     arms = arms[0] if arms else np.zeros((len(t), 0))
     if method == "auto":
-        stats["method"] = _auto_choice(stats, opt.stiff_method)
+        stats["method"] = _auto_choice(stats, opt.stiff_method, t0)
     result = Result(system, t, q, qd, stats, method, interrupted, arms)
     if failure is not None:
         message, time, cause = failure
@@ -400,13 +405,16 @@ def _check_closed(system, t0, q0, qd0, tol=1e-8):
 AUTO_STIFF_METHOD = "esdirk43"
 
 
-def _auto_choice(stats: dict, stiff_method: str) -> str:
-    """What ``auto`` ran, for ``Result.stats["method"]``: "dopri5", or the hand-over."""
+def _auto_choice(stats: dict, stiff_method: str, t0: float) -> str:
+    """What ``auto`` ran, for ``Result.stats["method"]``: "dopri5", the hand-over, or the stiff method
+    from the start (after a dopri5 probe found the problem stiff)."""
     switched, trials = stats.get("switched_at", np.nan), stats.get("auto_trials", 0)
     lost = trials - (1 if np.isfinite(switched) else 0)
     tried = f"; {lost} trial{'s' * (lost != 1)} of {stiff_method} lost" if lost else ""
     if not np.isfinite(switched):
         return f"dopri5{tried}"
+    if switched == t0:
+        return f"{stiff_method} from the start (a dopri5 probe found the problem stiff){tried}"
     return f"dopri5, then {stiff_method} from t = {switched:.6g} s{tried}"
 
 
