@@ -17,7 +17,10 @@
 //
 // The Maxwell arms' forces s (arms.hpp) are stages too: S_i = ŝ_i + γh (k V_i − S_i/τ) gives
 // S_i = (ŝ_i + γh k V_i)/(1 + γh/τ) in closed form, so the stage residual holds them and Newton's matrix
-// their stiffness (γh)² k/(1 + γh/τ); radau5 refuses them (its stages are coupled).
+// their stiffness (γh)² k/(1 + γh/τ); radau5 refuses them (its stages are coupled through them).
+//
+// Loops (both): each stage holds M A_i − f_i − G_iᵀλ_i = 0 and G_i A_i = γ_i (index 1) by the Schur
+// complement of Newton's matrix, and each accepted step is projected onto the loops (project).
 //
 // Radau IIA (3 stages, order 5): all stages at once, V = q̇_n 1ᵀ + h A aᵀ, Q = q_n 1ᵀ + h V aᵀ
 // (columns the stages, a the Butcher matrix), so Newton's matrix is I⊗M + h a⊗C + h² a²⊗K; with
@@ -102,8 +105,21 @@ class ImplicitRk : public Stepper {
     q_ = y0.head(n_), v_ = y0.segment(n_, n_), s_ = y0.tail(sys_.nz);
     set_arm_forces(sys_, d_, s_);
     a_ = forward_dynamics(sys_, d_, t0, q_, v_);
+    lambda_ = d_.lambda;  // with loops, the multipliers of the initial state too
     y_ << q_, v_;
     ys_ = y0;
+  }
+
+  /// Loops: (q, q̇) onto the constraint manifold at t after each accepted step (closure residual
+  /// <= 1e-12), and q̈, λ by the constrained forward dynamics there (the next step's first stage).
+  void project(double t) override {
+    project_onto_loops(sys_, d_, t, q_, v_, 1e-12, 10);
+    ++stats_.rhs_evaluations;
+    set_arm_forces(sys_, d_, s_);
+    a_ = forward_dynamics(sys_, d_, t, q_, v_);
+    lambda_ = d_.lambda;
+    y_ << q_, v_;
+    ys_ << y_, s_;
   }
 
   /// Hairer's first guess 0.01 ‖y‖/‖ẏ‖ in the error weights (1e-6 s when either is negligible).
@@ -263,6 +279,7 @@ class ImplicitRk : public Stepper {
   VecX y_, y1_, dy_, sc_;  // (2 nq) y_n, y_{n+1}, scratch, error weights atol + rtol |y_n|
   VecX s_, sp_, s1_;       // (nz) the Maxwell arms' forces: now, at the last step's start, the attempted step's end
   VecX ys_;                // (2 nq + nz) the state [q, q̇, s]
+  VecX lambda_;            // (nl) the loops' multipliers: now (esdirk43: at the stage being solved)
   MatX K_, C_, M_;         // (nq, nq) the tangent's parts
   bool jacobian_valid_ = false, jacobian_fresh_ = false, slow_ = false;
   double eta_ = 1.0;          // Newton's η of the last converged stage
@@ -277,14 +294,7 @@ class Esdirk final : public ImplicitRk {
   Esdirk(const System& sys, const IntegratorOptions& o, IntegratorStats& stats)
       : ImplicitRk(sys, o, stats), spring_(o.iteration_matrix == IterationMatrix::Spring), Q_(n_), qhat_(n_),
         vhat_(n_), dA_(n_), armature_(n_), rhs_(n_), V_(n_, T::s), A_(n_, T::s), Sd_(sys.nz, T::s),
-        shat_(sys.nz), S_arm_(sys.nz), e_(2 * n_), S_(n_, n_), lu_(n_),
-        lambda_(VecX::Zero(sys.nl)) {}
-
-  /// With loops, the multipliers λ of the initial state too.
-  void start(double t0, const VecX& y0) override {
-    ImplicitRk::start(t0, y0);
-    if (sys_.nl > 0) lambda_ = d_.lambda;
-  }
+        shat_(sys.nz), S_arm_(sys.nz), e_(2 * n_), S_(n_, n_), lu_(n_) {}
 
  private:
   /// Shampine's filter of the error estimate, ê = (I − γh J)⁻¹ e with J the Jacobian of y' = (q̇, q̈):
@@ -410,18 +420,6 @@ class Esdirk final : public ImplicitRk {
     lambda_ += dl;
   }
 
-  /// Loops: (q, q̇) onto the constraint manifold at t after each accepted step (closure residual
-  /// <= 1e-12), and q̈, λ by the constrained forward dynamics there (the next step's first stage).
-  void project(double t) override {
-    project_onto_loops(sys_, d_, t, q_, v_, 1e-12, 10);
-    ++stats_.rhs_evaluations;
-    set_arm_forces(sys_, d_, s_);
-    a_ = forward_dynamics(sys_, d_, t, q_, v_);
-    lambda_ = d_.lambda;
-    y_ << q_, v_;
-    ys_ << y_, s_;
-  }
-
   /// dA_ = −S⁻¹ r_: the factorised tangent, or the O(n) spring matrix at the iterate.
   void correction(double gh) {
     if (!spring_) {
@@ -463,8 +461,7 @@ class Esdirk final : public ImplicitRk {
   double gh_ = 0.0;  // γh of the factorised S
   double h_previous_ = 1.0;  // the last accepted step
   bool have_previous_ = false;
-  MatX G_;       // (nl, nq) the loops' Jacobian at the iterate
-  VecX lambda_;  // (nl) their multipliers at the stage being solved
+  MatX G_;  // (nl, nq) the loops' Jacobian at the iterate
 };
 
 /// Radau IIA of order 5 (Ehle; Hairer & Wanner IV.5, IV.8): c = ((4 − √6)/10, (4 + √6)/10, 1),
@@ -506,7 +503,7 @@ class Radau5 final : public ImplicitRk {
       : ImplicitRk(sys, o, stats), A_(n_, 3), V_(n_, 3), Q_(n_, 3), R_(n_, 3), D_(n_, 3), dV_(n_, 3), dQ_(n_, 3),
         Aprev_(n_, 3), Rt_(n_, 3), Dt_(n_, 3), z_(n_), zs_(n_), x_(n_), xs_(n_), b1_(n_), b2_(n_), qx_(n_), vx_(n_),
         Sr_(n_, n_),
-        Sc_(n_, n_), lur_(n_), luc_(n_) {}
+        Sc_(n_, n_), lur_(n_), luc_(n_), L_(sys.nl, 3), Cres_(sys.nl, 3) {}
 
  private:
   /// The stages by simplified Newton on the transformed system: R = [r_i] (nq, 3), R̃ = R P⁻ᵀ, each
@@ -514,25 +511,23 @@ class Radau5 final : public ImplicitRk {
   bool solve(double t, double h, const Tolerances* tol) override {
     if (tangent(t) || h != h_factored_) factor(t, h);
     predict(h);
+    predict_multipliers(h);
     slow_ = false;
     double previous = 0.0;
     for (int it = 0;; ++it) {
       stage_values(h);
       for (int i = 0; i < 3; ++i) {
         residual(t + tab_.c(i) * h, Q_.col(i), V_.col(i), A_.col(i));
+        if (sys_.nl > 0) {  // r_i −= G_iᵀ λ_i; c_i = γ_i − G_i A_i (d_.gamma with d_.qdda = A_i)
+          G_[i] = free_jacobian(sys_, d_);
+          r_.noalias() -= G_[i].transpose() * L_.col(i);
+          Cres_.col(i) = d_.gamma;
+        }
         R_.col(i) = r_;
       }
-      Rt_.noalias() = R_.cast<cplx>() * tab_.Pinv.transpose();
-      x_ = Rt_.col(0).real();
-      xs_.noalias() = lur_.solve(x_);
-      Dt_.col(0) = xs_.cast<cplx>();
-      z_ = Rt_.col(1);
-      zs_.noalias() = luc_.solve(z_);
-      Dt_.col(1) = zs_;
-      Dt_.col(2) = zs_.conjugate();
-      // ΔA = −Re(ΔÃ Pᵀ), with ΔÃ holding S_k⁻¹ R̃_k
-      D_.noalias() = Dt_.imag() * tab_.P.imag().transpose();
-      D_.noalias() -= Dt_.real() * tab_.P.real().transpose();
+      solve_stages(R_, D_);
+      D_ = -D_;  // ΔA = −𝒮⁻¹ R
+      if (sys_.nl > 0) close_loops_correction();
       ++stats_.newton_iterations;
       if (!D_.allFinite()) return false;
       A_ += D_;
@@ -550,6 +545,56 @@ class Radau5 final : public ImplicitRk {
     return true;
   }
 
+  /// The multipliers' first iterate, as predict's for A: the last step's stage multipliers continued
+  /// (λ_n at every stage on the first step). A poor one (λ_n) costs a second large increment, since G
+  /// is frozen at the last stage's: measured on the four-bar, Newton then failed its contraction test.
+  void predict_multipliers(double h) {
+    if (sys_.nl == 0) return;
+    if (!have_previous_)
+      L_.colwise() = lambda_;
+    else
+      continue_stages(h, lambda_start_, Lprev_, L_);
+  }
+
+  /// Y = 𝒮⁻¹ X (nq, 3) for Newton's matrix 𝒮 = I⊗M + h a⊗C + h² a²⊗K on the stages (columns): X̃ = X P⁻ᵀ,
+  /// each column solved with its block (S₁ real, S₂ complex, the third the conjugate), Y = Re(Ỹ Pᵀ).
+  void solve_stages(const MatX& X, MatX& Y) {
+    Rt_.noalias() = X.cast<cplx>() * tab_.Pinv.transpose();
+    x_ = Rt_.col(0).real();
+    xs_.noalias() = lur_.solve(x_);
+    Dt_.col(0) = xs_.cast<cplx>();
+    z_ = Rt_.col(1);
+    zs_.noalias() = luc_.solve(z_);
+    Dt_.col(1) = zs_;
+    Dt_.col(2) = zs_.conjugate();
+    Y.noalias() = Dt_.real() * tab_.P.real().transpose();
+    Y.noalias() -= Dt_.imag() * tab_.P.imag().transpose();
+  }
+
+  /// Loops, index 1 at each stage: M A_i − f_i − G_iᵀλ_i = 0 and G_i A_i = γ_i. With ΔA = −𝒮⁻¹R on entry
+  /// (D_), Newton's step [𝒮, −𝒢ᵀ; 𝒢, 0] [ΔA; ΔΛ] = −[R; −c] (𝒢 = diag(G_i), c_i = γ_i − G_i A_i) by its
+  /// Schur complement W = 𝒢 𝒮⁻¹ 𝒢ᵀ (3 nl × 3 nl, by 3 nl stage solves): W ΔΛ = c − 𝒢 ΔA (least norm:
+  /// redundant rows), then ΔA += 𝒮⁻¹ 𝒢ᵀ ΔΛ. Each stage its own G_i: G frozen at one stage's left the
+  /// iterations too slow to pass the contraction test (measured on the four-bar).
+  void close_loops_correction() {
+    const int nl = sys_.nl;
+    MatX W(3 * nl, 3 * nl), E = MatX::Zero(n_, 3), Z(n_, 3);
+    for (int j = 0; j < 3; ++j)
+      for (int r = 0; r < nl; ++r) {
+        E.setZero();
+        E.col(j) = G_[j].row(r).transpose();
+        solve_stages(E, Z);
+        for (int i = 0; i < 3; ++i) W.block(i * nl, j * nl + r, nl, 1) = G_[i] * Z.col(i);
+      }
+    VecX rhs(3 * nl);
+    for (int i = 0; i < 3; ++i) rhs.segment(i * nl, nl) = Cres_.col(i) - G_[i] * D_.col(i);
+    const VecX dl = least_norm(W, rhs);
+    for (int i = 0; i < 3; ++i) E.col(i) = G_[i].transpose() * dl.segment(i * nl, nl);
+    solve_stages(E, Z);
+    D_ += Z;
+    for (int i = 0; i < 3; ++i) L_.col(i) += dl.segment(i * nl, nl);
+  }
+
   /// V = q̇_n 1ᵀ + h A aᵀ, Q = q_n 1ᵀ + h V aᵀ.
   void stage_values(double h) {
     V_.noalias() = h * A_ * tab_.a.transpose();
@@ -561,10 +606,15 @@ class Radau5 final : public ImplicitRk {
   /// The first iterate: the accelerations' collocation polynomial of the last step (through q̈_n−1
   /// and its stages) continued to the new stage times, q̈_n at every stage on the first step.
   void predict(double h) {
-    if (!have_previous_) {
+    if (!have_previous_)
       A_.colwise() = a_;
-      return;
-    }
+    else
+      continue_stages(h, ap_, Aprev_, A_);
+  }
+
+  /// The polynomial through x(t_{n−1}) = start and the last step's stages prev (nq or nl, 3), at this
+  /// step's stage times (step h): Lagrange's cubic in θ = (t − t_{n−1})/h_{n−1}, into out.
+  void continue_stages(double h, const VecX& start, const MatX& prev, MatX& out) const {
     const double x[4] = {0.0, tab_.c(0), tab_.c(1), 1.0};
     for (int i = 0; i < 3; ++i) {
       const double theta = 1.0 + tab_.c(i) * h / h_previous_;
@@ -574,7 +624,7 @@ class Radau5 final : public ImplicitRk {
         for (int j = 0; j < 4; ++j)
           if (j != k) w[k] *= (theta - x[j]) / (x[k] - x[j]);
       }
-      A_.col(i) = w[0] * ap_ + w[1] * Aprev_.col(0) + w[2] * Aprev_.col(1) + w[3] * Aprev_.col(2);
+      out.col(i) = w[0] * start + w[1] * prev.col(0) + w[2] * prev.col(1) + w[3] * prev.col(2);
     }
   }
 
@@ -594,6 +644,7 @@ class Radau5 final : public ImplicitRk {
 
   void accepted() override {
     Aprev_ = A_;
+    Lprev_ = L_, lambda_start_ = lambda_;  // lambda_: still the step's start (project follows)
     h_previous_ = h_;
     have_previous_ = true;
     rejected_ = false;
@@ -660,6 +711,10 @@ class Radau5 final : public ImplicitRk {
   Eigen::PartialPivLU<MatXc> luc_;
   double h_factored_ = 0.0, h_previous_ = 1.0;
   bool have_previous_ = false, rejected_ = false;
+  MatX G_[3];         // (nl, nq) the loops' Jacobian at each stage of the iterate
+  MatX L_, Cres_;     // (nl, 3) the stages' multipliers and constraint residuals γ_i − G_i A_i
+  MatX Lprev_;        // (nl, 3) the last step's stage multipliers
+  VecX lambda_start_;  // (nl) the multipliers at the last step's start
 };
 
 }  // namespace

@@ -155,9 +155,6 @@ void check_options(const System& sys, double t0, double t_end, const VecX& q0, c
                                 std::to_string(sys.nz) + " arm forces as internal variables); use esdirk43, "
                                 "generalized_alpha or dopri5");
   if (o.s0.size() != 0) check_vector(o.s0, sys.nz, "s0", "nz (the Maxwell arms' forces, N or N·m)");
-  if (o.method == Method::Radau5 && sys.nl > 0)
-    throw std::invalid_argument("method: 'radau5' does not integrate loop closures (the system has " +
-                                std::to_string(sys.nl) + " constraint rows); use esdirk43, generalized_alpha or dopri5");
   if (o.method == Method::Radau5 && o.iteration_matrix == IterationMatrix::Spring)
     throw std::invalid_argument("iteration_matrix: radau5 takes the exact tangent ('auto' or 'tangent'), got 'spring' "
                                 "(its complex block has no O(n) form); use esdirk43 for the spring matrix");

@@ -62,8 +62,9 @@ rtol' = 0.1 rtol^(2/3) (atol scaled alike), as in radau5.f, since it bounds an o
 from far above. Both methods: output at ``t_eval`` by the quintic Hermite interpolant of q through
 (q, q̇, q̈) at both ends of each step. Loop closures: ``esdirk43`` holds them at the acceleration
 level in each stage (M A − f − Gᵀλ = 0 with G A = γ, by the Schur complement as in the Newmark
-family) and projects each step's end onto them, like the explicit methods; ``radau5`` refuses them
-(ValueError).
+family) and projects each step's end onto them, like the explicit methods; ``radau5`` holds them in
+all its stages at once (the Schur complement W = 𝒢 𝒮⁻¹ 𝒢ᵀ over the stages, 3 nl × 3 nl, each stage
+with its own G_i) and projects likewise.
 """
 
 from __future__ import annotations
@@ -316,8 +317,8 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
     every loop (``System.assemble`` finds them); explicit methods project every accepted step back
     onto the loops (closure residual <= 1e-12), the Newmark family solves the index-3 equations
     (Arnold & Brüls: the constraints hold at every step to Newton's tolerance), esdirk43 holds them
-    at the acceleration level in its stages and projects like the explicit methods, radau5 refuses
-    them. ``scipy:`` methods
+    at the acceleration level in its stages and projects like the explicit methods, radau5 likewise
+    for its three stages together. ``scipy:`` methods
     integrate the constrained accelerations without projection (their residual drifts).
 
     Ctrl-C in the main thread — in the C++ loop, in a Python drive or force law, or in a
