@@ -9,7 +9,7 @@ import pytest
 
 import rigidfem as rf
 from rigidfem import samples
-from rigidfem.simulation import AUTO_STIFF_METHOD
+from rigidfem.simulation import AUTO_RADAU_RTOL, AUTO_STIFF_METHOD
 
 
 def pendulum():
@@ -49,11 +49,14 @@ def test_stiff_hands_over_and_is_cheaper_than_dopri5():
     tip = lambda r: r.position(h["beam"].tip, frame=h["hub"])  # noqa: E731
     auto = rf.simulate(system, 20.0, rtol=1e-5, atol=1e-7, t_eval=t_eval)
     dopri = rf.simulate(system, 20.0, method="dopri5", rtol=1e-5, atol=1e-7, t_eval=t_eval, stiffness_warning=False)
-    # stiff from its first steps: the stiff method runs from the start, dopri5's probe thrown away
-    assert auto.stats["method"] == f"{AUTO_STIFF_METHOD} from the start (a dopri5 probe found the problem stiff)"
+    # stiff from its first steps: the stiff method (radau5 at rtol <= AUTO_RADAU_RTOL) runs from the start,
+    # dopri5's probe thrown away
+    assert auto.stats["method"] == "radau5 from the start (a dopri5 probe found the problem stiff)"
     assert auto.stats["switched_at"] == 0.0 and auto.t[0] == 0.0 and np.all(np.diff(auto.t) > 0)
-    alone = rf.simulate(system, 20.0, method=AUTO_STIFF_METHOD, rtol=1e-5, atol=1e-7, t_eval=t_eval)
+    alone = rf.simulate(system, 20.0, method="radau5", rtol=1e-5, atol=1e-7, t_eval=t_eval)
     np.testing.assert_array_equal(auto.q, alone.q)  # the same run as the stiff method's own, bit for bit
+    loose = rf.simulate(system, 20.0, rtol=2 * AUTO_RADAU_RTOL, atol=1e-4, t_eval=t_eval)
+    assert loose.stats["method"] == f"{AUTO_STIFF_METHOD} from the start (a dopri5 probe found the problem stiff)"
     assert auto.stats["rhs_evaluations"] < 0.5 * dopri.stats["rhs_evaluations"]
     error = np.abs(tip(auto) - tip(ref)).max()
     assert error < 1e-2, error  # the tip moves 2 m: a relative error below 1 %
@@ -122,13 +125,13 @@ def test_closed_chain_runs_and_stays_closed():
 
 
 def test_stiff_closed_chain_hands_over_and_stays_closed():
-    """A four-bar whose crank spring (1e6 N·m/rad) makes it stiff: auto hands over to esdirk43, which
+    """A four-bar whose crank spring (1e6 N·m/rad) makes it stiff: auto hands over to radau5, which
     projects every step onto the loop; its state stays within 20 rtol of a tight dopri5 run."""
     system, q0 = four_bar(dict(stiffness=1e6, rest=1.2, damping=1.0), [1.25, -1.9, 4.6])
     t = np.linspace(0, 0.2, 11)
     auto = rf.simulate(system, 0.2, q0=q0, t_eval=t, rtol=1e-6, atol=1e-9)
     ref = rf.simulate(system, 0.2, method="dopri5", q0=q0, t_eval=t, rtol=1e-9, atol=1e-12, stiffness_warning=False)
-    assert auto.stats["method"].startswith("dopri5, then esdirk43")
+    assert auto.stats["method"].startswith("dopri5, then radau5")
     assert np.abs(auto.q - ref.q).max() < 20 * 1e-6 * np.abs(ref.q).max()  # the global error, 11x rtol here
     g = [np.abs(system.loop_constraints(tk, q, np.zeros(3))[0]).max() for tk, q in zip(auto.t, auto.q)]
     assert max(g) < 1e-10

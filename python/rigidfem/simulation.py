@@ -23,8 +23,9 @@ name                   scheme                                                   
                        simplified Newton on all stages in the transformed         or ``dt``
                        real/complex form (exact tangent only), Hairer's filtered
                        estimate, PI control, dense output quintic Hermite
-``"auto"`` (default)   dopri5, handing over to esdirk43 where a counted trial finds  ``rtol``/``atol``
-                       it cheaper (stiff problems); the choice in ``stats["method"]``
+``"auto"`` (default)   dopri5, handing over to radau5 (rtol <= 0.03; else esdirk43)  ``rtol``/``atol``
+                       where a counted trial finds it cheaper (stiff problems); the
+                       choice in ``stats["method"]``
 ``"scipy:Radau"`` …    SciPy's solvers (Radau, BDF, LSODA, RK45, DOP853) with the  ``rtol``/``atol``
                        C++ ``rhs`` and ``jacobian`` (Python per step: the slow path)
 =====================  =========================================================  ===========
@@ -224,19 +225,22 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
     Parameters
     ----------
     method : str
-        "auto" (default): dopri5 while it is the cheaper, esdirk43 where it is not. dopri5 runs in
+        "auto" (default): dopri5 while it is the cheaper, a stiff method where it is not: radau5 at
+        rtol <= 0.03 (``AUTO_RADAU_RTOL``), esdirk43 at looser tolerances, with Maxwell arms or with
+        ``iteration_matrix="spring"`` (measured with ``python -m rigidfem bench``: radau5's order 5 wins
+        at practical tolerances, esdirk43's cheaper stages at rough ones). dopri5 runs in
         windows of 20 accepted steps (at rtol <= 1e-3: looser, its error control lets the stiff
         modes of a beam go unstable); a window that looks bounded by stability (a fifth of its
         steps at h ρ > 2, or a sixth as many rejections; in the first window only the former)
-        starts a trial of esdirk43 from the state reached, which keeps the run if it advances 1.25
+        starts a trial of the stiff method from the state reached, which keeps the run if it advances 1.25
         times as far per unit of work — counted, not timed (right-hand sides, nq per tangent,
         (nq/50)² per dense factorisation), so the choice is the same on every machine and thread —
         else dopri5 goes on and the next trial waits twice as long. A first trial within 100 steps
-        and a tenth of the run starts esdirk43 from the initial state instead (dopri5 was a probe:
+        and a tenth of the run starts the stiff method from the initial state instead (dopri5 was a probe:
         its state at the stability boundary carries errors in the stiff modes that an undamped
         beam keeps ringing) and is measured against the probe over the same interval.
-        ``stats["method"]`` says what ran ("dopri5", "esdirk43 from the start (...)", or "dopri5,
-        then esdirk43 from t = ... s"), ``stats["switched_at"]`` and ``stats["auto_trials"]`` the
+        ``stats["method"]`` says what ran ("dopri5", "radau5 from the start (...)", or "dopri5,
+        then radau5 from t = ... s"), ``stats["switched_at"]`` and ``stats["auto_trials"]`` the
         details.
         Closed chains too (both methods project each step onto the loops).
         Otherwise see the module docstring: "euler", "symplectic_euler", "rk4", "dopri5", "rkf45",
@@ -357,6 +361,8 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
         # scipy: methods check the options of the C++ ones too (they use only first_step of them)
         opt = _options("dopri5" if scipy else method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, beta,
                        gamma, alpha, rho_inf, newton_tol, newton_max_iterations, iteration_matrix)
+        if method == "auto" and nz:
+            opt.stiff_method = AUTO_STIFF_METHOD  # radau5 does not integrate Maxwell arms
         if scipy:
             first = None if first_step is None else opt.dt
             run = _run_scipy(system, method[6:], t0, t_end, q0, qd0, t_eval, rtol, atol, max_step, max_steps,
@@ -404,6 +410,8 @@ def _check_closed(system, t0, q0, qd0, tol=1e-8):
 
 #: The implicit method ``method="auto"`` hands over to when dopri5 finds the problem stiff.
 AUTO_STIFF_METHOD = "esdirk43"
+#: auto's stiff method at rtol <= this (and no Maxwell arms, no spring matrix): radau5, of order 5
+AUTO_RADAU_RTOL = 3e-2
 
 
 def _auto_choice(stats: dict, stiff_method: str, t0: float) -> str:
@@ -442,6 +450,8 @@ def _options(method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, 
         if adaptive is False:
             raise ValueError("adaptive: expected None or True with method 'auto' (it controls its steps), got False")
         opt.stiff_method = AUTO_STIFF_METHOD
+        if np.max(rtol) <= AUTO_RADAU_RTOL and iteration_matrix != "spring":
+            opt.stiff_method = "radau5"  # the system's Maxwell arms are checked by simulate (its caller)
     return opt
 
 
