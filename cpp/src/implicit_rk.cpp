@@ -503,7 +503,8 @@ class Radau5 final : public ImplicitRk {
       : ImplicitRk(sys, o, stats), A_(n_, 3), V_(n_, 3), Q_(n_, 3), R_(n_, 3), D_(n_, 3), dV_(n_, 3), dQ_(n_, 3),
         Aprev_(n_, 3), Rt_(n_, 3), Dt_(n_, 3), z_(n_), zs_(n_), x_(n_), xs_(n_), b1_(n_), b2_(n_), qx_(n_), vx_(n_),
         Sr_(n_, n_),
-        Sc_(n_, n_), lur_(n_), luc_(n_), L_(sys.nl, 3), Cres_(sys.nl, 3) {}
+        Sc_(n_, n_), lur_(n_), luc_(n_), L_(sys.nl, 3), Cres_(sys.nl, 3), W_(3 * sys.nl, 3 * sys.nl),
+        w_(3 * sys.nl), E_(n_, 3), Z_(n_, 3) {}
 
  private:
   /// The stages by simplified Newton on the transformed system: R = [r_i] (nq, 3), R̃ = R P⁻ᵀ, each
@@ -578,20 +579,21 @@ class Radau5 final : public ImplicitRk {
   /// iterations too slow to pass the contraction test (measured on the four-bar).
   void close_loops_correction() {
     const int nl = sys_.nl;
-    MatX W(3 * nl, 3 * nl), E = MatX::Zero(n_, 3), Z(n_, 3);
     for (int j = 0; j < 3; ++j)
       for (int r = 0; r < nl; ++r) {
-        E.setZero();
-        E.col(j) = G_[j].row(r).transpose();
-        solve_stages(E, Z);
-        for (int i = 0; i < 3; ++i) W.block(i * nl, j * nl + r, nl, 1) = G_[i] * Z.col(i);
+        E_.setZero();
+        E_.col(j) = G_[j].row(r).transpose();
+        solve_stages(E_, Z_);
+        for (int i = 0; i < 3; ++i) W_.block(i * nl, j * nl + r, nl, 1).noalias() = G_[i] * Z_.col(i);
       }
-    VecX rhs(3 * nl);
-    for (int i = 0; i < 3; ++i) rhs.segment(i * nl, nl) = Cres_.col(i) - G_[i] * D_.col(i);
-    const VecX dl = least_norm(W, rhs);
-    for (int i = 0; i < 3; ++i) E.col(i) = G_[i].transpose() * dl.segment(i * nl, nl);
-    solve_stages(E, Z);
-    D_ += Z;
+    for (int i = 0; i < 3; ++i) {
+      w_.segment(i * nl, nl) = Cres_.col(i);
+      w_.segment(i * nl, nl).noalias() -= G_[i] * D_.col(i);
+    }
+    const VecX dl = least_norm(W_, w_);
+    for (int i = 0; i < 3; ++i) E_.col(i).noalias() = G_[i].transpose() * dl.segment(i * nl, nl);
+    solve_stages(E_, Z_);
+    D_ += Z_;
     for (int i = 0; i < 3; ++i) L_.col(i) += dl.segment(i * nl, nl);
   }
 
@@ -714,6 +716,9 @@ class Radau5 final : public ImplicitRk {
   MatX G_[3];         // (nl, nq) the loops' Jacobian at each stage of the iterate
   MatX L_, Cres_;     // (nl, 3) the stages' multipliers and constraint residuals γ_i − G_i A_i
   MatX Lprev_;        // (nl, 3) the last step's stage multipliers
+  MatX W_;            // (3 nl, 3 nl) the Schur complement 𝒢 𝒮⁻¹ 𝒢ᵀ over the stages
+  VecX w_;            // (3 nl) its right-hand side
+  MatX E_, Z_;        // (nq, 3) stage right-hand sides and their 𝒮⁻¹
   VecX lambda_start_;  // (nl) the multipliers at the last step's start
 };
 
