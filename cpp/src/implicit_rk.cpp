@@ -547,8 +547,8 @@ class Radau5 final : public ImplicitRk {
   }
 
   /// The multipliers' first iterate, as predict's for A: the last step's stage multipliers continued
-  /// (λ_n at every stage on the first step). A poor one (λ_n) costs a second large increment, since G
-  /// is frozen at the last stage's: measured on the four-bar, Newton then failed its contraction test.
+  /// (λ_n at every stage on the first step), so that the first Newton increment is not mostly a
+  /// correction of the multipliers.
   void predict_multipliers(double h) {
     if (sys_.nl == 0) return;
     if (!have_previous_)

@@ -361,8 +361,8 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
         # scipy: methods check the options of the C++ ones too (they use only first_step of them)
         opt = _options("dopri5" if scipy else method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, beta,
                        gamma, alpha, rho_inf, newton_tol, newton_max_iterations, iteration_matrix)
-        if method == "auto" and nz:
-            opt.stiff_method = AUTO_STIFF_METHOD  # radau5 does not integrate Maxwell arms
+        if method == "auto":
+            opt.stiff_method = _auto_stiff_method(system, rtol, iteration_matrix)
         if scipy:
             first = None if first_step is None else opt.dt
             run = _run_scipy(system, method[6:], t0, t_end, q0, qd0, t_eval, rtol, atol, max_step, max_steps,
@@ -449,10 +449,15 @@ def _options(method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, 
     if method == "auto":
         if adaptive is False:
             raise ValueError("adaptive: expected None or True with method 'auto' (it controls its steps), got False")
-        opt.stiff_method = AUTO_STIFF_METHOD
-        if np.max(rtol) <= AUTO_RADAU_RTOL and iteration_matrix != "spring":
-            opt.stiff_method = "radau5"  # the system's Maxwell arms are checked by simulate (its caller)
     return opt
+
+
+def _auto_stiff_method(system, rtol, iteration_matrix: str) -> str:
+    """auto's stiff method: radau5 at rtol <= AUTO_RADAU_RTOL, unless the system has Maxwell arms or the
+    spring matrix is asked for (radau5 takes neither); esdirk43 otherwise."""
+    if np.max(rtol) <= AUTO_RADAU_RTOL and not system.nz and iteration_matrix != "spring":
+        return "radau5"
+    return AUTO_STIFF_METHOD
 
 
 def _keep_going(bar, stop, t0):
