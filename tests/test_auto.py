@@ -49,17 +49,46 @@ def test_stiff_hands_over_and_is_cheaper_than_dopri5():
     tip = lambda r: r.position(h["beam"].tip, frame=h["hub"])  # noqa: E731
     auto = rf.simulate(system, 20.0, rtol=1e-5, atol=1e-7, t_eval=t_eval)
     dopri = rf.simulate(system, 20.0, method="dopri5", rtol=1e-5, atol=1e-7, t_eval=t_eval, stiffness_warning=False)
-    # stiff from its first steps: the stiff method (radau5 at rtol <= AUTO_RADAU_RTOL) runs from the start,
-    # dopri5's probe thrown away
-    assert auto.stats["method"] == "radau5 from the start (a dopri5 probe found the problem stiff)"
+    # ω_max = 469 rad/s: dopri5 would need 20 s · 469 / 3.3 = 2800 steps for stability alone, so the
+    # stiff method (radau5 at rtol <= AUTO_RADAU_RTOL) runs from the start, without a dopri5 probe
+    assert auto.stats["method"] == "radau5 from the start (omega_max = 469 rad/s: stiff for dopri5)"
+    assert auto.stats["probe_steps"] == 0
     assert auto.stats["switched_at"] == 0.0 and auto.t[0] == 0.0 and np.all(np.diff(auto.t) > 0)
     alone = rf.simulate(system, 20.0, method="radau5", rtol=1e-5, atol=1e-7, t_eval=t_eval)
     np.testing.assert_array_equal(auto.q, alone.q)  # the same run as the stiff method's own, bit for bit
     loose = rf.simulate(system, 20.0, rtol=2 * AUTO_RADAU_RTOL, atol=1e-4, t_eval=t_eval)
-    assert loose.stats["method"] == f"{AUTO_STIFF_METHOD} from the start (a dopri5 probe found the problem stiff)"
+    assert loose.stats["method"].startswith(f"{AUTO_STIFF_METHOD} from the start (omega_max")
     assert auto.stats["rhs_evaluations"] < 0.5 * dopri.stats["rhs_evaluations"]
     error = np.abs(tip(auto) - tip(ref)).max()
     assert error < 1e-2, error  # the tip moves 2 m: a relative error below 1 %
+
+
+def test_short_stiff_run_is_found_by_a_probe():
+    """Kane's beam over 3 s: dopri5 would need 3 · 469 / 3.3 = 430 steps for stability, under the
+    500 that start the stiff method at once; a dopri5 probe finds its steps at the stability limit in
+    its first window and the stiff method runs from the start, measured against the probe."""
+    model, _ = samples.kane_beam(omega=6.0, duration=15.0, elements=10)
+    system = model.compile()
+    auto = rf.simulate(system, 3.0, rtol=1e-5, atol=1e-7, t_eval=np.linspace(0, 3, 31))
+    assert auto.stats["method"] == "radau5 from the start (a dopri5 probe of 20 steps found the problem stiff)"
+    alone = rf.simulate(system, 3.0, method="radau5", rtol=1e-5, atol=1e-7, t_eval=np.linspace(0, 3, 31))
+    np.testing.assert_array_equal(auto.q, alone.q)
+
+
+def test_omega_max_is_the_highest_natural_frequency():
+    """auto's estimate of the Jacobian's spectral radius against the spring chain's highest natural
+    frequency from numpy's eigh (absolute coordinates z = L x: M z'' = −K z)."""
+    n, k = 6, 1e6
+    system = spring_chain(n, k)
+    K_abs = k * (np.diag(np.r_[np.full(n - 1, 2.0), 1.0]) - np.diag(np.ones(n - 1), 1) - np.diag(np.ones(n - 1), -1))
+    omega_max = np.sqrt(np.linalg.eigvalsh(K_abs).max())  # m = 1 kg
+    result = rf.simulate(system, 0.01, q0=np.linspace(1e-3, -1e-3, n), t_eval=[0.0, 0.01])
+    assert abs(result.stats["omega_max"] - omega_max) < 1e-2 * omega_max  # measured: 0.23 % low
+    dopri = rf.simulate(system, 0.01, method="dopri5", q0=np.zeros(n), t_eval=[0.0, 0.01], stiffness_warning=False)
+    assert np.isnan(dopri.stats["omega_max"])
+    # stiff: 2 s · 1942 / 3.3 = 1180 dopri5 steps for stability alone, so radau5 from the start
+    long = rf.simulate(system, 2.0, q0=np.linspace(1e-3, -1e-3, n), t_eval=[0.0, 2.0], rtol=1e-6, atol=1e-9)
+    assert long.stats["method"] == "radau5 from the start (omega_max = 1.94e+03 rad/s: stiff for dopri5)"
 
 
 def test_choice_is_deterministic_across_threads():

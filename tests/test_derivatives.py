@@ -120,7 +120,7 @@ def test_inverse_dynamics_bad_input():
 
 def stiff_beam(elements=12, algorithm="recursive"):
     """A 3D steel cantilever (bending both ways and torsion) released from a static deflection
-    under a skew tip load: its highest sde frequencies are ~10⁴ times the first."""
+    under a skew tip load: its highest frequency (3.6·10⁴ rad/s) is 1.4·10³ times the lowest (rf.modal_analysis)."""
     def build(load):
         model, h = rf.samples.cantilever(elements=elements, deform=("torsion", "bend_y", "bend_z"))
         if load:

@@ -86,6 +86,8 @@ void bind_integrators(py::module_& m) {
         stats["stiff_at"] = st.stiff_at;
         stats["switched_at"] = st.switched_at;
         stats["auto_trials"] = st.auto_trials;
+        stats["omega_max"] = st.omega_max;
+        stats["probe_steps"] = st.probe_steps;
         return py::make_tuple(VecX(Eigen::Map<const VecX>(tr.t.data(), tr.t.size())), stack(tr.q, s.nq),
                               stack(tr.qd, s.nq), stats, tr.interrupted, failure, stack(tr.s, s.nz));
       },

@@ -23,9 +23,10 @@ name                   scheme                                                   
                        simplified Newton on all stages in the transformed         or ``dt``
                        real/complex form (exact tangent only), Hairer's filtered
                        estimate, PI control, dense output quintic Hermite
-``"auto"`` (default)   dopri5, handing over to radau5 (rtol <= 0.03; else esdirk43)  ``rtol``/``atol``
-                       where a counted trial finds it cheaper (stiff problems); the
-                       choice in ``stats["method"]``
+``"auto"`` (default)   radau5 (rtol <= 0.03; else esdirk43) from the start where     ``rtol``/``atol``
+                       ω_max at t0 makes dopri5 take >= 500 steps for stability;
+                       else dopri5, handing over where a counted trial finds the
+                       stiff method cheaper; the choice in ``stats["method"]``
 ``"scipy:Radau"`` …    SciPy's solvers (Radau, BDF, LSODA, RK45, DOP853) with the  ``rtol``/``atol``
                        C++ ``rhs`` and ``jacobian`` (Python per step: the slow path)
 =====================  =========================================================  ===========
@@ -228,20 +229,28 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
         "auto" (default): dopri5 while it is the cheaper, a stiff method where it is not: radau5 at
         rtol <= 0.03 (``AUTO_RADAU_RTOL``), esdirk43 at looser tolerances, with Maxwell arms or with
         ``iteration_matrix="spring"`` (measured with ``python -m rigidfem bench``: radau5's order 5 wins
-        at practical tolerances, esdirk43's cheaper stages at rough ones). dopri5 runs in
-        windows of 20 accepted steps (at rtol <= 1e-3: looser, its error control lets the stiff
-        modes of a beam go unstable); a window that looks bounded by stability (a fifth of its
-        steps at h ρ > 2, or a sixth as many rejections; in the first window only the former)
-        starts a trial of the stiff method from the state reached, which keeps the run if it advances 1.25
-        times as far per unit of work — counted, not timed (right-hand sides, nq per tangent,
-        (nq/50)² per dense factorisation), so the choice is the same on every machine and thread —
-        else dopri5 goes on and the next trial waits twice as long. A first trial within 100 steps
-        and a tenth of the run starts the stiff method from the initial state instead (dopri5 was a probe:
-        its state at the stability boundary carries errors in the stiff modes that an undamped
-        beam keeps ringing) and is measured against the probe over the same interval.
-        ``stats["method"]`` says what ran ("dopri5", "radau5 from the start (...)", or "dopri5,
-        then radau5 from t = ... s"), ``stats["switched_at"]`` and ``stats["auto_trials"]`` the
-        details.
+        at practical tolerances, esdirk43's cheaper stages at rough ones). First auto estimates the
+        spectral radius ρ of the Jacobian of (q̇, q̈) at t0 (``stats["omega_max"]``, rad/s: the highest
+        natural frequency of an undamped structure; power iteration, at most 40 right-hand sides).
+        Where dopri5 would need at least 500 steps for stability alone ((t_end − t0) ρ / 3.3 >= 500)
+        the stiff method runs from t0. Otherwise dopri5 runs in windows of 20 accepted steps (at
+        rtol <= 1e-3: looser, its error control lets the stiff modes of a beam go unstable). If its
+        first window holds a fifth of its steps at the stability boundary (h ρ > 2), the stiff
+        method starts again from the initial state (dopri5 was a probe: its state at the stability
+        boundary carries errors in the stiff modes that an undamped beam keeps ringing) and, when it
+        reaches the time the probe reached, keeps the run if it has advanced 1.25 times as far per
+        unit of work as the probe — counted, not timed (right-hand sides, nq per tangent, (nq/50)²
+        per dense factorisation), so the choice is the same on every machine and thread — else
+        dopri5 goes on. A later window that looks bounded by stability (a fifth of its steps at
+        h ρ > 2, or a sixth as many rejections) hands the run over to the stiff method from the
+        state reached, after waiting twice as many windows if the probe's trial was lost. A
+        hand-over is final. On a non-stiff problem run for long the rule by ρ can misjudge: a
+        pendulum over 1000 s (over 500 periods) runs radau5, 1.5 times dopri5's time at rtol = 1e-3,
+        0.88 and 0.79 times at 1e-6 and 1e-9.
+        ``stats["method"]`` says what ran ("dopri5", "radau5 from the start (omega_max = ... rad/s:
+        stiff for dopri5)", "radau5 from the start (a dopri5 probe of ... steps found the problem
+        stiff)", or "dopri5, then radau5 from t = ... s"), ``stats["switched_at"]``,
+        ``stats["auto_trials"]``, ``stats["probe_steps"]`` and ``stats["omega_max"]`` the details.
         Closed chains too (both methods project each step onto the loops).
         Otherwise see the module docstring: "euler", "symplectic_euler", "rk4", "dopri5", "rkf45",
         "newmark", "hht", "generalized_alpha", "implicit_spring", "esdirk43", "radau5", or "scipy:Radau",
@@ -416,14 +425,16 @@ AUTO_RADAU_RTOL = 3e-2
 
 def _auto_choice(stats: dict, stiff_method: str, t0: float) -> str:
     """What ``auto`` ran, for ``Result.stats["method"]``: "dopri5", the hand-over, or the stiff method
-    from the start (after a dopri5 probe found the problem stiff)."""
+    from the start (on the estimate of ω_max, or after a dopri5 probe found the problem stiff)."""
     switched, trials = stats.get("switched_at", np.nan), stats.get("auto_trials", 0)
     lost = trials - (1 if np.isfinite(switched) else 0)
     tried = f"; {lost} trial{'s' * (lost != 1)} of {stiff_method} lost" if lost else ""
     if not np.isfinite(switched):
         return f"dopri5{tried}"
+    if switched == t0 and stats.get("probe_steps", 0) > 0:
+        return f"{stiff_method} from the start (a dopri5 probe of {stats['probe_steps']} steps found the problem stiff){tried}"
     if switched == t0:
-        return f"{stiff_method} from the start (a dopri5 probe found the problem stiff){tried}"
+        return f"{stiff_method} from the start (omega_max = {stats['omega_max']:.3g} rad/s: stiff for dopri5){tried}"
     return f"dopri5, then {stiff_method} from t = {switched:.6g} s{tried}"
 
 

@@ -73,6 +73,10 @@ struct IntegratorStats {
   /// auto: the time (s) its stiff method took over for the rest of the run, NaN if the run ended on dopri5.
   double switched_at = std::numeric_limits<double>::quiet_NaN();
   long auto_trials = 0;  ///< auto: trials of its stiff method (a lost trial returns to dopri5)
+  /// auto: the spectral radius of y' = (q̇, q̈)'s Jacobian at t0 (rad/s; ω_max for an undamped
+  /// structure), NaN for the other methods.
+  double omega_max = std::numeric_limits<double>::quiet_NaN();
+  long probe_steps = 0;  ///< auto: dopri5's steps before its stiff method restarted from t0 (0: no probe)
 };
 
 /// States at the output times (every accepted step when no output times are given).
