@@ -25,8 +25,8 @@ name                   scheme                                                   
                        estimate, PI control, dense output quintic Hermite
 ``"auto"`` (default)   radau5 (rtol <= 0.03; else esdirk43) from the start where     ``rtol``/``atol``
                        ω_max at t0 makes dopri5 take >= 500 steps for stability;
-                       else dopri5, handing over where a counted trial finds the
-                       stiff method cheaper; the choice in ``stats["method"]``
+                       else dopri5, handing over for good where its steps sit at
+                       the stability limit; the choice in ``stats["method"]``
 ``"scipy:Radau"`` …    SciPy's solvers (Radau, BDF, LSODA, RK45, DOP853) with the  ``rtol``/``atol``
                        C++ ``rhs`` and ``jacobian`` (Python per step: the slow path)
 =====================  =========================================================  ===========
