@@ -250,6 +250,22 @@ def test_poses_need_t_when_drives_move_the_bodies():
     np.testing.assert_allclose(line, [rz(theta) @ [x, 0.0, 0.0] for x in s], atol=1e-15)
 
 
+def test_a_bad_vector_is_named_before_the_missing_t():
+    """An energy without t of a system with drives, and a q that could not be one (found by
+    scripts/fuzz.py): the ValueError names q, the argument that is wrong, not the t left out."""
+    model, _ = rf.samples.kane_beam(omega=6.0, duration=15.0, elements=3)
+    system = model.compile()
+    n = system.nq
+    with pytest.raises(ValueError, match=r"^q: .*NaN or inf"):
+        system.kinetic_energy(np.full(n, -np.inf), np.zeros(n))
+    with pytest.raises(ValueError, match=r"^q: .*expected shape \(3,\)"):
+        system.dissipated_power(np.zeros(n + 1), np.zeros(n))
+    with pytest.raises(ValueError, match=r"^qd: "):
+        system.kinetic_energy(np.zeros(n), np.zeros(n + 2))
+    with pytest.raises(ValueError, match=r"^t: required"):
+        system.kinetic_energy(np.zeros(n), np.zeros(n))
+
+
 def test_poses_default_to_t_0_without_drives():
     model, link = arm()
     system = model.compile()

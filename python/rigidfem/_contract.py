@@ -221,6 +221,10 @@ def guard(function: str, compiled, parameters: tuple, method: bool = True):
             elif not (v is True or v is False or v is _MISSING or isinstance(v, np.bool_)):
                 raise _refuse(function, parameters, p, v, args, kwargs)
         if t_default and n <= t_at and "t" not in kwargs and args and args[0].np:
+            for k, p, kind in checks:  # a bad vector is named before the missing t
+                v = args[k] if k < n else kwargs.get(p, _MISSING)
+                if kind == 1 and v is not _MISSING and _problem(p, v, args[0]):
+                    raise _refuse(function, parameters, p, v, args, kwargs)
             _checks.pose_time(args[0], None)  # raises: the drives make the answer depend on t
         if unread:
             k, p, j, flag = unread_at
