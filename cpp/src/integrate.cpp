@@ -367,7 +367,8 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
   if (o.method == Method::Auto)
     stats.omega_max = spectral_radius(sys, t0, q0, qd0, y0.tail(sys.nz), stats.rhs_evaluations);
   AutoChoice choice(o, n, stats.omega_max, span);
-  // auto on a stiff problem (choice.stiff_from_start): its stiff method from t0, measured like a trial.
+  // auto on a stiff problem (choice.stiff_from_start): its stiff method from t0 for the whole run (h = 0:
+  // no dopri5 step to go back to).
   const IntegratorOptions first = choice.stiff_from_start() ? choice.switched(t0, 0.0, stats) : o;
   std::unique_ptr<Stepper> stepper = method_info(first.method).make(sys, first, stats);
   StepControl control = stepper->control();
