@@ -231,7 +231,7 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
         ``iteration_matrix="spring"`` (measured with ``python -m rigidfem bench``: radau5's order 5 wins
         at practical tolerances, esdirk43's cheaper stages at rough ones). First auto estimates the
         spectral radius ρ of the Jacobian of (q̇, q̈) at t0 (``stats["omega_max"]``, rad/s: the highest
-        natural frequency of an undamped structure; power iteration, at most 40 right-hand sides).
+        natural frequency of an undamped structure; power iteration, at most 41 right-hand sides).
         Where dopri5 would need at least 500 steps for stability alone ((t_end − t0) ρ / 3.3 >= 500)
         the stiff method runs from t0. Otherwise dopri5 runs in windows of 20 accepted steps (at
         rtol <= 1e-3: looser, its error control lets the stiff modes of a beam go unstable). If its
