@@ -193,10 +193,11 @@ void check_options(const System& sys, double t0, double t_end, const VecX& q0, c
 /// power iteration on J² (an undamped oscillation's pair ±iω is one eigenvalue −ω² of J², so the
 /// iteration converges where J's own would circle), x ← J²x/‖J²x‖, ρ² = ‖J²x‖ for ‖x‖ = 1, with
 /// J x = (x_q̇, (q̈(q + ε x_q, q̇ + ε x_q̇) − q̈)/ε) by forward differences, O(n) each, counted in
-/// `evaluations`. The estimate grows towards ρ from below, by the ratio (ω₂/ω₁)² of the two highest modes per
+/// `evaluations`. The estimate grows towards ρ (from below for a symmetric M⁻¹K), by the ratio (ω₂/ω₁)² of the two highest modes per
 /// iteration; it stops when an iteration changes it by less than 0.1 %, after at most 20 iterations
-/// (41 evaluations with the one at the state itself). Measured against the highest frequency of rf.modal_analysis: 0.01–1.7 % low on
-/// the benchmark's five scenes, 0.23 % low on a chain of six equal springs (ω₂/ω₁ = 0.91).
+/// (41 evaluations with the one at the state itself). Measured against the highest frequency of
+/// rf.modal_analysis: 0.01–1.7 % low on four of the benchmark's scenes, 0.04 % high on the whippy strip
+/// (bent under gravity), 0.23 % low on a chain of six equal springs (ω₂/ω₁ = 0.91).
 double spectral_radius(const System& sys, double t, const VecX& q, const VecX& v, const VecX& s, long& evaluations) {
   constexpr int iterations = 20;
   const int n = sys.nq;
