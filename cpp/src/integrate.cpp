@@ -193,7 +193,7 @@ void check_options(const System& sys, double t0, double t_end, const VecX& q0, c
 /// power iteration on J² (an undamped oscillation's pair ±iω is one eigenvalue −ω² of J², so the
 /// iteration converges where J's own would circle), x ← J²x/‖J²x‖, ρ² = ‖J²x‖ for ‖x‖ = 1, with
 /// J x = (x_q̇, (q̈(q + ε x_q, q̇ + ε x_q̇) − q̈)/ε) by forward differences, O(n) each, counted in
-/// `evaluations`. The estimate grows towards ρ (from below for a symmetric M⁻¹K), by the ratio (ω₂/ω₁)² of the two highest modes per
+/// `evaluations`. The estimate settles on ρ at the ratio (ω₂/ω₁)² of the two highest modes per
 /// iteration; it stops when an iteration changes it by less than 0.1 %, after at most 20 iterations
 /// (41 evaluations with the one at the state itself). Measured against the highest frequency of
 /// rf.modal_analysis: 0.01–1.7 % low on four of the benchmark's scenes, 0.04 % high on the whippy strip
