@@ -39,8 +39,8 @@ def test_non_stiff_runs_dopri5_bit_for_bit():
 
 
 def test_stiff_hands_over_and_is_cheaper_than_dopri5():
-    """Kane's beam (m = 10): stiff for dopri5 (its step held at ~3.3/ω_max); auto's probe finds it in
-    the first window and runs the stiff method from the start, does far less work than dopri5 at the
+    """Kane's beam (m = 10): stiff for dopri5 (its step held at ~3.3/ω_max); auto's estimate of ω_max
+    at t0 says so and runs the stiff method from the start, does far less work than dopri5 at the
     same tolerance and meets a tight reference to the tolerance's order."""
     model, h = samples.kane_beam(omega=6.0, duration=15.0, elements=10)
     system = model.compile()

@@ -221,7 +221,8 @@ double spectral_radius(const System& sys, double t, const VecX& q, const VecX& v
     apply(x, y);
     apply(y, x);
     const double norm = x.norm();
-    if (!(norm > 0.0) || !std::isfinite(norm)) return std::isfinite(norm) ? 0.0 : rho;
+    if (!std::isfinite(norm)) return rho;  // the dynamics failed at a perturbed state: the last estimate
+    if (norm == 0.0) return 0.0;           // nothing moves the state: no frequency
     const double previous = rho;
     rho = std::sqrt(norm);
     x /= norm;
