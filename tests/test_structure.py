@@ -78,6 +78,7 @@ LAYERS = [
     {"kinematics", "constraints"},
     {"lagrange", "recursive", "derivatives"},  # the formulations
     {"dynamics"},                              # the only place that chooses one
+    {"error_measure"},                         # the outputs an error is measured on
     {"integrators", "stepper", "outputs", "timing"},
 ]
 RANK = {name: k for k, layer in enumerate(LAYERS) for name in layer}

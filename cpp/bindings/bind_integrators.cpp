@@ -37,6 +37,25 @@ void bind_integrators(py::module_& m) {
       .def_property(
           "iteration_matrix", [](const IntegratorOptions& o) { return iteration_matrix_name(o.iteration_matrix); },
           [](IntegratorOptions& o, const std::string& name) { o.iteration_matrix = parse_iteration_matrix(name); })
+      .def(
+          "set_error_on",
+          [](IntegratorOptions& o, const std::vector<std::tuple<std::string, int, Vec3>>& outputs) {
+            // (kind, index, r): "bodies", "point" (body, r), "coordinate" (q index), "element", "loop"
+            static const std::pair<const char*, OutputSpec::Kind> kinds[] = {
+                {"bodies", OutputSpec::Kind::Bodies}, {"point", OutputSpec::Kind::Point},
+                {"coordinate", OutputSpec::Kind::Coordinate}, {"element", OutputSpec::Kind::Element},
+                {"loop", OutputSpec::Kind::Loop}};
+            o.error_on.clear();
+            for (const auto& [kind, index, r] : outputs) {
+              OutputSpec spec{OutputSpec::Kind::Bodies, index, r};
+              bool known = false;
+              for (const auto& [name, k] : kinds)
+                if (kind == name) spec.kind = k, known = true;
+              if (!known) bad("error_on", "'bodies', 'point', 'coordinate', 'element' or 'loop' outputs", kind);
+              o.error_on.push_back(spec);
+            }
+          },
+          py::arg("outputs"), "The outputs the error is measured on: (kind, index, r) each; [] for the state.")
       .def_property(
           "stiff_method", [](const IntegratorOptions& o) { return method_name(o.stiff_method); },
           [](IntegratorOptions& o, const std::string& name) { o.stiff_method = parse_method(name); });
@@ -88,6 +107,7 @@ void bind_integrators(py::module_& m) {
         stats["auto_trials"] = st.auto_trials;
         stats["omega_max"] = st.omega_max;
         stats["probe_steps"] = st.probe_steps;
+        stats["model_size"] = st.model_size;
         return py::make_tuple(VecX(Eigen::Map<const VecX>(tr.t.data(), tr.t.size())), stack(tr.q, s.nq),
                               stack(tr.qd, s.nq), stats, tr.interrupted, failure, stack(tr.s, s.nz));
       },

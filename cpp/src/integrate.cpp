@@ -8,6 +8,7 @@
 
 #include "rigidfem/arms.hpp"
 #include "rigidfem/dynamics.hpp"
+#include "rigidfem/error_measure.hpp"
 #include "rigidfem/errors.hpp"
 #include "rigidfem/kinematics.hpp"
 #include "rigidfem/stepper.hpp"
@@ -74,6 +75,17 @@ double scaled_rms(const VecX& v, const VecX& sc) {
 
 double error_norm(const VecX& e, const VecX& y0, const VecX& y1, const VecX& atol, const VecX& rtol) {
   return scaled_rms(e, atol.array() + rtol.array() * y0.cwiseAbs().cwiseMax(y1.cwiseAbs()).array());
+}
+
+double Tolerances::norm(const VecX& e, const VecX& y0, const VecX& y1, double h) const {
+  if (measure) return measure->norm(e, h, output_atol, output_rtol);
+  return error_norm(e, y0, y1, atol, rtol);
+}
+
+Tolerances Tolerances::scaled(double factor) const {
+  Tolerances t = *this;
+  t.atol *= factor, t.rtol *= factor, t.output_atol *= factor, t.output_rtol *= factor;
+  return t;
 }
 
 VecX hermite(double theta, double h, const VecX& y0, const VecX& f0, const VecX& y1, const VecX& f1) {
@@ -167,6 +179,9 @@ void check_options(const System& sys, double t0, double t_end, const VecX& q0, c
         !tol->allFinite())
       throw std::invalid_argument(std::string(name) + ": expected non-negative tolerances, one or 2 nq = " +
                                   std::to_string(2 * sys.nq) + " of them");
+  if (!o.error_on.empty() && (o.rtol.size() != 1 || o.atol.size() != 1))
+    throw std::invalid_argument("rtol, atol: expected one value each with error_on (the tolerances of its outputs), "
+                                "got " + std::to_string(o.rtol.size()) + " and " + std::to_string(o.atol.size()));
   if (o.rtol.maxCoeff() == 0.0 && o.atol.minCoeff() == 0.0)
     throw std::invalid_argument("atol: expected positive values when rtol is zero");
   if (!(o.max_step > 0.0)) throw std::invalid_argument("max_step: expected a positive step in s");
@@ -235,7 +250,7 @@ double spectral_radius(const System& sys, double t, const VecX& q, const VecX& v
 ///  - from t0 at once, when dopri5 would need `direct_steps` or more for stability alone, span ρ/3.3
 ///    with ρ the Jacobian's spectral radius at t0 (spectral_radius);
 ///  - from t0 after a probe: dopri5's first window of `window` accepted steps holds a fifth at the
-///    stability boundary (h ρ > 2), within `probe` steps and a tenth of the run. dopri5's state at its
+///    stability boundary (h ρ > 2), within `probe` steps and a fifth of the run. dopri5's state at its
 ///    stability boundary carries errors ~ the tolerance in the stiff modes, which an undamped beam keeps
 ///    ringing and the stiff method's error control then resolves (measured on Kane's beam at rtol = 1e-3:
 ///    597 esdirk43 steps over t = 0.2-5 s from dopri5's state, 15 from the initial one), so the stiff
@@ -258,8 +273,10 @@ class AutoChoice {
   /// dopri5 is stable for h ρ up to about 3.3 (its region meets the real axis at −3.3; Hairer's test: 3.25).
   static constexpr double dopri5_stability = 3.3;
   /// The stiff method starts at t0, without a dopri5 probe, when dopri5 would need at least this many
-  /// steps for stability alone.
-  static constexpr double direct_steps = 500;
+  /// steps for stability alone (500 before the stiff method measured its error on outputs; 200 since,
+  /// measured on the whippy strip (395 steps): its probe's first window did not look stiff at tight
+  /// tolerances and dopri5 ran on, 1.9 times radau5's own time at a 1e-6 m tip error).
+  static constexpr double direct_steps = 200;
   AutoChoice(const IntegratorOptions& o, int nq, double rho, double span)
       : o_(o), nq_(nq), direct_(std::isfinite(rho) && span * rho >= direct_steps * dopri5_stability) {}
 
@@ -304,9 +321,11 @@ class AutoChoice {
   /// The step to continue dopri5 with after a lost trial.
   double explicit_step() const { return h_explicit_; }
   /// Whether the trial just started should start from the initial state: the first, after at most
-  /// `probe` dopri5 steps over at most a tenth of the run (a longer probe is not thrown away).
+  /// `probe` dopri5 steps over at most a fifth of the run (a longer probe is not thrown away; a tenth
+  /// until the stiff method started at once from 200 stability-bound steps instead of 500: a window of
+  /// 20 steps at the stability limit then spans more than a tenth of any run below that).
   bool restart(const IntegratorStats& stats, double t0, double span) const {
-    return stiff_running_ && stats.auto_trials == 1 && stats.steps <= probe && t_mark_ - t0 <= 0.1 * span;
+    return stiff_running_ && stats.auto_trials == 1 && stats.steps <= probe && t_mark_ - t0 <= 0.2 * span;
   }
   bool stiff_running() const { return stiff_running_; }
   /// The trial starts at t0 instead (restart): it will be measured when it reaches the time the probe
@@ -353,15 +372,34 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
   IntegratorStats& stats = traj.stats;
   Recorder out(sys, traj, t_eval);
   const int n = sys.nq;
-  const Tolerances asked{o.atol.size() == 1 ? VecX::Constant(2 * n, o.atol(0)) : o.atol,
-                         o.rtol.size() == 1 ? VecX::Constant(2 * n, o.rtol(0)) : o.rtol, t_end - t0};
+  const bool adaptive = is_adaptive(o);
+  // The outputs the error is measured on (error_measure.hpp), for adaptive runs; none: the state.
+  std::unique_ptr<ErrorMeasure> measure;
+  if (adaptive && !o.error_on.empty()) {
+    measure = std::make_unique<ErrorMeasure>(sys, o.error_on, t0, q0);
+    stats.model_size = measure->length();
+  }
+  // On outputs, the state's weights (Newton's increments, first steps) take as atol the rotation (rad)
+  // that moves a point at the model's far end L by the length tolerance: (atol + rtol L)/L.
+  const double state_atol = measure ? (o.atol(0) + o.rtol(0) * measure->length()) / measure->length() : o.atol(0);
+  const Tolerances asked{o.atol.size() == 1 ? VecX::Constant(2 * n, state_atol) : o.atol,
+                         o.rtol.size() == 1 ? VecX::Constant(2 * n, o.rtol(0)) : o.rtol,
+                         t_end - t0,
+                         measure.get(),
+                         o.atol(0),
+                         o.rtol(0)};
   // auto runs dopri5 at rtol <= 1e-3 (atol scaled alike): looser, its error control lets the stiff
   // modes of a beam go unstable (measured: the classical cantilever at rtol = 1e-2 ... 1e-1).
   const double loosest = asked.rtol.size() ? asked.rtol.maxCoeff() : 0.0;  // nq = 0: no tolerance to tighten
   const double tighten = o.method == Method::Auto && loosest > AutoChoice::loosest_explicit
                              ? AutoChoice::loosest_explicit / loosest : 1.0;
-  const Tolerances explicit_tol{tighten * asked.atol, tighten * asked.rtol, asked.span};
-  const bool adaptive = is_adaptive(o);
+  // auto's dopri5 holds the state whatever the outputs, to the tolerances as given: an explicit method's
+  // stability rests on its error control, and a mode that no output sees would grow unseen until it does.
+  Tolerances explicit_tol = asked.scaled(tighten);
+  if (o.method == Method::Auto && measure) {
+    explicit_tol.measure = nullptr;
+    explicit_tol.atol = tighten * (o.atol.size() == 1 ? VecX::Constant(2 * n, o.atol(0)) : o.atol);
+  }
   const double span = t_end - t0, grid = std::min(o.dt, o.max_step), near_end = t_end - 1e-12 * span;
 
   VecX y0(2 * n + sys.nz);
@@ -383,6 +421,7 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
   double err_prev = 1.0;  // the error estimate of the last accepted step (PI control)
   bool rejected_last = false;
   int stiff_steps = 0, nonstiff_steps = 0;  // Hairer's stiffness test (h ρ, dopri5)
+  bool measured = false;                    // the measure is linearised at the current state
   while (t < t_end) {
     // The step: to the grid point t0 + k·dt (fixed) or by h (adaptive), to t_end for the last one.
     double hs, t1;
@@ -399,6 +438,7 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
       step_failure(t, hs, "max_steps = " + std::to_string(o.max_steps) + " reached");
     if (hs < 16.0 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t)))
       step_failure(t, hs, "the step size fell below the minimum: the problem is too stiff or singular for this method");
+    if (measure && !measured) measure->at(t, stepper->state()), measured = true;  // linearised at the step's start
     double err = 0.0;
     if (!stepper->attempt(t, hs, adaptive ? tol : nullptr, err)) {
       if (!adaptive)
@@ -438,6 +478,7 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
       }
     }
     stepper->accept();
+    measured = false;
     if (sys.nl > 0) stepper->project(t1);
     t = t1;
     ++stats.steps;
@@ -464,6 +505,7 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
       }
       if (!choice.stiff_running()) h = choice.explicit_step();
       tol = choice.stiff_running() ? &asked : &explicit_tol;
+      measured = false;
       rejected_last = false;
       err_prev = 1.0;
     }

@@ -86,7 +86,14 @@ class NewmarkFamily final : public Stepper {
     // method propagates the solution it estimates, so the steps' errors add up (coherently, in the phase
     // of an oscillation); held to tol · h / span each, they add up to the tolerance over the run.
     const int n = sys_.nq;
-    err = error_norm((h * h * (beta_ - 1.0 / 6.0)) * (s1_.a - s_.a), s_.q, s1_.q, tol->atol.head(n), tol->rtol.head(n));
+    const VecX eq = (h * h * (beta_ - 1.0 / 6.0)) * (s1_.a - s_.a);
+    if (tol->measure) {
+      e_.resize(2 * n);
+      e_ << eq, VecX::Zero(n);
+      err = tol->norm(e_, e_, e_, h);  // on the outputs: the positions' error only
+    } else {
+      err = error_norm(eq, s_.q, s1_.q, tol->atol.head(n), tol->rtol.head(n));
+    }
     if (tol->span > 0.0) err *= tol->span / h;
     return true;
   }
@@ -260,6 +267,7 @@ class NewmarkFamily final : public Stepper {
   double t_ = 0.0, h_step_ = 1.0;    // the last attempted step
   VecX y_;                           // [q, q̇, s] after it
   VecX ya_, fa_, yb_, fb_, sa_;      // [q, q̇] and [q̇, q̈] before and after it, s before it
+  VecX e_;                           // (2 nq) the error estimate [e_q, 0] on outputs
 };
 
 }  // namespace

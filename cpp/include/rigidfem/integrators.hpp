@@ -12,6 +12,7 @@
 #include <string>
 #include <vector>
 
+#include "rigidfem/error_measure.hpp"
 #include "rigidfem/system.hpp"
 
 namespace rigidfem {
@@ -62,6 +63,9 @@ struct IntegratorOptions {
   IterationMatrix iteration_matrix = IterationMatrix::Auto;
   Method stiff_method = Method::GeneralizedAlpha;  ///< auto: the implicit method it hands over to
   VecX s0;  ///< (nz) the Maxwell arms' initial forces (N or N·m, arms.hpp); empty: relaxed, zero
+  /// The outputs an adaptive method measures its local error on (error_measure.hpp), held to the
+  /// scalars atol and rtol; empty: every component of the state [q, q̇] to its atol_i + rtol_i |y_i|.
+  std::vector<OutputSpec> error_on;
 };
 
 struct IntegratorStats {
@@ -77,6 +81,8 @@ struct IntegratorStats {
   /// structure), NaN for the other methods.
   double omega_max = std::numeric_limits<double>::quiet_NaN();
   long probe_steps = 0;  ///< auto: dopri5's steps before its stiff method restarted from t0 (0: no probe)
+  /// The model's size L (m) that a relative tolerance on points and bodies refers to (error_on), NaN without.
+  double model_size = std::numeric_limits<double>::quiet_NaN();
 };
 
 /// States at the output times (every accepted step when no output times are given).

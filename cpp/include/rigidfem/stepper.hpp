@@ -13,11 +13,22 @@
 
 namespace rigidfem {
 
-/// Error weights per component of y = [q, q̇] (2 nq each): sc_i = atol_i + rtol_i max(|y0_i|, |y1_i|).
-/// span: the run's length t_end − t0 (s), for the methods that control the error per unit step.
+class ErrorMeasure;
+
+/// What a step's error is held to: per component of y = [q, q̇] (2 nq each) with the weights
+/// sc_i = atol_i + rtol_i max(|y0_i|, |y1_i|), or, with a `measure`, on its outputs with the scalars
+/// output_atol, output_rtol (error_measure.hpp). span: the run's length t_end − t0 (s), for the methods
+/// that control the error per unit step.
 struct Tolerances {
   VecX atol, rtol;
   double span = 0.0;
+  ErrorMeasure* measure = nullptr;
+  double output_atol = 0.0, output_rtol = 0.0;
+  /// The scaled norm of the error e = [e_q, e_q̇] (2 nq) of the step y0 → y1 over h (s): on the
+  /// outputs, or per component of the state.
+  double norm(const VecX& e, const VecX& y0, const VecX& y1, double h) const;
+  /// The tolerances scaled by `factor` (atol and rtol alike).
+  Tolerances scaled(double factor) const;
 };
 /// RMS of v_i / sc_i, with 0/0 counted as 0 (an exactly zero component under a pure relative
 /// tolerance); 0 for an empty vector (nq = 0).

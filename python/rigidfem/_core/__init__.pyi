@@ -522,6 +522,10 @@ class IntegratorOptions:
     stiff_method: str
     def __init__(self) -> None:
         ...
+    def set_error_on(self, outputs: collections.abc.Sequence[tuple[str, typing.SupportsInt | typing.SupportsIndex, typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]]]) -> None:
+        """
+        The outputs the error is measured on: (kind, index, r) each; [] for the state.
+        """
     @property
     def adaptive(self) -> int:
         """
