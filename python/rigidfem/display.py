@@ -126,6 +126,9 @@ def result_html(result) -> str:
              "steps": _stat(s, "steps"), "rejected steps": _stat(s, "rejected_steps"),
              "rhs evaluations": _stat(s, "rhs_evaluations"), "Newton iterations": _stat(s, "newton_iterations"),
              "wall time": f"{s.get('wall_time', float('nan')):.3g} s", "interrupted": result.interrupted}
+    estimate = getattr(result, "estimate", None)
+    if estimate is not None:
+        facts["estimated error"] = "; ".join(f"{n}: {m:.2g} {u}" for n, u, m in estimate.table())
     return _facts("rigidfem Result", facts)
 
 

@@ -5,7 +5,9 @@ Column names of a Result's table (``Result.to_dataframe``, ``Result.to_csv``):
 - ``t``: time, s (the DataFrame's index; the first CSV column);
 - one column per coordinate, named as in ``System.coordinate_names`` (``"link.rz"``): q, m or rad;
 - ``<name>.dot`` per coordinate: q̇, m/s or rad/s;
-- for ``points={"tip": beam.tip}``: ``tip.x``, ``tip.y``, ``tip.z``, the global position in m.
+- for ``points={"tip": beam.tip}``: ``tip.x``, ``tip.y``, ``tip.z``, the global position in m;
+- once ``Result.error_estimate`` has been computed: ``<output>.error`` per output it estimates
+  (``bodies.error`` by default), the estimated time-integration error in the output's unit.
 
 The modes' table (``Modes.table``, ``Modes.to_dataframe``) has the columns ``mode`` (1, 2, ...),
 ``omega (rad/s)``, ``f (Hz)`` and ``zeta`` (the modal damping ratio, dimensionless).
@@ -20,6 +22,8 @@ import numpy as np
 
 #: Suffix of the velocity columns: "<coordinate name>.dot" holds q̇ (m/s or rad/s).
 RATE = ".dot"
+#: Suffix of the error columns: "<output>.error" holds Result.error_estimate's history, once computed.
+ERROR = ".error"
 MODE_COLUMNS = ("mode", "omega (rad/s)", "f (Hz)", "zeta")
 
 
@@ -47,6 +51,10 @@ def result_columns(result, points=None) -> tuple[list[str], np.ndarray]:
     for key, point in points.items():
         columns += [f"{key}.{axis}" for axis in "xyz"]
         blocks.append(result.position(point))  # checks the point (ValueError naming it)
+    estimate = getattr(result, "estimate", None)
+    if estimate is not None:  # the error bar, once computed: "<output>.error" in its unit
+        columns += [f"{name}{ERROR}" for name in estimate.names]
+        blocks.append(estimate.history)
     return columns, np.hstack(blocks).reshape(len(result.t), len(columns))
 
 

@@ -23,8 +23,8 @@ name                   scheme                                                   
                        simplified Newton on all stages in the transformed         or ``dt``
                        real/complex form (exact tangent only), Hairer's filtered
                        estimate, PI control, dense output quintic Hermite
-``"auto"`` (default)   radau5 (rtol <= 0.03; else esdirk43) from the start where     ``rtol``/``atol``
-                       ω_max at t0 makes dopri5 take >= 500 steps for stability;
+``"auto"`` (default)   radau5 (esdirk43 with Maxwell arms) from the start where     ``rtol``/``atol``
+                       ω_max at t0 makes dopri5 take >= 200 steps for stability;
                        else dopri5, handing over for good where its steps sit at
                        the stability limit; the choice in ``stats["method"]``
 ``"scipy:Radau"`` …    SciPy's solvers (Radau, BDF, LSODA, RK45, DOP853) with the  ``rtol``/``atol``
@@ -77,7 +77,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _checks, _core, display, export
+from . import _checks, _core, display, error_control, export
 from ._progress import ProgressBar
 from .persistence import Versioned
 from ._core import Body, Point
@@ -94,7 +94,10 @@ class Result(Versioned):
     without arms. The other arrays are computed from them on first use: ``qdd`` (len(t), nq),
     ``driving_forces`` (len(t), np; N or N·m), energies (len(t),; J; the elastic energy holds the
     arms' Σ s²/(2k)) and ``dissipated_power`` (len(t),; W). ``stats`` holds steps, rejected_steps,
-    rhs_evaluations, jacobians, factorizations, newton_iterations and wall_time (s).
+    rhs_evaluations, jacobians, factorizations, newton_iterations, wall_time (s) and model_size (m:
+    the L that a relative tolerance on outputs refers to; NaN when the run held the state).
+    ``error_estimate`` is the error bar of the time integration (computed on first use: a second run);
+    ``run`` keeps the arguments of the call that made the result.
     """
 
     system: object = field(repr=False)
@@ -105,6 +108,8 @@ class Result(Versioned):
     method: str
     interrupted: bool = False
     arm_forces: np.ndarray = None
+    run: dict = field(default=None, repr=False)        #: the arguments of the simulate call that made it
+    estimate: object = field(default=None, repr=False)  #: the ErrorEstimate, once computed
 
     def __post_init__(self):
         if self.arm_forces is None:
@@ -164,6 +169,18 @@ class Result(Versioned):
         per ``system.element_names``; positive pushing the two points apart."""
         return self.system._element_force_history(self.t, self.q, self.qd)
 
+    @property
+    def error_estimate(self):
+        """The estimated global time-integration error of the outputs the run measured its error on
+        (``error_on``; "bodies" by default), an ``ErrorEstimate``: computed on first use by a second run
+        at tolerances 10 times smaller (adaptive methods) or at half the step (fixed steps; Richardson's
+        factor 2^p/(2^p − 1) for order p), then kept; ``simulate(..., error_estimate=True)`` computes it
+        with the run. ``res.error_estimate.of(lambda r: r.position(beam.tip))`` estimates any other
+        quantity's error. The model's own (spatial) error is ``rigidfem.resolve``'s."""
+        if self.estimate is None:
+            self.estimate = _estimate_error(self)
+        return self.estimate
+
     def position(self, point, frame: Body | None = None) -> np.ndarray:
         """Positions (len(t), 3) in m of a ``Point`` (or a ``Body``'s origin), in the global
         frame or in the frame of the body ``frame``."""
@@ -182,8 +199,11 @@ class Result(Versioned):
     def __repr__(self) -> str:
         s = self.stats
         chosen = f" ({s['method']})" if "method" in s else ""
+        bar = ""
+        if self.estimate is not None:
+            bar = ", estimated error " + ", ".join(f"{n} {m:.2g} {u}" for n, u, m in self.estimate.table())
         return (f"<rigidfem Result {self.method}{chosen}: {len(self.t)} outputs to t = {self.t[-1]:g} s, {s['steps']} steps "
-                f"({s['rejected_steps']} rejected), {s['rhs_evaluations']} rhs, {s['wall_time']:.3g} s"
+                f"({s['rejected_steps']} rejected), {s['rhs_evaluations']} rhs, {s['wall_time']:.3g} s{bar}"
                 f"{', interrupted' if self.interrupted else ''}>")
 
     def _repr_html_(self) -> str:
@@ -220,19 +240,20 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
              first_step: float | None = None, stiffness_warning: bool = True,
              max_steps: int = 1_000_000, max_step: float = np.inf, adaptive: bool | None = None, beta: float = 0.25,
              gamma: float = 0.5, alpha: float = -0.05, rho_inf: float = 0.8, newton_tol: float = 1e-10,
-             newton_max_iterations: int = 10, iteration_matrix: str = "auto", stop=None, s0=None) -> Result:
+             newton_max_iterations: int = 10, iteration_matrix: str = "auto", stop=None, s0=None,
+             error_on=None, error_estimate: bool = False) -> Result:
     """Integrate ``system`` from ``t0`` to ``t_end`` (s) in C++ (no Python per step).
 
     Parameters
     ----------
     method : str
-        "auto" (default): dopri5 while it is the cheaper, a stiff method where it is not: radau5 at
-        rtol <= 0.03 (``AUTO_RADAU_RTOL``), esdirk43 at looser tolerances, with Maxwell arms or with
-        ``iteration_matrix="spring"`` (measured with ``python -m rigidfem bench``: radau5's order 5 wins
-        at practical tolerances, esdirk43's cheaper stages at rough ones). First auto estimates the
+        "auto" (default): dopri5 while it is the cheaper, a stiff method where it is not: radau5, or
+        esdirk43 with Maxwell arms or with ``iteration_matrix="spring"`` (radau5 takes neither). dopri5
+        holds the state (its stability rests on its error control); radau5 measures its error on the
+        outputs (``error_on``: the bodies' displacements by default), esdirk43 holds the state. First auto estimates the
         spectral radius ρ of the Jacobian of (q̇, q̈) at t0 (``stats["omega_max"]``, rad/s: the highest
         natural frequency of an undamped structure; power iteration, at most 41 right-hand sides).
-        Where dopri5 would need at least 500 steps for stability alone ((t_end − t0) ρ / 3.3 >= 500)
+        Where dopri5 would need at least 200 steps for stability alone ((t_end − t0) ρ / 3.3 >= 200)
         the stiff method runs from t0. Otherwise dopri5 runs in windows of 20 accepted steps (at
         rtol <= 1e-3: looser, its error control lets the stiff modes of a beam go unstable). If its
         first window holds a fifth of its steps at the stability boundary (h ρ > 2), the stiff
@@ -262,10 +283,32 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
     dt : float
         Step (s) of the fixed-step methods: steps end on t0 + k·dt exactly, the last on t_end.
     rtol, atol : float or (2 nq,) array
-        Error control of adaptive methods, per component of y = [q, q̇] (m, rad; per s). With
-        atol = 0 a component's tolerance is purely relative (an exactly zero component counts as
-        exact). SciPy's methods raise rtol to their floor 100 ε; scipy:Radau and scipy:BDF take one
-        rtol, the smallest given.
+        Error control of adaptive methods. On outputs (``error_on``) each output's local error is held
+        to atol + rtol × scale: the model's size L (m, ``stats["model_size"]``: the diagonal of the box
+        holding the bodies' origins and centres of mass at t0) for points and bodies, so that rtol is
+        relative to the model and atol is in m; the largest magnitude reached so far for coordinates,
+        element forces and loop reactions. On the state, per component of y = [q, q̇] (m, rad; per s):
+        atol_i + rtol_i |y_i|, with atol = 0 a purely relative tolerance (an exactly zero component
+        counts as exact); (2 nq,) arrays are per component and imply ``error_on="state"``. SciPy's
+        methods raise rtol to their floor 100 ε; scipy:Radau and scipy:BDF take one rtol, the
+        smallest given.
+    error_on : None, "bodies", "state" or list, optional
+        What the adaptive C++ methods measure their local error on (``rigidfem.error_control``):
+        a list of points and bodies (their positions, m), coordinate names or indices (m or rad),
+        force element names (their axial force, N) and loop names (their multipliers, N or N·m), each
+        error mapped from the state's through the output's Jacobian, a velocity's held as the
+        displacement it makes over the step. ``None`` (the default): "bodies" — every body's
+        displacement, the RMS over its material √(|δc|² + δθᵀ I_C δθ/m) — for radau5, the adaptive
+        Newmark family and auto's radau5; "state" for dopri5, rkf45, esdirk43 and auto's dopri5 phase
+        (an explicit method's stability rests on holding every component; esdirk43's filtered
+        estimate hides most of what it damps). On outputs a mode that no output sees is not resolved:
+        the L-stable radau5 damps it (the released strip of 1 m, m = 32: 2,800 steps to 1e-6 m
+        instead of 177,000). radau5 counts 10 times an oscillation that a step neither resolves nor
+        damps (its error adds up over the steps that follow): the largest tip error of the benchmark's
+        scenes is then 0.02-2 times rtol × L (``python -m benchmarks accuracy``).
+    error_estimate : bool
+        Compute ``Result.error_estimate`` with the run (a second run at tolerances / 10, or at dt / 2
+        for fixed steps); it is computed on first use otherwise.
     first_step : float, optional
         First step (s) of an adaptive run (scipy: methods too); estimated (Hairer's rule) by
         default. scipy: methods check dt, adaptive, beta, ... like the others but do not use them.
@@ -356,6 +399,18 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
     max_steps = _checks.integer(max_steps, "max_steps", minimum=1, maximum=2**62)
     max_step = _checks.step_limit(max_step, "max_step")
     rtol, atol = _tolerance(rtol, "rtol", n, 1e-6), _tolerance(atol, "atol", n, 1e-9)
+    per_component = np.size(rtol) > 1 or np.size(atol) > 1
+    if per_component and error_on is not None and not (isinstance(error_on, str) and error_on == "state"):
+        raise ValueError(f"rtol, atol: expected one value each with error_on={error_on!r} (per-component "
+                         f"tolerances hold the state: error_on='state'), got {np.size(rtol)} and {np.size(atol)}")
+    fixed = adaptive is False or (method in _FIXED_STEP and adaptive is not True)
+    if error_on is not None and (method.startswith("scipy:") or fixed) and not (
+            isinstance(error_on, str) and error_on == "state"):
+        raise ValueError(f"error_on: expected None or 'state' for {method!r}"
+                         f"{' at fixed steps' if fixed else ''} (it controls no error on outputs), got {error_on!r}")
+    state = per_component or method.startswith("scipy:") or (error_on is None and not _measures_outputs(
+        method, system, iteration_matrix))
+    outputs = [] if state else error_control.specs(system, error_on)
     if stop is not None and not callable(getattr(stop, "is_set", None)):
         raise ValueError(f"stop: expected None or a threading.Event (an object with is_set()), got {stop!r}")
     _check_closed(system, t0, q0, qd0)
@@ -371,13 +426,14 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
         opt = _options("dopri5" if scipy else method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, beta,
                        gamma, alpha, rho_inf, newton_tol, newton_max_iterations, iteration_matrix)
         if method == "auto":
-            opt.stiff_method = _auto_stiff_method(system, rtol, iteration_matrix)
+            opt.stiff_method = _auto_stiff_method(system, iteration_matrix)
         if scipy:
             first = None if first_step is None else opt.dt
             run = _run_scipy(system, method[6:], t0, t_end, q0, qd0, t_eval, rtol, atol, max_step, max_steps,
                              _keep_going(bar, stop, t0), first)
         else:
             opt.s0 = s0
+            opt.set_error_on(outputs)
             run = _core._integrate(system, t0, t_end, q0, qd0, t_eval, opt, _keep_going(bar, stop, t0))
     finally:
         if bar is not None:
@@ -386,7 +442,11 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
     arms = arms[0] if arms else np.zeros((len(t), 0))
     if method == "auto":
         stats["method"] = _auto_choice(stats, opt.stiff_method, t0)
-    result = Result(system, t, q, qd, stats, method, interrupted, arms)
+    call = dict(method=method, t_end=t_end, t0=t0, q0=q0, qd0=qd0, s0=s0, t_eval=t_eval if len(t_eval) else None,
+                rtol=rtol, atol=atol, dt=dt, first_step=first_step, max_steps=max_steps, max_step=max_step,
+                adaptive=adaptive, beta=beta, gamma=gamma, alpha=alpha, rho_inf=rho_inf, newton_tol=newton_tol,
+                newton_max_iterations=newton_max_iterations, iteration_matrix=iteration_matrix, error_on=error_on)
+    result = Result(system, t, q, qd, stats, method, interrupted, arms, dict(call, outputs=bool(outputs), fixed=fixed))
     if failure is not None:
         message, time, cause = failure
         error = _core.SimulationError(message)
@@ -401,7 +461,38 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
     if interrupted:
         warnings.warn(f"simulation interrupted at t = {t[-1] if len(t) else t0:g} s: returning the partial result",
                       RuntimeWarning, stacklevel=2)
+    elif _checks.boolean(error_estimate, "error_estimate"):
+        result.estimate = _estimate_error(result)
     return result
+
+
+#: The order of each C++ method's propagated solution (Richardson's factor of a fixed-step error estimate).
+_ORDER = {"euler": 1, "symplectic_euler": 1, "rk4": 4, "dopri5": 5, "rkf45": 4, "newmark": 2, "hht": 2,
+          "generalized_alpha": 2, "implicit_spring": 2, "esdirk43": 4, "radau5": 5}
+
+
+def _estimate_error(result: Result):
+    """Result.error_estimate: the second run (tolerances / TIGHTER, or dt / 2) at the same output times."""
+    run = result.run
+    if run is None:
+        raise ValueError("result: expected a Result made by rigidfem.simulate (a loaded one has no run to repeat)")
+    if result.interrupted or not len(result.t) or result.t[-1] < run["t_end"]:
+        raise ValueError("result: expected a finished run for its error estimate, got one that stopped at "
+                         f"t = {result.t[-1] if len(result.t) else run['t0']:g} s")
+    kw = {k: v for k, v in run.items() if k not in ("outputs", "fixed")}
+    kw["t_eval"], kw["stiffness_warning"] = result.t, False
+    if run["fixed"]:
+        kw["dt"] = run["dt"] / 2.0
+        order = _ORDER[run["method"]]
+    else:
+        kw["rtol"], kw["atol"] = run["rtol"] / error_control.TIGHTER, run["atol"] / error_control.TIGHTER
+        kw["max_steps"] = 10 * run["max_steps"]
+        order = None
+    try:
+        rerun = simulate(result.system, **kw)
+    except _core.SimulationError as e:
+        raise _core.SimulationError(f"error_estimate: the second run failed {e}") from e
+    return error_control.estimate(result, rerun, order)
 
 
 def _check_closed(system, t0, q0, qd0, tol=1e-8):
@@ -417,10 +508,11 @@ def _check_closed(system, t0, q0, qd0, tol=1e-8):
                              "system.assemble(q0, qd0, t0) finds the nearest ones")
 
 
+#: The methods that run at a fixed step unless told otherwise (adaptive=True: the Newmark family).
+_FIXED_STEP = ("euler", "symplectic_euler", "rk4", "newmark", "hht", "generalized_alpha", "implicit_spring")
+
 #: The implicit method ``method="auto"`` hands over to when dopri5 finds the problem stiff.
 AUTO_STIFF_METHOD = "esdirk43"
-#: auto's stiff method at rtol <= this (and no Maxwell arms, no spring matrix): radau5, of order 5
-AUTO_RADAU_RTOL = 3e-2
 
 
 def _auto_choice(stats: dict, stiff_method: str, t0: float) -> str:
@@ -463,12 +555,20 @@ def _options(method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, 
     return opt
 
 
-def _auto_stiff_method(system, rtol, iteration_matrix: str) -> str:
-    """auto's stiff method: radau5 at rtol <= AUTO_RADAU_RTOL, unless the system has Maxwell arms or the
-    spring matrix is asked for (radau5 takes neither); esdirk43 otherwise."""
-    if np.max(rtol) <= AUTO_RADAU_RTOL and not system.nz and iteration_matrix != "spring":
-        return "radau5"
-    return AUTO_STIFF_METHOD
+def _auto_stiff_method(system, iteration_matrix: str) -> str:
+    """auto's stiff method: radau5, unless the system has Maxwell arms or the spring matrix is asked for
+    (radau5 takes neither); esdirk43 then."""
+    return "radau5" if not system.nz and iteration_matrix != "spring" else AUTO_STIFF_METHOD
+
+
+def _measures_outputs(method: str, system, iteration_matrix: str) -> bool:
+    """Whether ``error_on=None`` measures the bodies' displacements (else the state): for radau5, the
+    adaptive Newmark family and auto when its stiff method is radau5 — the methods whose estimate sees
+    what a step loses of an oscillation. dopri5 and rkf45 hold the state (their stability rests on their
+    error control), esdirk43 too (its filtered estimate hides most of what it damps: error_control)."""
+    if method == "auto":
+        return _auto_stiff_method(system, iteration_matrix) == "radau5"
+    return method in ("radau5", "newmark", "hht", "generalized_alpha", "implicit_spring")
 
 
 def _keep_going(bar, stop, t0):
