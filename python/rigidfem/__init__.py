@@ -41,6 +41,8 @@ from .simulation import Result, load_npz, simulate
 from . import display, export  # noqa: E402 (notebook displays; tables, CSV and NumPy archives)
 from .linearize import NotAnEquilibriumWarning, linearize  # noqa: E402 (rigidfem.linearize: the function)
 from .sweep import sweep
+from .resolution import Plan, ResolveError, resolve  # noqa: E402 (rf.resolve: elements and deformations for a tolerance)
+from .error_control import ErrorEstimate  # noqa: E402
 
 __version__ = "0.1.0"
 
@@ -62,6 +64,7 @@ __all__ = [
     "Body",
     "Data",
     "Equilibrium",
+    "ErrorEstimate",
     "Joint",
     "JointSpec",
     "Material",
@@ -69,8 +72,10 @@ __all__ = [
     "Model",
     "NotAnEquilibriumWarning",
     "Modes",
+    "Plan",
     "Point",
     "Profile",
+    "ResolveError",
     "Result",
     "Section",
     "SimulationError",
@@ -91,6 +96,7 @@ __all__ = [
     "load_npz",
     "modal_analysis",
     "motion",
+    "resolve",
     "rfe_parameters",
     "sde_parameters",
     "samples",
