@@ -119,3 +119,19 @@ def test_tolerance_study_quick(tmp_path, capsys):
     assert all(r["warned"] in ("no", "warning") for r in table.rows)
     assert [r["method"] for r in fixed.rows] == ["implicit_spring"] and fixed.rows[0]["finished"] in ("yes", "no")
     assert (tmp_path / "tolerance.csv").exists() and "| method | rtol | tip_error_rms_m |" in capsys.readouterr().out
+
+
+def test_accuracy_study_quick(tmp_path, capsys):
+    """The accuracy benchmark's quick run (the strip at m = 8, the modified cantilever at m = 6, to 1e-4 m):
+    the default asked for the target delivers it, its error bar is within a factor 3 of its true error,
+    and the best run of the sweep is at least as accurate as the target."""
+    from benchmarks import accuracy
+
+    tables = accuracy.run(tmp_path, quick=True)
+    table, runs = tables["accuracy"], tables["accuracy_sweep"]
+    assert table.columns == accuracy.COLUMNS and [r["scene"] for r in table.rows] == ["strip m=8", "cantilever modified m=6"]
+    for row in table.rows:
+        assert row["delivered_over_asked"] <= 1.0 and 1 / 3 < row["estimate_over_true"] < 3, row
+        assert row["best_error_m"] <= row["target_m"] and row["auto_over_best"] > 0
+    assert {r["method"] for r in runs.rows} >= {"auto", "radau5", "radau5 (state)", "esdirk43", "generalized_alpha"}
+    assert (tmp_path / "accuracy.csv").exists() and "| scene | target_m | auto_error_m |" in capsys.readouterr().out
