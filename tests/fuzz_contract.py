@@ -1676,6 +1676,8 @@ class Gen:
         for key in ("q0", "qd0"):
             if self.chance(0.5):
                 kw[key] = self.vector_arg(key)
+                if key == "q0" and kw[key].get("x"):
+                    kw[key]["soft"] = 1  # beyond ±1e15 m or rad simulate refuses q0 (a step drowns in rounding)
         if self.chance(0.7) or heavy:
             if self.chance(0.1):
                 kw["max_steps"] = A(self.choice(["0", "-3", "2.5", "'10'", "None", "10**30", "True", "nan"]), bad=True)

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "rigidfem/errors.hpp"
+#include "rigidfem/transforms.hpp"
 
 namespace rigidfem::bindings {
 namespace py = pybind11;
@@ -82,6 +83,32 @@ M matrix_arg(const py::handle& x, const std::string& name, const std::string& ex
     if (kind == 'c') bad(name, expected + " (real numbers)", "complex values");
   }
   bad(name, expected, arg_repr(x));
+}
+
+/// A 1-D array of real numbers (a numpy array or sequence; complex numbers, strings, None and 2-D
+/// arrays such as (1, n) are refused rather than converted or flattened).
+inline VecX vector_arg(const py::handle& x, const std::string& name, const std::string& expected) {
+  PyObject* o = x.ptr();
+  if (!x.is_none() && !PyUnicode_Check(o) && !PyBytes_Check(o)) {
+    const py::array a = py::array::ensure(x);
+    const char kind = a ? a.dtype().kind() : 'x';
+    if (kind == 'c') bad(name, expected + " (real numbers)", "complex values");
+    if ((kind == 'f' || kind == 'i' || kind == 'u' || kind == 'b') && a.ndim() != 1)
+      bad(name, expected, "an array of " + std::to_string(a.ndim()) + " dimensions");
+    if (kind == 'f' || kind == 'i' || kind == 'u' || kind == 'b') return py::cast<VecX>(a);
+  }
+  bad(name, expected, arg_repr(x));
+}
+
+/// A list of strings (names), each refused with the argument's name if it is not a string.
+inline std::vector<std::string> names_arg(const py::handle& x, const std::string& name, const std::string& expected) {
+  if (PyUnicode_Check(x.ptr()) || !py::isinstance<py::sequence>(x)) bad(name, expected, arg_repr(x));
+  std::vector<std::string> out;
+  for (const py::handle item : py::reinterpret_borrow<py::sequence>(x)) {
+    if (!PyUnicode_Check(item.ptr())) bad(name, expected, arg_repr(x));
+    out.push_back(item.cast<std::string>());
+  }
+  return out;
 }
 
 void bind_transforms(py::module_& m);

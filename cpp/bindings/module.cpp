@@ -41,27 +41,42 @@ void bind_transforms(py::module_& m) {
       "inverse", [](const py::object& T) { return inverse(matrix_arg<Mat4>(T, "T", "a homogeneous transform (4, 4)")); },
       py::arg("T"), "Inverse of a homogeneous transform, [[R^T, -R^T r], [0, 1]] (4, 4).");
 
-  auto axes_of = [](const std::vector<std::string>& names) {
+  // (coordinates, q) checked: names from x, y, z, rz, ry, rx; q a real vector of their number.
+  auto axes_of = [](const py::object& coordinates) {
     std::vector<Axis> axes;
-    for (const auto& n : names) axes.push_back(parse_coordinate(n, "coordinates"));
+    for (const auto& n : names_arg(coordinates, "coordinates", "a list of names from 'x', 'y', 'z', 'rz', 'ry', 'rx'"))
+      axes.push_back(parse_coordinate(n, "coordinates"));
     return Joint::make("custom", axes).axes;
+  };
+  auto values_of = [](const py::object& q, std::size_t n) {
+    const VecX v = vector_arg(q, "q", std::to_string(n) + " coordinates (m, rad), one per name");
+    check_vector(v, static_cast<Eigen::Index>(n), "q", "one per coordinate name");
+    return v;
   };
   m.def(
       "joint_transform",
-      [axes_of](const std::vector<std::string>& c, const VecX& q) { return joint_transform(axes_of(c), q); },
+      [axes_of, values_of](const py::object& c, const py::object& q) {
+        const auto axes = axes_of(c);
+        return joint_transform(axes, values_of(q, axes.size()));
+      },
       py::arg("coordinates"), py::arg("q"),
       "Joint transform Trans(x, y, z) R3(phi3) R2(phi2) R1(phi1) restricted to `coordinates`\n"
       "(names from 'x', 'y', 'z', 'rz', 'ry', 'rx', taken in the book's order); q in m and rad. (4, 4).");
   m.def(
       "joint_transform_derivative",
-      [axes_of](const std::vector<std::string>& c, const VecX& q, int i) {
-        return joint_transform_derivative(axes_of(c), q, i);
+      [axes_of, values_of](const py::object& c, const py::object& q, const py::object& i) {
+        const auto axes = axes_of(c);
+        return joint_transform_derivative(axes, values_of(q, axes.size()),
+                                          static_cast<int>(int_arg(i, "i", "the index of a coordinate")));
       },
       py::arg("coordinates"), py::arg("q"), py::arg("i"), "dT/dq_i of joint_transform (4, 4).");
   m.def(
       "joint_transform_second_derivative",
-      [axes_of](const std::vector<std::string>& c, const VecX& q, int i, int j) {
-        return joint_transform_second_derivative(axes_of(c), q, i, j);
+      [axes_of, values_of](const py::object& c, const py::object& q, const py::object& i, const py::object& j) {
+        const auto axes = axes_of(c);
+        return joint_transform_second_derivative(axes, values_of(q, axes.size()),
+                                                 static_cast<int>(int_arg(i, "i", "the index of a coordinate")),
+                                                 static_cast<int>(int_arg(j, "j", "the index of a coordinate")));
       },
       py::arg("coordinates"), py::arg("q"), py::arg("i"), py::arg("j"), "d2T/dq_i dq_j of joint_transform (4, 4).");
 }

@@ -225,16 +225,17 @@ double spectral_radius(const System& sys, double t, const VecX& q, const VecX& v
   VecX x(2 * n), y(2 * n), qe(n), ve(n);
   for (int i = 0; i < 2 * n; ++i) x(i) = 1.0 + 0.1 * (i % 7);  // every mode present, none favoured
   x.normalize();
-  auto apply = [&](const VecX& in, VecX& out) {  // out = J in
+  auto apply = [&](const VecX& in, VecX& out) {  // out = J in; false at a perturbed state beyond doubles
     qe = q + eps * in.head(n), ve = v + eps * in.tail(n);
+    if (!qe.allFinite() || !ve.allFinite()) return false;
     out.head(n) = in.tail(n);
     out.tail(n) = (forward_dynamics(sys, d, t, qe, ve) - a) / eps;
     ++evaluations;
+    return true;
   };
   double rho = 0.0;
   for (int k = 0; k < iterations; ++k) {
-    apply(x, y);
-    apply(y, x);
+    if (!apply(x, y) || !apply(y, x)) return rho;  // the last estimate
     const double norm = x.norm();
     if (!std::isfinite(norm)) return rho;  // the dynamics failed at a perturbed state: the last estimate
     if (norm == 0.0) return 0.0;           // nothing moves the state: no frequency

@@ -4,6 +4,7 @@
 #include <stdexcept>
 
 #include "rigidfem/arms.hpp"
+#include "rigidfem/constraints.hpp"
 #include "rigidfem/dynamics.hpp"
 #include "rigidfem/kinematics.hpp"
 
@@ -26,8 +27,9 @@ double gravity_energy(const System& sys, const Data& d) {
 double elastic_energy(const System& sys, const Data& d) {
   check_data(sys, d);
   double V = 0.0;
-  for (int i = 0; i < sys.nc; ++i)
-    V += 0.5 * d.spring_scale(i) * sys.coords[i].stiffness * std::pow(d.qa(i) - sys.coords[i].rest, 2);
+  for (int i = 0; i < sys.nc; ++i)  // the coordinates without a spring add nothing (not 0 · ∞ at a huge q)
+    if (sys.coords[i].stiffness != 0.0)
+      V += 0.5 * d.spring_scale(i) * sys.coords[i].stiffness * std::pow(d.qa(i) - sys.coords[i].rest, 2);
   for (const ForceElement& E : sys.elements) {  // ½ k (l − l₀)² of the elements' springs, ½ EA/l_u (l − l_u)² of taut ropes
     if (E.rope) {
       const auto [lu, lud] = unstretched_length(E, d.t);
@@ -122,7 +124,8 @@ StateOutputs evaluate_outputs(const System& sys, const Eigen::Ref<const VecX>& t
   if (Q.rows() != N || QD.rows() != N || Q.cols() != sys.nq || QD.cols() != sys.nq)
     throw std::invalid_argument("q, qd: expected (len(t), nq) arrays");
   if (S.rows() != N || S.cols() != sys.nz) throw std::invalid_argument("s: expected a (len(t), nz) array");
-  StateOutputs out{MatX(N, sys.nq), MatX(N, sys.np), VecX(N), VecX(N), VecX(N), VecX(N)};
+  const Eigen::Index nloops = static_cast<Eigen::Index>(sys.loops.size());
+  StateOutputs out{MatX(N, sys.nq), MatX(N, sys.np), VecX(N), VecX(N), VecX(N), VecX(N), MatX(N, 6 * nloops)};
   Data d(sys);
   VecX s(sys.nz);
   for (Eigen::Index k = 0; k < N; ++k) {
@@ -138,6 +141,10 @@ StateOutputs evaluate_outputs(const System& sys, const Eigen::Ref<const VecX>& t
     out.qdd.row(k) = d.qdd.transpose();
     driving_forces(sys, d);
     out.tau.row(k) = d.tau.transpose();
+    if (nloops) {
+      const RowMatX w = loop_reactions(sys, d, d.lambda);  // (nloops, 6), from this forward dynamics' λ
+      out.reactions.row(k) = Eigen::Map<const Eigen::RowVectorXd>(w.data(), w.size());
+    }
   }
   return out;
 }

@@ -52,6 +52,10 @@ SIGNATURES = {
     "_position": ("point", "q", "t"),
     "_positions": ("points", "q", "t"),
     "_velocity": ("point", "q", "qd", "t"),
+    "loop_constraints": ("t", "q", "qd"),
+    "loop_multipliers": ("t", "q", "qd"),
+    "loop_reactions": ("t", "q", "qd"),
+    "element_states": ("t", "q", "qd"),
 }
 
 
@@ -236,7 +240,7 @@ def guard(function: str, compiled, parameters: tuple, method: bool = True):
         if converted is not None:
             args, kwargs = tuple(converted[0]), converted[1]
         try:
-            return compiled(*args, **kwargs)
+            return _finite(function, compiled(*args, **kwargs), parameters, args[1:] if method else args, kwargs)
         except TypeError as e:
             if "incompatible function arguments" not in str(e):
                 raise
@@ -253,6 +257,24 @@ def guard(function: str, compiled, parameters: tuple, method: bool = True):
             raise
 
     return call
+
+
+def _finite(function: str, result, parameters: tuple, args: tuple, kwargs: dict):
+    """``result`` unless it holds NaN or inf, which finite inputs (checked by the compiled call) can only
+    give by overflowing the range of doubles: then a SimulationError naming the call, its time and the
+    largest input."""
+    values = result if isinstance(result, tuple) else (result,)
+    if all(not isinstance(v, (np.ndarray, float)) or np.all(np.isfinite(v)) for v in values):
+        return result
+    given = dict(zip(parameters, args)) | kwargs
+    t = given.get("t", 0.0)
+    t = float(t) if _numeric(t) and np.ndim(t) == 0 else 0.0
+    sizes = ", ".join(f"largest |{p}| = {np.max(np.abs(np.asarray(given[p], dtype=float))):.3g}"
+                      for p in parameters if p in VECTORS and p in given and np.size(given[p]))
+    error = SimulationError(f"at t = {t:.10g} s: {function}() overflowed: finite inputs ({sizes}) gave NaN or inf, "
+                            "beyond the range of doubles")
+    error.time, error.cause = t, f"{function}() overflowed"
+    raise error
 
 
 def guard_methods(cls) -> None:

@@ -33,7 +33,7 @@ import scipy.linalg
 import scipy.optimize
 from scipy.linalg import lapack
 
-from . import _checks, display, export
+from . import _checks, _core, display, export
 from ._core import SimulationError
 from .persistence import Versioned
 
@@ -288,7 +288,7 @@ def static_equilibrium(system, q0=None, t: float = 0.0, load_steps: int = 10, to
         what = f"statics at load factor {lam:.4g}"
         f = system.static_forces(t, q, lam)
         for it in range(1, max_iterations + 1):
-            K = -system.force_jacobians(t, q, np.zeros(n), lam, True)[0]
+            K = -_core._System.force_jacobians(system, t, q, np.zeros(n), lam, True)[0]
             _require_finite(t, what, **{"f(q)": f, "tangent stiffness K": K})
             dq = _solve_tangent(K, f)
             if dq is None:
@@ -348,7 +348,7 @@ def _constrained_statics(system, q: np.ndarray, t: float, steps: int, tol: float
         f, g, c = state(q, lf)
         lam = c.multipliers(-f)
         for it in range(1, max_iterations + 1):
-            K = -system.force_jacobians(t, q, zero, lf, True)[0]
+            K = -_core._System.force_jacobians(system, t, q, zero, lf, True)[0]
             _require_finite(t, what, **{"f(q)": f, "tangent stiffness K": K, "loop Jacobian G": c.G, "g(q)": g})
             Kt = K + _constraint_stiffness(system, t, q, lam)
             _require_finite(t, what, **{"geometric stiffness of the loops": Kt})
@@ -553,8 +553,8 @@ def modal_analysis(system, q=None, qd=None, t: float = 0.0) -> Modes:
                       "out: K and C are those of the relaxed structure (E = E_inf); rigidfem.linearize keeps the arms' "
                       "forces as states (the eigenvalues of its A are the viscoelastic modes')", UserWarning,
                       stacklevel=2)
-    M = system.mass_matrix(q, t)
-    dfdq, dfdqd = system.force_jacobians(t, q, qd)
+    M = _core._System.mass_matrix(system, q, t)
+    dfdq, dfdqd = _core._System.force_jacobians(system, t, q, qd)
     K, C = -dfdq, -dfdqd
     _require_finite(t, "modal analysis", **{"mass matrix": M, "stiffness K = −∂f/∂q": K,
                                             "damping/gyroscopic matrix C = −∂f/∂q̇": C})
@@ -563,9 +563,14 @@ def modal_analysis(system, q=None, qd=None, t: float = 0.0) -> Modes:
         return _constrained_modes(system, q, qd, t, M, K, C)
     _check_mass_matrix(M, names, t)
     try:
-        omega, zeta, shapes, lam = _modes(M, K, C)
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # an overflow is reported below
+            omega, zeta, shapes, lam = _modes(M, K, C)
     except np.linalg.LinAlgError as err:  # the eigensolvers' own failures, rare after the checks above
         raise SimulationError(f"{_frame(t, 'modal analysis')}: eigensolver failed ({err})") from err
+    if not (np.all(np.isfinite(omega)) and np.all(np.isfinite(lam)) and np.all(np.isfinite(shapes))):
+        raise SimulationError(f"{_frame(t, 'modal analysis')}: the eigenvalues overflowed (K/M beyond the range of "
+                              f"doubles: largest |K| = {np.max(np.abs(K)):.3g}, smallest mass-matrix diagonal "
+                              f"{np.min(np.abs(np.diag(M))):.3g})")
     order = np.argsort(omega, kind="stable")
     shapes = shapes[:, order] / np.max(np.abs(shapes[:, order]), axis=0)
     return Modes(omega[order], omega[order] / (2 * np.pi), zeta[order], shapes, lam[order], q, M, K, C)

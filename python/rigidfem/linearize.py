@@ -40,7 +40,7 @@ import warnings
 import numpy as np
 import scipy.signal
 
-from . import _checks
+from . import _checks, _core
 from ._core import Body, Point
 from .analysis import _EPS, _loop_tangent, _require_finite
 from .export import RATE
@@ -108,7 +108,7 @@ def linearize(system, q, qd=None, t: float = 0.0, inputs=(), outputs=None, dt: f
     dt = None if dt is None else _checks.scalar(dt, "dt", positive=True, unit="s")
     in_names, Q = _inputs(system, q, t, inputs)
     out_names, Cq, Cv, y0 = _outputs(system, q, qd, t, outputs)
-    M = system.mass_matrix(q, t)
+    M = _core._System.mass_matrix(system, q, t)
     if system.nl:
         A, B, N, C = _reduced(system, q, qd, t, M, Q, Cq, Cv)
         states = [f"y[{k}]" for k in range(N.shape[1])]
@@ -153,7 +153,7 @@ def _with_arms(system, M, N, A, B, C, states):
 
 def _reduced(system, q, qd, t, M, Q, Cq, Cv):
     """(A, B, N, C) of a closed chain in the loops' null space: δq = N δy (see the module docstring)."""
-    dfdq, dfdqd = system.force_jacobians(t, q, qd)
+    dfdq, dfdqd = _core._System.force_jacobians(system, t, q, qd)
     c, Kt, _ = _loop_tangent(system, q, qd, t, -dfdq, "linearize")
     N = c.N
     k = N.shape[1]
