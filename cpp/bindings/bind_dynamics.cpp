@@ -174,19 +174,6 @@ void bind_dynamics(py::module_& m) {
           "Reaction of every loop closure on its body b (nloops, 6): force (N) and torque (N m, about frame B's\n"
           "origin) in frame A's axes; for a distance loop (an actuator) the force along the line in column 0,\n"
           "positive pushing b away from a.")
-      .def(
-          "_loop_reaction_history",
-          [](const System& s, const RefV& t, const Eigen::Ref<const RowMatX>& q, const Eigen::Ref<const RowMatX>& qd) {
-            Workspace d(s);
-            RowMatX W(t.size(), 6 * s.loops.size());
-            for (Eigen::Index k = 0; k < t.size(); ++k) {
-              rigidfem::forward_dynamics(s, *d, t(k), q.row(k).transpose(), qd.row(k).transpose());
-              const RowMatX w = rigidfem::loop_reactions(s, *d, (*d).lambda);
-              W.row(k) = Eigen::Map<const Eigen::RowVectorXd>(w.data(), w.size());
-            }
-            return W;
-          },
-          py::arg("t"), py::arg("q"), py::arg("qd"))
       .def_property_readonly(
           "element_names",
           [](const System& s) {

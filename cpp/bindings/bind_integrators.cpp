@@ -119,7 +119,7 @@ void bind_integrators(py::module_& m) {
       [](const System& s, const Eigen::Ref<const VecX>& t, const Eigen::Ref<const RowMatX>& Q,
          const Eigen::Ref<const RowMatX>& QD, const Eigen::Ref<const RowMatX>& S) {
         StateOutputs o = evaluate_outputs(s, t, Q, QD, S);
-        return py::make_tuple(o.qdd, o.tau, o.kinetic, o.gravity, o.elastic, o.power);
+        return py::make_tuple(o.qdd, o.tau, o.kinetic, o.gravity, o.elastic, o.power, o.reactions);
       },
       py::arg("system"), py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("s"));
   m.def(
