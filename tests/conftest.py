@@ -84,3 +84,9 @@ def central_jacobians(s, t, q, qd, h=1e-6):
         Kq[:, j] = (s.generalized_forces(t, q + e, qd) - s.generalized_forces(t, q - e, qd)) / (2 * h)
         Kqd[:, j] = (s.generalized_forces(t, q, qd + e) - s.generalized_forces(t, q, qd - e)) / (2 * h)
     return Kq, Kqd
+
+
+def step_of(method: str, dt: float) -> dict:
+    """The keyword for a step dt: dt for a fixed-step method, first_step for an adaptive one (a dt would set
+    its first step with a UserWarning)."""
+    return {"first_step": dt} if method in ("auto", "dopri5", "rkf45", "esdirk43", "radau5") else {"dt": dt}

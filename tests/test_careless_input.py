@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import rigidfem as rf
+from conftest import step_of
 from rigidfem import stages
 
 
@@ -188,7 +189,7 @@ def test_per_component_tolerances_of_a_system_without_coordinates(method):
     m = rf.Model()
     m.add_body("b", m.ground, rf.Joint.fixed(), mass=0.5, inertia=(0.1, 0.1, 0.1))
     s = m.compile()
-    r = rf.simulate(s, 0.2, method=method, dt=0.05, rtol=np.full(0, 1e-6), atol=np.full(0, 1e-6))
+    r = rf.simulate(s, 0.2, method=method, **step_of(method, 0.05), rtol=np.full(0, 1e-6), atol=np.full(0, 1e-6))
     assert r.q.shape[1] == 0 and r.t[-1] == pytest.approx(0.2)
 
 

@@ -112,15 +112,8 @@ def test_error_on_element_forces_and_loop_reactions():
     r = rf.simulate(system, 1.0, q0=q0, rtol=1e-6, atol=0.0, error_on=[spring], t_eval=t)
     error = np.abs(r.element_forces[:, 0] - ref.element_forces[:, 0]).max()
     assert error < 20 * 1e-6 * np.abs(ref.element_forces).max(), error
-    model = rf.Model(gravity=(0, -9.81, 0))
-
-    def rod(L):
-        return dict(mass=1.0, inertia=(1e-4, L * L / 12, L * L / 12), com=(L / 2, 0, 0))
-
-    crank = model.add_body("crank", model.ground, rf.Joint.revolute("z"), **rod(0.3))
-    coupler = model.add_body("coupler", crank, rf.Joint.revolute("z"), **rod(0.8), placement=rf.transform((0.3, 0, 0)))
-    rocker = model.add_body("rocker", model.ground, rf.Joint.revolute("z"), **rod(0.6), placement=rf.transform((0.7, 0, 0)))
-    name = model.add_loop_joint("revolute", coupler.point((0.8, 0, 0)), rocker.point((0.6, 0, 0)), name="close")
+    model, h = rf.samples.four_bar()
+    name = h["loop"]
     system = model.compile()
     q0 = system.assemble([0.4, -1.9, 4.6])[0]
     r = rf.simulate(system, 1.0, q0=q0, rtol=1e-6, atol=0.0, error_on=[name], t_eval=t)

@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import rigidfem as rf
+from conftest import step_of
 
 A, B, C, D = 0.3, 0.8, 0.6, 0.7  # crank, coupler, rocker, ground link (m)
 G0 = 9.81
@@ -68,7 +69,7 @@ def test_driven_four_bar_follows_the_closed_form_and_the_power_balance(algorithm
     _, qd0 = s.assemble(q0, qd_exact + 0.1, t=0.0)
     np.testing.assert_allclose(qd0, qd_exact, atol=1e-7)
     t = np.linspace(0.0, 1.0, 201)
-    r = rf.simulate(s, 1.0, method=method, dt=1e-3, q0=q0, qd0=qd0, t_eval=t, rtol=1e-10, atol=1e-12)
+    r = rf.simulate(s, 1.0, method=method, **step_of(method, 1e-3), q0=q0, qd0=qd0, t_eval=t, rtol=1e-10, atol=1e-12)
     theta1 = 0.4 + 2 * t + t * t
     exact = np.array([closed_q(x)[1:] for x in theta1])
     np.testing.assert_allclose(wrap(r.q - exact), 0.0, atol=1e-9)

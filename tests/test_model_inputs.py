@@ -14,6 +14,7 @@ import numpy as np
 import pytest
 
 import rigidfem as rf
+from conftest import step_of
 
 NAN, INF = float("nan"), float("inf")
 
@@ -332,7 +333,7 @@ def test_a_bad_force_law_stops_a_simulation_at_its_time(method, returned):
     model.add_generalized_force(body, law)
     with pytest.raises(rf.SimulationError, match=r"^at t = 0\.05\d* s: the force law '.*law' on coordinate "
                                                  r"'block\.x' returned") as info:
-        rf.simulate(model.compile(), 1.0, method=method, dt=1e-3, q0=[0.01])
+        rf.simulate(model.compile(), 1.0, method=method, **step_of(method, 1e-3), q0=[0.01])
     error = info.value
     step = 1e-3 if method == "rk4" else 0.1  # dopri5 and the implicit methods adapt their step
     assert t_bad <= error.time < t_bad + step and "expected a finite number" in error.cause

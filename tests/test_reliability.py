@@ -9,6 +9,7 @@ import numpy as np
 import pytest
 
 import rigidfem as rf
+from conftest import step_of
 from rigidfem import samples
 
 ALL_METHODS = ["euler", "symplectic_euler", "rk4", "dopri5", "rkf45", "newmark", "hht", "generalized_alpha",
@@ -28,7 +29,7 @@ def test_no_free_coordinate_gives_the_drive_history(method):
     system, hub = driven_hub()
     assert system.nq == 0
     t = np.linspace(0.0, 1.0, 6)
-    r = rf.simulate(system, 1.0, method=method, dt=0.05, t_eval=t)
+    r = rf.simulate(system, 1.0, method=method, **step_of(method, 0.05), t_eval=t)
     np.testing.assert_array_equal(r.t, t)
     assert r.q.shape == (6, 0)
     np.testing.assert_allclose(r.driving_forces[:, 0], -8.0 * np.sin(2.0 * t), atol=1e-12)
@@ -109,7 +110,7 @@ def pendulum_on_a_python_drive(after_calls):
 def test_ctrl_c_in_a_python_drive_returns_the_partial_result(method):
     system = pendulum_on_a_python_drive(after_calls=400)
     with pytest.warns(RuntimeWarning, match="interrupted"):
-        r = rf.simulate(system, 100.0, method=method, dt=1e-3, q0=[0.3], t_eval=np.linspace(0, 100, 10001))
+        r = rf.simulate(system, 100.0, method=method, **step_of(method, 1e-3), q0=[0.3], t_eval=np.linspace(0, 100, 10001))
     assert r.interrupted and 1 <= len(r.t) < 10001 and np.all(np.isfinite(r.q))
 
 
@@ -146,7 +147,7 @@ def test_a_run_in_a_worker_thread_stops_on_its_event(method):
     def work():
         with warnings.catch_warnings(record=True) as caught:
             warnings.simplefilter("always")
-            out["result"] = rf.simulate(system, 1e4, method=method, dt=1e-4, q0=[0.5, 0.0], stop=stop,
+            out["result"] = rf.simulate(system, 1e4, method=method, **step_of(method, 1e-4), q0=[0.5, 0.0], stop=stop,
                                         t_eval=np.linspace(0, 1e4, 11))
         out["warnings"] = [str(w.message) for w in caught]
 

@@ -57,6 +57,7 @@ Vec3 point_displacement(const Vec6& delta, const Vec3& x) { return delta.tail<3>
 
 ErrorMeasure::ErrorMeasure(const System& sys, std::vector<OutputSpec> outputs, double t0, const VecX& q0)
     : sys_(sys), outputs_(std::move(outputs)), d_(sys), dq_(sys.nbodies), dv_(sys.nbodies), xc_(sys.nbodies),
+      xc0_(sys.nbodies),
       gyration_(sys.nbodies), element_e_(sys.elements.size()), element_dF_(sys.elements.size()),
       scale_(VecX::Zero(outputs_.size())) {
   if (outputs_.empty()) bad("error_on", "at least one output", "none");
@@ -71,8 +72,9 @@ ErrorMeasure::ErrorMeasure(const System& sys, std::vector<OutputSpec> outputs, d
   Vec3 lo = Vec3::Constant(std::numeric_limits<double>::infinity()), hi = -lo;
   const auto hold = [&](const Vec3& x) { lo = lo.cwiseMin(x), hi = hi.cwiseMax(x); };
   for (int p = 0; p < sys.nbodies; ++p) {
+    xc0_[p] = (d_.T[p] * d_.com[p].homogeneous()).head<3>();
     hold(d_.T[p].block<3, 1>(0, 3));
-    hold((d_.T[p] * d_.com[p].homogeneous()).head<3>());
+    hold(xc0_[p]);
     if (sys.parent[p] < 0) hold(sys.B[p].block<3, 1>(0, 3));
   }
   const double L = sys.nbodies ? (hi - lo).norm() : 0.0;
@@ -87,6 +89,8 @@ void ErrorMeasure::at(double t, const VecX& y) {
   kinematics(sys_, d_, need_elements_);  // T, the axes (and Ṫ for the elements' rates)
   for (int p = 0; p < sys_.nbodies; ++p) {
     xc_[p] = (d_.T[p] * d_.com[p].homogeneous()).head<3>();
+    const double moved = (xc_[p] - xc0_[p]).norm();
+    if (std::isfinite(moved)) moved_ = std::max(moved_, moved);
     const Mat3 R = d_.T[p].topLeftCorner<3, 3>();
     gyration_[p] = d_.mass[p] > 0.0 ? Mat3(R * d_.inertia[p] * R.transpose() / d_.mass[p]) : Mat3::Zero();
   }
@@ -129,7 +133,7 @@ double ErrorMeasure::norm(const Eigen::Ref<const VecX>& e, double h, double atol
   if (n == 0) return 0.0;
   twists(e.head(n), dq_);
   twists(e.segment(n, n), dv_);
-  const double length_tol = atol + rtol * L_;
+  const double length_tol = atol + rtol * reach();
   double worst = 0.0;
   for (std::size_t k = 0; k < outputs_.size(); ++k) {
     const OutputSpec& o = outputs_[k];

@@ -121,7 +121,8 @@ def _stat(stats: dict, key: str):
 def result_html(result) -> str:
     """Method, outputs, steps, rejected steps, rhs evaluations, Newton iterations, wall time."""
     s, t = result.stats, result.t
-    facts = {"method": result.method + (f" ({result.stats['method']})" if "method" in result.stats else ""), "outputs": len(t),
+    chosen = result.stats.get("method", result.method)
+    facts = {"method": result.method + (f" ({chosen})" if chosen != result.method else ""), "outputs": len(t),
              "t": f"{t[0]:g} … {t[-1]:g} s" if len(t) else "—", "nq": result.q.shape[1],
              "steps": _stat(s, "steps"), "rejected steps": _stat(s, "rejected_steps"),
              "rhs evaluations": _stat(s, "rhs_evaluations"), "Newton iterations": _stat(s, "newton_iterations"),

@@ -4,8 +4,8 @@ The C++ measure (``cpp/include/rigidfem/error_measure.hpp``) maps a step's error
 e = (e_q, e_q̇) through the Jacobians of the outputs: a point moves by δp = J_p e_q and its velocity
 by J_p e_q̇, held as the displacement h·J_p e_q̇ it makes over the step h. Each output's error is
 held to atol + rtol · scale: the model's size L (m, ``Result.stats["model_size"]``) for points and
-bodies, the largest magnitude the output has reached so far for coordinates, element forces and
-loop reactions.
+bodies (or the farthest a centre of mass has moved, if larger), the largest magnitude the output has
+reached so far for coordinates, element forces and loop reactions.
 
 ``error_on`` takes
 

@@ -86,6 +86,25 @@ def spring_mass(mass: float = 2.0, stiffness: float = 800.0, damping: float = 0.
     return model, {"block": block}
 
 
+def four_bar(crank_spring: dict | None = None):
+    """A planar four-bar in the x–y plane under gravity −y: crank 0.3 m from the origin, coupler 0.8 m,
+    rocker 0.6 m from (0.7, 0, 0), each a 1 kg slender rod on a revolute joint about z; the coupler's
+    tip joined to the rocker's by a revolute loop joint "C" (3 of its 5 rows redundant in the plane).
+    ``crank_spring``: keyword arguments of the crank's joint (``stiffness=``, ``rest=``, ``damping=``).
+    ``System.assemble`` closes the loop from a guess, e.g. (0.4, −1.9, 4.6) rad. Handles: ``crank``,
+    ``coupler``, ``rocker``, ``loop`` (the loop's name)."""
+    model = Model(gravity=(0.0, -9.81, 0.0))
+
+    def rod(length):
+        return dict(mass=1.0, inertia=(1e-4, length**2 / 12, length**2 / 12), com=(length / 2, 0, 0))
+
+    crank = model.add_body("crank", model.ground, Joint.revolute("z", **(crank_spring or {})), **rod(0.3))
+    coupler = model.add_body("coupler", crank, Joint.revolute("z"), **rod(0.8), placement=transform((0.3, 0, 0)))
+    rocker = model.add_body("rocker", model.ground, Joint.revolute("z"), **rod(0.6), placement=transform((0.7, 0, 0)))
+    loop = model.add_loop_joint("revolute", coupler.point((0.8, 0, 0)), rocker.point((0.6, 0, 0)), name="C")
+    return model, {"crank": crank, "coupler": coupler, "rocker": rocker, "loop": loop}
+
+
 def cantilever(elements: int = 10, length: float = 1.0, material: Material | None = None,
                section: Section | None = None, formulation: str = "modified", deform=("bend_z",),
                linear: bool = False, gravity=None):

@@ -155,13 +155,14 @@ class Result(Versioned):
         arms (Σ s²/(k τ)): its integral over t closes the energy balance with ``energy``."""
         return self._outputs[5]
 
-    @functools.cached_property
+    @property
     def loop_reactions(self) -> np.ndarray:
         """Reactions of the loop closures (len(t), nloops, 6): force (N) and torque (N·m) on body
-        b in frame A's axes, per ``system.loop_names``; an actuator's force in column 0."""
-        n = len(self.system.loop_names)
-        W = self.system._loop_reaction_history(self.t, self.q, self.qd)
-        return W.reshape(len(self.t), n, 6)
+        b in frame A's axes, per ``system.loop_names``; an actuator's force in column 0. From the
+        multipliers of the forward dynamics at each output (q, q̇ and the Maxwell arms' forces): the
+        same computation as ``qdd`` (the multipliers an integrator iterates on inside its steps are not
+        kept)."""
+        return self._outputs[6].reshape(len(self.t), len(self.system.loop_names), 6)
 
     @functools.cached_property
     def element_forces(self) -> np.ndarray:
@@ -198,7 +199,7 @@ class Result(Versioned):
 
     def __repr__(self) -> str:
         s = self.stats
-        chosen = f" ({s['method']})" if "method" in s else ""
+        chosen = f" ({s['method']})" if s.get("method", self.method) != self.method else ""
         bar = ""
         if self.estimate is not None:
             bar = ", estimated error " + ", ".join(f"{n} {m:.2g} {u}" for n, u, m in self.estimate.table())
@@ -281,13 +282,16 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
         M + diag(γ'h b + β'h² c): the articulated-body algorithm solves it in O(n), so a stiff beam
         takes steps far beyond the explicit stability limit at O(n) per Newton iteration.
     dt : float
-        Step (s) of the fixed-step methods: steps end on t0 + k·dt exactly, the last on t_end.
+        Step (s) of the fixed-step methods: steps end on t0 + k·dt exactly, the last on t_end. Given to an
+        adaptive method (dopri5, rkf45, esdirk43, radau5, auto) it sets only the first step, with a
+        UserWarning saying so (``adaptive=False`` runs those at fixed steps of dt).
     rtol, atol : float or (2 nq,) array
         Error control of adaptive methods. On outputs (``error_on``) each output's local error is held
-        to atol + rtol × scale: the model's size L (m, ``stats["model_size"]``: the diagonal of the box
-        holding the bodies' origins and centres of mass at t0) for points and bodies, so that rtol is
-        relative to the model and atol is in m; the largest magnitude reached so far for coordinates,
-        element forces and loop reactions. On the state, per component of y = [q, q̇] (m, rad; per s):
+        to atol + rtol × scale: for points and bodies the model's size L (m, ``stats["model_size"]``: the
+        diagonal of the box holding the bodies' origins and centres of mass at t0), or the farthest a
+        centre of mass has moved from where it started if that is larger (a motion that outgrows the
+        model stays relative to itself), so that rtol is relative to the model and atol is in m; the
+        largest magnitude reached so far for coordinates, element forces and loop reactions. On the state, per component of y = [q, q̇] (m, rad; per s):
         atol_i + rtol_i |y_i|, with atol = 0 a purely relative tolerance (an exactly zero component
         counts as exact); (2 nq,) arrays are per component and imply ``error_on="state"``. SciPy's
         methods raise rtol to their floor 100 ε; scipy:Radau and scipy:BDF take one rtol, the
@@ -374,8 +378,8 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
     onto the loops (closure residual <= 1e-12), the Newmark family solves the index-3 equations
     (Arnold & Brüls: the constraints hold at every step to Newton's tolerance), esdirk43 holds them
     at the acceleration level in its stages and projects like the explicit methods, radau5 likewise
-    for its three stages together. ``scipy:`` methods
-    integrate the constrained accelerations without projection (their residual drifts).
+    for its three stages together. ``scipy:`` methods refuse them (ValueError): they would integrate
+    the constrained accelerations without holding the loops closed.
 
     Ctrl-C in the main thread — in the C++ loop, in a Python drive or force law, or in a
     ``scipy:`` method — returns the partial result with a RuntimeWarning (``result.interrupted``).
@@ -385,6 +389,10 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
         raise ValueError(f"system: expected a compiled System (call model.compile()), got {got}")
     n = system.nq
     q0 = np.zeros(n) if q0 is None else _checks.array(q0, (n,), "q0")
+    if n and np.max(np.abs(q0)) > _LARGEST_COORDINATE:
+        raise ValueError(f"q0: expected coordinates within ±{_LARGEST_COORDINATE:g} (m, rad), beyond which a double "
+                         f"no longer resolves a step of a tenth (its spacing is 1/8 at 1e15), got "
+                         f"{q0[np.argmax(np.abs(q0))]:g} ({system.coordinate_names[int(np.argmax(np.abs(q0)))]})")
     qd0 = np.zeros(n) if qd0 is None else _checks.array(qd0, (n,), "qd0")
     t0 = _checks.scalar(t0, "t0")
     t_end = _checks.scalar(t_end, "t_end")
@@ -416,6 +424,11 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
     _check_closed(system, t0, q0, qd0)
     nz = system.nz
     s0 = np.zeros(nz) if s0 is None else _checks.array(s0, (nz,), "s0")
+    if system.nl and method.startswith("scipy:"):
+        raise ValueError(f"method: expected a C++ method for a system with loop closures ({system.nl} constraint rows), "
+                         f"got {method!r}: SciPy's solvers integrate the constrained accelerations without holding "
+                         "g(q) = 0, whose residual drifts (2.5e-4 on a four-bar at rtol = 1e-8); use 'auto', 'radau5', "
+                         "'dopri5' or 'generalized_alpha', which close the loops at every output")
     if nz and method.startswith("scipy:"):
         raise ValueError(f"method: expected a C++ method for a system with Maxwell arms ({nz} arm forces as internal "
                          f"variables), got {method!r}; use 'auto', 'esdirk43', 'generalized_alpha' or 'dopri5'")
@@ -425,6 +438,10 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
         # scipy: methods check the options of the C++ ones too (they use only first_step of them)
         opt = _options("dopri5" if scipy else method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, beta,
                        gamma, alpha, rho_inf, newton_tol, newton_max_iterations, iteration_matrix)
+        if dt is not None and adaptive is None and first_step is None and method in _ADAPTIVE:
+            warnings.warn(f"dt: {method!r} is adaptive: dt = {opt.dt:g} s only sets its first step; give "
+                          "adaptive=False for fixed steps of dt, or first_step= for the first step without this warning",
+                          UserWarning, stacklevel=2)
         if method == "auto":
             opt.stiff_method = _auto_stiff_method(system, iteration_matrix)
         if scipy:
@@ -440,8 +457,7 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
             bar.close()
     t, q, qd, stats, interrupted, failure, *arms = run
     arms = arms[0] if arms else np.zeros((len(t), 0))
-    if method == "auto":
-        stats["method"] = _auto_choice(stats, opt.stiff_method, t0)
+    stats["method"] = _auto_choice(stats, opt.stiff_method, t0) if method == "auto" else method
     call = dict(method=method, t_end=t_end, t0=t0, q0=q0, qd0=qd0, s0=s0, t_eval=t_eval if len(t_eval) else None,
                 rtol=rtol, atol=atol, dt=dt, first_step=first_step, max_steps=max_steps, max_step=max_step,
                 adaptive=adaptive, beta=beta, gamma=gamma, alpha=alpha, rho_inf=rho_inf, newton_tol=newton_tol,
@@ -458,12 +474,36 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
                       "loose tolerances the stiff modes keep errors above the tolerance, or grow; an implicit method "
                       "(auto, esdirk43, radau5, generalized_alpha) is cheaper and keeps the tolerance here",
                       RuntimeWarning, stacklevel=2)
+    _warn_growth(result, q0, qd0)
     if interrupted:
         warnings.warn(f"simulation interrupted at t = {t[-1] if len(t) else t0:g} s: returning the partial result",
                       RuntimeWarning, stacklevel=2)
     elif _checks.boolean(error_estimate, "error_estimate"):
         result.estimate = _estimate_error(result)
     return result
+
+
+#: A coordinate that grows this many times beyond its start (the larger of 1, |q0| and |qd0| × the run's
+#: length) is reported: a model run far outside its range or an unstable system, not an answer.
+GROWTH_WARNING = 1e6
+
+
+def _warn_growth(result: Result, q0, qd0) -> None:
+    """RuntimeWarning when a coordinate grew GROWTH_WARNING times beyond its start (the linear Kane model
+    finished with angles of 1e26 rad without a word)."""
+    if not result.q.size:
+        return
+    span = result.t[-1] - result.t[0] if len(result.t) else 0.0
+    start = np.maximum(1.0, np.maximum(np.abs(q0), np.abs(qd0) * span))
+    with np.errstate(over="ignore", invalid="ignore"):
+        growth = np.abs(result.q) / start
+    if not np.nanmax(growth) > GROWTH_WARNING:
+        return
+    k, j = np.unravel_index(np.nanargmax(growth), growth.shape)
+    warnings.warn(f"the state grew {growth[k, j]:.3g} times beyond its start: {result.system.coordinate_names[j]} "
+                  f"reached {result.q[k, j]:.3g} (m or rad) at t = {result.t[k]:g} s; a model run far outside its "
+                  "range (a linear beam model bent or spun beyond small deflections) or an unstable system",
+                  RuntimeWarning, stacklevel=3)
 
 
 #: The order of each C++ method's propagated solution (Richardson's factor of a fixed-step error estimate).
@@ -510,6 +550,13 @@ def _check_closed(system, t0, q0, qd0, tol=1e-8):
 
 #: The methods that run at a fixed step unless told otherwise (adaptive=True: the Newmark family).
 _FIXED_STEP = ("euler", "symplectic_euler", "rk4", "newmark", "hht", "generalized_alpha", "implicit_spring")
+
+#: The largest initial coordinate (m or rad) simulate takes: beyond it the steps of a coordinate drown in its
+#: rounding (scipy: methods then crawled for minutes at q0 = 1e300; the C++ ones returned q frozen at q0).
+_LARGEST_COORDINATE = 1e15
+
+#: The methods that control their step by default (a dt given to them sets only the first step).
+_ADAPTIVE = ("auto", "dopri5", "rkf45", "esdirk43", "radau5")
 
 #: The implicit method ``method="auto"`` hands over to when dopri5 finds the problem stiff.
 AUTO_STIFF_METHOD = "esdirk43"

@@ -75,6 +75,25 @@ def _takes_seed(function) -> bool:
         return False
 
 
+def _check_parameters(function, cases, seed) -> None:
+    """ValueError naming a case's parameter that ``function`` does not take (every case would just record
+    the same TypeError), or a ``seed`` given to a function without a ``seed`` parameter (it would be
+    ignored). Functions with ``**kwargs``, or without a signature, take anything."""
+    try:
+        parameters = inspect.signature(function).parameters
+    except (TypeError, ValueError):  # a builtin without a signature
+        return
+    if any(p.kind is inspect.Parameter.VAR_KEYWORD for p in parameters.values()):
+        return
+    unknown = sorted({name for case in cases for name in case} - set(parameters))
+    if unknown:
+        raise ValueError(f"cases: expected parameters of {getattr(function, '__name__', 'the function')}"
+                         f"({', '.join(parameters)}), got {unknown}")
+    if seed is not None and SEED not in parameters:
+        raise ValueError(f"seed: expected None for a function without a 'seed' parameter "
+                         f"({getattr(function, '__name__', 'the function')}({', '.join(parameters)})), got {seed!r}")
+
+
 def run_case(function, case: dict, seed: int | None, record_errors: bool):
     """One case in a worker: (value, error, wall time in s). ``error`` is "Type: message" when the
     function raised and errors are recorded, else None."""
@@ -243,6 +262,7 @@ def sweep(function: Callable, cases: Sequence[Mapping] | None = None, *, grid: M
     cases = _cases(cases, grid)
     if executor == "processes":
         _check_pickles(function)
+    _check_parameters(function, cases, seed)
     draw = _takes_seed(function) and not any(SEED in case for case in cases)  # else cases give their own
     seeds = _seeds(seed, len(cases)) if draw else [None] * len(cases)
     pool, owned = _resolve_executor(executor, workers)

@@ -7,8 +7,10 @@
 /// displacement it makes over the step, h δż, so that a mode the output does not see is not resolved
 /// for its velocities either. The norm is the largest, over the outputs k,
 ///   ε_k = max(|δz_k|, h |δż_k|) / (atol + rtol · scale_k),
-/// |·| Euclidean for a point (3) and a body, scale_k the model's size L (m) for points and bodies and
-/// the largest |z_k| reached so far for coordinates, element forces and loop reactions.
+/// |·| Euclidean for a point (3) and a body, scale_k for points and bodies the larger of the model's size
+/// L (m) and the farthest a body's centre of mass has moved from where it started (a motion that outgrows
+/// the model, such as a diverging linear model, is then held relative to itself), and for coordinates,
+/// element forces and loop reactions the largest |z_k| reached so far.
 ///
 /// Kinds of output:
 ///   Bodies      every body with mass: the RMS displacement of its material, √(|δc|² + δθᵀ I_C δθ / m)
@@ -21,6 +23,7 @@
 ///               of the constrained forward dynamics along e (no velocity part).
 #pragma once
 
+#include <algorithm>
 #include <memory>
 #include <vector>
 
@@ -52,6 +55,8 @@ class ErrorMeasure {
   double norm(const Eigen::Ref<const VecX>& e, double h, double atol, double rtol);
 
   double length() const { return L_; }  ///< L, m
+  /// max(L, the farthest a centre of mass has moved from its place at t0 so far), m: the scale of points and bodies
+  double reach() const { return std::max(L_, moved_); }
 
  private:
   /// δ_p = (δθ, δo) (6, ground coordinates at the origin) of every body for the coordinate changes dq:
@@ -66,7 +71,8 @@ class ErrorMeasure {
   double t_ = 0.0;
   VecX y_, ye_, lambda_;               // the linearisation point; a perturbed one; λ there (nl)
   std::vector<Vec6> dq_, dv_;          // (nbodies) twists of e_q and e_q̇
-  std::vector<Vec3> xc_;               // (nbodies) centres of mass, global
+  std::vector<Vec3> xc_, xc0_;         // (nbodies) centres of mass, global: now and at t0
+  double moved_ = 0.0;                 // the farthest a centre of mass has moved from xc0_ so far (m)
   std::vector<Mat3> gyration_;         // (nbodies) R I_C Rᵀ / m, global (m²)
   std::vector<Vec3> element_e_;        // (nelements) unit vectors e of the elements
   std::vector<std::pair<double, double>> element_dF_;  // (nelements) ∂F/∂l, ∂F/∂l̇

@@ -1,0 +1,118 @@
+"""Robust at every position and size (issue 27): no silent NaN or inf from finite inputs, the contract of
+the loop and element methods and of rf.joint_transform, loop reactions with the Maxwell arms' forces,
+closed chains refused by the scipy: methods, dt given to an adaptive method, every run's stats["method"],
+the growth warning, and rf.sweep's parameters."""
+
+import numpy as np
+import pytest
+
+import rigidfem as rf
+
+
+def four_bar(arm: bool = False):
+    """rf.samples.four_bar with a spring-damper from the ground to the coupler and, optionally, a Maxwell arm
+    on the crank's joint: (model, system, q0 closing the loop, crank)."""
+    model, h = rf.samples.four_bar()
+    model.add_spring_damper(model.ground, h["coupler"], stiffness=10.0, length=0.5)
+    if arm:
+        model.add_maxwell_arm(h["crank"], stiffness=50.0, tau=0.1)
+    system = model.compile()
+    return model, system, system.assemble([0.4, -1.9, 4.6])[0], h["crank"]
+
+
+@pytest.mark.parametrize("name", ["loop_constraints", "loop_multipliers", "loop_reactions", "element_states"])
+@pytest.mark.parametrize("bad, says", [("complex", "complex values"), ("row", r"shape \(1, 3\)"), ("text", "'abc'")])
+def test_loop_and_element_methods_name_a_bad_q(name, bad, says):
+    _, system, q, _ = four_bar()
+    value = {"complex": q.astype(complex), "row": q[None, :], "text": "abc"}[bad]
+    with pytest.raises(ValueError, match=f"^q: expected an array of nq = 3 coordinates.*{says}"):
+        getattr(system, name)(0.0, value, np.zeros(3))
+
+
+@pytest.mark.parametrize("bad, says", [([0.1 + 1j], "complex values"), ([[0.1]], "an array of 2 dimensions"),
+                                       ("x", "'x'"), ([0.1, 0.2], "got 2")])
+def test_joint_transform_names_a_bad_q(bad, says):
+    with pytest.raises(ValueError, match=f"^q: expected.*{says}"):
+        rf.joint_transform(["rz"], bad)
+    with pytest.raises(ValueError, match="^coordinates: expected a list of names"):
+        rf.joint_transform("rz", [0.1])
+    with pytest.raises(ValueError, match="^i: expected the index of a coordinate"):
+        rf.joint_transform_derivative(["rz"], [0.1], "0")
+
+
+def test_overflowing_results_are_simulation_errors():
+    """Finite but huge rates make the velocity terms overflow: a SimulationError naming the call and the
+    largest input, never NaN or inf returned."""
+    model, h = rf.samples.kane_beam(elements=3)
+    system = model.compile()
+    q, huge = np.zeros(system.nq), np.full(system.nq, 1e200)
+    for call in (lambda: system.generalized_forces(0.0, q, huge), lambda: system.inverse_dynamics(0.0, q, huge, q),
+                 lambda: system.kinetic_energy(q, huge, 0.0)):
+        with pytest.raises(rf.SimulationError, match=r"overflowed: finite inputs \(.*largest \|qd\| = 1e\+200"):
+            call()
+    stiff = rf.Model(gravity=None)
+    stiff.add_body("b", stiff.ground, rf.Joint.prismatic("x", stiffness=1e300), mass=1e-12, inertia=(1, 1, 1))
+    with pytest.raises(rf.SimulationError, match="modal analysis: the eigenvalues overflowed"):
+        rf.modal_analysis(stiff.compile())
+
+
+def test_a_huge_initial_angle_is_refused_and_energies_stay_finite():
+    model, h = rf.samples.pendulum()
+    system = model.compile()
+    with pytest.raises(ValueError, match=r"q0: expected coordinates within ±1e\+15"):
+        rf.simulate(system, 0.1, q0=[1e300])
+    # no spring: its coordinate adds no elastic energy even where (q − q⁰)² would overflow
+    assert system.elastic_energy([1e200]) == 0.0
+    r = rf.simulate(system, 0.1, q0=[1e12])
+    assert np.all(np.isfinite(r.energy))
+
+
+def test_loop_reactions_hold_the_arm_forces():
+    """A four-bar with a Maxwell arm on the crank, released with the arm's force s0 = 5 N·m: its reactions
+    are those of the same four-bar without the arm under a constant torque −5 N·m on the crank (the arm's
+    force acts as −s on its coordinate), and differ from the relaxed arm's."""
+    _, system, q0, _ = four_bar(arm=True)
+    t = np.linspace(0.0, 0.05, 3)
+    with_arm = rf.simulate(system, 0.05, q0=q0, t_eval=t, s0=[5.0])
+    model, _, _, crank = four_bar()
+    model.add_generalized_force(crank, -5.0)
+    torqued = model.compile()
+    expected = torqued.loop_reactions(0.0, with_arm.q[0], with_arm.qd[0])
+    np.testing.assert_allclose(with_arm.loop_reactions[0], expected, rtol=1e-9, atol=1e-9)
+    relaxed = rf.simulate(system, 0.05, q0=q0, t_eval=t)
+    assert np.abs(relaxed.loop_reactions[0] - with_arm.loop_reactions[0]).max() > 1.0
+
+
+def test_scipy_methods_refuse_closed_chains():
+    _, system, q0, _ = four_bar()
+    with pytest.raises(ValueError, match="method: expected a C\\+\\+ method for a system with loop closures"):
+        rf.simulate(system, 0.1, q0=q0, method="scipy:Radau")
+
+
+def test_dt_to_an_adaptive_method_warns_and_every_run_names_its_method():
+    model, _ = rf.samples.pendulum()
+    system = model.compile()
+    with pytest.warns(UserWarning, match="dt: 'dopri5' is adaptive: dt = 0.1 s only sets its first step"):
+        r = rf.simulate(system, 1.0, method="dopri5", dt=0.1, q0=[0.5])
+    assert r.stats["steps"] > 10 and r.stats["method"] == "dopri5"
+    assert rf.simulate(system, 1.0, method="rk4", dt=0.1, q0=[0.5]).stats["method"] == "rk4"
+    assert rf.simulate(system, 0.1, method="scipy:RK45", q0=[0.5]).stats["method"] == "scipy:RK45"
+    assert "(" not in repr(r).split(":")[0]  # the method once, not "dopri5 (dopri5)"
+
+
+def test_a_diverging_state_is_reported():
+    """The linear Kane model spun up: its angles grow to 1e26 rad; the run says so."""
+    model, _ = rf.samples.kane_beam(omega=6.0, duration=15.0, elements=5, linear=True)
+    with pytest.warns(RuntimeWarning, match=r"the state grew .* times beyond its start: beam\.rfe"):
+        rf.simulate(model.compile(), 20.0)
+
+
+def test_sweep_names_parameters_the_function_does_not_take():
+    def f(a, b=1.0):
+        return a + b
+
+    with pytest.raises(ValueError, match=r"cases: expected parameters of f\(a, b\), got \['c'\]"):
+        rf.sweep(f, grid={"a": [1.0], "c": [2.0]})
+    with pytest.raises(ValueError, match="seed: expected None for a function without a 'seed' parameter"):
+        rf.sweep(f, grid={"a": [1.0]}, seed=3)
+    assert rf.sweep(lambda **kw: sum(kw.values()), grid={"x": [1.0, 2.0]}, as_frame=False) is not None
