@@ -247,3 +247,38 @@ def test_one_element_against_a_symbolic_derivation():
         spring = beam.sde[0].stiffness["bend_z"] * LENGTH(0.0)[0] / Lt * th0
         got = s.inverse_dynamics(tt, [th0], [thd], [thdd])[0] - spring
         assert got == pytest.approx(expected, rel=1e-11, abs=1e-14)
+
+
+@pytest.mark.parametrize("L0, v", [(0.6, -0.5), (0.3, 0.5)], ids=["retraction", "extrusion"])
+def test_rates_at_rest_leave_the_shape_in_place(L0, v):
+    """At constant speed from the static shape: with Beam.rates_at_rest the tip converges at second order
+    to the continuum released with its shape at rest in the guide (∂w/∂t = 0 at fixed x;
+    tests/extrusion_reference.py, gravity g/100 as above); with zero joint rates — a shape that stretches
+    with L(t) — it does not (retraction: 1.2 % of the deflection at every m; extrusion: ratios 3.6, 2.3)."""
+    from extrusion_reference import solve
+
+    E, rho, b, h, g = 2.1e11, 7850.0, 0.02, 0.002, 0.0981
+    t = np.linspace(0.0, 0.5, 51)
+    ref = solve(E, b * h**3 / 12, rho, b * h, g, lambda s: L0 + v * s, lambda s: v + 0 * s, lambda s: 0 * s,
+                t_span=(0.0, 0.5), t_eval=t, modes=16, axial_inertia=True)
+    deflection = np.abs(ref.tip).max()
+    at_rest, zero = [], []
+    for m in (8, 16, 32):
+        model = rf.Model(gravity=(0.0, 0.0, -g))
+        beam = model.add_beam("tape", model.ground, rf.motion.polynomial([L0, v]), rf.Material(E=E, rho=rho),
+                              rf.Section.rectangle(b, h), m, deform=("bend_y",))
+        s = model.compile()
+        q0 = rf.static_equilibrium(s).q
+        qd0 = beam.rates_at_rest(s, q0, 0.0)
+        assert np.abs(qd0).max() > 0
+        for rates, errors in ((qd0, at_rest), (np.zeros(s.nq), zero)):
+            r = rf.simulate(s, 0.5, method="radau5", rtol=0.0, atol=1e-10, q0=q0, qd0=rates, t_eval=t)
+            errors.append(np.abs(beam.tip_positions(r)[:, 2] - ref.tip).max())
+    ratios = at_rest[0] / at_rest[1], at_rest[1] / at_rest[2]
+    assert 3.6 < ratios[0] < 4.4 and 3.6 < ratios[1] < 4.4, (at_rest, ratios)  # measured 4.0, 4.0 (both)
+    if v < 0:
+        assert zero[-1] > 0.01 * deflection and zero[-1] > 10 * at_rest[-1], (zero, at_rest)  # measured 1.2 %
+    else:
+        assert zero[1] / zero[2] < 3.0 and zero[-1] > 1.5 * at_rest[-1], (zero, at_rest)  # not second order
+    model, handles = rf.samples.cantilever(4)
+    assert not handles["beam"].rates_at_rest(model.compile(), np.zeros(4)).any()  # a constant length: zeros
