@@ -5,7 +5,12 @@ cantilevers (``samples.cantilever`` with bend_z, bend_y and torsion: 3 rotations
   Lagrange formulation;
 - ``implicit_step_scaling``: time per step of ``implicit_spring`` (O(n) Newton matrix)
   against generalised-α with the exact tangent, and one rk4 step for scale;
-- ``run``: both, written to ``dynamics_scaling.csv`` and ``implicit_step_scaling.csv``::
+- ``implicit_methods_scaling``: time per step of every implicit method (the Newmark family,
+  esdirk43, radau5, auto) with its default Newton matrix on planar bending-only cantilevers of
+  10² … 10⁴ rfes, open and with a closed loop: O(n) once the tangent is matrix-free (Krylov,
+  ``rigidfem.simulate``'s ``iteration_matrix``);
+- ``run``: all three, written to ``dynamics_scaling.csv``, ``implicit_step_scaling.csv`` and
+  ``implicit_methods_scaling.csv``::
 
     python -m benchmarks scaling [--quick] [--output DIR]
 
@@ -101,10 +106,55 @@ def implicit_step_scaling(elements=ELEMENTS, tangent_up_to: int = 200, steps: in
                         "tangent_iterations_per_step", "tangent_jacobians", "rk4_s_per_step", "spring_exponent"))
 
 
+LARGE_ELEMENTS = (100, 300, 1000, 3000, 10000)
+QUICK_LARGE_ELEMENTS = (100, 300)
+#: (method, options): 10 fixed steps of 1 ms, and auto over 1 ms at atol = 1e-4 m.
+IMPLICIT_METHODS = (("implicit_spring", {"dt": 1e-3}), ("generalized_alpha", {"dt": 1e-3}),
+                    ("esdirk43", {"dt": 1e-3, "adaptive": False}), ("radau5", {"dt": 1e-3, "adaptive": False}),
+                    ("auto", {"rtol": 0.0, "atol": 1e-4}))
+
+
+def large_beam(elements: int, loop: bool = False):
+    """A planar steel cantilever of 1 m (20 × 5 mm, ``bend_z`` only: one coordinate per sde) under
+    gravity and a 20 N tip load; with ``loop``, its tip held 0.5 m from the ground point
+    (1, 0.5, 0) m by a distance loop (one constraint row)."""
+    model, hd = samples.cantilever(elements=elements, deform=("bend_z",), gravity=(0.0, -9.81, 0.0))
+    model.add_force(hd["beam"].tip, (0.0, 20.0, 0.0))
+    if loop:
+        model.add_loop_joint("distance", hd["beam"].tip, model.ground.point((1.0, 0.5, 0.0)), length=0.5)
+    return model.compile()
+
+
+def implicit_methods_scaling(elements=LARGE_ELEMENTS) -> Table:
+    """Cost per step (s, timed in C++) of each implicit method with its default Newton matrix against
+    nq on ``large_beam`` (open and closed): 10 fixed steps of 1 ms each (esdirk43 and radau5 with
+    ``adaptive=False``), and the default method ``auto`` over 1 ms holding every body's displacement
+    to 1e-4 m (its ω_max estimate and choice included). Also the Newton and GMRES iterations per step
+    (the tangent is dense up to 200 coordinates, matrix-free above) and, per method and scene, the
+    fitted exponent of the cost per step over all the sizes."""
+    rows = []
+    for loop in (False, True):
+        for m in elements:
+            system = large_beam(m, loop)
+            for name, options in IMPLICIT_METHODS:
+                t_end = 10 * options["dt"] if "dt" in options else 1e-3
+                result = simulate(system, t_end, method=name, t_eval=[t_end], **options)
+                st = result.stats
+                rows.append({"scene": "loop" if loop else "open", "m": m, "nq": system.nq, "method": name,
+                             "steps": st["steps"], "s_per_step": st["wall_time"] / st["steps"],
+                             "newton_per_step": st["newton_iterations"] / st["steps"],
+                             "gmres_per_step": st["linear_iterations"] / st["steps"]})
+    for scene in ("open", "loop"):
+        for name, _ in IMPLICIT_METHODS:
+            _fit_exponent([r for r in rows if r["scene"] == scene and r["method"] == name], "s_per_step", "exponent")
+    return Table(rows, ("scene", "method", "m", "nq", "steps", "s_per_step", "newton_per_step", "gmres_per_step",
+                        "exponent"))
+
+
 def run(output_dir="bench", quick: bool = False) -> dict:
-    """``python -m benchmarks scaling``: both studies (m = 10 … 1000 rfes; ``quick``: m = 10,
-    20, 40 and 20 implicit steps), written to ``output_dir`` as ``dynamics_scaling.csv`` and
-    ``implicit_step_scaling.csv`` and printed as markdown. Returns name -> Table."""
+    """``python -m benchmarks scaling``: the three studies (m = 10 … 1000 rfes and 10² … 10⁴ for
+    the implicit methods; ``quick``: m = 10, 20, 40, 20 implicit steps and 100, 300), written to
+    ``output_dir`` as ``<name>.csv`` and printed as markdown. Returns name -> Table."""
     elements = QUICK_ELEMENTS if quick else ELEMENTS
     print(machine(), flush=True)
     return report({
@@ -112,4 +162,6 @@ def run(output_dir="bench", quick: bool = False) -> dict:
                              dynamics_scaling(elements)),
         "implicit_step_scaling": ("Implicit step, time per step (s) against nq (h = T1/50)",
                                   implicit_step_scaling(elements, steps=20 if quick else 50)),
+        "implicit_methods_scaling": ("Every implicit method, time per step (s) against nq, 10^2-10^4 rfes",
+                                     implicit_methods_scaling(QUICK_LARGE_ELEMENTS if quick else LARGE_ELEMENTS)),
     }, output_dir)

@@ -110,7 +110,7 @@ def test_inverse_dynamics_bad_input():
         system.inverse_dynamics(0.0, np.zeros(2), np.zeros(2), np.zeros(3))
     with pytest.raises(ValueError, match="^qdd: expected 2 "):
         system.inverse_dynamics_derivatives(0.0, np.zeros(2), np.zeros(2), np.array([0.0, np.nan]))
-    with pytest.raises(ValueError, match="^iteration_matrix: expected 'auto', 'tangent' or 'spring'"):
+    with pytest.raises(ValueError, match="^iteration_matrix: expected 'auto', 'tangent', 'spring' or 'krylov'"):
         rf.simulate(system, 0.1, method="generalized_alpha", dt=0.01, iteration_matrix="diagonal")
 
 

@@ -101,6 +101,7 @@ void bind_integrators(py::module_& m) {
         stats["jacobians"] = st.jacobians;
         stats["factorizations"] = st.factorizations;
         stats["newton_iterations"] = st.newton_iterations;
+        stats["linear_iterations"] = st.linear_iterations;
         stats["wall_time"] = st.wall_time;
         stats["stiff_at"] = st.stiff_at;
         stats["switched_at"] = st.switched_at;

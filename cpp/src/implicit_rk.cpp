@@ -37,6 +37,7 @@
 #include "rigidfem/error_measure.hpp"
 #include "rigidfem/errors.hpp"
 #include "rigidfem/kinematics.hpp"
+#include "rigidfem/newton_matrix.hpp"
 #include "rigidfem/stepper.hpp"
 
 namespace rigidfem {
@@ -98,7 +99,7 @@ class ImplicitRk : public Stepper {
   ImplicitRk(const System& sys, const IntegratorOptions& o, IntegratorStats& stats)
       : sys_(sys), d_(sys), stats_(stats), n_(sys.nq), newton_tol_(o.newton_tol), max_it_(o.newton_max_iterations),
         q_(n_), v_(n_), a_(n_), qp_(n_), vp_(n_), ap_(n_), q1_(n_), v1_(n_), a1_(n_), r_(n_), y_(2 * n_),
-        y1_(2 * n_), dy_(2 * n_), sc_(2 * n_), K_(n_, n_), C_(n_, n_), M_(n_, n_) {}
+        y1_(2 * n_), dy_(2 * n_), sc_(2 * n_), zero_(VecX::Zero(n_)), matrix_(NewtonMatrix::make(sys, o, stats)) {}
 
   /// The initial acceleration, q̈_0 = M⁻¹ f at (t0, q0, q̇0, s0).
   void start(double t0, const VecX& y0) override {
@@ -203,18 +204,10 @@ class ImplicitRk : public Stepper {
   }
 
   /// The tangent at the step's start (q_n, q̇_n, q̈_n) unless the kept one is valid: K = ∂r/∂q,
-  /// C = ∂r/∂q̇ and M. Returns whether it is new (the factorisations must follow).
+  /// C = ∂r/∂q̇ and M (newton_matrix.hpp). Returns whether it is new (the factorisations must follow).
   bool tangent(double t) {
     if (jacobian_valid_) return false;
-    set_state(sys_, d_, t, q_, v_);
-    set_accelerations(sys_, d_, a_);
-    dynamics_kinematics(sys_, d_);
-    auto [drdq, drdqd] = inverse_dynamics_derivatives(sys_, d_);
-    K_ = drdq, C_ = drdqd;
-    mass_matrix(sys_, d_);
-    M_ = d_.A;
-    ++stats_.jacobians;
-    if (!analytic_derivatives(sys_)) stats_.rhs_evaluations += 4 * n_;  // the central differences
+    matrix_->linearize(t, q_, v_, a_, s_);
     jacobian_valid_ = jacobian_fresh_ = true;
     return true;
   }
@@ -238,13 +231,13 @@ class ImplicitRk : public Stepper {
   }
 
   /// out = (I − gJ)⁻¹ x (2 nq), J = [[0, I], [−M⁻¹K, −M⁻¹C]] the Jacobian of y' = (q̇, q̈) at the tangent:
-  /// (M + gC + g²K) out_v = M x_v − g K x_q, out_q = x_q + g out_v, with lu the factorised M + gC + g²K.
-  template <class Lu>
-  void filter(double g, const Lu& lu, const VecX& x, VecX& out) {
-    rhs_.noalias() = M_ * x.tail(n_);
-    rhs_.noalias() -= g * (K_ * x.head(n_));
+  /// (M + gC + g²K) out_v = M x_v − g K x_q, out_q = x_q + g out_v, with the real block M + gC + g²K factorised.
+  void filter(double g, const VecX& x, VecX& out) {
+    xq_ = -g * x.head(n_), xv_ = x.tail(n_);
+    matrix_->derivative(xq_, zero_, xv_, rhs_);
+    matrix_->solve(rhs_, xv_);
     out.resize(2 * n_);
-    out.tail(n_) = lu.solve(rhs_);
+    out.tail(n_) = xv_;
     out.head(n_) = x.head(n_) + g * out.tail(n_);
   }
 
@@ -261,12 +254,11 @@ class ImplicitRk : public Stepper {
   /// sees one step, let modes of 10-20 times the tolerance through); with κ = 10 at every step
   /// 0.05-1.17 times, over-delivering 5-20 fold on short runs (2.0-4.3 times the cheapest run's time);
   /// with κ = run/(200 h) up to 1.26 times; with κ as here 0.07-0.70 times.
-  template <class Lu>
-  double output_error(double g, const Lu& lu, const VecX& e_hat, const Tolerances& tol, double h) {
+  double output_error(double g, const VecX& e_hat, const Tolerances& tol, double h) {
     constexpr double steps_per_count = 100.0, most = 20.0;
     const double kappa = std::clamp(tol.span / (steps_per_count * h), 1.0, most);
-    filter(g, lu, e_hat, band_);
-    filter(g, lu, band_, band2_);
+    filter(g, e_hat, band_);
+    filter(g, band_, band2_);
     band2_ = 4.0 * (band2_ - band_);
     return std::max(tol.norm(e_hat, y_, y1_, h), kappa * tol.norm(band2_, y_, y1_, h));
   }
@@ -298,9 +290,8 @@ class ImplicitRk : public Stepper {
 
   /// The singular-matrix failure of a factorisation by its reciprocal condition number (not the
   /// determinant, which under- or overflows for large n).
-  template <class Lu>
-  void check_regular(const Lu& lu, double t, double h, const char* matrix) const {
-    if (!(lu.rcond() > 1e-15))
+  void check_regular(double rcond, double t, double h, const char* matrix) const {
+    if (!(rcond > 1e-15))
       throw SimulationError(t, std::string("the Newton iteration matrix ") + matrix + " is singular (step size h = " +
                                    num(h) + " s)");
   }
@@ -320,7 +311,8 @@ class ImplicitRk : public Stepper {
   VecX ys_;                // (2 nq + nz) the state [q, q̇, s]
   VecX lambda_;            // (nl) the loops' multipliers: now (esdirk43: at the stage being solved)
   VecX rhs_, band_, band2_;  // (nq) a filter's right-hand side; (2 nq) the band-pass of output_error
-  MatX K_, C_, M_;         // (nq, nq) the tangent's parts
+  VecX xq_, xv_, zero_;      // (nq) a filter's directions
+  std::unique_ptr<NewtonMatrix> matrix_;  // the tangent's Newton matrix (dense or Krylov)
   bool jacobian_valid_ = false, jacobian_fresh_ = false, slow_ = false;
   double eta_ = 1.0;          // Newton's η of the last converged stage
   double t_ = 0.0, h_ = 1.0;  // the last attempted step
@@ -334,7 +326,7 @@ class Esdirk final : public ImplicitRk {
   Esdirk(const System& sys, const IntegratorOptions& o, IntegratorStats& stats)
       : ImplicitRk(sys, o, stats), spring_(o.iteration_matrix == IterationMatrix::Spring), Q_(n_), qhat_(n_),
         vhat_(n_), dA_(n_), armature_(n_), V_(n_, T::s), A_(n_, T::s), Sd_(sys.nz, T::s),
-        shat_(sys.nz), S_arm_(sys.nz), e_(2 * n_), S_(n_, n_), lu_(n_) {}
+        shat_(sys.nz), S_arm_(sys.nz), e_(2 * n_) {}
 
  private:
   // The estimate is filtered (Shampine), ê = (I − γh J)⁻¹ e with J the Jacobian of y' = (q̇, q̈) (filter):
@@ -395,8 +387,8 @@ class Esdirk final : public ImplicitRk {
     e_.head(n_).noalias() = h * (V_ * e);
     e_.tail(n_).noalias() = h * (A_ * e);
     if (spring_) return tol.norm(e_, y_, y1_, h);  // no tangent to filter with
-    filter(T::gamma * h, lu_, e_, e_hat_);
-    return tol.measure ? output_error(T::gamma * h, lu_, e_hat_, tol, h) : tol.norm(e_hat_, y_, y1_, h);
+    filter(T::gamma * h, e_, e_hat_);
+    return tol.measure ? output_error(T::gamma * h, e_hat_, tol, h) : tol.norm(e_hat_, y_, y1_, h);
   }
 
   /// The first iterate of A_i: for the first implicit stage, the last step's interpolant continued
@@ -450,7 +442,7 @@ class Esdirk final : public ImplicitRk {
   /// γ − G A when d.qdda holds A), then dA_ += Y Δλ and λ += Δλ. The state is projected onto the
   /// loops after each step (project).
   void close_loops_correction() {
-    const MatX Y = spring_ ? solve_armature(sys_, d_, G_.transpose()) : MatX(lu_.solve(G_.transpose()));
+    const MatX Y = spring_ ? solve_armature(sys_, d_, G_.transpose()) : matrix_->solve(MatX(G_.transpose()));
     const VecX dl = least_norm(G_ * Y, d_.gamma - G_ * dA_);
     dA_ += Y * dl;
     lambda_ += dl;
@@ -459,7 +451,7 @@ class Esdirk final : public ImplicitRk {
   /// dA_ = −S⁻¹ r_: the factorised tangent, or the O(n) spring matrix at the iterate.
   void correction(double gh) {
     if (!spring_) {
-      dA_.noalias() = lu_.solve(r_);
+      matrix_->solve(r_, dA_);
       dA_ = -dA_;
       return;
     }
@@ -476,14 +468,12 @@ class Esdirk final : public ImplicitRk {
     solve_armature(sys_, d_, dA_, dA_);
   }
 
-  /// S = M + γh C + (γh)² K.
+  /// S = M + γh C + (γh)² K (+ the arms' diagonal).
   void factor(double t, double gh) {
-    S_ = M_ + gh * C_ + (gh * gh) * K_;
-    if (sys_.nz > 0) arm_matrix(gh), S_.diagonal() += arm_diag_;
-    lu_.compute(S_);
-    ++stats_.factorizations;
+    if (sys_.nz > 0) arm_matrix(gh);
+    const double rcond = matrix_->factor(gh, gh * gh, sys_.nz > 0 ? arm_diag_ : VecX());
     gh_ = gh;
-    check_regular(lu_, t, gh / T::gamma, "M + γh C + (γh)² K");
+    check_regular(rcond, t, gh / T::gamma, "M + γh C + (γh)² K");
   }
 
   bool spring_;
@@ -492,8 +482,6 @@ class Esdirk final : public ImplicitRk {
   MatX Sd_;                               // (nz, s) the stages' arm rates Ṡ_i
   VecX shat_, S_arm_, arm_diag_;          // (nz) ŝ_i and S_i of the stage being solved; (nq) their matrix part
   VecX e_, e_hat_;                        // (2 nq) the error estimate, filtered
-  MatX S_;                                // (nq, nq)
-  Eigen::PartialPivLU<MatX> lu_;
   double gh_ = 0.0;  // γh of the factorised S
   double h_previous_ = 1.0;  // the last accepted step
   bool have_previous_ = false;
@@ -538,8 +526,7 @@ class Radau5 final : public ImplicitRk {
   Radau5(const System& sys, const IntegratorOptions& o, IntegratorStats& stats)
       : ImplicitRk(sys, o, stats), A_(n_, 3), V_(n_, 3), Q_(n_, 3), R_(n_, 3), D_(n_, 3), dV_(n_, 3), dQ_(n_, 3),
         Aprev_(n_, 3), Rt_(n_, 3), Dt_(n_, 3), z_(n_), zs_(n_), x_(n_), xs_(n_), b1_(n_), b2_(n_), qx_(n_), vx_(n_),
-        Sr_(n_, n_),
-        Sc_(n_, n_), lur_(n_), luc_(n_), L_(sys.nl, 3), Cres_(sys.nl, 3), W_(3 * sys.nl, 3 * sys.nl),
+        L_(sys.nl, 3), Cres_(sys.nl, 3), W_(3 * sys.nl, 3 * sys.nl),
         w_(3 * sys.nl), E_(n_, 3), Z_(n_, 3) {}
 
  private:
@@ -598,10 +585,10 @@ class Radau5 final : public ImplicitRk {
   void solve_stages(const MatX& X, MatX& Y) {
     Rt_.noalias() = X.cast<cplx>() * tab_.Pinv.transpose();
     x_ = Rt_.col(0).real();
-    xs_.noalias() = lur_.solve(x_);
+    matrix_->solve(x_, xs_);
     Dt_.col(0) = xs_.cast<cplx>();
     z_ = Rt_.col(1);
-    zs_.noalias() = luc_.solve(z_);
+    matrix_->solve(z_, zs_);
     Dt_.col(1) = zs_;
     Dt_.col(2) = zs_.conjugate();
     Y.noalias() = Dt_.real() * tab_.P.real().transpose();
@@ -722,25 +709,22 @@ class Radau5 final : public ImplicitRk {
   double filtered_error(double h, const Tolerances& tol) {
     const double g = h * tab_.d(0).real();
     x_ = (g * g) * b2_ + g * b1_;
-    xs_.noalias() = M_ * x_;
-    xs_.noalias() += (g * g) * (C_ * b1_);
-    x_.noalias() = lur_.solve(xs_);
+    xv_ = (g * g) * b1_;
+    matrix_->derivative(zero_, xv_, x_, xs_);  // M x + g² C b₁
+    matrix_->solve(xs_, x_);
     dy_ << x_, x_ / g - b1_;
-    return tol.measure ? output_error(g, lur_, dy_, tol, h) : tol.norm(dy_, y_, y1_, h);
+    return tol.measure ? output_error(g, dy_, tol, h) : tol.norm(dy_, y_, y1_, h);
   }
 
   /// The blocks M + h d_k C + (h d_k)² K: d₁ real, d₂ complex (d₃ its conjugate).
   void factor(double t, double h) {
     const double g = h * tab_.d(0).real();
-    Sr_ = M_ + g * C_ + (g * g) * K_;
-    lur_.compute(Sr_);
+    const double real = matrix_->factor(g, g * g, VecX());
     const cplx gc = h * tab_.d(1);
-    Sc_ = M_.cast<cplx>() + gc * C_.cast<cplx>() + (gc * gc) * K_.cast<cplx>();
-    luc_.compute(Sc_);
-    stats_.factorizations += 2;
+    const double complex = matrix_->factor(gc, gc * gc);
     h_factored_ = h;
-    check_regular(lur_, t, h, "M + h d₁ C + (h d₁)² K");
-    check_regular(luc_, t, h, "M + h d₂ C + (h d₂)² K");
+    check_regular(real, t, h, "M + h d₁ C + (h d₁)² K");
+    check_regular(complex, t, h, "M + h d₂ C + (h d₂)² K");
   }
 
   const RadauTableau tab_;
@@ -749,10 +733,6 @@ class Radau5 final : public ImplicitRk {
   MatXc Rt_, Dt_;                             // (nq, 3) transformed residuals and increments
   Eigen::VectorXcd z_, zs_;                   // (nq) the complex block's right-hand side and solution
   VecX x_, xs_, b1_, b2_, qx_, vx_;           // (nq) the error estimate's
-  MatX Sr_;
-  MatXc Sc_;
-  Eigen::PartialPivLU<MatX> lur_;
-  Eigen::PartialPivLU<MatXc> luc_;
   double h_factored_ = 0.0, h_previous_ = 1.0;
   bool have_previous_ = false, rejected_ = false;
   MatX G_[3];         // (nl, nq) the loops' Jacobian at each stage of the iterate

@@ -11,6 +11,7 @@
 #include "rigidfem/error_measure.hpp"
 #include "rigidfem/errors.hpp"
 #include "rigidfem/kinematics.hpp"
+#include "rigidfem/newton_matrix.hpp"
 #include "rigidfem/stepper.hpp"
 
 namespace rigidfem {
@@ -33,7 +34,7 @@ const MethodInfo methods[] = {
     {Method::Auto, "auto", 5, true, true, make_runge_kutta},  // dopri5 and its stiff method (AutoChoice)
 };
 
-const char* iteration_matrices[] = {"auto", "tangent", "spring"};
+const char* iteration_matrices[] = {"auto", "tangent", "spring", "krylov"};
 
 using Clock = std::chrono::steady_clock;
 
@@ -57,9 +58,9 @@ Method parse_method(const std::string& name) {
 const char* method_name(Method method) { return method_info(method).name; }
 
 IterationMatrix parse_iteration_matrix(const std::string& name) {
-  for (int k = 0; k < 3; ++k)
+  for (int k = 0; k < 4; ++k)
     if (name == iteration_matrices[k]) return static_cast<IterationMatrix>(k);
-  bad("iteration_matrix", "'auto', 'tangent' or 'spring'", "'" + name + "'");
+  bad("iteration_matrix", "'auto', 'tangent', 'spring' or 'krylov'", "'" + name + "'");
 }
 
 const char* iteration_matrix_name(IterationMatrix matrix) { return iteration_matrices[static_cast<int>(matrix)]; }
@@ -169,8 +170,11 @@ void check_options(const System& sys, double t0, double t_end, const VecX& q0, c
                                 "generalized_alpha or dopri5");
   if (o.s0.size() != 0) check_vector(o.s0, sys.nz, "s0", "nz (the Maxwell arms' forces, N or N·m)");
   if (o.method == Method::Radau5 && o.iteration_matrix == IterationMatrix::Spring)
-    throw std::invalid_argument("iteration_matrix: radau5 takes the exact tangent ('auto' or 'tangent'), got 'spring' "
-                                "(its complex block has no O(n) form); use esdirk43 for the spring matrix");
+    throw std::invalid_argument("iteration_matrix: radau5 takes the exact tangent ('auto', 'tangent' or 'krylov'), got "
+                                "'spring' ('krylov' is its O(n) form); use esdirk43 for the spring matrix");
+  if (o.iteration_matrix == IterationMatrix::Krylov && !articulated(sys))
+    throw std::invalid_argument("iteration_matrix: 'krylov' needs a system compiled with algorithm='recursive' (its "
+                                "products are the recursive inverse dynamics'); use 'tangent' or 'auto'");
   if (!is_adaptive(o) && !(o.dt > 0.0 && std::isfinite(o.dt)))
     throw std::invalid_argument(std::string("dt: expected a positive step in s for the fixed-step method '") + m.name +
                                 "', got " + num(o.dt));
@@ -265,7 +269,8 @@ double spectral_radius(const System& sys, double t, const VecX& q, const VecX& v
 /// the benchmark's five scenes at rtol = 1e-1, 3e-2, 1e-2, 1e-4, 1e-6: trials were lost and repeated up
 /// to 9 times, 8 of the 25 runs took 1.11-1.48 times as long, 4 (the stiff 3D cantilever at rtol <= 3e-2)
 /// 0.61-0.81 times.) Work is counted, not timed, so the choice is the same on every run and machine: one unit per right-hand side (or residual) evaluation, nq per tangent (the analytic
-/// derivatives cost about nq evaluations) and max(1, (nq/50)²) per dense factorisation (one for the O(n) one).
+/// derivatives cost about nq evaluations) and max(1, (nq/50)²) per dense factorisation (one for the O(n) one;
+/// a Krylov tangent's evaluations are residuals, counted as such).
 class AutoChoice {
  public:
   static constexpr int window = 20, probe = 100;
@@ -278,8 +283,10 @@ class AutoChoice {
   /// measured on the whippy strip (395 steps): its probe's first window did not look stiff at tight
   /// tolerances and dopri5 ran on, 1.9 times radau5's own time at a 1e-6 m tip error).
   static constexpr double direct_steps = 200;
-  AutoChoice(const IntegratorOptions& o, int nq, double rho, double span)
-      : o_(o), nq_(nq), direct_(std::isfinite(rho) && span * rho >= direct_steps * dopri5_stability) {}
+  /// krylov: the stiff method's tangent is matrix-free (krylov_tangent).
+  AutoChoice(const IntegratorOptions& o, int nq, double rho, double span, bool krylov)
+      : o_(o), nq_(nq), direct_(std::isfinite(rho) && span * rho >= direct_steps * dopri5_stability),
+        krylov_(krylov) {}
 
   /// Whether the stiff method takes the run from t0 on ρ (then call switched(t0, 0, stats)).
   bool stiff_from_start() const { return direct_; }
@@ -315,7 +322,7 @@ class AutoChoice {
     }
     stats.switched_at = stiff_running_ ? t : std::numeric_limits<double>::quiet_NaN();
     windows_since_trial_ = 0;
-    spring_ = next.method == Method::ImplicitSpring || next.iteration_matrix == IterationMatrix::Spring;
+    spring_ = next.method == Method::ImplicitSpring || next.iteration_matrix == IterationMatrix::Spring || krylov_;
     mark(t, stats);
     return next;
   }
@@ -343,7 +350,8 @@ class AutoChoice {
   /// The work done so far, in right-hand-side evaluations (see the class comment).
   double work(const IntegratorStats& s) const {
     const double factorization = spring_ ? 1.0 : std::max(1.0, (nq_ / 50.0) * (nq_ / 50.0));
-    return static_cast<double>(s.rhs_evaluations) + nq_ * static_cast<double>(s.jacobians) +
+    const double tangent = krylov_ ? 0.0 : nq_;
+    return static_cast<double>(s.rhs_evaluations) + tangent * static_cast<double>(s.jacobians) +
            factorization * static_cast<double>(s.factorizations);
   }
   /// A new window from t: its time, work and rejections measured from here, its steps counted from 0.
@@ -354,6 +362,7 @@ class AutoChoice {
   IntegratorOptions o_;
   int nq_;
   bool direct_;  // the stiff method from t0 on ρ alone
+  bool krylov_;  // the stiff method's tangent is matrix-free
   bool stiff_running_ = false, spring_ = false, restarted_ = false, first_window_ = true;
   double probe_end_ = 0.0, probe_rate_ = 0.0;  // the restarted trial's comparison (switched_at)
   // The first window holds dopri5's start from its first step (rejections, a low rate): only its steps at the
@@ -407,7 +416,9 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
   y0 << q0, qd0, (o.s0.size() ? o.s0 : VecX::Zero(sys.nz));
   if (o.method == Method::Auto)
     stats.omega_max = spectral_radius(sys, t0, q0, qd0, y0.tail(sys.nz), stats.rhs_evaluations);
-  AutoChoice choice(o, n, stats.omega_max, span);
+  IntegratorOptions stiff = o;
+  stiff.method = o.stiff_method;
+  AutoChoice choice(o, n, stats.omega_max, span, krylov_tangent(sys, stiff));
   // auto on a stiff problem (choice.stiff_from_start): its stiff method from t0 for the whole run (h = 0:
   // no dopri5 step to go back to).
   const IntegratorOptions first = choice.stiff_from_start() ? choice.switched(t0, 0.0, stats) : o;

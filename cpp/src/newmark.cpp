@@ -16,6 +16,7 @@
 #include "rigidfem/dynamics.hpp"
 #include "rigidfem/errors.hpp"
 #include "rigidfem/kinematics.hpp"
+#include "rigidfem/newton_matrix.hpp"
 #include "rigidfem/stepper.hpp"
 
 namespace rigidfem {
@@ -38,7 +39,8 @@ class NewmarkFamily final : public Stepper {
         spring_(o.iteration_matrix == IterationMatrix::Spring ||
                 (o.iteration_matrix == IterationMatrix::Auto && o.method == Method::ImplicitSpring)),
         armature_(sys.nq),
-        arm_stiffness_(VecX::Zero(sys.nq)) {
+        arm_stiffness_(VecX::Zero(sys.nq)),
+        matrix_(NewtonMatrix::make(sys, o, stats)) {
     if (o.method == Method::Newmark) {
       am_ = af_ = 0.0;
       beta_ = o.beta;
@@ -201,37 +203,33 @@ class NewmarkFamily final : public Stepper {
   /// matrix, (G Y) Δλ = −g/(β'h²) − G dx, then dx += Y Δλ and λ += Δλ. O(n·nl + nl³).
   void close_loops_correction(double bh2, NewmarkState& s1, VecX& dx) {
     const MatX G = free_jacobian(sys_, d_);
-    const MatX Y = spring_now_ ? solve_armature(sys_, d_, G.transpose()) : MatX(lu_.solve(G.transpose()));
+    const MatX Y = spring_now_ ? solve_armature(sys_, d_, G.transpose()) : matrix_->solve(MatX(G.transpose()));
     const VecX dl = least_norm(G * Y, -d_.g / bh2 - G * dx);
     dx += Y * dl;
     s1.lambda += dl;
   }
 
-  /// Newton: −S⁻¹ r with the tangent S = M + γ' h ∂r/∂q̇ + β' h² ∂r/∂q, kept while h stays
-  /// within 30 % of its own (it only steers the iterations).
+  /// Newton: −S⁻¹ r with the tangent S = M + γ' h ∂r/∂q̇ + β' h² ∂r/∂q (newton_matrix.hpp: dense, or
+  /// matrix-free by GMRES for a large recursive system), kept while h stays within 30 % of its own (it
+  /// only steers the iterations).
   VecX tangent_correction(double t, double h, const VecX& r, double bp, double gp, bool predictor) {
     if (!valid_ || std::abs(h / h_ - 1.0) > 0.3) {
       // At the iterate of residual(); at the predictor with q̈ = 0: there the inertia term
       // ∂(M q̈)/∂q of a stiff mode's far-off q̈ steers worse than leaving it to the iterations
       // (measured on a stiff 3D beam at h = 2e-3 s), while near the solution it makes Newton's
       // convergence quadratic.
-      if (predictor) set_accelerations(sys_, d_, VecX::Zero(sys_.nq));
-      auto [drdq, drdqd] = inverse_dynamics_derivatives(sys_, d_);
-      mass_matrix(sys_, d_);
-      ++stats_.jacobians;
-      ++stats_.factorizations;
-      if (!analytic_derivatives(sys_)) stats_.rhs_evaluations += 4 * sys_.nq;  // the central differences
-      drdq.diagonal() += arm_stiffness_;
-      lu_.compute(d_.A + (gp * h) * drdqd + (bp * h * h) * drdq);
+      matrix_->linearize(t, s1_.q, s1_.v, predictor ? VecX::Zero(sys_.nq) : s1_.qdd, s1_.s);
       // The reciprocal condition number, not the determinant, which under- or overflows for large n.
-      if (!(lu_.rcond() > 1e-15))
+      if (!(matrix_->factor(gp * h, bp * h * h, (bp * h * h) * arm_stiffness_) > 1e-15))
         throw SimulationError(t, "the Newton iteration matrix M + γh C + βh² K is singular (step size h = " + num(h) +
                                      " s)");
       valid_ = true;
       fresh_ = true;
       h_ = h;
     }
-    return -lu_.solve(r);
+    VecX dx;
+    matrix_->solve(r, dx);
+    return -dx;
   }
 
   /// The O(n) step: −(M + diag(γ' h b + β' h² c))⁻¹ r, the springs c and dampers b of the
@@ -260,7 +258,7 @@ class NewmarkFamily final : public Stepper {
   VecX armature_;
   VecX arm_stiffness_;  // (nq) ∂s_{n+1}/∂q_{n+1} of the arms over the step (arm_step_stiffness)
   double am_ = 0, af_ = 0, beta_ = 0.25, gamma_ = 0.5;
-  Eigen::PartialPivLU<MatX> lu_;
+  std::unique_ptr<NewtonMatrix> matrix_;  // the tangent's
   bool valid_ = false, fresh_ = false, full_newton_ = false;
   double h_ = 0.0;                   // step of the kept tangent
   NewmarkState s_, s1_;              // the current state and the attempted step

@@ -343,10 +343,16 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
         esdirk43 and radau5 runs stop it at 0.03 of the error weights instead (newton_tol is for
         their fixed steps).
     iteration_matrix : str
-        Newton matrix of the Newmark family and esdirk43: "tangent" (the exact tangent
-        M + γ'h ∂r/∂q̇ + β'h² ∂r/∂q, analytic for recursive systems, dense LU; γh and (γh)² for
-        esdirk43), "spring" (the O(n) matrix of "implicit_spring") or "auto" (spring for
-        implicit_spring, else tangent). radau5 takes the tangent only.
+        Newton matrix of the implicit methods: "tangent" (the exact tangent
+        M + γ'h ∂r/∂q̇ + β'h² ∂r/∂q, analytic for recursive systems, formed and factorised by dense
+        LU: O(n³); γh and (γh)² for esdirk43, h d_k for radau5's blocks), "krylov" (the same
+        tangent, never formed: its products are directional derivatives of the inverse dynamics
+        and its solves GMRES preconditioned by the spring matrix, O(n) per iteration; recursive
+        systems), "spring" (the O(n) matrix of "implicit_spring": M + diag(γ'h b + β'h² c), the
+        rest of the tangent left to Newton's iterations) or "auto" (spring for implicit_spring,
+        else krylov for a recursive system of more than 200 coordinates and tangent below).
+        radau5 takes the tangent, dense or krylov. ``stats["linear_iterations"]`` counts the
+        GMRES iterations (one inverse dynamics and one articulated-body solve each).
     stop : threading.Event, optional
         Checked about every 0.05 s of wall time: once set, the run stops and returns its partial
         result (with a RuntimeWarning). The way to stop a run in a worker thread, which Ctrl-C
@@ -594,7 +600,7 @@ def _options(method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, 
     opt.newton_max_iterations = _checks.integer(newton_max_iterations, "newton_max_iterations", minimum=1,
                                                 maximum=10**6)
     if not isinstance(iteration_matrix, str):
-        raise ValueError(f"iteration_matrix: expected 'auto', 'tangent' or 'spring', got {iteration_matrix!r}")
+        raise ValueError(f"iteration_matrix: expected 'auto', 'tangent', 'spring' or 'krylov', got {iteration_matrix!r}")
     opt.iteration_matrix = iteration_matrix
     if method == "auto":
         if adaptive is False:

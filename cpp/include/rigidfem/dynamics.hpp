@@ -18,6 +18,9 @@ namespace rigidfem {
 void dynamics_kinematics(const System& sys, Data& d);
 /// Whether ∂r/∂(q, q̇) is analytic (recursive) rather than differenced (4 nq residuals, Lagrange).
 inline bool analytic_derivatives(const System& sys) { return sys.algorithm == Algorithm::Recursive; }
+/// Whether M + diag δ has the O(n) articulated-body factorisation (recursive systems): the matrix-free
+/// Newton matrix's preconditioner (newton_matrix.hpp).
+inline bool articulated(const System& sys) { return sys.algorithm == Algorithm::Recursive; }
 
 // Stages, after set_state and a kinematics pass.
 /// => f (nq): loads, velocity terms and passive forces (f − A q̈ if d.qdda holds free accelerations).

@@ -39,9 +39,11 @@ const char* method_name(Method method);
 
 /// The implicit methods' Newton matrix: Tangent, M + γ'h ∂r/∂q̇ + β'h² ∂r/∂q (analytic for recursive
 /// systems, factorised densely; γh and (γh)² for the ESDIRK's stages); Spring, M + diag(γ'h b + β'h² c)
-/// (the sde springs and dampers as armature of the articulated-body algorithm: O(n)); Auto, Spring
-/// for implicit_spring, else Tangent.
-enum class IterationMatrix { Auto, Tangent, Spring };
+/// (the sde springs and dampers as armature of the articulated-body algorithm: O(n)); Krylov, the
+/// tangent applied matrix-free and solved by GMRES preconditioned with the spring matrix (recursive
+/// systems, O(n) per iteration: newton_matrix.hpp); Auto, Spring for implicit_spring, else Krylov for
+/// recursive systems of more than krylov_from_nq coordinates and Tangent below.
+enum class IterationMatrix { Auto, Tangent, Spring, Krylov };
 IterationMatrix parse_iteration_matrix(const std::string& name);
 const char* iteration_matrix_name(IterationMatrix matrix);
 
@@ -70,6 +72,7 @@ struct IntegratorOptions {
 
 struct IntegratorStats {
   long steps = 0, rejected = 0, rhs_evaluations = 0, jacobians = 0, factorizations = 0, newton_iterations = 0;
+  long linear_iterations = 0;  ///< GMRES iterations of a Krylov Newton matrix (each one residual evaluation)
   double wall_time = 0.0;  ///< s
   /// dopri5 only: first time (s) Hairer's stiffness test fired (h ρ > 3.25 over 15 accepted
   /// steps: the step is bounded by stability, not accuracy), NaN if never.

@@ -1,0 +1,362 @@
+#include "rigidfem/newton_matrix.hpp"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "rigidfem/arms.hpp"
+#include "rigidfem/dynamics.hpp"
+#include "rigidfem/errors.hpp"
+#include "rigidfem/stepper.hpp"
+
+namespace rigidfem {
+
+bool krylov_tangent(const System& sys, const IntegratorOptions& o) {
+  if (!articulated(sys)) return false;
+  return o.iteration_matrix == IterationMatrix::Krylov ||
+         (o.iteration_matrix == IterationMatrix::Auto && sys.nq > krylov_from_nq);
+}
+
+MatX NewtonMatrix::solve(const MatX& B) {
+  MatX X(B.rows(), B.cols());
+  VecX b, x;
+  for (Eigen::Index j = 0; j < B.cols(); ++j) {
+    b = B.col(j);
+    solve(b, x);
+    X.col(j) = x;
+  }
+  return X;
+}
+
+namespace {
+
+/// The dense form: M, C, K at the tangent, S by LU.
+class DenseNewtonMatrix final : public NewtonMatrix {
+ public:
+  DenseNewtonMatrix(const System& sys, IntegratorStats& stats) : sys_(sys), d_(sys), stats_(stats) {}
+
+  void linearize(double t, const VecX& q, const VecX& qd, const VecX& qdd, const VecX& s) override {
+    set_arm_forces(sys_, d_, s);
+    auto [drdq, drdqd] = inverse_dynamics_derivatives(sys_, d_, t, q, qd, qdd);
+    K_ = std::move(drdq), C_ = std::move(drdqd);
+    M_ = mass_matrix(sys_, d_, t, q);
+    ++stats_.jacobians;
+    if (!analytic_derivatives(sys_)) stats_.rhs_evaluations += 4 * sys_.nq;  // the central differences
+  }
+
+  void derivative(const VecX& dq, const VecX& dqd, const VecX& dqdd, VecX& out) override {
+    out.noalias() = M_ * dqdd;
+    out.noalias() += C_ * dqd;
+    out.noalias() += K_ * dq;
+  }
+
+  double factor(double c1, double c2, const VecX& e) override {
+    S_ = M_ + c1 * C_ + c2 * K_;
+    if (e.size()) S_.diagonal() += e;
+    lu_.compute(S_);
+    ++stats_.factorizations;
+    return lu_.rcond();
+  }
+
+  double factor(cplx c1, cplx c2) override {
+    Sc_ = M_.cast<cplx>() + c1 * C_.cast<cplx>() + c2 * K_.cast<cplx>();
+    luc_.compute(Sc_);
+    ++stats_.factorizations;
+    return luc_.rcond();
+  }
+
+  void solve(const VecX& b, VecX& x) override { x.noalias() = lu_.solve(b); }
+  void solve(const VecXc& b, VecXc& x) override { x.noalias() = luc_.solve(b); }
+  bool krylov() const override { return false; }
+
+ private:
+  const System& sys_;
+  Data d_;
+  IntegratorStats& stats_;
+  MatX K_, C_, M_, S_;
+  Eigen::MatrixXcd Sc_;
+  Eigen::PartialPivLU<MatX> lu_;
+  Eigen::PartialPivLU<Eigen::MatrixXcd> luc_;
+};
+
+/// M + diag(δ) factorised by the articulated-body recursion in the arithmetic of Scalar (recursive.hpp's
+/// aba_factor and aba_solve for a system at rest, without gravity or loads): leaves to root, U = I^A S,
+/// D = Sᵀ U + diag δ, the parent gets I^A − U D⁻¹ Uᵀ; the solve runs ABA's bias passes with the forces b.
+/// Transposes, not adjoints: M + diag δ is complex symmetric.
+template <class Scalar>
+class Articulated {
+  using Mat6s = Eigen::Matrix<Scalar, 6, 6>;
+  using Vec6s = Eigen::Matrix<Scalar, 6, 1>;
+  using Sub = Eigen::Matrix<Scalar, 6, Eigen::Dynamic, 0, 6, 6>;
+  using Small = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
+  using SmallVec = Eigen::Matrix<Scalar, Eigen::Dynamic, 1, 0, 6, 1>;
+  using VecS = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
+
+ public:
+  explicit Articulated(const System& sys)
+      : sys_(sys), IA_(sys.nbodies), S_(sys.nbodies), U_(sys.nbodies), Dinv_(sys.nbodies), pA_(sys.nbodies),
+        a_(sys.nbodies), u_(sys.nbodies) {}
+
+  /// At the spatial kinematics of d (its inertias I_p and axes).
+  void factor(const Data& d, const VecS& delta) {
+    for (int p = 0; p < sys_.nbodies; ++p) IA_[p] = d.I[p].template cast<Scalar>();
+    for (int p = sys_.nbodies - 1; p >= 0; --p) {
+      const int k0 = sys_.q_index[p], nf = sys_.nq_of[p];
+      S_[p].resize(6, nf);
+      for (int k = 0; k < nf; ++k) S_[p].col(k) = d.axes[sys_.q_use[k0 + k]].template cast<Scalar>();
+      U_[p].noalias() = IA_[p] * S_[p];
+      if (nf > 0) {
+        Small D = S_[p].transpose() * U_[p];
+        D.diagonal() += delta.segment(k0, nf);
+        Dinv_[p] = D.inverse();
+        if (!Dinv_[p].allFinite())
+          throw SimulationError(d.t, "the preconditioner M + diag(c1 b + c2 k) of the Newton matrix is singular at body '" +
+                                         sys_.body_names[p] + "'");
+        IA_[p].noalias() -= U_[p] * Dinv_[p] * U_[p].transpose();
+      }
+      if (sys_.parent[p] >= 0) IA_[sys_.parent[p]] += IA_[p];
+    }
+  }
+
+  /// x = (M + diag δ)⁻¹ b (x may not be b).
+  void solve(const VecS& b, VecS& x) {
+    x.resize(sys_.nq);
+    for (int p = 0; p < sys_.nbodies; ++p) pA_[p].setZero();
+    // u = b − Sᵀ p^A, the parent gets p^A + U D⁻¹ u (leaves to root)
+    for (int p = sys_.nbodies - 1; p >= 0; --p) {
+      Vec6s pa = pA_[p];
+      if (sys_.nq_of[p] > 0) {
+        u_[p] = b.segment(sys_.q_index[p], sys_.nq_of[p]) - S_[p].transpose() * pA_[p];
+        pa.noalias() += U_[p] * (Dinv_[p] * u_[p]);
+      }
+      if (sys_.parent[p] >= 0) pA_[sys_.parent[p]] += pa;
+    }
+    // x_p = D⁻¹ (u − Uᵀ a_λ), a = a_λ + S x_p (root to leaves)
+    for (int p = 0; p < sys_.nbodies; ++p) {
+      Vec6s a = sys_.parent[p] >= 0 ? a_[sys_.parent[p]] : Vec6s::Zero();
+      if (sys_.nq_of[p] > 0) {
+        const SmallVec xp = Dinv_[p] * (u_[p] - U_[p].transpose() * a);
+        x.segment(sys_.q_index[p], sys_.nq_of[p]) = xp;
+        a.noalias() += S_[p] * xp;
+      }
+      a_[p] = a;
+    }
+  }
+
+ private:
+  const System& sys_;
+  std::vector<Mat6s> IA_;
+  std::vector<Sub> S_, U_;
+  std::vector<Small> Dinv_;
+  std::vector<Vec6s> pA_, a_;
+  std::vector<SmallVec> u_;
+};
+
+/// Restarted GMRES(m) with right preconditioning (Saad & Schultz; Saad, Iterative Methods, 9.3.2) in the
+/// arithmetic of Scalar: x = P⁻¹ y minimising ‖b − S P⁻¹ y‖ over the Krylov space of S P⁻¹ from x = 0,
+/// Arnoldi by modified Gram–Schmidt, the least-squares problem by Givens rotations. Stops when
+/// ‖b − S x‖ <= rtol ‖b‖ or after max_iterations; returns the iterations taken.
+template <class Scalar>
+class Gmres {
+  using VecS = Eigen::Matrix<Scalar, Eigen::Dynamic, 1>;
+  using MatS = Eigen::Matrix<Scalar, Eigen::Dynamic, Eigen::Dynamic>;
+
+ public:
+  static constexpr int restart = 30;
+
+  template <class Op, class Prec>
+  int solve(const Op& S, const Prec& Pinv, const VecS& b, VecS& x, double rtol, int max_iterations) {
+    const Eigen::Index n = b.size();
+    V_.resize(n, restart + 1), H_.setZero(restart + 1, restart), g_.resize(restart + 1), cs_.resize(restart),
+        sn_.resize(restart);
+    x.setZero(n);
+    const double bnorm = b.norm();
+    if (bnorm == 0.0) return 0;
+    r_ = b;
+    int iterations = 0;
+    bool converged = false;
+    for (;;) {  // a cycle of at most `restart` Arnoldi steps from the residual r_
+      const double beta = r_.norm();
+      if (!(beta > rtol * bnorm)) return iterations;
+      V_.col(0) = r_ / beta;
+      g_.setZero();
+      g_(0) = beta;
+      H_.setZero();
+      int j = 0;
+      for (; j < restart && iterations < max_iterations; ++j, ++iterations) {
+        Pinv(VecS(V_.col(j)), z_);
+        S(z_, w_);
+        for (int i = 0; i <= j; ++i) {  // h_ij = v_iᴴ w, w −= h_ij v_i
+          H_(i, j) = V_.col(i).dot(w_);
+          w_.noalias() -= H_(i, j) * V_.col(i);
+        }
+        const double h_next = w_.norm();
+        H_(j + 1, j) = h_next;
+        if (h_next > 0.0) V_.col(j + 1) = w_ / h_next;
+        for (int i = 0; i < j; ++i) rotate(i, H_(i, j), H_(i + 1, j));
+        // the rotation that zeroes h_{j+1,j}: c = |a|/t, s = (a/|a|) conj(b)/t, t = √(|a|² + |b|²)
+        const Scalar a = H_(j, j), bb = H_(j + 1, j);
+        const double t = std::sqrt(std::norm(a) + std::norm(bb));
+        if (t == 0.0) {
+          cs_(j) = 1.0, sn_(j) = Scalar(0);
+        } else if (std::abs(a) == 0.0) {
+          cs_(j) = 0.0, sn_(j) = Scalar(1);
+        } else {
+          cs_(j) = std::abs(a) / t, sn_(j) = (a / std::abs(a)) * conj(bb) / t;
+        }
+        rotate(j, H_(j, j), H_(j + 1, j));
+        rotate(j, g_(j), g_(j + 1));
+        if (!(std::abs(g_(j + 1)) > rtol * bnorm) || h_next == 0.0) {
+          converged = true;
+          ++j, ++iterations;
+          break;
+        }
+      }
+      // x += P⁻¹ V y, H y = g on the first j rows; |g_{j+1}| is the residual's norm (in exact arithmetic)
+      const VecS y = H_.topLeftCorner(j, j).template triangularView<Eigen::Upper>().solve(g_.head(j));
+      Pinv(VecS(V_.leftCols(j) * y), z_);
+      x += z_;
+      if (converged || iterations >= max_iterations || !x.allFinite()) return iterations;
+      S(x, w_);
+      r_ = b - w_;
+    }
+  }
+
+ private:
+  static Scalar conj(const Scalar& z) { return Eigen::numext::conj(z); }
+  /// [x; y] ← [c x + s y; −conj(s) x + c y] with rotation i.
+  void rotate(int i, Scalar& x, Scalar& y) const {
+    const Scalar xi = x;
+    x = cs_(i) * xi + sn_(i) * y;
+    y = -conj(sn_(i)) * xi + cs_(i) * y;
+  }
+
+  MatS V_, H_;
+  VecS g_, sn_, r_, z_, w_;
+  Eigen::VectorXd cs_;
+};
+
+/// The matrix-free form (the header's comment).
+class KrylovNewtonMatrix final : public NewtonMatrix {
+ public:
+  /// GMRES stops at a relative residual of 1e-6: Newton's own test then sees the increments of an
+  /// exact solve to about that fraction; a few iterations more than 1e-3 at most (measured below).
+  static constexpr double rtol = 1e-3;
+  static constexpr int max_iterations = 60;
+
+  KrylovNewtonMatrix(const System& sys, IntegratorStats& stats)
+      : sys_(sys), d0_(sys), dp_(sys), stats_(stats), real_(sys), complex_(sys) {}
+
+  void linearize(double t, const VecX& q, const VecX& qd, const VecX& qdd, const VecX& s) override {
+    t_ = t, q_ = q, qd_ = qd, qdd_ = qdd;
+    set_arm_forces(sys_, d0_, s);
+    set_arm_forces(sys_, dp_, s);
+    r0_ = inverse_dynamics(sys_, d0_, t, q, qd, qdd);  // leaves the spatial kinematics the factors use
+    ++stats_.rhs_evaluations;
+    ++stats_.jacobians;
+  }
+
+  /// (r(q + ε δq, q̇ + ε δq̇, q̈ + ε δq̈) − r)/ε, ε making the larger relative change of q and q̇ √ε_mach
+  /// (of q̈ when both are zero). r is linear in q̈, so δq̈ does not limit ε: held to √ε_mach too, the
+  /// displacements (γh)² δq̈ of a stiff beam's step would be round-off in r (measured: GMRES then stalled
+  /// at relative residuals of 1e-5, taking its 60 iterations per solve on a 100-element cantilever).
+  void derivative(const VecX& dq, const VecX& dqd, const VecX& dqdd, VecX& out) override {
+    double size = std::max(max_abs(dq) / (1.0 + max_abs(q_)), max_abs(dqd) / (1.0 + max_abs(qd_)));
+    if (size == 0.0) size = max_abs(dqdd) / (1.0 + max_abs(qdd_));
+    if (size == 0.0) {
+      out.setZero(sys_.nq);
+      return;
+    }
+    const double eps = std::sqrt(std::numeric_limits<double>::epsilon()) / size;
+    qe_ = q_ + eps * dq, qde_ = qd_ + eps * dqd, qdde_ = qdd_ + eps * dqdd;
+    out = (inverse_dynamics(sys_, dp_, t_, qe_, qde_, qdde_) - r0_) / eps;
+    ++stats_.rhs_evaluations;
+  }
+
+  double factor(double c1, double c2, const VecX& e) override {
+    c1_ = c1, c2_ = c2;
+    e_ = e.size() ? e : VecX::Zero(sys_.nq);
+    armature(cplx(c1), cplx(c2));
+    real_.factor(d0_, delta_.real() + e_);
+    ++stats_.factorizations;
+    return 1.0;  // a singular pivot of the recursion throws
+  }
+
+  double factor(cplx c1, cplx c2) override {
+    z1_ = c1, z2_ = c2;
+    armature(c1, c2);
+    complex_.factor(d0_, delta_);
+    ++stats_.factorizations;
+    return 1.0;
+  }
+
+  /// GMRES on S x = (K c₂ + C c₁ + M) x + e ⊙ x, preconditioned by the real factor.
+  void solve(const VecX& b, VecX& x) override {
+    auto S = [&](const VecX& v, VecX& out) {
+      cq_ = c2_ * v, cv_ = c1_ * v;
+      derivative(cq_, cv_, v, out);
+      out.array() += e_.array() * v.array();
+    };
+    auto P = [&](const VecX& v, VecX& out) { real_.solve(v, out); };
+    stats_.linear_iterations += gmres_.solve(S, P, b, x, rtol, max_iterations);
+  }
+
+  /// GMRES on S x = (K c₂ + C c₁ + M) x for complex x and shifts: S is real-linear in x, so each product is
+  /// two directional derivatives, of the real and of the imaginary part.
+  void solve(const VecXc& b, VecXc& x) override {
+    auto S = [&](const VecXc& v, VecXc& out) {
+      out.resize(v.size());
+      for (int part = 0; part < 2; ++part) {
+        const VecXc dq = z2_ * v, dv = z1_ * v;
+        if (part == 0)
+          cq_ = dq.real(), cv_ = dv.real(), ca_ = v.real();
+        else
+          cq_ = dq.imag(), cv_ = dv.imag(), ca_ = v.imag();
+        derivative(cq_, cv_, ca_, w_);
+        if (part == 0)
+          out.real() = w_;
+        else
+          out.imag() = w_;
+      }
+    };
+    auto P = [&](const VecXc& v, VecXc& out) { complex_.solve(v, out); };
+    stats_.linear_iterations += gmresc_.solve(S, P, b, x, rtol, max_iterations);
+  }
+
+  bool krylov() const override { return true; }
+
+ private:
+  /// δ = c₁ b + c₂ k of each free coordinate (its damper and spring, scaled as in the forces) into delta_.
+  void armature(cplx c1, cplx c2) {
+    delta_.resize(sys_.nq);
+    for (int k = 0; k < sys_.nq; ++k) {
+      const int i = sys_.free_coords[k];
+      const Coordinate& c = sys_.coords[i];
+      delta_(k) = d0_.spring_scale(i) * (c1 * c.damping + c2 * c.stiffness);
+    }
+  }
+
+  const System& sys_;
+  Data d0_, dp_;  // the tangent's state; the perturbed states
+  IntegratorStats& stats_;
+  double t_ = 0.0, c1_ = 0.0, c2_ = 0.0;
+  cplx z1_, z2_;
+  VecX q_, qd_, qdd_, r0_, qe_, qde_, qdde_, e_, cq_, cv_, ca_, w_;
+  VecXc delta_;
+  Articulated<double> real_;
+  Articulated<cplx> complex_;
+  Gmres<double> gmres_;
+  Gmres<cplx> gmresc_;
+};
+
+}  // namespace
+
+std::unique_ptr<NewtonMatrix> NewtonMatrix::make(const System& sys, const IntegratorOptions& o,
+                                                 IntegratorStats& stats) {
+  if (krylov_tangent(sys, o)) return std::make_unique<KrylovNewtonMatrix>(sys, stats);
+  return std::make_unique<DenseNewtonMatrix>(sys, stats);
+}
+
+}  // namespace rigidfem
