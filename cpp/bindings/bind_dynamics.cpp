@@ -26,9 +26,14 @@ VecX free_coordinate_values(const System& s, double Coordinate::*field) {
 // recently called systems, so calls allocate nothing (a fresh Data costs as much as the dynamics
 // from ~800 elements on). A call re-entered from a Python callback (a force law calling the
 // system) gets a fresh Data while the outer call holds the kept one.
+//
+// It also answers Ctrl-C: while it lives, the long loops of the core (interruption_point) look at
+// Python's signals (the calls hold the GIL) and stop with the KeyboardInterrupt.
 class Workspace {
  public:
-  explicit Workspace(const System& s) {
+  explicit Workspace(const System& s) : interrupt_([] {
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+  }) {
     std::vector<Entry>& cache = entries();
     const std::weak_ptr<const System> me = s.weak_from_this();
     const auto same = [&me](const Entry& e) { return !e.system.owner_before(me) && !me.owner_before(e.system); };
@@ -71,6 +76,7 @@ class Workspace {
     thread_local std::vector<Entry> cache;
     return cache;
   }
+  rigidfem::InterruptScope interrupt_;
   Data* data_ = nullptr;
   std::unique_ptr<Data> fresh_;
 };

@@ -170,6 +170,7 @@ std::pair<MatX, MatX> rnea_derivatives(const System& sys, Data& d) {
   Tangent w(sys);
   for (int j = 0; j < sys.nq; ++j) {
     const int i = sys.free_coords[j], b = sys.coords[i].body, u = sys.q_use[j];
+    interruption_point();
     tangent_column(sys, d, loads, elements, flows, u, b, true, w, dq.col(j));
     tangent_column(sys, d, loads, elements, flows, u, b, false, w, dqd.col(j));
     // −∂Q_j/∂(q_j, q̇_j) of the coordinate's own spring, damper and force law.

@@ -30,6 +30,7 @@ std::pair<MatX, MatX> differenced(const System& sys, Data& d) {
   MatX dq(sys.nq, sys.nq), dqd(sys.nq, sys.nq);
   for (int j = 0; j < sys.nq; ++j) {
     dq.col(j) = central_difference(r, q, j);
+    interruption_point();
     dqd.col(j) = central_difference(r, qd, j);
   }
   r();
@@ -168,6 +169,7 @@ double project_onto_loops(const System& sys, Data& d, double t, VecX& q, VecX& q
   bool stalled = false;  // the last correction was at round-off level
   for (int it = 0;; ++it) {
     loop_equations(sys, d, t, q, qd);
+    interruption_point();
     residual = d.g.cwiseAbs().maxCoeff();
     if (residual <= tol || (stalled && residual <= 1e-9)) break;  // converged, or at the round-off floor
     if (it == max_iterations || stalled || !std::isfinite(residual) || sys.nq == 0)
@@ -235,10 +237,10 @@ std::pair<MatX, MatX> acceleration_derivatives(const System& sys, Data& d, doubl
   set_accelerations(sys, d, qdd);
   dynamics_kinematics(sys, d);
   auto [dq, dqd] = inverse_dynamics_derivatives(sys, d);
-  mass_matrix(sys, d);
-  d.llt.compute(d.A);
-  if (d.llt.info() != Eigen::Success) throw SimulationError(t, "the mass matrix is not positive definite");
-  return {-d.llt.solve(dq), -d.llt.solve(dqd)};
+  // M⁻¹ by the articulated-body factorisation, column by column (O(n²) in all, Ctrl-C between the
+  // columns), or by the Cholesky factor of the Lagrange formulation's A
+  factor_armature(sys, d, VecX::Zero(sys.nq));
+  return {-solve_armature(sys, d, dq), -solve_armature(sys, d, dqd)};
 }
 
 VecX rhs(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& y) {
@@ -261,7 +263,10 @@ MatX rhs_jacobian(const System& sys, Data& d, double t, const Eigen::Ref<const V
     return J;
   }
   VecX yp = y;
-  for (int j = 0; j < n; ++j) J.col(j) = central_difference([&] { return rhs(sys, d, t, yp); }, yp, j);
+  for (int j = 0; j < n; ++j) {
+    interruption_point();
+    J.col(j) = central_difference([&] { return rhs(sys, d, t, yp); }, yp, j);
+  }
   return J;
 }
 
@@ -302,6 +307,7 @@ std::pair<MatX, MatX> force_jacobians(const System& sys, Data& d, double t, cons
   MatX dq(sys.nq, sys.nq), dqd = MatX::Zero(sys.nq, sys.nq);
   for (int j = 0; j < sys.nq; ++j) {
     dq.col(j) = central_difference(f, x, j);
+    interruption_point();
     if (!static_drives) dqd.col(j) = central_difference(f, xd, j);
   }
   for (int k = 0; k < sys.nq; ++k) {  // the scales at t (the state of the last evaluation)
@@ -331,6 +337,7 @@ MatX solve_armature(const System& sys, Data& d, const MatX& B) {
   MatX X(B.rows(), B.cols());
   VecX x;
   for (Eigen::Index j = 0; j < B.cols(); ++j) {
+    interruption_point();
     x = B.col(j);
     aba_solve(sys, d, x, x);
     X.col(j) = x;

@@ -416,6 +416,7 @@ class Esdirk final : public ImplicitRk {
     auto V = V_.col(i);
     double previous = 0.0;
     for (int it = 0;; ++it) {
+      interruption_point();
       V = vhat_ + gh * A;
       Q_ = qhat_ + gh * V;
       stage_arms(gh, V, i, false);
@@ -539,6 +540,7 @@ class Radau5 final : public ImplicitRk {
     slow_ = false;
     double previous = 0.0;
     for (int it = 0;; ++it) {
+      interruption_point();
       stage_values(h);
       for (int i = 0; i < 3; ++i) {
         residual(t + tab_.c(i) * h, Q_.col(i), V_.col(i), A_.col(i));

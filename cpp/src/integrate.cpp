@@ -239,6 +239,7 @@ double spectral_radius(const System& sys, double t, const VecX& q, const VecX& v
   };
   double rho = 0.0;
   for (int k = 0; k < iterations; ++k) {
+    interruption_point();
     if (!apply(x, y) || !apply(y, x)) return rho;  // the last estimate
     const double norm = x.norm();
     if (!std::isfinite(norm)) return rho;  // the dynamics failed at a perturbed state: the last estimate
@@ -554,8 +555,14 @@ Trajectory integrate(const System& sys, double t0, double t_end, const VecX& q0,
   const auto start = Clock::now();
   Trajectory traj;
   VecX last_q = q0;
+  // The long phases within a step (ω_max, tangents, Newton, GMRES) ask the monitor too.
+  InterruptScope interrupt([&] {
+    if (monitor && !monitor(traj.t.empty() ? t0 : traj.t.back())) throw Interrupted();
+  });
   try {
     run(sys, t0, t_end, q0, qd0, t_eval, o, monitor, traj, last_q);
+  } catch (const Interrupted&) {
+    traj.interrupted = true;
   } catch (const SimulationError& e) {
     traj.error = std::make_exception_ptr(explained(e, sys, q0, last_q, o));
   } catch (...) {

@@ -48,6 +48,7 @@ void lagrange_mass_matrix(const System& sys, Data& d) {
   d.A.setZero(sys.nq, sys.nq);
   for (int b = 0; b < sys.nbodies; ++b) {
     for (int v = sys.use_start[b]; v < sys.use_start[b + 1]; ++v) {
+      interruption_point();
       const int l = sys.use_q[v];
       if (l < 0) continue;  // prescribed
       const Mat4 P = d.Hbar[b] * d.U[v].transpose();

@@ -149,6 +149,7 @@ class NewmarkFamily final : public Stepper {
       s1.lambda = s.lambda;
       double previous = std::numeric_limits<double>::infinity();
       for (int it = 0; it < max_it_; ++it) {
+        interruption_point();
         update(h, s, s1);
         const VecX r = residual(t + h, s1);
         VecX dx = spring_now_ ? spring_correction(h, r, bp, gp) : tangent_correction(t + h, h, r, bp, gp, it == 0);

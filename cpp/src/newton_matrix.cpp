@@ -186,6 +186,7 @@ class Gmres {
       H_.setZero();
       int j = 0;
       for (; j < restart && iterations < max_iterations; ++j, ++iterations) {
+        interruption_point();
         Pinv(VecS(V_.col(j)), z_);
         S(z_, w_);
         for (int i = 0; i <= j; ++i) {  // h_ij = v_iᴴ w, w −= h_ij v_i

@@ -89,6 +89,7 @@ void crba(const System& sys, Data& d) {
   if (d.A.rows() != sys.nq) d.A.setZero(sys.nq, sys.nq);
   for (int b = 0; b < sys.nbodies; ++b)
     for (int v = sys.use_start[b]; v < sys.use_start[b + 1]; ++v) {
+      interruption_point();
       const int l = sys.use_q[v];
       if (l < 0) continue;
       const Vec6 F = d.IA[b] * d.axes[v];

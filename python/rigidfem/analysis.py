@@ -33,9 +33,15 @@ import scipy.linalg
 import scipy.optimize
 from scipy.linalg import lapack
 
-from . import _checks, _core, display, export
+from . import _checks, _core, _interrupt, display, export
 from ._core import SimulationError
 from .persistence import Versioned
+
+# The dense LAPACK routines of the analyses, answering Ctrl-C while they run (_interrupt).
+_eigh = _interrupt.responsive(scipy.linalg.eigh)
+_eig = _interrupt.responsive(np.linalg.eig)
+_getrf = _interrupt.responsive(lapack.dgetrf)
+_potrf = _interrupt.responsive(lapack.dpotrf)
 
 _EPS = np.finfo(float).eps
 #: The tangent stiffness counts as singular when its reciprocal condition number, after symmetric
@@ -223,7 +229,7 @@ def _solve_tangent(K: np.ndarray, f: np.ndarray):
     """Δq (nq,) with K Δq = f, or None when K is singular to working precision."""
     s = _row_scale(K)
     Ks = K / s[:, None] / s[None, :]
-    lu, piv, info = lapack.dgetrf(Ks)
+    lu, piv, info = _getrf(Ks)
     if info != 0:
         return None
     rcond, info = lapack.dgecon(lu, np.linalg.norm(Ks, 1))
@@ -435,7 +441,7 @@ def _check_mass_matrix(M: np.ndarray, names, t: float, basis: np.ndarray | None 
     singular = not np.all(s > 0)
     if not singular:
         Ms = M / s[:, None] / s[None, :]
-        L, info = lapack.dpotrf(Ms)
+        L, info = _potrf(Ms)
         singular = info != 0
         if not singular:
             rcond, info = lapack.dpocon(L, np.linalg.norm(Ms, 1))
@@ -457,17 +463,17 @@ def _undamped(K: np.ndarray, M: np.ndarray):
     """
     n = len(K)
     try:
-        mu, X = scipy.linalg.eigh(M, K)  # raises when K is not positive definite
+        mu, X = _eigh(M, K)  # raises when K is not positive definite
     except np.linalg.LinAlgError:
         mu = None
     if mu is None or not mu[0] > 0:  # a zero mode, a divergence (spin softening, buckling): stiffness form
-        w2, Phi = scipy.linalg.eigh(K, M)
+        w2, Phi = _eigh(K, M)
         w2[np.abs(w2) <= 64 * n * _EPS * np.max(np.abs(w2))] = 0.0  # rigid-body modes: zero, not ±round-off
         return w2, Phi
     w2, Phi = 1.0 / mu[::-1], X[:, ::-1] / np.sqrt(mu[::-1])
     if w2[-1] <= 1e6 * w2[0]:
         return w2, Phi
-    w2s, Phis = scipy.linalg.eigh(K, M)
+    w2s, Phis = _eigh(K, M)
     gm = np.sqrt(w2[0] * w2[-1])
     near = np.flatnonzero((w2[1:] >= gm / 10) & (w2[:-1] <= gm * 10)) + 1  # splits k: flexibility below k
     if near.size == 0:
@@ -487,7 +493,7 @@ def _roots(W: np.ndarray, Kt: np.ndarray, Ct: np.ndarray, basis: np.ndarray):
     """
     n = len(W)
     A = np.block([[np.zeros((n, n)), np.diag(W)], [-Kt / W[None, :], -Ct]])
-    ev, Z = np.linalg.eig(A)
+    ev, Z = _eig(A)
     ev = np.where(np.abs(ev) <= 64 * n * _EPS * np.max(np.abs(A)), 0.0, ev)  # zero roots: exactly zero
     keep = ev.imag >= 0
     ev, Y = ev[keep], Z[:n, keep] / W[:, None]

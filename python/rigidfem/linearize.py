@@ -40,10 +40,13 @@ import warnings
 import numpy as np
 import scipy.signal
 
-from . import _checks, _core
+from . import _checks, _core, _interrupt
 from ._core import Body, Point
 from .analysis import _EPS, _loop_tangent, _require_finite
 from .export import RATE
+
+_solve = _interrupt.responsive(np.linalg.solve)  # Ctrl-C while LAPACK runs (_interrupt)
+_inv = _interrupt.responsive(np.linalg.inv)
 
 _KINDS = ("force", "torque", "position", "velocity")  # the first entry of a spec tuple
 _AXES = {"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}
@@ -116,7 +119,7 @@ def linearize(system, q, qd=None, t: float = 0.0, inputs=(), outputs=None, dt: f
         dqdd_dq, dqdd_dqd = system.acceleration_derivatives(t, q, qd)
         # A = [[0, I], [∂q̈/∂q, ∂q̈/∂q̇]],  B = [[0], [M⁻¹ Q]],  C = [C_q, C_v]
         A = np.block([[np.zeros((n, n)), np.eye(n)], [dqdd_dq, dqdd_dqd]])
-        B = np.vstack([np.zeros((n, Q.shape[1])), np.linalg.solve(M, Q)])
+        B = np.vstack([np.zeros((n, Q.shape[1])), _solve(M, Q)])
         N, C, states = None, np.hstack([Cq, Cv]), list(system.coordinate_names)
     states = states + [s + RATE for s in states]
     if system.nz:
@@ -139,10 +142,10 @@ def _with_arms(system, M, N, A, B, C, states):
     E = np.zeros((n, nz))
     E[coordinate, np.arange(nz)] = 1.0
     if N is None:
-        force, rate = np.linalg.solve(M, E), E.T  # δq̈ −= M⁻¹ E s,  ṡ = K_a Eᵀ δq̇ − s/τ
+        force, rate = _solve(M, E), E.T  # δq̈ −= M⁻¹ E s,  ṡ = K_a Eᵀ δq̇ − s/τ
     else:
         Mr = N.T @ M @ N
-        force, rate = np.linalg.solve(0.5 * (Mr + Mr.T), N.T @ E), E.T @ N
+        force, rate = _solve(0.5 * (Mr + Mr.T), N.T @ E), E.T @ N
     A = np.block([[A, np.vstack([np.zeros((k, nz)), -force])],
                   [np.hstack([np.zeros((nz, k)), stiffness[:, None] * rate]), -np.diag(1.0 / tau)]])
     names = system.coordinate_names
@@ -159,7 +162,7 @@ def _reduced(system, q, qd, t, M, Q, Cq, Cv):
     k = N.shape[1]
     Mr = N.T @ M @ N
     # ÿ = −M_r⁻¹ (K_r y + C_r ẏ) + M_r⁻¹ Nᵀ Q u
-    Minv = np.linalg.inv(0.5 * (Mr + Mr.T))
+    Minv = _inv(0.5 * (Mr + Mr.T))
     A = np.block([[np.zeros((k, k)), np.eye(k)], [-Minv @ N.T @ Kt @ N, Minv @ N.T @ dfdqd @ N]])
     B = np.vstack([np.zeros((k, Q.shape[1])), Minv @ N.T @ Q])
     return A, B, N, np.hstack([Cq @ N, Cv @ N])

@@ -77,7 +77,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _checks, _core, display, error_control, export
+from . import _checks, _core, _interrupt, display, error_control, export
 from ._progress import ProgressBar
 from .persistence import Versioned
 from ._core import Body, Point
@@ -481,6 +481,8 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
                       "(auto, esdirk43, radau5, generalized_alpha) is cheaper and keeps the tolerance here",
                       RuntimeWarning, stacklevel=2)
     _warn_growth(result, q0, qd0)
+    if interrupted and (swept := _interrupt.current_sweep_stop()) is not None:
+        swept.set()  # Ctrl-C in a sweep's case (serial sweeps: the main thread's) stops the sweep
     if interrupted:
         warnings.warn(f"simulation interrupted at t = {t[-1] if len(t) else t0:g} s: returning the partial result",
                       RuntimeWarning, stacklevel=2)
@@ -627,13 +629,14 @@ def _measures_outputs(method: str, system, iteration_matrix: str) -> bool:
 def _keep_going(bar, stop, t0):
     """The monitor of a run, called about every 0.05 s with t: updates the progress bar, and
     returns False once ``stop`` is set. None when there is nothing to do."""
-    if bar is None and stop is None:
+    swept = _interrupt.current_sweep_stop()  # the run of a sweep's case: the sweep's Ctrl-C stops it too
+    if bar is None and stop is None and swept is None:
         return None
 
     def keep_going(t):
         if bar is not None:
             bar.update(t - t0)
-        return stop is None or not stop.is_set()
+        return (stop is None or not stop.is_set()) and (swept is None or not swept.is_set())
 
     return keep_going
 

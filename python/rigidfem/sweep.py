@@ -19,16 +19,23 @@ import inspect
 import itertools
 import os
 import pickle
+import threading
 import time
+import warnings
 from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 
+from . import _interrupt
 from ._progress import ProgressBar
 from .study import Table
 
 #: Columns a sweep adds to the parameters and the function's values.
 ERROR, WALL_TIME, SEED = "error", "wall_time_s", "seed"
+#: The error of a case that Ctrl-C stopped or kept from starting.
+INTERRUPTED = "KeyboardInterrupt: the sweep was interrupted"
+#: How long an interrupted sweep waits for its running cases (their runs stop within about 0.05 s).
+GRACE = 0.3
 
 
 def grid_cases(grid: Mapping[str, Sequence]) -> list[dict]:
@@ -141,10 +148,19 @@ def _resolve_executor(executor, workers):
                      f"dask.distributed.Client, got {executor!r}")
 
 
-def _submit_all(executor, function, cases, seeds, record_errors) -> list:
+def _case_in_thread(stop, function, case, seed, record_errors):
+    """run_case in a worker thread, whose runs stop with the sweep (``_interrupt.sweep_stop``)."""
+    with _interrupt.sweep_stop(stop):
+        return run_case(function, case, seed, record_errors)
+
+
+def _submit_all(executor, function, cases, seeds, record_errors, stop) -> list:
     """Futures of every case, in the order of the cases."""
     if _is_dask_client(executor):
         return [executor.submit(run_case, function, case, seed, record_errors, pure=False)
+                for case, seed in zip(cases, seeds)]
+    if isinstance(executor, concurrent.futures.ThreadPoolExecutor):
+        return [executor.submit(_case_in_thread, stop, function, case, seed, record_errors)
                 for case, seed in zip(cases, seeds)]
     return [executor.submit(run_case, function, case, seed, record_errors) for case, seed in zip(cases, seeds)]
 
@@ -157,20 +173,36 @@ def _as_completed(executor, futures):
     return concurrent.futures.as_completed(futures)
 
 
-def _outcomes(function, cases, seeds, executor, record_errors, bar) -> list:
-    """(value, error, wall time) per case, in the order of the cases."""
+def _outcomes(function, cases, seeds, executor, record_errors, bar, stop) -> list:
+    """(value, error, wall time) per case, in the order of the cases. Ctrl-C sets ``stop``: the running
+    cases' runs return their partial results, the cases not started are not (INTERRUPTED)."""
     if executor is None:
         out = []
-        for case, seed in zip(cases, seeds):
-            out.append(run_case(function, case, seed, record_errors))
+        with _interrupt.sweep_stop(stop):  # a run's Ctrl-C (it returns its partial result) stops the sweep
+            for case, seed in zip(cases, seeds):
+                if stop.is_set():
+                    break
+                out.append(run_case(function, case, seed, record_errors))
+                if bar is not None:
+                    bar.update(len(out))
+        return out + [(None, INTERRUPTED, float("nan"))] * (len(cases) - len(out))
+    futures = _submit_all(executor, function, cases, seeds, record_errors, stop)
+    try:
+        for done, _ in enumerate(_as_completed(executor, futures), start=1):
             if bar is not None:
-                bar.update(len(out))
-        return out
-    futures = _submit_all(executor, function, cases, seeds, record_errors)
-    for done, _ in enumerate(_as_completed(executor, futures), start=1):
-        if bar is not None:
-            bar.update(done)
-    return [f.result() for f in futures]
+                bar.update(done)
+    except KeyboardInterrupt:
+        stop.set()
+        for f in futures:
+            f.cancel()
+        concurrent.futures.wait([f for f in futures if not _is_dask_client(executor)], timeout=GRACE)
+    return [f.result() if f.done() and not f.cancelled() and f.exception() is None
+            else (None, INTERRUPTED if stop.is_set() else _failure(f), float("nan")) for f in futures]
+
+
+def _failure(future) -> str:
+    """errors="raise": the case's own exception, raised."""
+    raise future.exception()
 
 
 def _row(case: dict, seed, value, error, wall_time) -> dict:
@@ -267,12 +299,17 @@ def sweep(function: Callable, cases: Sequence[Mapping] | None = None, *, grid: M
     seeds = _seeds(seed, len(cases)) if draw else [None] * len(cases)
     pool, owned = _resolve_executor(executor, workers)
     bar = ProgressBar(len(cases), "cases", "sweep") if progress else None
+    stop = threading.Event()
     try:
-        outcomes = _outcomes(function, cases, seeds, pool, errors == "record", bar)
+        outcomes = _outcomes(function, cases, seeds, pool, errors == "record", bar, stop)
     finally:
         if bar is not None:
             bar.close()
         if owned:
-            pool.shutdown(wait=True, cancel_futures=True)
+            pool.shutdown(wait=not stop.is_set(), cancel_futures=True)
     rows = [_row(case, s, *outcome) for case, s, outcome in zip(cases, seeds, outcomes)]
+    if stop.is_set():
+        kept = sum(outcome[1] != INTERRUPTED for outcome in outcomes)
+        warnings.warn(f"sweep interrupted: returning the {kept} of {len(cases)} cases that ran (a run stopped part-way "
+                      f"keeps its partial result; the others' error is {INTERRUPTED!r})", RuntimeWarning, stacklevel=2)
     return _table(rows, as_frame)
