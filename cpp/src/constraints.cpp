@@ -1,6 +1,6 @@
 #include "rigidfem/constraints.hpp"
 
-#include <Eigen/QR>
+#include <Eigen/SVD>
 #include <cmath>
 #include <stdexcept>
 #include <utility>
@@ -121,9 +121,17 @@ void constraint_equations(const System& sys, Data& d) {
 }
 
 VecX least_norm(const MatX& A, const VecX& b) {
-  Eigen::CompleteOrthogonalDecomposition<MatX> cod(A);
-  cod.setThreshold(1e-10);
-  return cod.solve(b);
+  // x = V Σ⁺ Uᵀ b with σ_i⁺ = 1/σ_i for σ_i > 1e-10 σ_max, else 0. A = G S⁻¹ Gᵀ goes as G's squared
+  // singular values: G's rows count as dependent below 1e-5 of its largest, at the acceleration level
+  // and in the projection alike (project_onto_loops solves with the same A = G M⁻¹ Gᵀ). The SVD's
+  // singular values, unlike a pivoted QR's diagonal, pass smoothly through the threshold as G's rank
+  // changes on a singular position.
+  Eigen::JacobiSVD<MatX> svd(A, Eigen::ComputeThinU | Eigen::ComputeThinV);
+  const VecX& s = svd.singularValues();
+  const double floor = s.size() > 0 ? 1e-10 * s(0) : 0.0;
+  VecX c = svd.matrixU().transpose() * b;
+  for (Eigen::Index i = 0; i < s.size(); ++i) c(i) = s(i) > floor ? c(i) / s(i) : 0.0;
+  return svd.matrixV() * c;
 }
 
 MatX free_jacobian(const System& sys, const Data& d) { return d.G(Eigen::all, sys.free_coords); }

@@ -615,7 +615,11 @@ class Radau5 final : public ImplicitRk {
       w_.segment(i * nl, nl) = Cres_.col(i);
       w_.segment(i * nl, nl).noalias() -= G_[i] * D_.col(i);
     }
-    const VecX dl = least_norm(W_, w_);
+    // The least-norm multipliers themselves, W Λ⁺ = c − 𝒢 ΔA + W Λ, not the least-norm increment: in a
+    // direction where G lost rank W is blind to Λ, which must then be zero, not its prediction.
+    VecX L = Eigen::Map<const VecX>(L_.data(), 3 * nl);
+    w_.noalias() += W_ * L;
+    const VecX dl = least_norm(W_, w_) - L;
     for (int i = 0; i < 3; ++i) E_.col(i).noalias() = G_[i].transpose() * dl.segment(i * nl, nl);
     solve_stages(E_, Z_);
     D_ += Z_;

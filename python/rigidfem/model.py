@@ -480,8 +480,9 @@ class System(_core._System):
 
     def assemble(self, q, qd=None, t: float | None = None, tol: float = 1e-12, max_iterations: int = 50):
         """(q, qd) closing every loop, nearest to the guess: Gauss–Newton on g(q, t) = 0 with
-        least-norm corrections until max |g| <= ``tol`` (m, or the cosine of direction rows),
-        then the velocities projected onto G q̇ + ∂g/∂t = 0. Raises ``SimulationError`` naming the
+        mass-weighted least-norm corrections M⁻¹Gᵀ(G M⁻¹Gᵀ)⁺g while they gain (max |g| <= ``tol``
+        required, m or the cosine of direction rows; up to 1e-9 accepted where G has lost rank), then
+        the velocities projected onto G q̇ + ∂g/∂t = 0 in the mass metric (the kinetic energy never rises). Raises ``SimulationError`` naming the
         loop that cannot be closed from this guess. ``t`` (s) for prescribed motions; q in m and
         rad, qd per s (zero by default)."""
         return loops.assemble(self, q, qd, t, tol, max_iterations)

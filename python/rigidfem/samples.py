@@ -105,6 +105,34 @@ def four_bar(crank_spring: dict | None = None):
     return model, {"crank": crank, "coupler": coupler, "rocker": rocker, "loop": loop}
 
 
+def double_four_bar(rocker: float = 0.5, span: float = 1.0, rocker_mass: float = 1.0, coupler_mass: float = 2.0):
+    """Two parallelogram four-bars in a row sharing the middle rocker, in the x–y plane under gravity −y:
+    three rockers of length ``rocker`` (m, ``rocker_mass`` kg slender rods) on revolute joints about z at
+    (0, 0), (``span``, 0) and (2 ``span``, 0); coupler "c1" (``span`` m, ``coupler_mass`` kg) on the tip of
+    rocker "r0", closed onto the tip of "r1" by revolute loop "A"; coupler "c2" likewise from "r1" to "r2"
+    (loop "B"). Coordinates (r0, r1, r2, c1, c2); on the parallelogram branch all rockers at θ and both
+    couplers at −θ: one degree of freedom, a pendulum with T = ½ (3 m L²/3 + 2 m_c L²) θ̇² and
+    V = g sin θ (3 m L/2 + 2 m_c L). At θ = 0 and π the bars lie flat and each loop's Jacobian loses a row
+    (a singular position: the antiparallelogram branch crosses there), so a swing from above the
+    horizontal passes singular positions twice a period. Handles: ``rockers``, ``couplers``, ``loops``."""
+    model = Model(gravity=(0.0, -9.81, 0.0))
+
+    def rod(length, mass):
+        return dict(mass=mass, inertia=(1e-4 * mass, mass * length**2 / 12, mass * length**2 / 12),
+                    com=(length / 2, 0, 0))
+
+    rockers = [model.add_body(f"r{i}", model.ground, Joint.revolute("z"), **rod(rocker, rocker_mass),
+                              placement=transform((i * span, 0, 0))) for i in range(3)]
+    couplers, loops = [], []
+    for i, name in enumerate(("A", "B")):
+        c = model.add_body(f"c{i + 1}", rockers[i], Joint.revolute("z"), **rod(span, coupler_mass),
+                           placement=transform((rocker, 0, 0)))
+        couplers.append(c)
+        loops.append(model.add_loop_joint("revolute", c.point((span, 0, 0)), rockers[i + 1].point((rocker, 0, 0)),
+                                          name=name))
+    return model, {"rockers": rockers, "couplers": couplers, "loops": loops}
+
+
 def cantilever(elements: int = 10, length: float = 1.0, material: Material | None = None,
                section: Section | None = None, formulation: str = "modified", deform=("bend_z",),
                linear: bool = False, gravity=None):

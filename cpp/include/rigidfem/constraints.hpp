@@ -23,8 +23,10 @@ void constraint_equations(const System& sys, Data& d);
 /// The free columns of d.G (nl, nq).
 MatX free_jacobian(const System& sys, const Data& d);
 
-/// x = A⁺ b by a complete orthogonal decomposition with pivots below 1e-10 of the largest dropped:
-/// the multipliers of redundant rows (a planar loop closed in 3D) share the load with least norm.
+/// x = A⁺ b by the SVD of A with singular values below 1e-10 of the largest dropped (A = G S⁻¹ Gᵀ:
+/// G's rows below 1e-5 of its largest singular value count as dependent): the multipliers of
+/// redundant rows (a planar loop closed in 3D) share the load with least norm, and on a singular
+/// position (a four-bar flat) the row G loses carries no multiplier.
 VecX least_norm(const MatX& A, const VecX& b);
 
 /// The wrench each loop joint applies to its body B, in frame A's axes: (force N, torque N·m about

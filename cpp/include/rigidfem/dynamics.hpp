@@ -82,9 +82,11 @@ std::pair<MatX, MatX> force_jacobians(const System& sys, Data& d, double t, cons
 /// O(n·nl + nl³): no n×n factorisation with the recursive engine.
 void close_loops(const System& sys, Data& d);
 /// Moves (q, q̇) onto the constraint manifold at t: Gauss–Newton on g(q, t) = 0 with the
-/// least-norm corrections Δq = −Gᵀ (G Gᵀ)⁺ g until max |g| <= tol (m, and for direction rows
-/// the cosine), then q̇ ← q̇ − Gᵀ (G Gᵀ)⁺ ġ. Returns max |g| reached; SimulationError naming the
-/// loop with the largest residual when it stays above tol after max_iterations.
+/// mass-weighted least-norm corrections Δq = −M⁻¹Gᵀ (G M⁻¹ Gᵀ)⁺ g (least_norm: the rank decision
+/// of close_loops) while they gain (to round-off of the model's size, at most max_iterations),
+/// then q̇ ← q̇ − M⁻¹Gᵀ (G M⁻¹ Gᵀ)⁺ ġ, which never raises the kinetic energy. Returns max |g|
+/// reached (m, and for direction rows the cosine); SimulationError naming the loop with the
+/// largest residual when it ends above max(tol, 1e-9).
 /// g, ġ, G and γ (γ for q̈_free = 0) into d at (t, q, q̇).
 void loop_equations(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
                     const Eigen::Ref<const VecX>& qd);
