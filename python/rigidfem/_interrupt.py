@@ -4,10 +4,12 @@
   estimate, the loops' Gauss–Newton) look at Python's signals about every 0.05 s themselves
   (``InterruptScope`` in errors.hpp): a System method raises KeyboardInterrupt, ``rf.simulate``
   returns its partial result.
-- LAPACK (SciPy's and NumPy's dense eigensolvers and factorisations) releases the GIL but never
-  looks at signals: :func:`responsive` runs such a call in a worker thread while the calling
-  thread waits in 0.05 s slices, so Ctrl-C raises KeyboardInterrupt at once; the worker finishes
-  in the background and its result is dropped.
+- LAPACK never looks at signals: :func:`responsive` runs a dense routine that releases the GIL
+  in a worker thread while the calling thread waits in 0.05 s slices, so Ctrl-C raises
+  KeyboardInterrupt at once; the worker finishes in the background and its result is dropped.
+  Not every wrapper releases the GIL (measured with SciPy 1.17: ``scipy.linalg.eigh`` and
+  ``lapack.dpotrf`` hold it, NumPy's ``linalg`` routines and ``lapack.dgetrf`` do not): for large
+  matrices :func:`eigh` and :func:`cholesky` take NumPy's routines.
 - A sweep's worker threads never see Ctrl-C (Python delivers signals to the main thread):
   :func:`sweep_stop` gives the runs of a sweep's case the sweep's stop event, which ``rf.simulate``
   checks like its own ``stop``.
@@ -18,6 +20,9 @@ from __future__ import annotations
 import contextlib
 import functools
 import threading
+
+import numpy as np
+import scipy.linalg
 
 #: Matrices of fewer entries take less than a few ms in LAPACK: called directly.
 RESPONSIVE_FROM = 200 * 200
@@ -53,6 +58,34 @@ def responsive(function):
     return call
 
 
+def _reduced_eigh(A, B):
+    """A x = λ B x (A symmetric, B positive definite) as LAPACK's sygv computes it, by NumPy: B = L Lᵀ,
+    C = L⁻¹ A L⁻ᵀ, C y = λ y, x = L⁻ᵀ y (so Xᵀ B X = I). LinAlgError when B is not positive definite."""
+    L = np.linalg.cholesky(B)
+    C = np.linalg.solve(L, np.linalg.solve(L, A).T)  # L⁻¹ (L⁻¹ A)ᵀ = L⁻¹ A L⁻ᵀ (A symmetric)
+    w, Y = np.linalg.eigh(0.5 * (C + C.T))
+    return w, np.linalg.solve(L.T, Y)
+
+
+def eigh(A, B):
+    """scipy.linalg.eigh(A, B) for small matrices; for large ones the same reduction by NumPy's routines,
+    which release the GIL, in a worker thread (responsive)."""
+    if A.size < RESPONSIVE_FROM:
+        return scipy.linalg.eigh(A, B)
+    return _responsive_reduced_eigh(A, B)
+
+
+def cholesky(A):
+    """(U, info) of lapack.dpotrf(A) (upper: A = UᵀU) for small matrices; NumPy's (which releases the GIL)
+    in a worker thread for large ones, info = 1 when A is not positive definite."""
+    if A.size < RESPONSIVE_FROM:
+        return scipy.linalg.lapack.dpotrf(A)
+    try:
+        return _responsive_cholesky(A).T.copy(), 0
+    except np.linalg.LinAlgError:
+        return A, 1
+
+
 @contextlib.contextmanager
 def sweep_stop(event: threading.Event):
     """Within it, this thread's runs also stop when ``event`` is set (a sweep interrupted)."""
@@ -67,3 +100,7 @@ def sweep_stop(event: threading.Event):
 def current_sweep_stop():
     """The stop event of the sweep whose case this thread runs, or None."""
     return getattr(_local, "stop", None)
+
+
+_responsive_reduced_eigh = responsive(_reduced_eigh)
+_responsive_cholesky = responsive(np.linalg.cholesky)

@@ -38,10 +38,10 @@ from ._core import SimulationError
 from .persistence import Versioned
 
 # The dense LAPACK routines of the analyses, answering Ctrl-C while they run (_interrupt).
-_eigh = _interrupt.responsive(scipy.linalg.eigh)
+_eigh = _interrupt.eigh
 _eig = _interrupt.responsive(np.linalg.eig)
 _getrf = _interrupt.responsive(lapack.dgetrf)
-_potrf = _interrupt.responsive(lapack.dpotrf)
+_potrf = _interrupt.cholesky
 
 _EPS = np.finfo(float).eps
 #: The tangent stiffness counts as singular when its reciprocal condition number, after symmetric
