@@ -60,6 +60,9 @@ void bind_integrators(py::module_& m) {
           "stiff_method", [](const IntegratorOptions& o) { return method_name(o.stiff_method); },
           [](IntegratorOptions& o, const std::string& name) { o.stiff_method = parse_method(name); });
 
+  m.def("_check_options", &check_options, py::arg("system"), py::arg("t0"), py::arg("t_end"), py::arg("q0"),
+        py::arg("qd0"), py::arg("t_eval"), py::arg("options"),
+        "integrate's checks of the options alone (ValueError naming the first bad one).");
   m.def(
       "_integrate",
       [](const System& s, double t0, double t_end, const VecX& q0, const VecX& qd0,

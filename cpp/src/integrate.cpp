@@ -154,59 +154,6 @@ bool is_adaptive(const IntegratorOptions& o) {
   return o.adaptive >= 0 ? o.adaptive == 1 : method_info(o.method).adaptive;
 }
 
-void check_options(const System& sys, double t0, double t_end, const VecX& q0, const VecX& qd0,
-                   const Eigen::Ref<const VecX>& t_eval, const IntegratorOptions& o) {
-  const MethodInfo& m = method_info(o.method);
-  if (!std::isfinite(t0) || !std::isfinite(t_end) || !(t_end > t0))
-    throw std::invalid_argument("t_end: expected a finite end time after t0 = " + num(t0) + " s, got " + num(t_end));
-  check_vector(q0, sys.nq, "q0", "nq");
-  check_vector(qd0, sys.nq, "qd0", "nq");
-  if (!m.error_estimate && o.adaptive == 1)
-    throw std::invalid_argument(std::string("adaptive: the method '") + m.name +
-                                "' has no error estimate; use dopri5, rkf45, esdirk43, radau5 or the Newmark family");
-  if ((o.method == Method::Radau5 || (o.method == Method::Auto && o.stiff_method == Method::Radau5)) && sys.nz > 0)
-    throw std::invalid_argument("method: 'radau5' does not integrate Maxwell arms (the system has " +
-                                std::to_string(sys.nz) + " arm forces as internal variables); use esdirk43, "
-                                "generalized_alpha or dopri5");
-  if (o.s0.size() != 0) check_vector(o.s0, sys.nz, "s0", "nz (the Maxwell arms' forces, N or N·m)");
-  if (o.method == Method::Radau5 && o.iteration_matrix == IterationMatrix::Spring)
-    throw std::invalid_argument("iteration_matrix: radau5 takes the exact tangent ('auto', 'tangent' or 'krylov'), got "
-                                "'spring' ('krylov' is its O(n) form); use esdirk43 for the spring matrix");
-  if (o.iteration_matrix == IterationMatrix::Krylov && !articulated(sys))
-    throw std::invalid_argument("iteration_matrix: 'krylov' needs a system compiled with algorithm='recursive' (its "
-                                "products are the recursive inverse dynamics'); use 'tangent' or 'auto'");
-  if (!is_adaptive(o) && !(o.dt > 0.0 && std::isfinite(o.dt)))
-    throw std::invalid_argument(std::string("dt: expected a positive step in s for the fixed-step method '") + m.name +
-                                "', got " + num(o.dt));
-  for (const auto& [tol, name] : {std::pair<const VecX*, const char*>{&o.rtol, "rtol"}, {&o.atol, "atol"}})
-    if (tol->size() == 0 || (tol->size() != 1 && tol->size() != 2 * sys.nq) || !(tol->minCoeff() >= 0.0) ||
-        !tol->allFinite())
-      throw std::invalid_argument(std::string(name) + ": expected non-negative tolerances, one or 2 nq = " +
-                                  std::to_string(2 * sys.nq) + " of them");
-  if (!o.error_on.empty() && (o.rtol.size() != 1 || o.atol.size() != 1))
-    throw std::invalid_argument("rtol, atol: expected one value each with error_on (the tolerances of its outputs), "
-                                "got " + std::to_string(o.rtol.size()) + " and " + std::to_string(o.atol.size()));
-  if (o.rtol.maxCoeff() == 0.0 && o.atol.minCoeff() == 0.0)
-    throw std::invalid_argument("atol: expected positive values when rtol is zero");
-  if (!(o.max_step > 0.0)) throw std::invalid_argument("max_step: expected a positive step in s");
-  if (o.max_steps < 1) throw std::invalid_argument("max_steps: expected a positive number of steps");
-  if (o.method == Method::Newmark && !(o.gamma >= 0.5 && o.beta >= 0.25 * (0.5 + o.gamma) * (0.5 + o.gamma) - 1e-15))
-    throw std::invalid_argument("beta, gamma: expected the unconditionally stable range gamma >= 1/2, "
-                                "beta >= (gamma + 1/2)^2 / 4, got beta = " + num(o.beta) + ", gamma = " + num(o.gamma));
-  if (o.method == Method::HHT && !(o.alpha >= -1.0 / 3.0 && o.alpha <= 0.0))
-    throw std::invalid_argument("alpha: expected a value in [-1/3, 0], got " + num(o.alpha));
-  if ((o.method == Method::GeneralizedAlpha || o.method == Method::ImplicitSpring) &&
-      !(o.rho_inf >= 0.0 && o.rho_inf <= 1.0))
-    throw std::invalid_argument("rho_inf: expected a value in [0, 1], got " + num(o.rho_inf));
-  const Method stiff = o.stiff_method;
-  if (o.method == Method::Auto && (!method_info(stiff).error_estimate || stiff == Method::Dopri5 ||
-                                   stiff == Method::RKF45 || stiff == Method::Auto))
-    throw std::invalid_argument(std::string("stiff_method: expected an implicit method with an error estimate, got '") +
-                                method_name(stiff) + "'");
-  for (Eigen::Index k = 0; k < t_eval.size(); ++k)
-    if (!(t_eval(k) >= t0 && t_eval(k) <= t_end) || (k > 0 && !(t_eval(k) > t_eval(k - 1))))
-      throw std::invalid_argument("t_eval: expected increasing times within [t0, t_end]");
-}
 
 /// The spectral radius ρ of the Jacobian J = [[0, I], [∂q̈/∂q, ∂q̈/∂q̇]] of y' = (q̇, q̈) at (t, q, q̇, s):
 /// power iteration on J² (an undamped oscillation's pair ±iω is one eigenvalue −ω² of J², so the
@@ -548,6 +495,60 @@ SimulationError explained(const SimulationError& e, const System& sys, const Vec
 }
 
 }  // namespace
+
+void check_options(const System& sys, double t0, double t_end, const VecX& q0, const VecX& qd0,
+                   const Eigen::Ref<const VecX>& t_eval, const IntegratorOptions& o) {
+  const MethodInfo& m = method_info(o.method);
+  if (!std::isfinite(t0) || !std::isfinite(t_end) || !(t_end > t0))
+    throw std::invalid_argument("t_end: expected a finite end time after t0 = " + num(t0) + " s, got " + num(t_end));
+  check_vector(q0, sys.nq, "q0", "nq");
+  check_vector(qd0, sys.nq, "qd0", "nq");
+  if (!m.error_estimate && o.adaptive == 1)
+    throw std::invalid_argument(std::string("adaptive: the method '") + m.name +
+                                "' has no error estimate; use dopri5, rkf45, esdirk43, radau5 or the Newmark family");
+  if ((o.method == Method::Radau5 || (o.method == Method::Auto && o.stiff_method == Method::Radau5)) && sys.nz > 0)
+    throw std::invalid_argument("method: 'radau5' does not integrate Maxwell arms (the system has " +
+                                std::to_string(sys.nz) + " arm forces as internal variables); use esdirk43, "
+                                "generalized_alpha or dopri5");
+  if (o.s0.size() != 0) check_vector(o.s0, sys.nz, "s0", "nz (the Maxwell arms' forces, N or N·m)");
+  if (o.method == Method::Radau5 && o.iteration_matrix == IterationMatrix::Spring)
+    throw std::invalid_argument("iteration_matrix: radau5 takes the exact tangent ('auto', 'tangent' or 'krylov'), got "
+                                "'spring' ('krylov' is its O(n) form); use esdirk43 for the spring matrix");
+  if (o.iteration_matrix == IterationMatrix::Krylov && !articulated(sys))
+    throw std::invalid_argument("iteration_matrix: 'krylov' needs a system compiled with algorithm='recursive' (its "
+                                "products are the recursive inverse dynamics'); use 'tangent' or 'auto'");
+  if (!is_adaptive(o) && !(o.dt > 0.0 && std::isfinite(o.dt)))
+    throw std::invalid_argument(std::string("dt: expected a positive step in s for the fixed-step method '") + m.name +
+                                "', got " + num(o.dt));
+  for (const auto& [tol, name] : {std::pair<const VecX*, const char*>{&o.rtol, "rtol"}, {&o.atol, "atol"}})
+    if (tol->size() == 0 || (tol->size() != 1 && tol->size() != 2 * sys.nq) || !(tol->minCoeff() >= 0.0) ||
+        !tol->allFinite())
+      throw std::invalid_argument(std::string(name) + ": expected non-negative tolerances, one or 2 nq = " +
+                                  std::to_string(2 * sys.nq) + " of them");
+  if (!o.error_on.empty() && (o.rtol.size() != 1 || o.atol.size() != 1))
+    throw std::invalid_argument("rtol, atol: expected one value each with error_on (the tolerances of its outputs), "
+                                "got " + std::to_string(o.rtol.size()) + " and " + std::to_string(o.atol.size()));
+  if (o.rtol.maxCoeff() == 0.0 && o.atol.minCoeff() == 0.0)
+    throw std::invalid_argument("atol: expected positive values when rtol is zero");
+  if (!(o.max_step > 0.0)) throw std::invalid_argument("max_step: expected a positive step in s");
+  if (o.max_steps < 1) throw std::invalid_argument("max_steps: expected a positive number of steps");
+  if (o.method == Method::Newmark && !(o.gamma >= 0.5 && o.beta >= 0.25 * (0.5 + o.gamma) * (0.5 + o.gamma) - 1e-15))
+    throw std::invalid_argument("beta, gamma: expected the unconditionally stable range gamma >= 1/2, "
+                                "beta >= (gamma + 1/2)^2 / 4, got beta = " + num(o.beta) + ", gamma = " + num(o.gamma));
+  if (o.method == Method::HHT && !(o.alpha >= -1.0 / 3.0 && o.alpha <= 0.0))
+    throw std::invalid_argument("alpha: expected a value in [-1/3, 0], got " + num(o.alpha));
+  if ((o.method == Method::GeneralizedAlpha || o.method == Method::ImplicitSpring) &&
+      !(o.rho_inf >= 0.0 && o.rho_inf <= 1.0))
+    throw std::invalid_argument("rho_inf: expected a value in [0, 1], got " + num(o.rho_inf));
+  const Method stiff = o.stiff_method;
+  if (o.method == Method::Auto && (!method_info(stiff).error_estimate || stiff == Method::Dopri5 ||
+                                   stiff == Method::RKF45 || stiff == Method::Auto))
+    throw std::invalid_argument(std::string("stiff_method: expected an implicit method with an error estimate, got '") +
+                                method_name(stiff) + "'");
+  for (Eigen::Index k = 0; k < t_eval.size(); ++k)
+    if (!(t_eval(k) >= t0 && t_eval(k) <= t_end) || (k > 0 && !(t_eval(k) > t_eval(k - 1))))
+      throw std::invalid_argument("t_eval: expected increasing times within [t0, t_end]");
+}
 
 Trajectory integrate(const System& sys, double t0, double t_end, const VecX& q0, const VecX& qd0,
                      const Eigen::Ref<const VecX>& t_eval, const IntegratorOptions& o, const Monitor& monitor) {

@@ -427,10 +427,24 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
     outputs = [] if state else error_control.specs(system, error_on)
     if stop is not None and not callable(getattr(stop, "is_set", None)):
         raise ValueError(f"stop: expected None or a threading.Event (an object with is_set()), got {stop!r}")
-    _check_closed(system, t0, q0, qd0)
     nz = system.nz
     s0 = np.zeros(nz) if s0 is None else _checks.array(s0, (nz,), "s0")
-    if system.nl and method.startswith("scipy:"):
+    scipy = method.startswith("scipy:")
+    if scipy and method[6:] not in SCIPY_METHODS:
+        raise ValueError(f"method: expected one of {['scipy:' + m for m in SCIPY_METHODS]}, got {method!r}")
+    # scipy: methods check the options of the C++ ones too (they use only first_step of them); the options
+    # are checked before the loops are, so that a bad option is named whatever the state
+    opt = _options("dopri5" if scipy else method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, beta,
+                   gamma, alpha, rho_inf, newton_tol, newton_max_iterations, iteration_matrix)
+    if method == "auto":
+        opt.stiff_method = _auto_stiff_method(system, iteration_matrix)
+    if scipy:
+        opt.adaptive = -1  # SciPy's solvers are adaptive whatever it says (checked above for its type)
+    opt.s0 = s0
+    opt.set_error_on(outputs)
+    _core._check_options(system, t0, t_end, q0, qd0, t_eval, opt)
+    _check_closed(system, t0, q0, qd0)
+    if system.nl and scipy:
         raise ValueError(f"method: expected a C++ method for a system with loop closures ({system.nl} constraint rows), "
                          f"got {method!r}: SciPy's solvers integrate the constrained accelerations without holding "
                          "g(q) = 0, whose residual drifts (2.5e-4 on a four-bar at rtol = 1e-8); use 'auto', 'radau5', "
@@ -440,23 +454,15 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
                          f"variables), got {method!r}; use 'auto', 'esdirk43', 'generalized_alpha' or 'dopri5'")
     bar = ProgressBar(t_end - t0, "s", "simulate") if progress else None
     try:
-        scipy = method.startswith("scipy:")
-        # scipy: methods check the options of the C++ ones too (they use only first_step of them)
-        opt = _options("dopri5" if scipy else method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, beta,
-                       gamma, alpha, rho_inf, newton_tol, newton_max_iterations, iteration_matrix)
         if dt is not None and adaptive is None and first_step is None and method in _ADAPTIVE:
             warnings.warn(f"dt: {method!r} is adaptive: dt = {opt.dt:g} s only sets its first step; give "
                           "adaptive=False for fixed steps of dt, or first_step= for the first step without this warning",
                           UserWarning, stacklevel=2)
-        if method == "auto":
-            opt.stiff_method = _auto_stiff_method(system, iteration_matrix)
         if scipy:
             first = None if first_step is None else opt.dt
             run = _run_scipy(system, method[6:], t0, t_end, q0, qd0, t_eval, rtol, atol, max_step, max_steps,
                              _keep_going(bar, stop, t0), first)
         else:
-            opt.s0 = s0
-            opt.set_error_on(outputs)
             run = _core._integrate(system, t0, t_end, q0, qd0, t_eval, opt, _keep_going(bar, stop, t0))
     finally:
         if bar is not None:

@@ -105,6 +105,10 @@ struct Trajectory {
 /// the run (Ctrl-C), which then returns what it has.
 using Monitor = std::function<bool(double)>;
 
+/// The options' checks of integrate(): std::invalid_argument naming the first bad one.
+void check_options(const System& sys, double t0, double t_end, const VecX& q0, const VecX& qd0,
+                   const Eigen::Ref<const VecX>& t_eval, const IntegratorOptions& o);
+
 /// Integrates from (t0, q0, q̇0) to t_end. Output at `t_eval` (increasing, within
 /// [t0, t_end]) by each method's dense output — Dormand–Prince's own continuous extension,
 /// cubic Hermite interpolation of y and ẏ otherwise — or at every step if it is empty.
