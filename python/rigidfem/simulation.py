@@ -94,8 +94,9 @@ class Result(Versioned):
     without arms. The other arrays are computed from them on first use: ``qdd`` (len(t), nq),
     ``driving_forces`` (len(t), np; N or N·m), energies (len(t),; J; the elastic energy holds the
     arms' Σ s²/(2k)) and ``dissipated_power`` (len(t),; W). ``stats`` holds steps, rejected_steps,
-    rhs_evaluations, jacobians, factorizations, newton_iterations, wall_time (s) and model_size (m:
-    the L that a relative tolerance on outputs refers to; NaN when the run held the state).
+    rhs_evaluations, jacobians, factorizations, newton_iterations, linear_iterations (GMRES, of the
+    matrix-free tangent), wall_time (s) and model_size (m: the L that a relative tolerance on outputs
+    refers to; NaN when the run held the state).
     ``error_estimate`` is the error bar of the time integration (computed on first use: a second run);
     ``run`` keeps the arguments of the call that made the result.
     """
