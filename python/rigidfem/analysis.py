@@ -111,8 +111,9 @@ _LOOP_ROWS = {"revolute": 5, "spherical": 3, "universal": 4, "prismatic": 5, "cy
 #: A row of G counts as zero below this fraction of the largest row (round-off of a row that is
 #: zero in exact arithmetic, e.g. the out-of-plane rows of a planar loop).
 _ROW_ZERO = 1e-10
-#: G's rank: singular values of G (rows scaled to unit length) above this fraction of the largest;
-#: the same threshold as the least-norm solves of the dynamics (complete orthogonal decomposition).
+#: G's rank for the analyses: singular values of G (rows scaled to unit length) above this fraction of
+#: the largest. (The dynamics' least-norm solves decide on G M⁻¹ Gᵀ, 1e-10 of its largest singular
+#: value, i.e. rows below about 1e-5 of G's largest: constraints.cpp.)
 _RANK_TOL = 1e-10
 
 
