@@ -457,11 +457,7 @@ class Esdirk final : public ImplicitRk {
       return;
     }
     // M + diag(γh b + (γh)² c): the sde springs and dampers as armature of the articulated-body algorithm
-    for (int k = 0; k < n_; ++k) {
-      const int i = sys_.free_coords[k];
-      const Coordinate& c = sys_.coords[i];
-      armature_(k) = d_.spring_scale(i) * (gh * c.damping + gh * gh * c.stiffness);
-    }
+    spring_armature(sys_, d_, gh, gh * gh, armature_);
     if (sys_.nz > 0) arm_matrix(gh), armature_ += arm_diag_;
     ++stats_.factorizations;
     factor_armature(sys_, d_, armature_);  // at the state residual() left in d_

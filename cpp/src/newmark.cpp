@@ -237,11 +237,8 @@ class NewmarkFamily final : public Stepper {
   /// coordinates entering like joint armature in the articulated-body recursion (the rest
   /// of the tangent, geometric and gyroscopic, is left to the iterations).
   VecX spring_correction(double h, const VecX& r, double bp, double gp) {
-    for (int k = 0; k < sys_.nq; ++k) {
-      const int i = sys_.free_coords[k];
-      const Coordinate& c = sys_.coords[i];
-      armature_(k) = d_.spring_scale(i) * (gp * h * c.damping + bp * h * h * c.stiffness) + bp * h * h * arm_stiffness_(k);
-    }
+    spring_armature(sys_, d_, gp * h, bp * h * h, armature_);  // d_: the iterate's state (residual())
+    armature_ += (bp * h * h) * arm_stiffness_;
     ++stats_.factorizations;
     factor_armature(sys_, d_, armature_);  // residual() left the state of the iterate in d_
     VecX dx = -r;

@@ -33,6 +33,19 @@ constexpr int krylov_from_nq = 200;
 /// Whether the exact tangent of the run's implicit method is matrix-free (Krylov) rather than dense.
 bool krylov_tangent(const System& sys, const IntegratorOptions& o);
 
+/// δ_k = s_i (c₁ b_i + c₂ k_i): the damper b_i and spring k_i of each free coordinate i, scaled as in its
+/// force (Data::spring_scale), as the armature of the spring matrix M + diag δ (implicit_spring's Newton
+/// matrix, esdirk43's with iteration_matrix="spring", the Krylov form's preconditioner).
+template <class Scalar>
+void spring_armature(const System& sys, const Data& d, Scalar c1, Scalar c2, Eigen::Matrix<Scalar, Eigen::Dynamic, 1>& delta) {
+  delta.resize(sys.nq);
+  for (int k = 0; k < sys.nq; ++k) {
+    const int i = sys.free_coords[k];
+    const Coordinate& c = sys.coords[i];
+    delta(k) = d.spring_scale(i) * (c1 * c.damping + c2 * c.stiffness);
+  }
+}
+
 class NewtonMatrix {
  public:
   /// Dense or Krylov (krylov_tangent) for the system and options; factorisations and the tangent's
