@@ -83,6 +83,28 @@ def test_loop_reactions_hold_the_arm_forces():
     assert np.abs(relaxed.loop_reactions[0] - with_arm.loop_reactions[0]).max() > 1.0
 
 
+def test_the_newmark_family_reports_its_own_multipliers(tmp_path):
+    """generalized_alpha's loop reactions are its own index-3 multipliers λ_{n+1} (linear inside a step):
+    second order against a tight esdirk43 reference (whose reactions are the forward dynamics' at its
+    outputs), distinct from the forward dynamics' at its own outputs, and said so in stats; kept by npz."""
+    import dataclasses
+
+    _, system, q0, _ = four_bar(arm=True)
+    t = np.linspace(0.0, 0.5, 11)  # outputs inside the steps of 3 ms and on those of 1.5 ms
+    ref = rf.simulate(system, 0.5, q0=q0, t_eval=t, s0=[5.0], method="esdirk43", rtol=1e-11, atol=1e-12)
+    assert ref.stats["loop_reactions"] == "the forward dynamics' multipliers at each output's state"
+    errors = []
+    for dt in (3e-3, 1.5e-3):
+        r = rf.simulate(system, 0.5, q0=q0, t_eval=t, s0=[5.0], method="generalized_alpha", dt=dt)
+        assert r.stats["loop_reactions"] == "generalized_alpha's own multipliers (index 3, linear between its steps' ends)"
+        errors.append(np.abs(r.loop_reactions - ref.loop_reactions).max())
+        state = dataclasses.replace(r, multipliers=None).loop_reactions  # the forward dynamics' at r's outputs
+        assert 0.05 * errors[-1] < np.abs(r.loop_reactions - state).max() < 10 * errors[-1]
+    assert 3.5 < errors[0] / errors[1] < 4.5, errors
+    back = rf.load_npz(r.to_npz(tmp_path / "r.npz"), system)
+    assert np.array_equal(back.loop_reactions, r.loop_reactions)
+
+
 def test_scipy_methods_refuse_closed_chains():
     _, system, q0, _ = four_bar()
     with pytest.raises(ValueError, match="method: expected a C\\+\\+ method for a system with loop closures"):

@@ -1,4 +1,6 @@
 // The C++ integrators: options, the run (GIL released), and batch outputs for results.
+#include <limits>
+
 #include "bindings.hpp"
 #include "rigidfem/errors.hpp"
 #include "rigidfem/integrators.hpp"
@@ -12,6 +14,13 @@ RowMatX stack(const std::vector<VecX>& rows, int n) {
   RowMatX M(rows.size(), n);
   for (size_t k = 0; k < rows.size(); ++k) M.row(k) = rows[k].transpose();
   return M;
+}
+// The method's own multipliers at the outputs as (len t, nl) rows, NaN where it has none.
+RowMatX multipliers(const std::vector<VecX>& rows, int nl) {
+  RowMatX L = RowMatX::Constant(rows.size(), nl, std::numeric_limits<double>::quiet_NaN());
+  for (size_t k = 0; k < rows.size(); ++k)
+    if (rows[k].size() == nl) L.row(k) = rows[k].transpose();
+  return L;
 }
 }  // namespace
 
@@ -113,7 +122,8 @@ void bind_integrators(py::module_& m) {
         stats["probe_steps"] = st.probe_steps;
         stats["model_size"] = st.model_size;
         return py::make_tuple(VecX(Eigen::Map<const VecX>(tr.t.data(), tr.t.size())), stack(tr.q, s.nq),
-                              stack(tr.qd, s.nq), stats, tr.interrupted, failure, stack(tr.s, s.nz));
+                              stack(tr.qd, s.nq), stats, tr.interrupted, failure, stack(tr.s, s.nz),
+                              multipliers(tr.lambda, s.nl));
       },
       py::arg("system"), py::arg("t0"), py::arg("t_end"), py::arg("q0"), py::arg("qd0"), py::arg("t_eval"),
       py::arg("options"), py::arg("keep_going"));
@@ -121,11 +131,11 @@ void bind_integrators(py::module_& m) {
   m.def(
       "_evaluate_outputs",
       [](const System& s, const Eigen::Ref<const VecX>& t, const Eigen::Ref<const RowMatX>& Q,
-         const Eigen::Ref<const RowMatX>& QD, const Eigen::Ref<const RowMatX>& S) {
-        StateOutputs o = evaluate_outputs(s, t, Q, QD, S);
+         const Eigen::Ref<const RowMatX>& QD, const Eigen::Ref<const RowMatX>& S, const Eigen::Ref<const RowMatX>& L) {
+        StateOutputs o = evaluate_outputs(s, t, Q, QD, S, L);
         return py::make_tuple(o.qdd, o.tau, o.kinetic, o.gravity, o.elastic, o.power, o.reactions);
       },
-      py::arg("system"), py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("s"));
+      py::arg("system"), py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("s"), py::arg("lambda_"));
   m.def(
       "_point_positions",
       [](const System& s, int body, const Vec3& r, int frame, const Eigen::Ref<const VecX>& t,

@@ -110,34 +110,37 @@ class Recorder {
       : sys_(sys), traj_(traj), t_eval_(t_eval), nq_(sys.nq) {
     if (sys.nl > 0) d_ = std::make_unique<Data>(sys);
   }
-  void push(double t, const VecX& y) {
+  /// y = [q, q̇, s] at t; the stepper's own multipliers there, if any (Stepper::multipliers).
+  void push(double t, const VecX& y, const Stepper* stepper = nullptr) {
     traj_.t.push_back(t);
+    traj_.lambda.emplace_back();
+    if (stepper && !stepper->multipliers(t, traj_.lambda.back())) traj_.lambda.back().resize(0);
     traj_.q.push_back(y.head(nq_));
     traj_.qd.push_back(y.segment(nq_, nq_));
     traj_.s.push_back(y.tail(sys_.nz));
     if (d_) project_onto_loops(sys_, *d_, t, traj_.q.back(), traj_.qd.back(), 1e-12, 10);
   }
-  void start(double t0, const VecX& y0) {
+  void start(double t0, const VecX& y0, const Stepper& stepper) {
     if (t_eval_.size() == 0) {
-      push(t0, y0);
+      push(t0, y0, &stepper);
       return;
     }
-    while (next_ < t_eval_.size() && t_eval_(next_) <= t0) push(t_eval_(next_++), y0);
+    while (next_ < t_eval_.size() && t_eval_(next_) <= t0) push(t_eval_(next_++), y0, &stepper);
   }
   /// Forgets every output (a run that starts again from t0).
   void clear() {
-    traj_.t.clear(), traj_.q.clear(), traj_.qd.clear(), traj_.s.clear();
+    traj_.t.clear(), traj_.q.clear(), traj_.qd.clear(), traj_.s.clear(), traj_.lambda.clear();
     next_ = 0;
   }
   /// After an accepted step ending at t1: the requested times in (t0, t1] by dense output.
   void step(double t1, const VecX& y1, const Stepper& stepper) {
     if (t_eval_.size() == 0) {
-      push(t1, y1);
+      push(t1, y1, &stepper);
       return;
     }
     while (next_ < t_eval_.size() && t_eval_(next_) <= t1) {
       const double t = t_eval_(next_++);
-      push(t, t == t1 ? y1 : stepper.dense(t));
+      push(t, t == t1 ? y1 : stepper.dense(t), &stepper);
     }
   }
 
@@ -373,7 +376,7 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
   std::unique_ptr<Stepper> stepper = method_info(first.method).make(sys, first, stats);
   StepControl control = stepper->control();
   stepper->start(t0, y0);
-  out.start(t0, stepper->state());
+  out.start(t0, stepper->state(), *stepper);
   const Tolerances* tol = o.method == Method::Auto && !choice.stiff_running() ? &explicit_tol : &asked;
   double h = o.dt > 0.0 ? std::min(o.dt, span) : stepper->initial_step(span, *tol, o.max_step);
 
@@ -457,7 +460,7 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
         choice.switched_at(t0, stats);
         stepper->start(t0, y0);
         out.clear();
-        out.start(t0, stepper->state());
+        out.start(t0, stepper->state(), *stepper);
         last_q = q0;
         h = stepper->initial_step(span, asked, o.max_step);
       } else {

@@ -68,6 +68,7 @@ class NewmarkFamily final : public Stepper {
     const VecX qdd = forward_dynamics(sys_, d_, t0, q0, qd0);
     s_ = {q0, qd0, qdd, qdd, d_.lambda, s0};
     y_ = y0;
+    t_ = t0, h_step_ = 1.0, lambda_a_ = s_.lambda;  // multipliers(t0): λ_0
   }
 
   double initial_step(double span, const Tolerances&, double max_step) override {
@@ -109,6 +110,7 @@ class NewmarkFamily final : public Stepper {
     fb_ << s1_.v, s1_.qdd;
     y_ << yb_, s1_.s;
     sa_ = s_.s;
+    lambda_a_ = s_.lambda;
     s_ = s1_;
   }
 
@@ -121,6 +123,13 @@ class NewmarkFamily final : public Stepper {
     arm_step(sys_, t - t_, sa_, ya_.head(n), y.head(n), s);
     y.tail(sys_.nz) = s;
     return y;
+  }
+  /// λ by linear interpolation of λ_n, λ_{n+1} (second order, as the method).
+  bool multipliers(double t, VecX& lambda) const override {
+    if (sys_.nl == 0) return false;
+    const double theta = (t - t_) / h_step_;
+    lambda = (1.0 - theta) * lambda_a_ + theta * s_.lambda;
+    return true;
   }
   /// The estimate per unit step is O(h²).
   StepControl control() const override { return {2, 5.0, false, 1.25}; }
@@ -263,6 +272,7 @@ class NewmarkFamily final : public Stepper {
   double t_ = 0.0, h_step_ = 1.0;    // the last attempted step
   VecX y_;                           // [q, q̇, s] after it
   VecX ya_, fa_, yb_, fb_, sa_;      // [q, q̇] and [q̇, q̈] before and after it, s before it
+  VecX lambda_a_;                    // (nl) λ before it
   VecX e_;                           // (2 nq) the error estimate [e_q, 0] on outputs
 };
 

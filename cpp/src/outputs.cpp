@@ -119,11 +119,14 @@ MatX element_force_history(const System& sys, const Eigen::Ref<const VecX>& t, c
 }
 
 StateOutputs evaluate_outputs(const System& sys, const Eigen::Ref<const VecX>& t, const Eigen::Ref<const RowMatX>& Q,
-                              const Eigen::Ref<const RowMatX>& QD, const Eigen::Ref<const RowMatX>& S) {
+                              const Eigen::Ref<const RowMatX>& QD, const Eigen::Ref<const RowMatX>& S,
+                              const Eigen::Ref<const RowMatX>& L) {
   const Eigen::Index N = t.size();
   if (Q.rows() != N || QD.rows() != N || Q.cols() != sys.nq || QD.cols() != sys.nq)
     throw std::invalid_argument("q, qd: expected (len(t), nq) arrays");
   if (S.rows() != N || S.cols() != sys.nz) throw std::invalid_argument("s: expected a (len(t), nz) array");
+  if ((L.rows() != N && L.rows() != 0) || L.cols() != sys.nl)
+    throw std::invalid_argument("lambda: expected a (len(t), nl) or (0, nl) array");
   const Eigen::Index nloops = static_cast<Eigen::Index>(sys.loops.size());
   StateOutputs out{MatX(N, sys.nq), MatX(N, sys.np), VecX(N), VecX(N), VecX(N), VecX(N), MatX(N, 6 * nloops)};
   Data d(sys);
@@ -142,7 +145,9 @@ StateOutputs evaluate_outputs(const System& sys, const Eigen::Ref<const VecX>& t
     driving_forces(sys, d);
     out.tau.row(k) = d.tau.transpose();
     if (nloops) {
-      const RowMatX w = loop_reactions(sys, d, d.lambda);  // (nloops, 6), from this forward dynamics' λ
+      // (nloops, 6) from the integrator's λ where it has its own, else this forward dynamics'
+      const bool own = L.rows() && L.row(k).allFinite();
+      const RowMatX w = loop_reactions(sys, d, own ? VecX(L.row(k).transpose()) : d.lambda);
       out.reactions.row(k) = Eigen::Map<const Eigen::RowVectorXd>(w.data(), w.size());
     }
   }

@@ -96,7 +96,8 @@ class Result(Versioned):
     arms' Σ s²/(2k)) and ``dissipated_power`` (len(t),; W). ``stats`` holds steps, rejected_steps,
     rhs_evaluations, jacobians, factorizations, newton_iterations, linear_iterations (GMRES, of the
     matrix-free tangent), wall_time (s) and model_size (m: the L that a relative tolerance on outputs
-    refers to; NaN when the run held the state).
+    refers to; NaN when the run held the state), method (what ran) and, with loops, loop_reactions (whose
+    multipliers ``loop_reactions`` are).
     ``error_estimate`` is the error bar of the time integration (computed on first use: a second run);
     ``run`` keeps the arguments of the call that made the result.
     """
@@ -109,6 +110,9 @@ class Result(Versioned):
     method: str
     interrupted: bool = False
     arm_forces: np.ndarray = None
+    #: (len(t), nl) the loop multipliers the method solved for itself at each output, NaN rows where it has
+    #: none of its own (``loop_reactions`` then takes the forward dynamics'); None: none at all
+    multipliers: np.ndarray = field(default=None, repr=False)
     run: dict = field(default=None, repr=False)        #: the arguments of the simulate call that made it
     estimate: object = field(default=None, repr=False)  #: the ErrorEstimate, once computed
 
@@ -118,7 +122,9 @@ class Result(Versioned):
 
     @functools.cached_property
     def _outputs(self):
-        return _core._evaluate_outputs(self.system, self.t, self.q, self.qd, self.arm_forces)
+        nl = 0 if self.system is None else self.system.nl
+        own = np.zeros((0, nl)) if self.multipliers is None else np.ascontiguousarray(self.multipliers, dtype=float)
+        return _core._evaluate_outputs(self.system, self.t, self.q, self.qd, self.arm_forces, own)
 
     @property
     def qdd(self) -> np.ndarray:
@@ -159,10 +165,19 @@ class Result(Versioned):
     @property
     def loop_reactions(self) -> np.ndarray:
         """Reactions of the loop closures (len(t), nloops, 6): force (N) and torque (N·m) on body
-        b in frame A's axes, per ``system.loop_names``; an actuator's force in column 0. From the
-        multipliers of the forward dynamics at each output (q, q̇ and the Maxwell arms' forces): the
-        same computation as ``qdd`` (the multipliers an integrator iterates on inside its steps are not
-        kept)."""
+        b in frame A's axes, per ``system.loop_names``; an actuator's force in column 0.
+        ``stats["loop_reactions"]`` says where they come from:
+
+        - the Newmark family (newmark, hht, generalized_alpha, implicit_spring) solves for its own
+          multipliers λ_{n+1} with q̈_{n+1} at each step's end (index 3, Arnold & Brüls): those, linear
+          between the steps' ends at outputs inside a step. They converge as h² to the exact ones and
+          differ by O(h²) from the forward dynamics' at the output's (q, q̇);
+        - every other method: the multipliers of the forward dynamics at each output's (q, q̇) and
+          Maxwell arms' forces, the same computation as ``qdd``. esdirk43 and radau5 solve the loops at
+          the acceleration level inside their stages and take exactly these at each step's end, after
+          the projection onto the loops; the explicit methods and SciPy's have none of their own.
+
+        ``system.loop_reactions(t, q, qd)`` gives the forward dynamics' at any state."""
         return self._outputs[6].reshape(len(self.t), len(self.system.loop_names), 6)
 
     @functools.cached_property
@@ -468,14 +483,17 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
     finally:
         if bar is not None:
             bar.close()
-    t, q, qd, stats, interrupted, failure, *arms = run
-    arms = arms[0] if arms else np.zeros((len(t), 0))
+    t, q, qd, stats, interrupted, failure, *extra = run
+    arms, own = extra if extra else (np.zeros((len(t), 0)), None)
     stats["method"] = _auto_choice(stats, opt.stiff_method, t0) if method == "auto" else method
+    if system.nl:
+        stats["loop_reactions"] = _reactions_source(own, method)
     call = dict(method=method, t_end=t_end, t0=t0, q0=q0, qd0=qd0, s0=s0, t_eval=t_eval if len(t_eval) else None,
                 rtol=rtol, atol=atol, dt=dt, first_step=first_step, max_steps=max_steps, max_step=max_step,
                 adaptive=adaptive, beta=beta, gamma=gamma, alpha=alpha, rho_inf=rho_inf, newton_tol=newton_tol,
                 newton_max_iterations=newton_max_iterations, iteration_matrix=iteration_matrix, error_on=error_on)
-    result = Result(system, t, q, qd, stats, method, interrupted, arms, dict(call, outputs=bool(outputs), fixed=fixed))
+    result = Result(system, t, q, qd, stats, method, interrupted, arms, own if system.nl else None,
+                    dict(call, outputs=bool(outputs), fixed=fixed))
     if failure is not None:
         message, time, cause = failure
         error = _core.SimulationError(message)
@@ -575,6 +593,14 @@ _ADAPTIVE = ("auto", "dopri5", "rkf45", "esdirk43", "radau5")
 
 #: The implicit method ``method="auto"`` hands over to when dopri5 finds the problem stiff.
 AUTO_STIFF_METHOD = "esdirk43"
+
+
+def _reactions_source(own, method: str) -> str:
+    """Where ``Result.loop_reactions`` come from, for ``stats["loop_reactions"]``: the method's own
+    multipliers (``own`` finite: the Newmark family's, at every output) or the forward dynamics'."""
+    if own is not None and np.isfinite(own).all():
+        return f"{method}'s own multipliers (index 3, linear between its steps' ends)"
+    return "the forward dynamics' multipliers at each output's state"
 
 
 def _auto_choice(stats: dict, stiff_method: str, t0: float) -> str:

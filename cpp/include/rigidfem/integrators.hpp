@@ -93,6 +93,9 @@ struct Trajectory {
   std::vector<double> t;
   std::vector<VecX> q, qd;  // (len t) x (nq)
   std::vector<VecX> s;      // (len t) x (nz) the Maxwell arms' forces; empty without arms
+  /// (len t) x (nl) the multipliers the method solved for itself at each output (Stepper::multipliers:
+  /// the Newmark family's), a row of size 0 where it has none (the forward dynamics' then stand).
+  std::vector<VecX> lambda;
   IntegratorStats stats;
   bool interrupted = false;  ///< the monitor asked to stop: the trajectory ends early
   /// The exception that ended the run early — a SimulationError (numerical failure, max_steps),

@@ -46,14 +46,17 @@ MatX element_force_history(const System& sys, const Eigen::Ref<const VecX>& t, c
 /// Quantities at a batch of states (t_k, q_k, q̇_k, s_k), rows k (S: the Maxwell arms' forces, (N, nz),
 /// or (N, 0) without arms): accelerations, driving forces, energies (J; elastic with the arms'
 /// Σ s²/(2k)), the dissipated power (W; with the arms' Σ s²/(kτ)) and the loops' reactions from the
-/// multipliers of the same forward dynamics (the arm forces included). Used for simulation results.
+/// multipliers of the same forward dynamics (the arm forces included) or, where a row of L (N, nl; or
+/// (0, nl): none) is finite, from those (an integrator's own, Trajectory::lambda). Used for simulation
+/// results.
 struct StateOutputs {
   MatX qdd, tau;                          // (N, nq), (N, np)
   VecX kinetic, gravity, elastic, power;  // (N)
   MatX reactions;                         // (N, 6 nloops): each loop's wrench on its body b (loop_reactions), arms included
 };
 StateOutputs evaluate_outputs(const System& sys, const Eigen::Ref<const VecX>& t, const Eigen::Ref<const RowMatX>& Q,
-                              const Eigen::Ref<const RowMatX>& QD, const Eigen::Ref<const RowMatX>& S);
+                              const Eigen::Ref<const RowMatX>& QD, const Eigen::Ref<const RowMatX>& S,
+                              const Eigen::Ref<const RowMatX>& L);
 /// Global positions (N, 3) of the point r (body frame) of `body` at (t_k, q_k), expressed in
 /// the frame of body `frame` (−1: global): one positions-only kinematics pass per sample.
 MatX point_positions(const System& sys, int body, const Vec3& r, int frame, const Eigen::Ref<const VecX>& t,

@@ -78,6 +78,12 @@ class Stepper {
   /// Systems with loops: moves the current state onto the constraint manifold at t (explicit
   /// methods, whose steps drift off it); the Newmark family satisfies g(q) = 0 in every step.
   virtual void project(double /*t*/) {}
+  /// Systems with loops: the multipliers λ (nl) the method itself solved for, at a time t within the last
+  /// accepted step; false where the method has none of its own. The Newmark family's (index 3: λ_{n+1}
+  /// with q̈_{n+1}, linear between the steps' ends) differ from the forward dynamics' at the output's
+  /// state by O(h²); the implicit Runge–Kutta methods take the forward dynamics' at each step's end
+  /// (project), so they return false, as do the explicit ones.
+  virtual bool multipliers(double /*t*/, VecX& /*lambda*/) const { return false; }
   /// h ρ of the last attempted step (ρ the dominant eigenvalue) where the method estimates it (dopri5,
   /// rkf45: from two stages at t + h), else 0.
   virtual double h_rho() const { return 0.0; }
