@@ -110,8 +110,8 @@ class Result(Versioned):
     method: str
     interrupted: bool = False
     arm_forces: np.ndarray = None
-    #: (len(t), nl) the loop multipliers the method solved for itself at each output, NaN rows where it has
-    #: none of its own (``loop_reactions`` then takes the forward dynamics'); None: none at all
+    #: (len(t), nl) the loop multipliers the method solved for itself at each output (the Newmark family's);
+    #: None where it has none of its own (``loop_reactions`` then takes the forward dynamics')
     multipliers: np.ndarray = field(default=None, repr=False)
     run: dict = field(default=None, repr=False)        #: the arguments of the simulate call that made it
     estimate: object = field(default=None, repr=False)  #: the ErrorEstimate, once computed
@@ -485,6 +485,8 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
             bar.close()
     t, q, qd, stats, interrupted, failure, *extra = run
     arms, own = extra if extra else (np.zeros((len(t), 0)), None)
+    if own is not None and not (system.nl and np.isfinite(own).all()):
+        own = None  # the method has no multipliers of its own (NaN rows from _core._integrate)
     stats["method"] = _auto_choice(stats, opt.stiff_method, t0) if method == "auto" else method
     if system.nl:
         stats["loop_reactions"] = _reactions_source(own, method)
@@ -492,7 +494,7 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
                 rtol=rtol, atol=atol, dt=dt, first_step=first_step, max_steps=max_steps, max_step=max_step,
                 adaptive=adaptive, beta=beta, gamma=gamma, alpha=alpha, rho_inf=rho_inf, newton_tol=newton_tol,
                 newton_max_iterations=newton_max_iterations, iteration_matrix=iteration_matrix, error_on=error_on)
-    result = Result(system, t, q, qd, stats, method, interrupted, arms, own if system.nl else None,
+    result = Result(system, t, q, qd, stats, method, interrupted, arms, own,
                     dict(call, outputs=bool(outputs), fixed=fixed))
     if failure is not None:
         message, time, cause = failure
@@ -597,8 +599,8 @@ AUTO_STIFF_METHOD = "esdirk43"
 
 def _reactions_source(own, method: str) -> str:
     """Where ``Result.loop_reactions`` come from, for ``stats["loop_reactions"]``: the method's own
-    multipliers (``own`` finite: the Newmark family's, at every output) or the forward dynamics'."""
-    if own is not None and np.isfinite(own).all():
+    multipliers (``own``: the Newmark family's, at every output) or, with None, the forward dynamics'."""
+    if own is not None:
         return f"{method}'s own multipliers (index 3, linear between its steps' ends)"
     return "the forward dynamics' multipliers at each output's state"
 
