@@ -82,8 +82,9 @@ void bind_transforms(py::module_& m) {
 }
 
 void bind_profiles(py::module_& m) {
-  py::class_<Profile, ProfilePtr>(m, "Profile", "A prescribed motion q(t) with its rates (see rigidfem.motion).",
-                                  py::dynamic_attr())
+  py::class_<Profile, ProfilePtr> profile(m, "Profile", "A prescribed motion q(t) with its rates (see rigidfem.motion).",
+                                          py::dynamic_attr());
+  profile
       .def(
           "__call__",
           [](const Profile& p, const py::object& time) {
@@ -112,6 +113,48 @@ void bind_profiles(py::module_& m) {
               arguments[k] = std::visit([](const auto& a) { return py::cast(a); }, r.arguments[k]);
             return py::make_tuple(py::module_::import("rigidfem._core").attr(r.maker.c_str()), arguments);
           });
+  // Composition, each a C++ profile holding its parts: p ± r, p ± c, c ± p, c·p, p/c, −p (c a number; anything
+  // else: NotImplemented, Python's TypeError) and p.shifted(delay). The result's Python object keeps its parts'
+  // (`_parts`), so that a part made by rigidfem.motion.function still pickles as its function.
+  auto composed = [](ProfilePtr made, py::tuple parts) {
+    py::object o = py::cast(std::move(made));
+    o.attr("_parts") = std::move(parts);
+    return o;
+  };
+  // w_self · self + w_other · other, other a profile or a number (then an offset)
+  auto combine = [composed](const py::object& self, const py::object& other, double w_self, double w_other) -> py::object {
+    const ProfilePtr p = self.cast<ProfilePtr>();
+    if (py::isinstance<Profile>(other))
+      return composed(sum_profile({w_self, w_other}, {p, other.cast<ProfilePtr>()}, 0.0), py::make_tuple(self, other));
+    if (py::isinstance<py::str>(other) || !(PyFloat_Check(other.ptr()) || PyLong_Check(other.ptr()) ||
+                                            PyObject_HasAttrString(other.ptr(), "__float__")))
+      return py::reinterpret_borrow<py::object>(Py_NotImplemented);
+    return composed(sum_profile({w_self}, {p}, w_other * other.cast<double>()), py::make_tuple(self));
+  };
+  auto scale = [composed](const py::object& self, const py::object& c, bool divide) -> py::object {
+    if (py::isinstance<Profile>(c) || py::isinstance<py::str>(c) ||
+        !(PyFloat_Check(c.ptr()) || PyLong_Check(c.ptr()) || PyObject_HasAttrString(c.ptr(), "__float__")))
+      return py::reinterpret_borrow<py::object>(Py_NotImplemented);
+    const double w = divide ? 1.0 / c.cast<double>() : c.cast<double>();
+    return composed(sum_profile({w}, {self.cast<ProfilePtr>()}, 0.0), py::make_tuple(self));
+  };
+  profile
+      .def("__add__", [combine](const py::object& p, const py::object& r) { return combine(p, r, 1.0, 1.0); })
+      .def("__radd__", [combine](const py::object& p, const py::object& r) { return combine(p, r, 1.0, 1.0); })
+      .def("__sub__", [combine](const py::object& p, const py::object& r) { return combine(p, r, 1.0, -1.0); })
+      .def("__rsub__", [combine](const py::object& p, const py::object& r) { return combine(p, r, -1.0, 1.0); })
+      .def("__mul__", [scale](const py::object& p, const py::object& c) { return scale(p, c, false); })
+      .def("__rmul__", [scale](const py::object& p, const py::object& c) { return scale(p, c, false); })
+      .def("__truediv__", [scale](const py::object& p, const py::object& c) { return scale(p, c, true); })
+      .def("__neg__", [scale](const py::object& p) { return scale(p, py::float_(-1.0), false); })
+      .def("__pos__", [](const py::object& p) { return p; })
+      .def(
+          "shifted",
+          [composed](const py::object& p, const py::object& delay) {
+            const double d = real_arg(delay, "delay", "a finite time in s");
+            return composed(shifted_profile(p.cast<ProfilePtr>(), d), py::make_tuple(p));
+          },
+          py::arg("delay"), "The same motion `delay` s later: q(t − delay), with its rates.");
   m.def("constant_profile", &constant_profile, py::arg("value"));
   m.def("polynomial_profile", &polynomial_profile, py::arg("coefficients"));
   m.def("harmonic_profile", &harmonic_profile, py::arg("amplitude"), py::arg("omega"), py::arg("phase"),
@@ -120,6 +163,14 @@ void bind_profiles(py::module_& m) {
         py::arg("phases"), py::arg("offset"));
   m.def("spin_up_profile", &spin_up_profile, py::arg("omega"), py::arg("duration"));
   m.def("spline_profile", &spline_profile, py::arg("t"), py::arg("q"));
+  m.def("rest_to_rest_profile", &rest_to_rest_profile, py::arg("law"), py::arg("start"), py::arg("end"), py::arg("t0"),
+        py::arg("duration"), py::arg("fraction"));
+  m.def("ramp_profile", &ramp_profile, py::arg("law"), py::arg("rate"), py::arg("t0"), py::arg("duration"),
+        py::arg("start"), py::arg("fraction"));
+  m.def("sum_profile", &sum_profile, py::arg("weights"), py::arg("parts"), py::arg("offset"), py::keep_alive<0, 2>());
+  m.def("shifted_profile", &shifted_profile, py::arg("profile"), py::arg("delay"), py::keep_alive<0, 1>());
+  m.def("piecewise_profile", &piecewise_profile, py::arg("pieces"), py::arg("breaks"), py::arg("continuity"),
+        py::keep_alive<0, 1>());
   m.def(
       "callback_profile",
       [](std::function<std::tuple<double, double, double>(double)> f) {

@@ -1,5 +1,7 @@
 #include "rigidfem/profiles.hpp"
 
+#include "rigidfem/errors.hpp"
+
 #include <algorithm>
 #include <cmath>
 #include <sstream>
@@ -162,6 +164,189 @@ class Spline final : public Profile {
   std::vector<double> t_, q_, m_;
 };
 
+/// A normalised point-to-point law s(τ) on τ ∈ [0, 1], s(0) = 0, s(1) = 1, symmetric (s(τ) + s(1 − τ) = 1),
+/// with s', s'' and S(τ) = ∫₀^τ s (S(1) = 1/2).
+struct Law {
+  enum class Kind { Quintic, Cycloidal, Trapezoidal } kind;
+  double f = 0.0;  // trapezoidal: the fraction of T spent accelerating (and decelerating), 0 < f ≤ 1/2; else 0
+
+  std::string name() const {
+    return kind == Kind::Quintic ? "quintic" : kind == Kind::Cycloidal ? "cycloidal" : "trapezoidal";
+  }
+  /// (s, s', s'') at τ.
+  MotionState at(double tau) const {
+    switch (kind) {
+      case Kind::Quintic: {  // s = 10τ³ − 15τ⁴ + 6τ⁵, s' = 30τ²(1 − τ)², s'' = 60τ(1 − τ)(1 − 2τ)
+        const double u = 1.0 - tau;
+        return {tau * tau * tau * (10.0 - 15.0 * tau + 6.0 * tau * tau), 30.0 * tau * tau * u * u,
+                60.0 * tau * u * (1.0 - 2.0 * tau)};
+      }
+      case Kind::Cycloidal: {  // s = τ − sin(2πτ)/(2π), s' = 1 − cos(2πτ), s'' = 2π sin(2πτ)
+        const double k = 2.0 * M_PI;
+        return {tau - std::sin(k * tau) / k, 1.0 - std::cos(k * tau), k * std::sin(k * tau)};
+      }
+      case Kind::Trapezoidal: {  // peak rate v = 1/(1 − f): s'' = v/f, 0, −v/f on [0, f), [f, 1 − f], (1 − f, 1]
+        const double v = 1.0 / (1.0 - f);
+        if (tau < f) return {v * tau * tau / (2.0 * f), v * tau / f, v / f};
+        if (tau <= 1.0 - f) return {v * (tau - 0.5 * f), v, 0.0};
+        const double u = 1.0 - tau;
+        return {1.0 - v * u * u / (2.0 * f), v * u / f, -v / f};
+      }
+    }
+    return {};
+  }
+  /// S(τ) = ∫₀^τ s; beyond τ = 1/2 from the symmetry, S(τ) = τ − 1/2 + S(1 − τ).
+  double integral(double tau) const {
+    if (tau > 0.5) return tau - 0.5 + integral(1.0 - tau);
+    switch (kind) {
+      case Kind::Quintic:  // 5τ⁴/2 − 3τ⁵ + τ⁶
+        return tau * tau * tau * tau * (2.5 - 3.0 * tau + tau * tau);
+      case Kind::Cycloidal: {  // τ²/2 + (cos(2πτ) − 1)/(2π)²
+        const double k = 2.0 * M_PI;
+        return 0.5 * tau * tau + (std::cos(k * tau) - 1.0) / (k * k);
+      }
+      case Kind::Trapezoidal: {  // v τ³/(6f) on [0, f), then S(f) + v [(τ² − f²)/2 − f (τ − f)/2]
+        const double v = 1.0 / (1.0 - f);
+        if (tau < f) return v * tau * tau * tau / (6.0 * f);
+        return v * f * f / 6.0 + v * (0.5 * (tau * tau - f * f) - 0.5 * f * (tau - f));
+      }
+    }
+    return 0.0;
+  }
+};
+
+Law make_law(const std::string& name, double fraction) {
+  if (name == "quintic") return {Law::Kind::Quintic, 0.0};
+  if (name == "cycloidal") return {Law::Kind::Cycloidal, 0.0};
+  if (name == "trapezoidal") {
+    if (!(fraction > 0.0 && fraction <= 0.5))
+      throw std::invalid_argument("fraction: expected the share of the duration spent accelerating, in (0, 0.5], got " +
+                                  num(fraction));
+    return {Law::Kind::Trapezoidal, fraction};
+  }
+  throw std::invalid_argument("law: expected 'quintic', 'cycloidal' or 'trapezoidal', got '" + name + "'");
+}
+
+class RestToRest final : public Profile {
+ public:
+  RestToRest(Law law, double q0, double q1, double t0, double T) : law_(law), q0_(q0), q1_(q1), t0_(t0), T_(T) {}
+  MotionState at(double t) const override {
+    const double tau = (t - t0_) / T_, d = q1_ - q0_;
+    if (!(tau > 0.0)) return {q0_, 0.0, 0.0};  // also NaN: at rest
+    if (tau >= 1.0) return {q1_, 0.0, 0.0};
+    const MotionState s = law_.at(tau);  // q = q0 + Δ s, q̇ = Δ s'/T, q̈ = Δ s''/T²
+    return {q0_ + d * s.q, d * s.qd / T_, d * s.qdd / (T_ * T_)};
+  }
+  std::string describe() const override {
+    std::ostringstream o;
+    o << "rest_to_rest(" << law_.name() << ", " << q0_ << " -> " << q1_ << ", t = " << t0_ << " ... " << t0_ + T_ << " s)";
+    return o.str();
+  }
+  ProfileRecipe recipe() const override { return {"rest_to_rest_profile", {law_.name(), q0_, q1_, t0_, T_, law_.f}}; }
+
+ private:
+  Law law_;
+  double q0_, q1_, t0_, T_;
+};
+
+class Ramp final : public Profile {
+ public:
+  Ramp(Law law, double rate, double t0, double T, double start) : law_(law), v_(rate), t0_(t0), T_(T), q0_(start) {}
+  MotionState at(double t) const override {
+    const double tau = (t - t0_) / T_;
+    if (!(tau > 0.0)) return {q0_, 0.0, 0.0};
+    if (tau >= 1.0) return {q0_ + v_ * (t - t0_ - 0.5 * T_), v_, 0.0};
+    const MotionState s = law_.at(tau);  // q = q0 + v T S(τ), q̇ = v s(τ), q̈ = v s'(τ)/T
+    return {q0_ + v_ * T_ * law_.integral(tau), v_ * s.q, v_ * s.qd / T_};
+  }
+  std::string describe() const override {
+    std::ostringstream o;
+    o << "ramp(" << law_.name() << ", rate " << v_ << " from t = " << t0_ << " s over " << T_ << " s)";
+    return o.str();
+  }
+  ProfileRecipe recipe() const override {
+    return {"ramp_profile", {law_.name(), v_, t0_, T_, q0_, law_.f}};
+  }
+
+ private:
+  Law law_;
+  double v_, t0_, T_, q0_;
+};
+
+class Sum final : public Profile {
+ public:
+  Sum(std::vector<double> w, std::vector<ProfilePtr> parts, double offset)
+      : w_(std::move(w)), parts_(std::move(parts)), offset_(offset) {}
+  MotionState at(double t) const override {
+    MotionState m{offset_, 0.0, 0.0};  // Σ w_k p_k + offset, term by term in q, q̇, q̈
+    for (size_t k = 0; k < parts_.size(); ++k) {
+      const MotionState p = parts_[k]->at(t);
+      m.q += w_[k] * p.q, m.qd += w_[k] * p.qd, m.qdd += w_[k] * p.qdd;
+    }
+    return m;
+  }
+  std::string describe() const override {
+    // "a − 2·b + 1": unit weights left out (sums are flat: sum_profile)
+    std::ostringstream o;
+    for (size_t k = 0; k < parts_.size(); ++k) {
+      const double w = std::abs(w_[k]);
+      o << (k ? (w_[k] < 0 ? " − " : " + ") : (w_[k] < 0 ? "−" : ""));
+      if (w != 1.0) o << w << "·";
+      o << parts_[k]->describe();
+    }
+    if (offset_ != 0.0 || parts_.empty())
+      o << (parts_.empty() ? (offset_ < 0 ? "−" : "") : (offset_ < 0 ? " − " : " + ")) << std::abs(offset_);
+    return o.str();
+  }
+  ProfileRecipe recipe() const override { return {"sum_profile", {w_, parts_, offset_}}; }
+  const std::vector<double>& weights() const { return w_; }
+  const std::vector<ProfilePtr>& parts() const { return parts_; }
+  double offset() const { return offset_; }
+
+ private:
+  std::vector<double> w_;
+  std::vector<ProfilePtr> parts_;
+  double offset_;
+};
+
+class Shifted final : public Profile {
+ public:
+  Shifted(ProfilePtr p, double delay) : p_(std::move(p)), delay_(delay) {}
+  MotionState at(double t) const override { return p_->at(t - delay_); }
+  std::string describe() const override {
+    std::ostringstream o;
+    o << p_->describe() << " delayed by " << delay_ << " s";
+    return o.str();
+  }
+  ProfileRecipe recipe() const override { return {"shifted_profile", {p_, delay_}}; }
+
+ private:
+  ProfilePtr p_;
+  double delay_;
+};
+
+class Piecewise final : public Profile {
+ public:
+  Piecewise(std::vector<ProfilePtr> pieces, std::vector<double> breaks, int continuity)
+      : pieces_(std::move(pieces)), breaks_(std::move(breaks)), continuity_(continuity) {}
+  MotionState at(double t) const override {
+    // the piece k with breaks[k−1] ≤ t < breaks[k]
+    const auto k = std::upper_bound(breaks_.begin(), breaks_.end(), t) - breaks_.begin();
+    return pieces_[static_cast<size_t>(k)]->at(t);
+  }
+  std::string describe() const override {
+    return "piecewise(" + std::to_string(pieces_.size()) + " pieces, continuity " + std::to_string(continuity_) + ")";
+  }
+  ProfileRecipe recipe() const override {
+    return {"piecewise_profile", {pieces_, breaks_, continuity_}};
+  }
+
+ private:
+  std::vector<ProfilePtr> pieces_;
+  std::vector<double> breaks_;
+  int continuity_;
+};
+
 class Callback final : public Profile {
  public:
   explicit Callback(std::function<MotionState(double)> f) : f_(std::move(f)) {}
@@ -229,6 +414,84 @@ ProfilePtr spline_profile(const std::vector<double>& t, const std::vector<double
     if (k > 0 && !(t[k] > t[k - 1])) throw std::invalid_argument("t: expected strictly increasing times");
   }
   return std::make_shared<Spline>(t, q);
+}
+
+ProfilePtr rest_to_rest_profile(const std::string& law, double start, double end, double t0, double duration,
+                                double fraction) {
+  const Law l = make_law(law, fraction);
+  require_finite(start, "start");
+  require_finite(end, "end");
+  require_finite(t0, "t0");
+  if (!(duration > 0.0) || !std::isfinite(duration))
+    throw std::invalid_argument("duration: expected a positive time in s, got " + num(duration));
+  return std::make_shared<RestToRest>(l, start, end, t0, duration);
+}
+
+ProfilePtr ramp_profile(const std::string& law, double rate, double t0, double duration, double start,
+                        double fraction) {
+  const Law l = make_law(law, fraction);
+  require_finite(rate, "rate");
+  require_finite(t0, "t0");
+  require_finite(start, "start");
+  if (!(duration > 0.0) || !std::isfinite(duration))
+    throw std::invalid_argument("duration: expected a positive time in s, got " + num(duration));
+  return std::make_shared<Ramp>(l, rate, t0, duration, start);
+}
+
+ProfilePtr sum_profile(const std::vector<double>& weights, const std::vector<ProfilePtr>& parts, double offset) {
+  if (weights.size() != parts.size())
+    throw std::invalid_argument("weights: expected " + std::to_string(parts.size()) + " values (one per part), got " +
+                                std::to_string(weights.size()));
+  for (double w : weights) require_finite(w, "weights");
+  for (const ProfilePtr& p : parts)
+    if (!p) throw std::invalid_argument("parts: expected profiles, got None");
+  require_finite(offset, "offset");
+  // A sum of sums is one sum: w·(Σ v_j r_j + c) adds the terms w v_j r_j and the offset w c.
+  std::vector<double> w;
+  std::vector<ProfilePtr> terms;
+  for (size_t k = 0; k < parts.size(); ++k) {
+    if (const auto* inner = dynamic_cast<const Sum*>(parts[k].get())) {
+      for (size_t j = 0; j < inner->parts().size(); ++j)
+        w.push_back(weights[k] * inner->weights()[j]), terms.push_back(inner->parts()[j]);
+      offset += weights[k] * inner->offset();
+    } else {
+      w.push_back(weights[k]), terms.push_back(parts[k]);
+    }
+  }
+  return std::make_shared<Sum>(std::move(w), std::move(terms), offset);
+}
+
+ProfilePtr shifted_profile(const ProfilePtr& profile, double delay) {
+  if (!profile) throw std::invalid_argument("profile: expected a profile, got None");
+  require_finite(delay, "delay");
+  return std::make_shared<Shifted>(profile, delay);
+}
+
+ProfilePtr piecewise_profile(const std::vector<ProfilePtr>& pieces, const std::vector<double>& breaks, int continuity) {
+  if (pieces.empty()) throw std::invalid_argument("pieces: expected at least one profile, got none");
+  for (const ProfilePtr& p : pieces)
+    if (!p) throw std::invalid_argument("pieces: expected profiles, got None");
+  if (breaks.size() + 1 != pieces.size())
+    throw std::invalid_argument("breaks: expected " + std::to_string(pieces.size() - 1) +
+                                " times (one between each two pieces), got " + std::to_string(breaks.size()));
+  if (continuity < 0 || continuity > 2)
+    throw std::invalid_argument("continuity: expected 0 (q), 1 (q and q̇) or 2 (q, q̇ and q̈), got " +
+                                std::to_string(continuity));
+  for (size_t k = 0; k < breaks.size(); ++k) {
+    require_finite(breaks[k], "breaks");
+    if (k > 0 && !(breaks[k] > breaks[k - 1])) throw std::invalid_argument("breaks: expected strictly increasing times");
+    // The two pieces meeting at the break must agree to 1e-9 (1 + |x|) in q, q̇, q̈ up to the continuity asked.
+    const MotionState a = pieces[k]->at(breaks[k]), b = pieces[k + 1]->at(breaks[k]);
+    const double left[3] = {a.q, a.qd, a.qdd}, right[3] = {b.q, b.qd, b.qdd};
+    static const char* names[3] = {"q", "qd", "qdd"};
+    for (int i = 0; i <= continuity; ++i)
+      if (!(std::abs(left[i] - right[i]) <= 1e-9 * (1.0 + std::max(std::abs(left[i]), std::abs(right[i])))))
+        throw std::invalid_argument("pieces: expected pieces " + std::to_string(k) + " and " + std::to_string(k + 1) +
+                                    " to meet at the break t = " + num(breaks[k]) + " s with continuity " +
+                                    std::to_string(continuity) + ", got " + names[i] + " = " + num(left[i]) +
+                                    " before and " + num(right[i]) + " after");
+  }
+  return std::make_shared<Piecewise>(pieces, breaks, continuity);
 }
 
 ProfilePtr callback_profile(std::function<MotionState(double)> f) {

@@ -2,6 +2,12 @@
 scale loads in time). Each returns a profile ``p`` with ``p(t) -> (q, qd, qdd)``;
 units follow the coordinate (m or rad; per s; per s²). All but ``function`` are
 evaluated in C++ at no Python cost.
+
+Profiles compose, in C++ with their exact rates: ``p + r``, ``p - r``, ``p + c``, ``c * p``,
+``p / c``, ``-p`` (c a number in the coordinate's units, or a factor), ``p.shifted(delay)`` (the
+same motion ``delay`` s later) and ``piecewise([p0, p1, ...], breaks)`` (one after the other,
+checked to join continuously). Rest-to-rest moves (``rest_to_rest``) and smooth ramps of the rate
+(``ramp``) stop and start where they say, unlike a polynomial, which keeps growing after its end.
 """
 
 from __future__ import annotations
@@ -58,6 +64,72 @@ def spline(t: Sequence[float], q: Sequence[float]) -> _core.Profile:
     """Natural cubic spline through tabulated (t, q); outside the table q continues
     linearly with the end slope."""
     return _core.spline_profile(list(_checks.vector(t, "t")), list(_checks.vector(q, "q")))
+
+
+LAWS = ("quintic", "cycloidal", "trapezoidal")
+
+
+def rest_to_rest(start: float, end: float, t0: float, duration: float, law: str = "quintic",
+                 fraction: float = 1 / 3) -> _core.Profile:
+    """A move from rest at ``start`` to rest at ``end`` (m or rad) between ``t0`` and ``t0 + duration``
+    (s): q = start before, q = end after, and q = start + (end − start) s(τ), τ = (t − t0)/duration, in
+    between, with its exact rates q̇ = (end − start) s'(τ)/T and q̈ = (end − start) s''(τ)/T².
+
+    ``law``:
+
+    - ``"quintic"``: s = 10τ³ − 15τ⁴ + 6τ⁵; q̇ and q̈ zero at both ends (no jump in any force);
+      peak rate 1.875 Δ/T;
+    - ``"cycloidal"``: s = τ − sin(2πτ)/(2π); likewise, peak rate 2 Δ/T;
+    - ``"trapezoidal"``: constant acceleration over the first and last ``fraction`` (0 < f ≤ 1/2) of
+      the duration, constant rate 1/(1 − f) · Δ/T between; q̈ jumps at four instants (an adaptive
+      method steps onto them).
+    """
+    return _core.rest_to_rest_profile(_law(law), _checks.scalar(start, "start"), _checks.scalar(end, "end"),
+                                      _checks.scalar(t0, "t0"), _checks.scalar(duration, "duration"),
+                                      _fraction(law, fraction))
+
+
+def ramp(rate: float, t0: float, duration: float, law: str = "cycloidal", start: float = 0.0,
+         fraction: float = 1 / 3) -> _core.Profile:
+    """A smooth start of a constant rate: q̇ = rate · s(τ) rises from 0 at ``t0`` to ``rate`` (m/s or
+    rad/s) at ``t0 + duration`` by the rest-to-rest ``law`` s (see ``rest_to_rest``), then stays; q =
+    start + rate · T · S(τ) with S(τ) = ∫₀^τ s, and q = start + rate (t − t0 − T/2) after the ramp. A winch
+    paying out a rope, a hub spun up (``law="cycloidal"`` is Kane's ``spin_up`` from ``t0``)."""
+    return _core.ramp_profile(_law(law), _checks.scalar(rate, "rate"), _checks.scalar(t0, "t0"),
+                              _checks.scalar(duration, "duration"), _checks.scalar(start, "start"),
+                              _fraction(law, fraction))
+
+
+def piecewise(pieces: Sequence[_core.Profile], breaks: Sequence[float], continuity: int = 1) -> _core.Profile:
+    """The profiles ``pieces`` one after the other: piece k holds on [breaks[k−1], breaks[k]) (the first
+    from −∞, the last on to +∞), each evaluated at the time t itself (``p.shifted(delay)`` starts one
+    later). ``breaks`` (s) has one time fewer than ``pieces``, increasing.
+
+    At every break the two pieces must meet — in q (``continuity=0``), in q and q̇ (1, the default:
+    a drive without a jump of velocity), or in q, q̇ and q̈ (2) — to 1e-9 (1 + |x|); otherwise a
+    ValueError names the break and the jump."""
+    if isinstance(pieces, _core.Profile) or not isinstance(pieces, Sequence) or \
+            not all(isinstance(p, _core.Profile) for p in pieces):
+        raise ValueError(f"pieces: expected a list of rigidfem.motion profiles, got {pieces!r}")
+    if isinstance(continuity, bool) or not isinstance(continuity, (int, np.integer)):
+        raise ValueError(f"continuity: expected 0 (q), 1 (q and qd) or 2 (q, qd and qdd), got {continuity!r}")
+    return _core.piecewise_profile(list(pieces), list(_checks.vector(breaks, "breaks")), int(continuity))
+
+
+def _law(law) -> str:
+    if law not in LAWS:
+        raise ValueError(f"law: expected one of {', '.join(map(repr, LAWS))}, got {law!r}")
+    return law
+
+
+def _fraction(law: str, fraction) -> float:
+    """The trapezoidal law's acceleration share, in (0, 1/2]; checked (and passed) for that law only."""
+    if law != "trapezoidal":
+        return 0.0
+    f = _checks.scalar(fraction, "fraction")
+    if not 0.0 < f <= 0.5:
+        raise ValueError(f"fraction: expected the share of the duration spent accelerating, in (0, 0.5], got {f}")
+    return f
 
 
 def function(f: Callable[[float], tuple[float, float, float]]) -> _core.Profile:

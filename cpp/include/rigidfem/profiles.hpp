@@ -15,12 +15,15 @@ struct MotionState {
   double q = 0.0, qd = 0.0, qdd = 0.0;
 };
 
+class Profile;
+using ProfilePtr = std::shared_ptr<Profile>;  // profiles are immutable: only const methods
+
 /// How a profile was made: the name of its maker below (e.g. "harmonic_profile") and the maker's
-/// arguments, enough to make it again bit for bit (pickling). Empty maker: not remakeable (a
-/// Python function, an internal profile).
+/// arguments, enough to make it again bit for bit (pickling; a composite names its parts). Empty
+/// maker: not remakeable (a Python function, an internal profile).
 struct ProfileRecipe {
   std::string maker;
-  std::vector<std::variant<double, std::vector<double>>> arguments;
+  std::vector<std::variant<double, int, std::vector<double>, std::string, ProfilePtr, std::vector<ProfilePtr>>> arguments;
 };
 
 class Profile {
@@ -30,8 +33,6 @@ class Profile {
   virtual std::string describe() const = 0;
   virtual ProfileRecipe recipe() const { return {}; }
 };
-
-using ProfilePtr = std::shared_ptr<Profile>;  // profiles are immutable: only const methods
 
 /// q = value.
 ProfilePtr constant_profile(double value);
@@ -49,6 +50,26 @@ ProfilePtr spin_up_profile(double omega, double duration);
 /// Natural cubic spline through (t_k, q_k); beyond the table q continues linearly
 /// with the end slope (q̈ = 0).
 ProfilePtr spline_profile(const std::vector<double>& t, const std::vector<double>& q);
+/// Rest to rest: q = start for t ≤ t0, q = end for t ≥ t0 + T, and in between
+/// q = start + (end − start) s(τ), τ = (t − t0)/T, q̇ = (end − start) s'(τ)/T, q̈ = (end − start) s''(τ)/T², with
+/// the law s named: "quintic" (10τ³ − 15τ⁴ + 6τ⁵: q̇ = q̈ = 0 at both ends),
+/// "cycloidal" (τ − sin(2πτ)/(2π): likewise) or "trapezoidal" (constant acceleration over the first
+/// and last `fraction` of T, constant rate between: q̈ jumps at four instants). T in s.
+ProfilePtr rest_to_rest_profile(const std::string& law, double start, double end, double t0, double duration,
+                                double fraction);
+/// A smooth ramp of the rate: q̇ = rate s(τ) rising from 0 at t0 to `rate` at t0 + T by the law s, then
+/// constant; q = start + rate T S(τ), S(τ) = ∫₀^τ s, and q = start + rate (t − t0 − T/2) after the ramp (every
+/// law here has S(1) = 1/2). A winch paying out, a hub spun up (cycloidal: Kane's spin_up_profile).
+ProfilePtr ramp_profile(const std::string& law, double rate, double t0, double duration, double start,
+                        double fraction);
+/// Σ_k w_k p_k(t) + offset, with the rates alike.
+ProfilePtr sum_profile(const std::vector<double>& weights, const std::vector<ProfilePtr>& parts, double offset);
+/// p(t − delay): the same motion `delay` s later.
+ProfilePtr shifted_profile(const ProfilePtr& profile, double delay);
+/// pieces[k] on [breaks[k−1], breaks[k]) (the first from −∞, the last on to +∞), each evaluated at the time t
+/// itself (shift a piece to start it later). At every break the two pieces must agree to 1e-9 (1 + |x|) in q
+/// (continuity 0), and q̇ (1), and q̈ (2); std::invalid_argument names the first break where they do not.
+ProfilePtr piecewise_profile(const std::vector<ProfilePtr>& pieces, const std::vector<double>& breaks, int continuity);
 /// A user function t -> (q, q̇, q̈): the slow path (called through Python).
 ProfilePtr callback_profile(std::function<MotionState(double)> f);
 
