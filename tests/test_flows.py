@@ -1,4 +1,4 @@
-"""Links of varying free length L(t) (rigidfem.flows): the material terms against finite
+"""Links of varying free length L(t) (cpp/include/rigidfem/flows.hpp): the material terms against finite
 differences of material positions, the fixed-length cantilever, the tangents, bad input."""
 
 import numpy as np

@@ -39,7 +39,7 @@ from .model import Model, System
 from . import sea  # noqa: E402 (rigidfem.sea: sea states for a moving base)
 from .simulation import Result, load_npz, simulate
 from . import display, export  # noqa: E402 (notebook displays; tables, CSV and NumPy archives)
-from .linearize import NotAnEquilibriumWarning, linearize  # noqa: E402 (rigidfem.linearize: the function)
+from .state_space import NotAnEquilibriumWarning, linearize  # noqa: E402
 from .sweep import sweep
 from .resolution import Plan, ResolveError, resolve  # noqa: E402 (rf.resolve: elements and deformations for a tolerance)
 from .error_control import ErrorEstimate  # noqa: E402

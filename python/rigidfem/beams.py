@@ -402,7 +402,7 @@ def add_beam(
     O(m) in time and memory for the exact (nonlinear) model: the parameters of all rfes and sdes
     come from one vectorised quadrature and the rfes 1..m are added in one call; the linear model's
     couplings make it O(m²). A ``length`` given as a ``rigidfem.motion`` profile L(t) makes a link
-    of varying free length (``rigidfem.flows``): built at L(0), its sde joints get a prescribed
+    of varying free length (the equations: ``cpp/include/rigidfem/flows.hpp``): built at L(0), its sde joints get a prescribed
     "x" coordinate first that spreads the rfes over L(t)."""
     flow = None
     if isinstance(length, _core.Profile):

@@ -380,7 +380,7 @@ class Model(_core._Model):
         length : float or rigidfem.motion profile
             L, m; the beam lies along the x axis of its frame. A profile L(t) makes a link of
             varying free length sliding out of (L̇ > 0) or into its guide, the beam's frame
-            (``rigidfem.flows``: uniform beams without axial deformation, tip mass or the
+            (the equations in ``cpp/include/rigidfem/flows.hpp``: uniform beams without axial deformation, tip mass or the
             linear model).
         material : Material, function of s, or list of m
             ``rigidfem.Material`` (constant), a function of the arc length s (m), or one

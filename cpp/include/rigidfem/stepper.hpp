@@ -3,7 +3,8 @@
 /// integrate() runs one loop for every method, fixed or adaptive: it asks a Stepper to attempt a
 /// step, controls the step size from the error estimate, records outputs by the stepper's dense
 /// output and lands on t_end once. To add a method: write its Stepper (one file per family:
-/// runge_kutta.cpp, newmark.cpp), add its Method and a row in the table of integrate.cpp.
+/// runge_kutta.cpp, newmark.cpp, implicit_rk.cpp), add its Method and a row in the table of
+/// integrate.cpp.
 #pragma once
 
 #include <memory>

@@ -21,8 +21,8 @@ state is x = (δy, δẏ) (2k, k = nq − rank G) and
 M_r = NᵀMN, K_r = NᵀK_tN (K_t = −∂f/∂q − ∂(Gᵀλ)/∂q, the loops' geometric stiffness included),
 C_r = −Nᵀ∂f/∂q̇ N: exact about an equilibrium at rest (the rates of G are not linearised).
 
-``rigidfem.linearize`` is the function (the package imports it over this module's name); import
-the module's other names with ``from rigidfem.linearize import NotAnEquilibriumWarning``.
+The module is ``rigidfem.state_space``; the package exports ``linearize`` and
+``NotAnEquilibriumWarning``.
 
 Maxwell arms (``System.nz`` > 0: the Zener and Prony sde laws) add their forces s to the state,
 x = (δq, δq̇, s) (2 nq + nz), about relaxed arms (s = 0, the only value at rest):
