@@ -259,7 +259,9 @@ void bind_dynamics(py::module_& m) {
             Workspace d(s);
             return rigidfem::rhs(s, *d, t, y);
           },
-          py::arg("t"), py::arg("y"), "dy/dt = [qd, qdd] for y = [q, qd] (2 nq,): the signature of scipy's solve_ivp.")
+          py::arg("t"), py::arg("y"), "dy/dt = [qd, qdd] for y = [q, qd] (2 nq,): the signature of scipy's solve_ivp.\n"
+          "With loop closures qdd holds them at the acceleration level only: g(q) = 0 drifts under solve_ivp\n"
+          "(rigidfem.simulate's methods project onto the loops).")
       .def(
           "jacobian", [](const System& s, double t, const RefV& y) {
             Workspace d(s);
@@ -293,7 +295,8 @@ void bind_dynamics(py::module_& m) {
             return rigidfem::acceleration_derivatives(s, *d, t, q, qd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"),
-          "(dqdd/dq, dqdd/dqd), each (nq, nq): -A^-1 (dr/dq, dr/dqd) at the forward-dynamics qdd.")
+          "(dqdd/dq, dqdd/dqd), each (nq, nq): -A^-1 (dr/dq, dr/dqd) at the forward-dynamics qdd; with loop\n"
+          "closures, of the constrained qdd (multipliers and constraint Jacobian varying too), by central differences.")
       .def(
           "transform", [](const System& s, int body, const RefV& q, double t) {
             Workspace d(s);

@@ -259,6 +259,19 @@ std::pair<MatX, MatX> inverse_dynamics_derivatives(const System& sys, Data& d, d
 
 std::pair<MatX, MatX> acceleration_derivatives(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
                                                const Eigen::Ref<const VecX>& qd) {
+  if (sys.nl > 0) {
+    // With loops q̈ = q̈(q, q̇) of the constrained dynamics (its least-norm λ(q, q̇) and G(q) included),
+    // whose derivatives the tree's −A⁻¹ ∂r/∂(q, q̇) leaves out: central differences, O(n) per evaluation.
+    VecX x = q, v = qd;
+    MatX dq(sys.nq, sys.nq), dqd(sys.nq, sys.nq);
+    for (int j = 0; j < sys.nq; ++j) {
+      interruption_point();
+      dq.col(j) = central_difference([&] { return forward_dynamics(sys, d, t, x, v); }, x, j);
+      dqd.col(j) = central_difference([&] { return forward_dynamics(sys, d, t, x, v); }, v, j);
+    }
+    forward_dynamics(sys, d, t, q, qd);  // d left at the state, as below
+    return {dq, dqd};
+  }
   const VecX qdd = forward_dynamics(sys, d, t, q, qd);
   set_state(sys, d, t, q, qd);
   set_accelerations(sys, d, qdd);

@@ -60,13 +60,14 @@ VecX inverse_dynamics(const System& sys, Data& d, double t, const Eigen::Ref<con
 std::pair<MatX, MatX> inverse_dynamics_derivatives(const System& sys, Data& d, double t,
                                                    const Eigen::Ref<const VecX>& q, const Eigen::Ref<const VecX>& qd,
                                                    const Eigen::Ref<const VecX>& qdd);
-/// ∂q̈/∂q and ∂q̈/∂q̇ (nq, nq) at (t, q, q̇): −A⁻¹ (∂r/∂q, ∂r/∂q̇) at the forward-dynamics q̈.
+/// ∂q̈/∂q and ∂q̈/∂q̇ (nq, nq) at (t, q, q̇): −A⁻¹ (∂r/∂q, ∂r/∂q̇) at the forward-dynamics q̈; with loops, of
+/// the constrained q̈ (λ(q, q̇) and G(q) varying too) by central differences.
 std::pair<MatX, MatX> acceleration_derivatives(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
                                                const Eigen::Ref<const VecX>& qd);
 /// dy/dt = [q̇, q̈] for y = [q, q̇] (2 nq).
 VecX rhs(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& y);
-/// ∂(dy/dt)/∂y (2nq, 2nq): from acceleration_derivatives (recursive), central differences of rhs
-/// (Lagrange).
+/// ∂(dy/dt)/∂y (2nq, 2nq): from acceleration_derivatives (recursive; with loops its differences), central
+/// differences of rhs (Lagrange).
 MatX rhs_jacobian(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& y);
 /// ∂f/∂q and ∂f/∂q̇ (nq, nq) at (t, q, q̇) with the loads scaled by load_factor, the prescribed
 /// coordinates moving (static_drives = false) or held at their values at t (true: at rest, q̇
