@@ -79,7 +79,7 @@ LAYERS = [
     {"lagrange", "recursive", "derivatives"},  # the formulations
     {"dynamics"},                              # the only place that chooses one
     {"error_measure"},                         # the outputs an error is measured on
-    {"integrators", "stepper", "newton_matrix", "outputs", "timing"},
+    {"integrators", "stepper", "newton_matrix", "outputs", "timing", "auto_method"},
 ]
 RANK = {name: k for k, layer in enumerate(LAYERS) for name in layer}
 # Sources named after their family rather than a header.

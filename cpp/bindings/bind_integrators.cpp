@@ -2,6 +2,7 @@
 #include <limits>
 
 #include "bindings.hpp"
+#include "rigidfem/auto_method.hpp"
 #include "rigidfem/errors.hpp"
 #include "rigidfem/integrators.hpp"
 #include "rigidfem/outputs.hpp"
@@ -69,6 +70,14 @@ void bind_integrators(py::module_& m) {
           "stiff_method", [](const IntegratorOptions& o) { return method_name(o.stiff_method); },
           [](IntegratorOptions& o, const std::string& name) { o.stiff_method = parse_method(name); });
 
+  m.def(
+      "_auto_stiff_method",
+      [](const System& s, const std::string& iteration_matrix) {
+        IntegratorOptions o;
+        o.iteration_matrix = parse_iteration_matrix(iteration_matrix);
+        return std::string(method_name(auto_stiff_method(s, o)));
+      },
+      py::arg("system"), py::arg("iteration_matrix"), "The implicit method method='auto' hands over to.");
   m.def("_check_options", &check_options, py::arg("system"), py::arg("t0"), py::arg("t_end"), py::arg("q0"),
         py::arg("qd0"), py::arg("t_eval"), py::arg("options"),
         "integrate's checks of the options alone (ValueError naming the first bad one).");
@@ -107,6 +116,7 @@ void bind_integrators(py::module_& m) {
         }
         const auto& st = tr.stats;
         py::dict stats;
+        stats["method"] = st.method;
         stats["steps"] = st.steps;
         stats["rejected_steps"] = st.rejected;
         stats["rhs_evaluations"] = st.rhs_evaluations;

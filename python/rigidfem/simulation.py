@@ -452,8 +452,6 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
     # are checked before the loops are, so that a bad option is named whatever the state
     opt = _options("dopri5" if scipy else method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, beta,
                    gamma, alpha, rho_inf, newton_tol, newton_max_iterations, iteration_matrix)
-    if method == "auto":
-        opt.stiff_method = _auto_stiff_method(system, iteration_matrix)
     if scipy:
         opt.adaptive = -1  # SciPy's solvers are adaptive whatever it says (checked above for its type)
     opt.s0 = s0
@@ -487,7 +485,8 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
     arms, own = extra if extra else (np.zeros((len(t), 0)), None)
     if own is not None and not (system.nl and np.isfinite(own).all()):
         own = None  # the method has no multipliers of its own (NaN rows from _core._integrate)
-    stats["method"] = _auto_choice(stats, opt.stiff_method, t0) if method == "auto" else method
+    if scipy:
+        stats["method"] = method  # the C++ runs say what ran (auto: what it chose)
     if system.nl:
         stats["loop_reactions"] = _reactions_source(own, method)
     call = dict(method=method, t_end=t_end, t0=t0, q0=q0, qd0=qd0, s0=s0, t_eval=t_eval if len(t_eval) else None,
@@ -593,9 +592,6 @@ _LARGEST_COORDINATE = 1e15
 #: The methods that control their step by default (a dt given to them sets only the first step).
 _ADAPTIVE = ("auto", "dopri5", "rkf45", "esdirk43", "radau5")
 
-#: The implicit method ``method="auto"`` hands over to when dopri5 finds the problem stiff.
-AUTO_STIFF_METHOD = "esdirk43"
-
 
 def _reactions_source(own, method: str) -> str:
     """Where ``Result.loop_reactions`` come from, for ``stats["loop_reactions"]``: the method's own
@@ -603,21 +599,6 @@ def _reactions_source(own, method: str) -> str:
     if own is not None:
         return f"{method}'s own multipliers (index 3, linear between its steps' ends)"
     return "the forward dynamics' multipliers at each output's state"
-
-
-def _auto_choice(stats: dict, stiff_method: str, t0: float) -> str:
-    """What ``auto`` ran, for ``Result.stats["method"]``: "dopri5", the hand-over, or the stiff method
-    from the start (on the estimate of ω_max, or after a dopri5 probe found the problem stiff)."""
-    switched, trials = stats.get("switched_at", np.nan), stats.get("auto_trials", 0)
-    lost = trials - (1 if np.isfinite(switched) else 0)
-    tried = f"; {lost} trial{'s' * (lost != 1)} of {stiff_method} lost" if lost else ""
-    if not np.isfinite(switched):
-        return f"dopri5{tried}"
-    if switched == t0 and stats.get("probe_steps", 0) > 0:
-        return f"{stiff_method} from the start (a dopri5 probe of {stats['probe_steps']} steps found the problem stiff){tried}"
-    if switched == t0:
-        return f"{stiff_method} from the start (omega_max = {stats['omega_max']:.3g} rad/s: stiff for dopri5){tried}"
-    return f"dopri5, then {stiff_method} from t = {switched:.6g} s{tried}"
 
 
 def _options(method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, beta, gamma, alpha, rho_inf,
@@ -645,19 +626,13 @@ def _options(method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, 
     return opt
 
 
-def _auto_stiff_method(system, iteration_matrix: str) -> str:
-    """auto's stiff method: radau5, unless the system has Maxwell arms or the spring matrix is asked for
-    (radau5 takes neither); esdirk43 then."""
-    return "radau5" if not system.nz and iteration_matrix != "spring" else AUTO_STIFF_METHOD
-
-
 def _measures_outputs(method: str, system, iteration_matrix: str) -> bool:
     """Whether ``error_on=None`` measures the bodies' displacements (else the state): for radau5, the
     adaptive Newmark family and auto when its stiff method is radau5 — the methods whose estimate sees
     what a step loses of an oscillation. dopri5 and rkf45 hold the state (their stability rests on their
     error control), esdirk43 too (its filtered estimate hides most of what it damps: error_control)."""
     if method == "auto":
-        return _auto_stiff_method(system, iteration_matrix) == "radau5"
+        return _core._auto_stiff_method(system, iteration_matrix) == "radau5"
     return method in ("radau5", "newmark", "hht", "generalized_alpha", "implicit_spring")
 
 

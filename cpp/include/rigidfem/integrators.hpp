@@ -63,7 +63,9 @@ struct IntegratorOptions {
   double newton_tol = 1e-10;        ///< Newton: increments below newton_tol (1 + |q|), relative for adaptive runs
   int newton_max_iterations = 10;
   IterationMatrix iteration_matrix = IterationMatrix::Auto;
-  Method stiff_method = Method::GeneralizedAlpha;  ///< auto: the implicit method it hands over to
+  /// auto: the implicit method it hands over to; Auto: auto_stiff_method's choice (radau5, or esdirk43 with
+  /// Maxwell arms or the spring matrix)
+  Method stiff_method = Method::Auto;
   VecX s0;  ///< (nz) the Maxwell arms' initial forces (N or N·m, arms.hpp); empty: relaxed, zero
   /// The outputs an adaptive method measures its local error on (error_measure.hpp), held to the
   /// scalars atol and rtol; empty: every component of the state [q, q̇] to its atol_i + rtol_i |y_i|.
@@ -71,6 +73,7 @@ struct IntegratorOptions {
 };
 
 struct IntegratorStats {
+  std::string method;  ///< what ran: the method's name, or for auto what it chose (auto_description)
   long steps = 0, rejected = 0, rhs_evaluations = 0, jacobians = 0, factorizations = 0, newton_iterations = 0;
   long linear_iterations = 0;  ///< GMRES iterations of a Krylov Newton matrix (each one residual evaluation)
   double wall_time = 0.0;  ///< s
