@@ -1,6 +1,13 @@
 """Shared helpers: integrate a compiled system with SciPy (the reference integrator here)."""
 
-import numpy as np
+import os
+
+# One BLAS thread, set before NumPy loads OpenBLAS: the suite's matrices are small, and once an idle OpenBLAS
+# thread pool hung the interpreter's exit (gotoblas_quit joining a server thread asleep on its condition) after
+# a run with tests/test_interrupt.py's SIGINTs — all tests passed, the process never ended.
+os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
+
+import numpy as np  # noqa: E402
 import pytest
 import scipy.linalg
 from scipy.integrate import solve_ivp
