@@ -131,7 +131,8 @@ def implicit_methods_scaling(elements=LARGE_ELEMENTS) -> Table:
     ``adaptive=False``), and the default method ``auto`` over 1 ms holding every body's displacement
     to 1e-4 m (its ω_max estimate and choice included). Also the Newton and GMRES iterations per step
     (the tangent is dense up to 200 coordinates, matrix-free above) and, per method and scene, the
-    fitted exponent of the cost per step over all the sizes."""
+    fitted exponent of the cost per step over all the sizes, over 10³–10⁴ rfes (the Krylov form alone), and
+    of the cost per step relative to implicit_spring's (the O(n) reference) at the same size and scene."""
     rows = []
     for loop in (False, True):
         for m in elements:
@@ -145,10 +146,16 @@ def implicit_methods_scaling(elements=LARGE_ELEMENTS) -> Table:
                              "newton_per_step": st["newton_iterations"] / st["steps"],
                              "gmres_per_step": st["linear_iterations"] / st["steps"]})
     for scene in ("open", "loop"):
+        spring = {r["m"]: r["s_per_step"] for r in rows if r["scene"] == scene and r["method"] == "implicit_spring"}
         for name, _ in IMPLICIT_METHODS:
-            _fit_exponent([r for r in rows if r["scene"] == scene and r["method"] == name], "s_per_step", "exponent")
+            mine = [r for r in rows if r["scene"] == scene and r["method"] == name]
+            for r in mine:  # the cost in steps of implicit_spring, the O(n) reference, at the same size
+                r["per_spring_step"] = r["s_per_step"] / spring[r["m"]]
+            _fit_exponent(mine, "s_per_step", "exponent")
+            _fit_exponent(mine, "s_per_step", "exponent_from_1000", smallest_nq=1000)
+            _fit_exponent(mine, "per_spring_step", "relative_exponent")
     return Table(rows, ("scene", "method", "m", "nq", "steps", "s_per_step", "newton_per_step", "gmres_per_step",
-                        "exponent"))
+                        "per_spring_step", "exponent", "exponent_from_1000", "relative_exponent"))
 
 
 def run(output_dir="bench", quick: bool = False) -> dict:

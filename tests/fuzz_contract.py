@@ -31,6 +31,7 @@ outcomes, minimisation into the corpus).
 
 from __future__ import annotations
 
+import inspect
 import json
 import math
 import os
@@ -42,6 +43,9 @@ import threading
 import time
 from collections import Counter, defaultdict, deque
 from pathlib import Path
+
+import rigidfem as rf
+from rigidfem import _contract
 
 HERE = Path(__file__).resolve().parent
 CORPUS = HERE / "fuzz_corpus"
@@ -981,32 +985,23 @@ METHODS = ("euler", "symplectic_euler", "rk4", "dopri5", "rkf45", "newmark", "hh
            "scipy:DOP853")
 FIXED_STEP = ("euler", "symplectic_euler", "rk4", "newmark", "hht", "generalized_alpha", "implicit_spring")
 
+def _parameters(name: str) -> tuple:
+    """The parameters of System.<name> after self, a "?" after those with a default: from the Python
+    signature, or for a compiled method from its binding's (rigidfem._contract.compiled_parameters)."""
+    function = getattr(rf.System, name)
+    try:
+        parameters = list(inspect.signature(function).parameters.values())[1:]
+        return tuple(p.name + "?" * (p.default is not p.empty) for p in parameters)
+    except (TypeError, ValueError):  # a compiled method (its guard wraps it): no Python signature
+        return tuple(p + "?" * default for p, default in _contract.compiled_parameters(function)[1:])
+
+
 #: System methods: parameter lists ("t?" is t with a default, required when the system has drives).
-SYSTEM_METHODS = {
-    "forward_dynamics": ("t", "q", "qd"),
-    "mass_matrix": ("q", "t?"),
-    "generalized_forces": ("t", "q", "qd", "load_factor?"),
-    "static_forces": ("t", "q", "load_factor?"),
-    "force_jacobians": ("t", "q", "qd", "load_factor?", "static?"),
-    "driving_forces": ("t", "q", "qd"),
-    "rhs": ("t", "y"),
-    "jacobian": ("t", "y"),
-    "inverse_dynamics": ("t", "q", "qd", "qdd"),
-    "inverse_dynamics_derivatives": ("t", "q", "qd", "qdd"),
-    "acceleration_derivatives": ("t", "q", "qd"),
-    "kinetic_energy": ("q", "qd", "t?"),
-    "gravity_energy": ("q", "t?"),
-    "elastic_energy": ("q", "t?"),
-    "potential_energy": ("q", "t?"),
-    "dissipated_power": ("q", "qd", "t?"),
-    "position": ("point", "q", "t?"),
-    "velocity": ("point", "q", "qd", "t?"),
-    "transform": ("body", "q", "t?"),
-    "loop_constraints": ("t", "q", "qd"),
-    "loop_multipliers": ("t", "q", "qd"),
-    "loop_reactions": ("t", "q", "qd"),
-    "element_states": ("t", "q", "qd"),
-}
+SYSTEM_METHODS = {name: _parameters(name) for name in (
+    "forward_dynamics", "mass_matrix", "generalized_forces", "static_forces", "force_jacobians", "driving_forces",
+    "rhs", "jacobian", "inverse_dynamics", "inverse_dynamics_derivatives", "acceleration_derivatives",
+    "kinetic_energy", "gravity_energy", "elastic_energy", "potential_energy", "dissipated_power", "position",
+    "velocity", "transform", "loop_constraints", "loop_multipliers", "loop_reactions", "element_states")}
 
 #: The arguments of rf.motion's profiles, which a ValueError about a bad profile may name.
 PROFILE_NAMES = ("amplitude", "omega", "phase", "offset", "duration", "t", "q", "coefficients", "value", "f")

@@ -13,7 +13,7 @@ import functools
 import numpy as np
 
 from . import _checks
-from ._core import SimulationError
+from ._core import SimulationError, _System
 
 #: What each argument of the compiled methods expects, by name; sizes in terms of the system.
 _EXPECTED = {
@@ -31,40 +31,43 @@ _EXPECTED = {
     "system": "a System from Model.compile()",
 }
 
-#: The parameters of each guarded method, in order (the compiled signature without self).
-SIGNATURES = {
-    "forward_dynamics": ("t", "q", "qd"),
-    "mass_matrix": ("q", "t"),
-    "generalized_forces": ("t", "q", "qd", "load_factor"),
-    "static_forces": ("t", "q", "load_factor"),
-    "force_jacobians": ("t", "q", "qd", "load_factor", "static"),
-    "driving_forces": ("t", "q", "qd"),
-    "rhs": ("t", "y"),
-    "jacobian": ("t", "y"),
-    "inverse_dynamics": ("t", "q", "qd", "qdd"),
-    "inverse_dynamics_derivatives": ("t", "q", "qd", "qdd"),
-    "acceleration_derivatives": ("t", "q", "qd"),
-    "kinetic_energy": ("q", "qd", "t"),
-    "gravity_energy": ("q", "t"),
-    "elastic_energy": ("q", "t"),
-    "potential_energy": ("q", "t"),
-    "dissipated_power": ("q", "qd", "t"),
-    "_position": ("point", "q", "t"),
-    "_positions": ("points", "q", "t"),
-    "_velocity": ("point", "q", "qd", "t"),
-    "loop_constraints": ("t", "q", "qd"),
-    "loop_multipliers": ("t", "q", "qd"),
-    "loop_reactions": ("t", "q", "qd"),
-    "element_states": ("t", "q", "qd"),
-}
+def compiled_parameters(function) -> tuple[tuple[str, bool], ...]:
+    """(name, has a default) of each parameter of a pybind11 function, read from the signature line that
+    pybind11 writes first in its docstring (``name(self: ..., t: float = 0.0, ...) -> ...``): the one
+    place the parameters are written is the binding's ``py::arg`` list."""
+    line = function.__doc__.splitlines()[0]
+    inside = line[line.index("(") + 1:line.rindex(") ->")]
+    parts, depth, quoted, start = [], 0, False, 0
+    for i, c in enumerate(inside + ","):
+        if c == '"':
+            quoted = not quoted
+        elif not quoted and c in "[(":
+            depth += 1
+        elif not quoted and c in "])":
+            depth -= 1
+        elif not quoted and depth == 0 and c == ",":
+            parts.append(inside[start:i].strip())
+            start = i + 1
+    return tuple((part.split(":")[0].strip(), " = " in part) for part in parts)
 
+
+#: The System methods the guard wraps.
+GUARDED = ("forward_dynamics", "mass_matrix", "generalized_forces", "static_forces", "force_jacobians",
+           "driving_forces", "rhs", "jacobian", "inverse_dynamics", "inverse_dynamics_derivatives",
+           "acceleration_derivatives", "kinetic_energy", "gravity_energy", "elastic_energy", "potential_energy",
+           "dissipated_power", "_position", "_positions", "_velocity", "loop_constraints", "loop_multipliers",
+           "loop_reactions", "element_states")
+
+_PARAMETERS = {name: compiled_parameters(getattr(_System, name))[1:] for name in GUARDED}  # without self
+
+#: The parameters of each guarded method, in order (the compiled signature without self).
+SIGNATURES = {name: tuple(p for p, _ in parameters) for name, parameters in _PARAMETERS.items()}
 
 #: The parameters that take vectors of real numbers, and how many per free coordinate.
 VECTORS = {"q": 1, "qd": 1, "qdd": 1, "y": 2}
 
 #: Methods whose t has a default (0) that only a system without prescribed coordinates may use.
-OPTIONAL_T = frozenset({"mass_matrix", "kinetic_energy", "gravity_energy", "elastic_energy", "potential_energy",
-                        "dissipated_power"})
+OPTIONAL_T = frozenset(name for name, parameters in _PARAMETERS.items() if ("t", True) in parameters)
 
 #: Vectors the compiled method ignores when a flag is set (it does not check them then): checked here.
 UNREAD = {"force_jacobians": ("qd", "static")}
