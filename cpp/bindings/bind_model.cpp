@@ -300,9 +300,12 @@ void bind_model(py::module_& m) {
           [](Model& model, const std::string& name, int a, const Vec3& point_a, int b, const Vec3& point_b,
              double stiffness, double damping, double length, double force, ProfilePtr profile,
              const std::optional<py::function>& law) {
-            ForceElement e{name, a, b, point_a, point_b, stiffness, damping, length, force, std::move(profile), {}};
             const std::string label = name.empty() ? "element" + std::to_string(model.force_elements().size()) : name;
-            if (law) e.law = python_law(*law, "force element '" + label + "'", "l", "ld", "N");
+            AxialFunction f = law ? AxialFunction(python_law(*law, "force element '" + label + "'", "l", "ld", "N"))
+                                  : AxialFunction();
+            const ForceElement e{name, a, b, point_a, point_b,
+                                 std::make_shared<SpringDamper>(stiffness, damping, length, force, std::move(profile),
+                                                                std::move(f))};
             return model.force_elements()[model.add_force_element(e)].name;
           },
           py::arg("name"), py::arg("a"), py::arg("point_a"), py::arg("b"), py::arg("point_b"), py::arg("stiffness"),
@@ -311,17 +314,8 @@ void bind_model(py::module_& m) {
           "_add_rope",
           [](Model& model, const std::string& name, int a, const Vec3& point_a, int b, const Vec3& point_b, double EA,
              double DA, double length, ProfilePtr unstretched) {
-            ForceElement e;
-            e.name = name;
-            e.body_a = a;
-            e.body_b = b;
-            e.point_a = point_a;
-            e.point_b = point_b;
-            e.rope = true;
-            e.EA = EA;
-            e.DA = DA;
-            e.length = length;
-            e.unstretched = std::move(unstretched);
+            const ForceElement e{name, a, b, point_a, point_b,
+                                 std::make_shared<Rope>(EA, DA, length, std::move(unstretched))};
             return model.force_elements()[model.add_force_element(e)].name;
           },
           py::arg("name"), py::arg("a"), py::arg("point_a"), py::arg("b"), py::arg("point_b"), py::arg("EA"),

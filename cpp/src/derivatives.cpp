@@ -61,7 +61,7 @@ void element_tangent(const System& sys, const Data& d, const ForceElement& E, co
   if (dd.isZero(0.0) && ddd.isZero(0.0)) return;
   const Vec3 de = (dd - st.e * st.e.dot(dd)) / st.l;
   const double dl = st.e.dot(dd), dld = de.dot(st.vb - st.va) + st.e.dot(ddd);
-  const auto [Fl, Fld] = axial_force_derivatives(E, d.t, st.l, st.ld, d.load_factor);
+  const auto [Fl, Fld] = E.law->derivatives(d.t, st.l, st.ld, d.load_factor);
   const Vec3 df = (Fl * dl + Fld * dld) * st.e + st.F * de;
   for (const auto& [body, x, f] : {std::tuple<int, Vec3, Vec3>{E.body_b, st.xb, df}, {E.body_a, st.xa, -df}}) {
     if (body < 0) continue;

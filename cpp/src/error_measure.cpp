@@ -98,7 +98,7 @@ void ErrorMeasure::at(double t, const VecX& y) {
     for (std::size_t j = 0; j < sys_.elements.size(); ++j) {
       const ElementState s = element_state(d_, sys_.elements[j], false);
       element_e_[j] = s.e;
-      element_dF_[j] = axial_force_derivatives(sys_.elements[j], t, s.l, s.ld, 1.0);
+      element_dF_[j] = sys_.elements[j].law->derivatives(t, s.l, s.ld, 1.0);
     }
   if (need_loops_) {
     if (!dl_) dl_ = std::make_unique<Data>(sys_);

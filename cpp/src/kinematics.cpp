@@ -197,10 +197,8 @@ ElementState element_state(const Data& d, const ForceElement& element, bool spat
                                    "' coincide (l = 0: its line of action is undefined)");
   s.e = r / s.l;
   s.ld = s.e.dot(s.vb - s.va);
-  if (element.rope && !(unstretched_length(element, d.t).first > 0.0))
-    throw SimulationError(d.t, "the unstretched length of rope '" + element.name + "' is l_u = " +
-                                   num(unstretched_length(element, d.t).first) + " m (a rope needs l_u > 0)");
-  s.F = axial_force(element, d.t, s.l, s.ld, d.load_factor);
+  element.law->check(d.t, element.name);
+  s.F = element.law->force(d.t, s.l, s.ld, d.load_factor);
   return s;
 }
 

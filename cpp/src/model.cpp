@@ -316,17 +316,8 @@ int Model::add_force_element(const ForceElement& element) {
     bad("b", "a body other than a (a force element joins two bodies)", "the same body");
   require_finite(element.point_a, "a");
   require_finite(element.point_b, "b");
-  for (const auto& [value, name, expected] :
-       {std::tuple<double, const char*, const char*>{element.stiffness, "stiffness", "a finite stiffness >= 0 in N/m"},
-        {element.damping, "damping", "a finite damping coefficient >= 0 in N·s/m"},
-        {element.length, "length", "a finite rest length >= 0 in m"}})
-    if (!(value >= 0.0 && std::isfinite(value))) bad(name, expected, num8(value));
-  if (!std::isfinite(element.force)) bad("force", "a finite force in N", num8(element.force));
-  if (element.rope) {
-    if (!(element.EA > 0.0 && std::isfinite(element.EA))) bad("EA", "a positive axial stiffness EA in N", num8(element.EA));
-    if (!(element.DA >= 0.0 && std::isfinite(element.DA))) bad("DA", "a finite axial damping DA >= 0 in N·s", num8(element.DA));
-    if (!element.unstretched && !(element.length > 0.0)) bad("length", "a positive unstretched length in m", num8(element.length));
-  }
+  if (!element.law) bad("law", "the law of a force element's kind", "none");
+  element.law->validate();
   elements_.push_back(with_unique_name(element, elements_, "element", "force element"));
   return static_cast<int>(elements_.size()) - 1;
 }

@@ -30,15 +30,8 @@ double elastic_energy(const System& sys, const Data& d) {
   for (int i = 0; i < sys.nc; ++i)  // the coordinates without a spring add nothing (not 0 · ∞ at a huge q)
     if (sys.coords[i].stiffness != 0.0)
       V += 0.5 * d.spring_scale(i) * sys.coords[i].stiffness * std::pow(d.qa(i) - sys.coords[i].rest, 2);
-  for (const ForceElement& E : sys.elements) {  // ½ k (l − l₀)² of the elements' springs, ½ EA/l_u (l − l_u)² of taut ropes
-    if (E.rope) {
-      const auto [lu, lud] = unstretched_length(E, d.t);
-      const double stretch = std::max(0.0, element_state(d, E, false).l - lu);
-      V += 0.5 * E.EA / lu * stretch * stretch;
-    } else if (E.stiffness != 0.0) {
-      V += 0.5 * E.stiffness * std::pow(element_state(d, E, false).l - E.length, 2);
-    }
-  }
+  for (const ForceElement& E : sys.elements)  // what each element's law stores (force_elements.hpp)
+    if (E.law->elastic()) V += E.law->energy(d.t, element_state(d, E, false).l);
   return V;
 }
 
@@ -46,15 +39,11 @@ double dissipated_power(const System& sys, const Data& d) {
   check_data(sys, d);
   double P = 0.0;
   for (int i = 0; i < sys.nc; ++i) P += d.spring_scale(i) * sys.coords[i].damping * d.qda(i) * d.qda(i);
-  for (const ForceElement& E : sys.elements) {  // c l̇² of the elements' dampers, DA/l_u (l̇ − l̇_u)² of pulling ropes
-    if (E.rope) {
+  for (const ForceElement& E : sys.elements)  // what each element's law dissipates (force_elements.hpp)
+    if (E.law->dissipative()) {
       const ElementState s = element_state(d, E, false);
-      const auto [lu, lud] = unstretched_length(E, d.t);
-      if (s.F < 0.0) P += E.DA / lu * (s.ld - lud) * (s.ld - lud);
-    } else if (E.damping != 0.0) {
-      P += E.damping * std::pow(element_state(d, E, false).ld, 2);
+      P += E.law->power(d.t, s.l, s.ld, s.F);
     }
-  }
   return P;
 }
 
