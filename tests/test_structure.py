@@ -116,3 +116,24 @@ def test_trajectories_are_row_major_for_the_batch_outputs():
     res = rf.simulate(model.compile(), 0.1, method="rk4", dt=0.01, q0=[0.3])
     assert res.q.flags["C_CONTIGUOUS"] and res.qd.flags["C_CONTIGUOUS"] and res.q.shape == (11, 1)
     assert res.position(h["tip"]).shape == (11, 3) and res.energy.shape == (11,)
+
+
+def test_one_table_of_loop_kinds():
+    """Python's loop kinds and row counts are the C++ table's (constraints.cpp, through the binding), and the
+    documented table of rigidfem.loops says the same."""
+    import re
+
+    from rigidfem import analysis, loops
+
+    table = rf._core._Model._loop_kinds()
+    assert loops.KINDS == tuple(table) and analysis._LOOP_ROWS == table
+    documented = dict((k, int(r)) for k, r in re.findall(r'``"(\w+)"``\s+(\d+)', loops.__doc__))
+    assert documented == table
+    for kind, rows in table.items():  # each kind's rows as the compiled system counts them
+        m = rf.Model(gravity=None)
+        a = m.add_body("a", m.ground, rf.Joint.free(), mass=1.0, inertia=(1, 1, 1))
+        if kind == "distance":
+            m.add_loop_joint(kind, m.ground, a.point((1.0, 0, 0)), length=1.0)
+        else:
+            m.add_loop_joint(kind, m.ground, a)
+        assert m.compile().nl == rows, kind

@@ -295,6 +295,16 @@ void bind_model(py::module_& m) {
           },
           py::arg("name"), py::arg("kind"), py::arg("a"), py::arg("frame_a"), py::arg("b"), py::arg("frame_b"),
           py::arg("length"), py::arg("drive"))
+      .def_static(
+          "_loop_kinds",
+          [] {
+            // name -> constraint rows of every loop kind, from the one table (constraints.cpp)
+            py::dict kinds;
+            for (int k = 0; k < loop_kind_count; ++k)
+              kinds[loop_kind_name(static_cast<LoopKind>(k))] = loop_rows(static_cast<LoopKind>(k));
+            return kinds;
+          },
+          "The loop kinds and their numbers of constraint rows.")
       .def(
           "_add_force_element",
           [](Model& model, const std::string& name, int a, const Vec3& point_a, int b, const Vec3& point_b,

@@ -173,9 +173,12 @@ const char* kind_names[] = {"revolute", "spherical", "universal", "prismatic", "
 const char* loop_kind_name(LoopKind kind) { return kind_names[static_cast<int>(kind)]; }
 
 LoopKind parse_loop_kind(const std::string& name, const std::string& argument) {
-  for (int k = 0; k < 7; ++k)
+  std::string names;
+  for (int k = 0; k < loop_kind_count; ++k) {
     if (name == kind_names[k]) return static_cast<LoopKind>(k);
-  bad(argument, "one of revolute, spherical, universal, prismatic, cylindrical, fixed, distance", "'" + name + "'");
+    names += std::string(k ? ", " : "") + kind_names[k];
+  }
+  bad(argument, "one of " + names, "'" + name + "'");
 }
 
 }  // namespace rigidfem

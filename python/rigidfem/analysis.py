@@ -106,8 +106,7 @@ def _describe_null_space(A: np.ndarray, names, limit: int = 3, basis: np.ndarray
 # --------------------------------------------------------------------------- loops
 
 #: Constraint rows of each loop kind (``rigidfem.loops``), in the order of ``System.loop_kinds``.
-_LOOP_ROWS = {"revolute": 5, "spherical": 3, "universal": 4, "prismatic": 5, "cylindrical": 4, "fixed": 6,
-              "distance": 1}
+_LOOP_ROWS = _core._Model._loop_kinds()
 #: A row of G counts as zero below this fraction of the largest row (round-off of a row that is
 #: zero in exact arithmetic, e.g. the out-of-plane rows of a planar loop).
 _ROW_ZERO = 1e-10

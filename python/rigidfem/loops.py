@@ -27,11 +27,11 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _checks
+from . import _checks, _core
 from ._core import Point, Profile
 from .force_elements import point_of
 
-KINDS = ("revolute", "spherical", "universal", "prismatic", "cylindrical", "fixed", "distance")
+KINDS = tuple(_core._Model._loop_kinds())  # the C++ table of kinds (constraints.cpp)
 
 
 def _frame(model, where, frame, name: str):

@@ -18,6 +18,8 @@ namespace rigidfem {
 ///   Cylindrical: translation along and rotation about z; Fixed: nothing;
 ///   Distance: everything but the distance |r_B − r_A| = l (constant, or l(t) for an actuator).
 enum class LoopKind { Revolute, Spherical, Universal, Prismatic, Cylindrical, Fixed, Distance };
+/// The number of kinds (the table of kinds: constraints.cpp, read by Python through _core._loop_kinds).
+constexpr int loop_kind_count = 7;
 
 /// One loop closure as the user describes it. Body −1 is the ground.
 struct Loop {

@@ -158,6 +158,11 @@ class _Model:
         ...
     def _add_flow(self, length: Profile, first: typing.SupportsInt | typing.SupportsIndex, elements: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
+    @staticmethod
+    def _loop_kinds() -> dict:
+        """
+        The loop kinds and their numbers of constraint rows.
+        """
     def _add_force_element(self, name: str, a: typing.SupportsInt | typing.SupportsIndex, point_a: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], b: typing.SupportsInt | typing.SupportsIndex, point_b: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], stiffness: typing.SupportsFloat | typing.SupportsIndex, damping: typing.SupportsFloat | typing.SupportsIndex, length: typing.SupportsFloat | typing.SupportsIndex, force: typing.SupportsFloat | typing.SupportsIndex, profile: Profile, law: collections.abc.Callable | None) -> str:
         ...
     def _add_generalized_force(self, body: typing.SupportsInt | typing.SupportsIndex, coordinate: typing.SupportsInt | typing.SupportsIndex, value: typing.SupportsFloat | typing.SupportsIndex, law: typing.Any) -> None:
