@@ -197,7 +197,7 @@ void bind_dynamics(py::module_& m) {
           py::arg("t"), py::arg("q"), py::arg("qd"),
           "Length l (m), rate dl/dt (m/s) and axial force F (N, positive pushing the two points apart) of every\n"
           "force element (nelements, 3).")
-      .def("_element_force_history", &rigidfem::element_force_history, py::arg("t"), py::arg("q"), py::arg("qd"))
+
       .def(
           "_assemble",
           [](const System& s, double t, const RefV& q, const RefV& qd, double tol, int max_iterations) {

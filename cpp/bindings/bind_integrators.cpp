@@ -143,7 +143,7 @@ void bind_integrators(py::module_& m) {
       [](const System& s, const Eigen::Ref<const VecX>& t, const Eigen::Ref<const RowMatX>& Q,
          const Eigen::Ref<const RowMatX>& QD, const Eigen::Ref<const RowMatX>& S, const Eigen::Ref<const RowMatX>& L) {
         StateOutputs o = evaluate_outputs(s, t, Q, QD, S, L);
-        return py::make_tuple(o.qdd, o.tau, o.kinetic, o.gravity, o.elastic, o.power, o.reactions);
+        return py::make_tuple(o.qdd, o.tau, o.kinetic, o.gravity, o.elastic, o.power, o.reactions, o.element_forces);
       },
       py::arg("system"), py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("s"), py::arg("lambda_"));
   m.def(

@@ -96,17 +96,6 @@ MatX element_states(const System& sys, Data& d, double t, const Eigen::Ref<const
   return S;
 }
 
-MatX element_force_history(const System& sys, const Eigen::Ref<const VecX>& t, const Eigen::Ref<const RowMatX>& Q,
-                           const Eigen::Ref<const RowMatX>& QD) {
-  if (Q.rows() != t.size() || QD.rows() != t.size() || Q.cols() != sys.nq || QD.cols() != sys.nq)
-    throw std::invalid_argument("q, qd: expected (len(t), nq) arrays");
-  MatX F(t.size(), sys.elements.size());
-  Data d(sys);
-  for (Eigen::Index k = 0; k < t.size(); ++k)
-    F.row(k) = element_states(sys, d, t(k), Q.row(k).transpose(), QD.row(k).transpose()).col(2).transpose();
-  return F;
-}
-
 StateOutputs evaluate_outputs(const System& sys, const Eigen::Ref<const VecX>& t, const Eigen::Ref<const RowMatX>& Q,
                               const Eigen::Ref<const RowMatX>& QD, const Eigen::Ref<const RowMatX>& S,
                               const Eigen::Ref<const RowMatX>& L) {
@@ -117,7 +106,8 @@ StateOutputs evaluate_outputs(const System& sys, const Eigen::Ref<const VecX>& t
   if ((L.rows() != N && L.rows() != 0) || L.cols() != sys.nl)
     throw std::invalid_argument("lambda: expected a (len(t), nl) or (0, nl) array");
   const Eigen::Index nloops = static_cast<Eigen::Index>(sys.loops.size());
-  StateOutputs out{MatX(N, sys.nq), MatX(N, sys.np), VecX(N), VecX(N), VecX(N), VecX(N), MatX(N, 6 * nloops)};
+  StateOutputs out{MatX(N, sys.nq), MatX(N, sys.np), VecX(N), VecX(N), VecX(N), VecX(N), MatX(N, 6 * nloops),
+                   MatX(N, sys.elements.size())};
   Data d(sys);
   VecX s(sys.nz);
   for (Eigen::Index k = 0; k < N; ++k) {
@@ -129,6 +119,8 @@ StateOutputs evaluate_outputs(const System& sys, const Eigen::Ref<const VecX>& t
     out.gravity(k) = gravity_energy(sys, d);
     out.elastic(k) = elastic_energy(sys, d) + arm_energy(sys, s);
     out.power(k) = dissipated_power(sys, d) + arm_power(sys, s);
+    for (std::size_t e = 0; e < sys.elements.size(); ++e)
+      out.element_forces(k, static_cast<Eigen::Index>(e)) = element_state(d, sys.elements[e], false).F;
     forward_dynamics(sys, d, t(k), Q.row(k).transpose(), QD.row(k).transpose());
     out.qdd.row(k) = d.qdd.transpose();
     driving_forces(sys, d);

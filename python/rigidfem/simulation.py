@@ -180,11 +180,11 @@ class Result(Versioned):
         ``system.loop_reactions(t, q, qd)`` gives the forward dynamics' at any state."""
         return self._outputs[6].reshape(len(self.t), len(self.system.loop_names), 6)
 
-    @functools.cached_property
+    @property
     def element_forces(self) -> np.ndarray:
-        """Axial forces (len(t), nelements) in N of the force elements (spring-dampers, cylinders),
-        per ``system.element_names``; positive pushing the two points apart."""
-        return self.system._element_force_history(self.t, self.q, self.qd)
+        """Axial forces (len(t), nelements) in N of the force elements (spring-dampers, cylinders, ropes),
+        per ``system.element_names``; positive pushing the two points apart (a rope's −T)."""
+        return self._outputs[7]
 
     @property
     def error_estimate(self):

@@ -39,13 +39,11 @@ Vec3 point_velocity(const System& sys, Data& d, const Point& point, double t, co
 /// apart) at (t, q, q̇): rows of (nelements, 3). Applied parts of F at load factor 1.
 MatX element_states(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
                     const Eigen::Ref<const VecX>& qd);
-/// The axial forces F (N) at (t_k, q_k, q̇_k): (N, nelements).
-MatX element_force_history(const System& sys, const Eigen::Ref<const VecX>& t, const Eigen::Ref<const RowMatX>& Q,
-                           const Eigen::Ref<const RowMatX>& QD);
 
 /// Quantities at a batch of states (t_k, q_k, q̇_k, s_k), rows k (S: the Maxwell arms' forces, (N, nz),
 /// or (N, 0) without arms): accelerations, driving forces, energies (J; elastic with the arms'
-/// Σ s²/(2k)), the dissipated power (W; with the arms' Σ s²/(kτ)) and the loops' reactions from the
+/// Σ s²/(2k)), the dissipated power (W; with the arms' Σ s²/(kτ)), the force elements' axial forces and the
+/// loops' reactions from the
 /// multipliers of the same forward dynamics (the arm forces included) or, where a row of L (N, nl; or
 /// (0, nl): none) is finite, from those (an integrator's own, Trajectory::lambda). Used for simulation
 /// results.
@@ -53,6 +51,7 @@ struct StateOutputs {
   MatX qdd, tau;                          // (N, nq), (N, np)
   VecX kinetic, gravity, elastic, power;  // (N)
   MatX reactions;                         // (N, 6 nloops): each loop's wrench on its body b (loop_reactions), arms included
+  MatX element_forces;                    // (N, nelements): the force elements' axial forces F (N, > 0 pushing)
 };
 StateOutputs evaluate_outputs(const System& sys, const Eigen::Ref<const VecX>& t, const Eigen::Ref<const RowMatX>& Q,
                               const Eigen::Ref<const RowMatX>& QD, const Eigen::Ref<const RowMatX>& S,
