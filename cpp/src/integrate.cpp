@@ -391,7 +391,9 @@ void check_options(const System& sys, double t0, double t_end, const VecX& q0, c
                                 method_name(stiff) + "'");
   for (Eigen::Index k = 0; k < t_eval.size(); ++k)
     if (!(t_eval(k) >= t0 && t_eval(k) <= t_end) || (k > 0 && !(t_eval(k) > t_eval(k - 1))))
-      throw std::invalid_argument("t_eval: expected increasing times within [t0, t_end]");
+      throw std::invalid_argument("t_eval: expected increasing times within [t0, t_end] = [" + num(t0) + ", " +
+                                  num(t_end) + "] s, got " + num(t_eval(k), 10) + " at index " + std::to_string(k) +
+                                  (k > 0 ? " after " + num(t_eval(k - 1), 10) : std::string()));
 }
 
 Trajectory integrate(const System& sys, double t0, double t_end, const VecX& q0, const VecX& qd0,
