@@ -127,6 +127,15 @@ def test_the_jacobian_of_a_closed_chain_is_that_of_its_constrained_rhs(algorithm
     assert runs[1].status == 0 and runs[1].nfev <= 2 * runs[0].nfev, (runs[0].nfev, runs[1].nfev)
 
 
+@pytest.mark.parametrize("bad", [5, None, "nope", ["spring"]])
+def test_a_bad_iteration_matrix_is_named_whatever_the_method(bad):
+    model, _ = rf.samples.pendulum()
+    system = model.compile()
+    for method in ("auto", "radau5", "generalized_alpha"):
+        with pytest.raises(ValueError, match="^iteration_matrix: expected 'auto', 'tangent', 'spring' or 'krylov'"):
+            rf.simulate(system, 0.1, method=method, iteration_matrix=bad)
+
+
 def test_scipy_methods_refuse_closed_chains():
     _, system, q0, _ = four_bar()
     with pytest.raises(ValueError, match="method: expected a C\\+\\+ method for a system with loop closures"):

@@ -626,8 +626,8 @@ def _measures_outputs(method: str, system, iteration_matrix: str) -> bool:
     adaptive Newmark family and auto when its stiff method is radau5 — the methods whose estimate sees
     what a step loses of an oscillation. dopri5 and rkf45 hold the state (their stability rests on their
     error control), esdirk43 too (its filtered estimate hides most of what it damps: error_control)."""
-    if method == "auto":
-        return _core._auto_stiff_method(system, iteration_matrix) == "radau5"
+    if method == "auto":  # a bad iteration_matrix is named by _options
+        return isinstance(iteration_matrix, str) and _core._auto_stiff_method(system, iteration_matrix) == "radau5"
     return method in ("radau5", "newmark", "hht", "generalized_alpha", "implicit_spring")
 
 
