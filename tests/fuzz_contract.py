@@ -1004,7 +1004,8 @@ SYSTEM_METHODS = {name: _parameters(name) for name in (
     "velocity", "transform", "loop_constraints", "loop_multipliers", "loop_reactions", "element_states")}
 
 #: The arguments of rf.motion's profiles, which a ValueError about a bad profile may name.
-PROFILE_NAMES = ("amplitude", "omega", "phase", "offset", "duration", "t", "q", "coefficients", "value", "f")
+PROFILE_NAMES = ("amplitude", "omega", "phase", "offset", "duration", "t", "q", "coefficients", "value", "f", "law",
+                 "fraction", "start", "end", "t0", "rate", "pieces", "breaks", "continuity", "delay", "weights")
 
 #: Expected names per role (a ValueError about a bad point may name its body).
 ROLE_NAMES = {"point": ("point", "body", "r"), "y": ("y", "q", "qd"), "body": ("body",)}
@@ -1332,14 +1333,20 @@ class Gen:
             self.beams.append({"var": name, "length": length, "rfes": rfes})
             self.bodies.extend(rfes)
 
-    def profile(self):
-        """(expression, bad, ambiguous) of a motion profile."""
-        kind = self.choice(["constant", "polynomial", "harmonic", "spin_up", "spline", "function"])
+    def profile(self, depth=0):
+        """(expression, bad, ambiguous) of a motion profile (composites of good parts up to depth 2)."""
+        kinds = ["constant", "polynomial", "harmonic", "spin_up", "spline", "function", "rest_to_rest", "ramp"]
+        kind = self.choice(kinds + (["composite"] if depth < 2 else []))
         if self.chance(0.06):
             e = self.choice(["rf.motion.harmonic(nan, 1.0)", "rf.motion.spin_up(1.0, 0.0)",
                              "rf.motion.spline([0.0, 2.0, 1.0], [0.0, 1.0, 2.0])", "rf.motion.spline([0.0], [0.0])",
                              "rf.motion.polynomial([])", "rf.motion.spline([0.0, 1.0], [0.0, 1.0, 2.0])",
-                             "rf.motion.constant(nan)", "rf.motion.function(3.0)"]
+                             "rf.motion.constant(nan)", "rf.motion.function(3.0)",
+                             "rf.motion.rest_to_rest(0.0, 1.0, 0.0, 0.0)", "rf.motion.ramp(1.0, 0.0, 1.0, law='sine')",
+                             "rf.motion.rest_to_rest(0.0, 1.0, 0.0, 1.0, law='trapezoidal', fraction=0.7)",
+                             "rf.motion.piecewise([rf.motion.constant(0.0), rf.motion.constant(1.0)], [1.0])",
+                             "rf.motion.piecewise([rf.motion.constant(0.0)], [1.0])",
+                             "rf.motion.constant(1.0) / 0.0", "rf.motion.constant(1.0).shifted(nan)"]
                             + (["rf.motion.polynomial('ab')", "rf.motion.constant('x')", "rf.motion.harmonic(None, 1.0)"]
                                if self.on("profile_bad_types") else []))
             return e, True, False
@@ -1354,6 +1361,23 @@ class Gen:
                    f"{fl(self.choice([0.0, 0.5]))})", False, False
         if kind == "spin_up":
             return f"rf.motion.spin_up({fl(self.choice([1.0, 6.0]))}, {fl(self.choice([0.5, 15.0]))})", False, False
+        if kind == "rest_to_rest":
+            law = self.choice(["quintic", "cycloidal", "trapezoidal"])
+            return f"rf.motion.rest_to_rest({fl(self.choice([0.0, 0.3]))}, {fl(self.choice([1.0, -0.5]))}, " \
+                   f"{fl(self.choice([0.0, 0.2]))}, {fl(self.choice([0.5, 2.0]))}, law={law!r})", False, False
+        if kind == "ramp":
+            law = self.choice(["quintic", "cycloidal", "trapezoidal"])
+            return f"rf.motion.ramp({fl(self.choice([1.0, -2.0, 6.0]))}, {fl(self.choice([0.0, 0.1]))}, " \
+                   f"{fl(self.choice([0.3, 1.0]))}, law={law!r})", False, False
+        if kind == "composite":
+            parts = [self.profile(depth + 1) for _ in range(2)]
+            if any(bad or ambiguous for _, bad, ambiguous in parts):
+                return "rf.motion.constant(0.2)", False, False
+            (p, _, _), (r, _, _) = parts
+            return self.choice([f"({p}) + ({r})", f"2.0 * ({p}) - ({r})", f"({p}) / 4.0 + 0.1",
+                                f"({p}).shifted({fl(self.choice([0.1, -0.3]))})", f"-({p})",
+                                f"rf.motion.piecewise([({p}), ({p}) + 0.0], [{fl(self.choice([0.2, 1.0]))}])"]), \
+                False, False
         if kind == "spline":
             n = self.integer(2, 5)
             ts = sorted({self.choice([0.0, 0.1, 0.5, 1.0, 2.0, 3.0]) for _ in range(n)})
@@ -1382,7 +1406,7 @@ class Gen:
         prof, pbad, _ = self.profile()
         if self.chance(0.4) and not pbad:
             var = self.new("p")
-            self.emit(prof, [], [], out=var, label="motion." + prof.split("(")[0].split(".")[-1], attr=True)
+            self.emit(prof, [], [], out=var, label="motion." + (prof.split("(")[0].split(".")[-1] if prof.startswith("rf.motion.") else "composite"), attr=True)
             self.profiles.append(var)
             prof = var
         free = [c for c in b["coords"] if c not in b["prescribed"]]
