@@ -1,6 +1,7 @@
 // rigidfem._core: the C++ core. Errors: std::invalid_argument -> ValueError,
 // rigidfem::SimulationError -> rigidfem.SimulationError (a RuntimeError).
 #include <cmath>
+#include <optional>
 
 #include "bindings.hpp"
 #include "rigidfem/errors.hpp"
@@ -121,23 +122,41 @@ void bind_profiles(py::module_& m) {
     o.attr("_parts") = std::move(parts);
     return o;
   };
+  // A real number (a Python or NumPy scalar), or nothing: a profile, a string, an array (even of one value)
+  // or anything without __float__ makes the operator return NotImplemented (Python's TypeError).
+  auto number = [](const py::object& x) -> std::optional<double> {
+    if (py::isinstance<Profile>(x) || py::isinstance<py::str>(x) || py::isinstance<py::bytes>(x) ||
+        !(PyFloat_Check(x.ptr()) || PyLong_Check(x.ptr()) || PyObject_HasAttrString(x.ptr(), "__float__")))
+      return std::nullopt;
+    if (py::hasattr(x, "ndim") && x.attr("ndim").cast<int>() != 0) return std::nullopt;
+    try {
+      return x.cast<double>();
+    } catch (const py::cast_error&) {
+      return std::nullopt;
+    }
+  };
+  const auto not_implemented = [] { return py::reinterpret_borrow<py::object>(Py_NotImplemented); };
   // w_self · self + w_other · other, other a profile or a number (then an offset)
-  auto combine = [composed](const py::object& self, const py::object& other, double w_self, double w_other) -> py::object {
+  auto combine = [composed, number, not_implemented](const py::object& self, const py::object& other, double w_self,
+                                                     double w_other) -> py::object {
     const ProfilePtr p = self.cast<ProfilePtr>();
     if (py::isinstance<Profile>(other))
       return composed(sum_profile({w_self, w_other}, {p, other.cast<ProfilePtr>()}, 0.0), py::make_tuple(self, other));
-    if (py::isinstance<py::str>(other) || !(PyFloat_Check(other.ptr()) || PyLong_Check(other.ptr()) ||
-                                            PyObject_HasAttrString(other.ptr(), "__float__")))
-      return py::reinterpret_borrow<py::object>(Py_NotImplemented);
-    return composed(sum_profile({w_self}, {p}, w_other * other.cast<double>()), py::make_tuple(self));
+    const std::optional<double> c = number(other);
+    if (!c) return not_implemented();
+    if (!std::isfinite(*c)) bad("offset", "a finite number", num(*c));
+    return composed(sum_profile({w_self}, {p}, w_other * *c), py::make_tuple(self));
   };
-  auto scale = [composed](const py::object& self, const py::object& c, bool divide) -> py::object {
-    if (py::isinstance<Profile>(c) || py::isinstance<py::str>(c) ||
-        !(PyFloat_Check(c.ptr()) || PyLong_Check(c.ptr()) || PyObject_HasAttrString(c.ptr(), "__float__")))
-      return py::reinterpret_borrow<py::object>(Py_NotImplemented);
-    const double w = divide ? 1.0 / c.cast<double>() : c.cast<double>();
-    return composed(sum_profile({w}, {self.cast<ProfilePtr>()}, 0.0), py::make_tuple(self));
+  // c · self, or self / c
+  auto scale = [composed, number, not_implemented](const py::object& self, const py::object& factor,
+                                                   bool divide) -> py::object {
+    const std::optional<double> c = number(factor);
+    if (!c) return not_implemented();
+    if (!std::isfinite(*c) || (divide && *c == 0.0))
+      bad("weights", divide ? "a finite, non-zero divisor" : "a finite number", num(*c));
+    return composed(sum_profile({divide ? 1.0 / *c : *c}, {self.cast<ProfilePtr>()}, 0.0), py::make_tuple(self));
   };
+  profile.attr("__array_ufunc__") = py::none();  // NumPy arrays do not broadcast over a profile: p * array is a TypeError
   profile
       .def("__add__", [combine](const py::object& p, const py::object& r) { return combine(p, r, 1.0, 1.0); })
       .def("__radd__", [combine](const py::object& p, const py::object& r) { return combine(p, r, 1.0, 1.0); })

@@ -458,6 +458,10 @@ ProfilePtr sum_profile(const std::vector<double>& weights, const std::vector<Pro
       w.push_back(weights[k]), terms.push_back(parts[k]);
     }
   }
+  // the products of weights (and the offset) may overflow where the factors did not: 1e200 · 1e200
+  for (double x : w)
+    if (!std::isfinite(x)) throw std::invalid_argument("weights: expected finite products of the weights, got " + num(x));
+  if (!std::isfinite(offset)) throw std::invalid_argument("offset: expected a finite sum of the offsets, got " + num(offset));
   return std::make_shared<Sum>(std::move(w), std::move(terms), offset);
 }
 
