@@ -568,15 +568,7 @@ def modal_analysis(system, q=None, qd=None, t: float = 0.0) -> Modes:
     if system.nl:
         return _constrained_modes(system, q, qd, t, M, K, C)
     _check_mass_matrix(M, names, t)
-    try:
-        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # an overflow is reported below
-            omega, zeta, shapes, lam = _modes(M, K, C)
-    except np.linalg.LinAlgError as err:  # the eigensolvers' own failures, rare after the checks above
-        raise SimulationError(f"{_frame(t, 'modal analysis')}: eigensolver failed ({err})") from err
-    if not (np.all(np.isfinite(omega)) and np.all(np.isfinite(lam)) and np.all(np.isfinite(shapes))):
-        raise SimulationError(f"{_frame(t, 'modal analysis')}: the eigenvalues overflowed (K/M beyond the range of "
-                              f"doubles: largest |K| = {np.max(np.abs(K)):.3g}, smallest mass-matrix diagonal "
-                              f"{np.min(np.abs(np.diag(M))):.3g})")
+    omega, zeta, shapes, lam = _solved_modes(M, K, C, t)
     order = np.argsort(omega, kind="stable")
     shapes = shapes[:, order] / np.max(np.abs(shapes[:, order]), axis=0)
     return Modes(omega[order], omega[order] / (2 * np.pi), zeta[order], shapes, lam[order], q, M, K, C)
@@ -598,7 +590,8 @@ def _loop_tangent(system, q: np.ndarray, qd: np.ndarray, t: float, K: np.ndarray
     f = system.generalized_forces(t, q, qd)
     _require_finite(t, what, **{"f(q, q̇)": f})
     lam = c.multipliers(-f)
-    Kt = K + _constraint_stiffness(system, t, q, lam)
+    with np.errstate(over="ignore", invalid="ignore"):  # an overflow is reported by _require_finite
+        Kt = K + _constraint_stiffness(system, t, q, lam)
     _require_finite(t, what, **{"geometric stiffness of the loops": Kt})
     return c, Kt, lam
 
@@ -613,17 +606,35 @@ def _constrained_modes(system, q: np.ndarray, qd: np.ndarray, t: float, M: np.nd
     if k == 0:  # the loops leave nothing free
         e = np.zeros(0)
         return Modes(e, e.copy(), e.copy(), np.zeros((system.nq, 0)), np.zeros(0, complex), q, M, Kt, C, N, lam)
-    Mr, Kr, Cr = N.T @ M @ N, N.T @ Kt @ N, N.T @ C @ N
+    with np.errstate(over="ignore", invalid="ignore"):  # an overflow is reported by _require_finite
+        Mr, Kr, Cr = N.T @ M @ N, N.T @ Kt @ N, N.T @ C @ N
+    _require_finite(t, what, **{"reduced stiffness NᵀK_tN": Kr, "reduced damping/gyroscopic matrix NᵀCN": Cr})
     Mr = 0.5 * (Mr + Mr.T)
     _check_mass_matrix(Mr, system.coordinate_names, t, basis=N)
-    try:
-        omega, zeta, phi, ev = _modes(Mr, Kr, Cr)
-    except np.linalg.LinAlgError as err:
-        raise SimulationError(f"{_frame(t, what)}: eigensolver failed ({err})") from err
+    omega, zeta, phi, ev = _solved_modes(Mr, Kr, Cr, t)
     order = np.argsort(omega, kind="stable")
     shapes = N @ phi[:, order]
     shapes = shapes / np.max(np.abs(shapes), axis=0)
     return Modes(omega[order], omega[order] / (2 * np.pi), zeta[order], shapes, ev[order], q, M, Kt, C, N, lam)
+
+
+def _solved_modes(M: np.ndarray, K: np.ndarray, C: np.ndarray, t: float):
+    """``_modes`` with its failures as SimulationErrors: the eigensolvers' own, and eigenvalues beyond the
+    range of doubles (K/M or C²/M² overflowing)."""
+    what = "modal analysis"
+    try:
+        with np.errstate(over="ignore", invalid="ignore", divide="ignore"):  # an overflow is reported below
+            omega, zeta, shapes, lam = _modes(M, K, C)
+    except np.linalg.LinAlgError as err:  # the eigensolvers' own failures, rare after the checks before
+        raise SimulationError(f"{_frame(t, what)}: eigensolver failed ({err})") from err
+    except ValueError as err:  # SciPy's "array must not contain infs or NaNs": an overflow inside _modes
+        raise SimulationError(f"{_frame(t, what)}: the eigenproblem overflowed (largest |K| = "
+                              f"{np.max(np.abs(K)):.3g}, |C| = {np.max(np.abs(C)):.3g}: {err})") from err
+    if not (np.all(np.isfinite(omega)) and np.all(np.isfinite(lam)) and np.all(np.isfinite(shapes))):
+        raise SimulationError(f"{_frame(t, what)}: the eigenvalues overflowed (K/M beyond the range of "
+                              f"doubles: largest |K| = {np.max(np.abs(K)):.3g}, smallest mass-matrix diagonal "
+                              f"{np.min(np.abs(np.diag(M))):.3g})")
+    return omega, zeta, shapes, lam
 
 
 def _modes(M: np.ndarray, K: np.ndarray, C: np.ndarray):
