@@ -1051,6 +1051,7 @@ class Gen:
         self.beams: list[dict] = []     # {"var", "length", "rfes": [body dicts]}
         self.profiles: list[str] = []
         self.nbodies = 0
+        self.body_names = 0  # names b0, b1, ... drawn so far: one per add_body, added or not (never reused)
         self.n_prescribed = 0
         self.results: list[str] = []
         self.counter = 0
@@ -1203,7 +1204,10 @@ class Gen:
         return var, coords
 
     def add_body(self):
-        name = f"b{len(self.bodies)}"
+        # a fresh name even after a call that was meant to fail: one that succeeded after all (a soft or
+        # ambiguous case) must not make the next body's name a duplicate
+        name = f"b{self.body_names}"
+        self.body_names += 1
         joint, coords, jbad = self.joint()
         internals = self.on("joint_internals") and self.chance(0.05)
         if internals:
