@@ -164,7 +164,7 @@ def test_piecewise_joins_and_checks_continuity():
     (lambda: motion.piecewise([motion.constant(0)] * 2, [1.0], continuity=3), "^continuity: expected 0"),
     (lambda: motion.piecewise([motion.constant(0)] * 2, [1.0], continuity=1.0), "^continuity: expected 0"),
     (lambda: motion.constant(1.0).shifted("later"), "^delay: expected a finite time in s, got 'later'"),
-    (lambda: motion.constant(1.0) / 0, "^weights: expected a finite number"),
+    (lambda: motion.constant(1.0) / 0, "^weights: expected a finite, non-zero divisor, got 0"),
 ])
 def test_bad_laws_and_joins_name_the_argument(call, message):
     with pytest.raises(ValueError, match=message):
