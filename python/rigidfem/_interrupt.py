@@ -6,7 +6,9 @@
   returns its partial result.
 - LAPACK never looks at signals: :func:`responsive` runs a dense routine that releases the GIL
   in a worker thread while the calling thread waits in 0.05 s slices, so Ctrl-C raises
-  KeyboardInterrupt at once; the worker finishes in the background and its result is dropped.
+  KeyboardInterrupt at once; the worker finishes in the background and its result is dropped, and
+  the interpreter's exit waits for it (OpenBLAS's shutdown at exit hangs, or with one BLAS thread
+  crashes, while a call is still in flight: measured 2 hangs in 50 runs of tests/test_interrupt.py).
   Not every wrapper releases the GIL (measured with SciPy 1.17: ``scipy.linalg.eigh`` and
   ``lapack.dpotrf`` hold it, NumPy's ``linalg`` routines and ``lapack.dgetrf`` do not): for large
   matrices :func:`eigh` and :func:`cholesky` take NumPy's routines.
@@ -17,6 +19,7 @@
 
 from __future__ import annotations
 
+import atexit
 import contextlib
 import functools
 import threading
@@ -29,6 +32,22 @@ RESPONSIVE_FROM = 200 * 200
 
 _local = threading.local()
 
+#: The workers of ``responsive`` still inside their routine, each by the event it sets when done.
+_unfinished: set = set()
+_unfinished_lock = threading.Lock()
+
+
+@atexit.register
+def _wait_for_workers() -> None:
+    """At exit, the workers a Ctrl-C left inside LAPACK finish first (a second Ctrl-C stops waiting)."""
+    with _unfinished_lock:
+        pending = list(_unfinished)
+    try:
+        for done in pending:
+            done.wait()
+    except KeyboardInterrupt:
+        pass
+
 
 def responsive(function):
     """``function`` (a NumPy/SciPy dense routine) made interruptible: for arrays of at least
@@ -40,17 +59,26 @@ def responsive(function):
         if not big or threading.current_thread() is not threading.main_thread():
             return function(*args, **kwargs)
         box = {}
+        done = threading.Event()
 
         def work():
             try:
                 box["value"] = function(*args, **kwargs)
             except BaseException as e:  # noqa: BLE001 (re-raised in the caller's thread)
                 box["error"] = e
+            finally:
+                with _unfinished_lock:
+                    _unfinished.discard(done)
+                done.set()
 
+        with _unfinished_lock:
+            _unfinished.add(done)
         worker = threading.Thread(target=work, name=f"rigidfem-{function.__name__}", daemon=True)
         worker.start()
-        while worker.is_alive():
-            worker.join(0.05)  # Ctrl-C raises KeyboardInterrupt here
+        # Ctrl-C raises KeyboardInterrupt here. The worker's own event says when it is done: a join(0.05)
+        # that Ctrl-C interrupts marks the thread finished while it still runs (CPython gh-90882, <= 3.12).
+        while not done.wait(0.05):
+            pass
         if "error" in box:
             raise box["error"]
         return box["value"]
