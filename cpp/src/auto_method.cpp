@@ -104,7 +104,7 @@ double spectral_radius(const System& sys, double t, const VecX& q, const VecX& v
 // until it does. The stiff method holds the tolerances as asked (on outputs where asked).
 AutoChoice::AutoChoice(const System& sys, const IntegratorOptions& o, const Tolerances& asked, double t0,
                        const VecX& y0, IntegratorStats& stats)
-    : sys_(sys), o_(o), asked_(asked), t0_(t0), span_(asked.span), y0_(y0), nq_(sys.nq) {
+    : sys_(sys), o_(o), asked_(asked), t0_(t0), span_(asked.span), y0_(y0) {
   o_.stiff_method = auto_stiff_method(sys, o);
   const int n = sys.nq;
   const double loosest = asked.rtol.size() ? asked.rtol.maxCoeff() : 0.0;  // nq = 0: no tolerance to tighten
@@ -199,8 +199,9 @@ void AutoChoice::switched_at(double t0, IntegratorStats& stats) {
 
 /// The work done so far, in right-hand-side evaluations (see the rules above).
 double AutoChoice::work(const IntegratorStats& s) const {
-  const double factorization = spring_ ? 1.0 : std::max(1.0, (nq_ / 50.0) * (nq_ / 50.0));
-  const double tangent = krylov_ ? 0.0 : nq_;
+  const double n = sys_.nq;
+  const double factorization = spring_ ? 1.0 : std::max(1.0, (n / 50.0) * (n / 50.0));
+  const double tangent = krylov_ ? 0.0 : n;
   return static_cast<double>(s.rhs_evaluations) + tangent * static_cast<double>(s.jacobians) +
          factorization * static_cast<double>(s.factorizations);
 }

@@ -263,11 +263,12 @@ std::pair<MatX, MatX> acceleration_derivatives(const System& sys, Data& d, doubl
     // With loops q̈ = q̈(q, q̇) of the constrained dynamics (its least-norm λ(q, q̇) and G(q) included),
     // whose derivatives the tree's −A⁻¹ ∂r/∂(q, q̇) leaves out: central differences, O(n) per evaluation.
     VecX x = q, v = qd;
+    const auto qdd = [&] { return forward_dynamics(sys, d, t, x, v); };
     MatX dq(sys.nq, sys.nq), dqd(sys.nq, sys.nq);
     for (int j = 0; j < sys.nq; ++j) {
       interruption_point();
-      dq.col(j) = central_difference([&] { return forward_dynamics(sys, d, t, x, v); }, x, j);
-      dqd.col(j) = central_difference([&] { return forward_dynamics(sys, d, t, x, v); }, v, j);
+      dq.col(j) = central_difference(qdd, x, j);
+      dqd.col(j) = central_difference(qdd, v, j);
     }
     forward_dynamics(sys, d, t, q, qd);  // d left at the state, as below
     return {dq, dqd};

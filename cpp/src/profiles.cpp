@@ -15,6 +15,12 @@ void require_finite(double x, const char* name) {
   if (!std::isfinite(x)) throw std::invalid_argument(std::string(name) + ": expected a finite number, got " + std::to_string(x));
 }
 
+/// The duration T of a timed law: a positive, finite time in s.
+void require_duration(double duration) {
+  if (!(duration > 0.0) || !std::isfinite(duration))
+    throw std::invalid_argument("duration: expected a positive time in s, got " + num(duration));
+}
+
 class Constant final : public Profile {
  public:
   explicit Constant(double v) : v_(v) {}
@@ -399,8 +405,7 @@ ProfilePtr harmonic_series_profile(const std::vector<double>& amplitudes, const 
 
 ProfilePtr spin_up_profile(double omega, double duration) {
   require_finite(omega, "omega");
-  if (!(duration > 0.0) || !std::isfinite(duration))
-    throw std::invalid_argument("duration: expected a positive time in s, got " + std::to_string(duration));
+  require_duration(duration);
   return std::make_shared<SpinUp>(omega, duration);
 }
 
@@ -422,8 +427,7 @@ ProfilePtr rest_to_rest_profile(const std::string& law, double start, double end
   require_finite(start, "start");
   require_finite(end, "end");
   require_finite(t0, "t0");
-  if (!(duration > 0.0) || !std::isfinite(duration))
-    throw std::invalid_argument("duration: expected a positive time in s, got " + num(duration));
+  require_duration(duration);
   return std::make_shared<RestToRest>(l, start, end, t0, duration);
 }
 
@@ -433,8 +437,7 @@ ProfilePtr ramp_profile(const std::string& law, double rate, double t0, double d
   require_finite(rate, "rate");
   require_finite(t0, "t0");
   require_finite(start, "start");
-  if (!(duration > 0.0) || !std::isfinite(duration))
-    throw std::invalid_argument("duration: expected a positive time in s, got " + num(duration));
+  require_duration(duration);
   return std::make_shared<Ramp>(l, rate, t0, duration, start);
 }
 

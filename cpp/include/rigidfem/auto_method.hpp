@@ -70,7 +70,6 @@ class AutoChoice {
   Tolerances asked_, explicit_tol_;
   double t0_, span_;
   VecX y0_;
-  int nq_;
   bool direct_ = false;  // the stiff method from t0 on ρ alone
   bool krylov_ = false;  // the stiff method's tangent is matrix-free
   bool stiff_running_ = false, spring_ = false, restarted_ = false, first_window_ = true;
