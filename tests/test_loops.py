@@ -81,6 +81,36 @@ def test_driven_four_bar_follows_the_closed_form_and_the_power_balance(algorithm
     np.testing.assert_allclose(power[2:-2], dEdt[2:-2], atol=2e-3 * np.abs(power).max())
 
 
+@pytest.mark.parametrize("kind", ["revolute", "spherical", "universal", "prismatic", "cylindrical", "fixed",
+                                  "distance"])
+def test_the_recursive_loop_equations_are_the_lagrange_ones(kind):
+    """g, ġ, G of every loop kind and the constrained q̈ (whose γ is the loops' second rate at
+    q̈ = 0) at a random state off the loop, with a prescribed coordinate moving: the recursive
+    algorithms' spatial kinematics (axes and spatial velocities along each path) against the
+    Lagrange formulation's 4x4 transforms and their rates, T̈ and U."""
+
+    def build(algorithm):
+        m = rf.Model(gravity=(0.3, -9.81, 0.5))
+        a = m.add_body("a", m.ground, rf.Joint.free(), mass=1.0, inertia=(0.1, 0.2, 0.3), com=(0.2, 0.1, 0))
+        b = m.add_body("b", a, rf.Joint.revolute("y"), mass=0.5, inertia=(0.05, 0.04, 0.03), com=(0.3, 0, 0.1),
+                       placement=rf.transform((0.4, 0, 0)))
+        c = m.add_body("c", m.ground, rf.Joint.free(), mass=0.7, inertia=(0.02, 0.03, 0.04), com=(0.1, 0.2, 0.0),
+                       placement=rf.transform((1.0, 0.2, 0.1)))
+        m.prescribe(b, rf.motion.polynomial([0.2, 1.5, -2.0]))
+        m.add_loop_joint(kind, b.point((0.5, 0.1, 0.0)), c.point((0.2, -0.1, 0.05)),
+                         **(dict(length=0.7) if kind == "distance" else {}))
+        return m.compile(algorithm)
+
+    recursive, lagrange = build("recursive"), build("lagrange")
+    rng = np.random.default_rng(7)
+    for _ in range(3):
+        t, q, qd = rng.uniform(0, 1), 0.5 * rng.normal(size=recursive.nq), rng.normal(size=recursive.nq)
+        for x, y in zip(recursive.loop_constraints(t, q, qd), lagrange.loop_constraints(t, q, qd)):
+            np.testing.assert_allclose(x, y, rtol=0, atol=1e-14 * (1 + np.abs(y).max()))
+        qdd = lagrange.forward_dynamics(t, q, qd)
+        np.testing.assert_allclose(recursive.forward_dynamics(t, q, qd), qdd, rtol=0, atol=1e-12 * np.abs(qdd).max())
+
+
 def test_free_four_bar_conserves_energy_and_generalized_alpha_converges_at_order_two():
     s = four_bar()
     q0, _ = s.assemble(closed_q(0.4))

@@ -1,6 +1,7 @@
 #include "rigidfem/constraints.hpp"
 
 #include <Eigen/SVD>
+#include <array>
 #include <cmath>
 #include <stdexcept>
 #include <utility>
@@ -23,16 +24,11 @@ struct Track {
 
 /// Column h of frame P = T_p F in body p (h = 0..2: an axis, 3: the origin) with its rates and its
 /// Jacobian ∂x/∂q_i = Σ_u U_u x̃ over the uses u on the path from p to the ground (x̃ = (x, 1)
-/// for the origin, (x, 0) for an axis). The ground (p = −1): F itself, at rest.
-Track track(const System& sys, const Data& d, int p, const Mat4& F, int h) {
+/// for the origin, (x, 0) for an axis): the Lagrange formulation's kinematics (T, Ṫ, T̈, U), which
+/// also holds the linear joints. The ground (p = −1): F itself, at rest.
+Track homogeneous_track(const System& sys, const Data& d, int p, const Mat4& F, int h) {
   Track tr;
   tr.J = Mat3X::Zero(3, sys.nc);
-  if (p < 0) {
-    tr.x = F.block<3, 1>(0, h);
-    tr.xd.setZero();
-    tr.xdd.setZero();
-    return tr;
-  }
   const Eigen::Vector4d c = F.col(h);
   tr.x = (d.T[p] * c).head<3>();
   tr.xd = (d.Td[p] * c).head<3>();
@@ -41,6 +37,58 @@ Track track(const System& sys, const Data& d, int p, const Mat4& F, int h) {
   for (int k = p; k >= 0; k = sys.parent[k])
     for (int u = sys.use_start[k]; u < sys.use_start[k + 1]; ++u)
       tr.J.col(sys.use_coord[u]) += (d.U[u] * xh).head<3>();
+  return tr;
+}
+
+/// The spatial velocity v_p and the acceleration a_p at q̈_free = 0 (the prescribed q̈ in, no
+/// gravity) of body p from the axes s_u = (ω_u, v_u) of the uses on its path, walked from p to the
+/// ground (last use first) with w = Σ s q̇ over the uses already passed (those after u):
+///   v_p = Σ_u s_u q̇_u,  a_p = Σ_u (s_u q̈_u + ṡ_u q̇_u) = Σ_u (s_u q̈_u + (s_u q̇_u) ×m w),
+/// since ṡ_u = v_before(u) ×m s_u and the sum over the pairs u' < u reads the same either way.
+std::pair<Vec6, Vec6> body_motion(const System& sys, const Data& d, int p) {
+  Vec6 w = Vec6::Zero(), a = Vec6::Zero();
+  for (int k = p; k >= 0; k = sys.parent[k])
+    for (int u = sys.use_start[k + 1] - 1; u >= sys.use_start[k]; --u) {
+      const int i = sys.use_coord[u];
+      const Vec6 sqd = d.axes[u] * d.qda(i);
+      a += d.axes[u] * d.qdda(i) + crossm(sqd, w);
+      w += sqd;
+    }
+  return {w, a};
+}
+
+/// The same from the recursive algorithms' kinematics (T and the axes: frames_and_axes), with the
+/// body's motion (ω, v_O), (α, a_O) from body_motion:
+///   origin x: ẋ = v_O + ω × x, ẍ = a_O + α × x + ω × ẋ, ∂x/∂q_u = ω_u × x + v_u;
+///   axis e:   ė = ω × e,       ë = α × e + ω × ė,       ∂e/∂q_u = ω_u × e.
+Track spatial_track(const System& sys, const Data& d, int p, const std::pair<Vec6, Vec6>& motion, const Mat4& F,
+                    int h) {
+  Track tr;
+  tr.J = Mat3X::Zero(3, sys.nc);
+  const bool point = h == 3;
+  tr.x = (d.T[p] * F.col(h)).head<3>();
+  const auto& [v, a] = motion;
+  tr.xd = v.head<3>().cross(tr.x) + (point ? Vec3(v.tail<3>()) : Vec3::Zero());
+  tr.xdd = a.head<3>().cross(tr.x) + v.head<3>().cross(tr.xd) + (point ? Vec3(a.tail<3>()) : Vec3::Zero());
+  for (int k = p; k >= 0; k = sys.parent[k])
+    for (int u = sys.use_start[k]; u < sys.use_start[k + 1]; ++u) {
+      const Vec6& s = d.axes[u];
+      tr.J.col(sys.use_coord[u]) += s.head<3>().cross(tr.x) + (point ? Vec3(s.tail<3>()) : Vec3::Zero());
+    }
+  return tr;
+}
+
+/// The columns h = 0..3 of frame F in body p as tracks, by the engine's kinematics.
+std::array<Track, 4> frame_tracks(const System& sys, const Data& d, int p, const Mat4& F, int columns) {
+  std::array<Track, 4> tr;
+  if (p < 0) {  // the ground: F itself, at rest
+    for (int h = 0; h < 4; ++h) tr[h] = {F.block<3, 1>(0, h), Vec3::Zero(), Vec3::Zero(), Mat3X::Zero(3, sys.nc)};
+    return tr;
+  }
+  const bool spatial = sys.algorithm == Algorithm::Recursive;
+  const auto motion = spatial ? body_motion(sys, d, p) : std::pair<Vec6, Vec6>{};
+  for (int h = 4 - columns; h < 4; ++h)
+    tr[h] = spatial ? spatial_track(sys, d, p, motion, F, h) : homogeneous_track(sys, d, p, F, h);
   return tr;
 }
 
@@ -100,19 +148,17 @@ void constraint_equations(const System& sys, Data& d) {
   for (std::size_t k = 0; k < sys.loops.size(); ++k) {
     const Loop& L = sys.loops[k];
     int r = sys.loop_row[k];
-    const Track rA = track(sys, d, L.body_a, L.frame_a, 3), rB = track(sys, d, L.body_b, L.frame_b, 3);
-    const Track dr = difference(rB, rA);
+    // The origins (columns 3) and, for the joints, the axes (columns 0..2) of frames A and B.
+    const int columns = L.kind == LoopKind::Distance ? 1 : 4;
+    const std::array<Track, 4> a = frame_tracks(sys, d, L.body_a, L.frame_a, columns),
+                               b = frame_tracks(sys, d, L.body_b, L.frame_b, columns);
+    const Track dr = difference(b[3], a[3]);
     if (L.kind == LoopKind::Distance) {
       const MotionState l = L.drive ? L.drive->at(d.t) : MotionState{L.length, 0.0, 0.0};
       if (!std::isfinite(l.q) || !std::isfinite(l.qd) || !std::isfinite(l.qdd))
         throw SimulationError(d.t, "the length drive of loop '" + L.name + "' returned NaN or inf");
       distance_row(d, r, dr, l, L.name);
       continue;
-    }
-    Track a[3], b[3];
-    for (int i = 0; i < 3; ++i) {
-      a[i] = track(sys, d, L.body_a, L.frame_a, i);
-      b[i] = track(sys, d, L.body_b, L.frame_b, i);
     }
     const RowLayout& rows = layout(L.kind);
     for (int i = 0; i < rows.positions; ++i) dot_row(d, r++, dr, a[i]);

@@ -37,11 +37,20 @@ std::pair<MatX, MatX> differenced(const System& sys, Data& d) {
   return {dq, dqd};
 }
 
-// The state (t, q, q̇) with every kinematic quantity (rates and twists) computed.
+// The kinematics the formulation's dynamics read: T and the axes (recursive, exact joints: read off
+// the frames, no 4x4 twists or rates), or T, Ṫ, T̈ and the twists U (Lagrange, linear joints too).
+void tree_kinematics(const System& sys, Data& d) {
+  if (recursive(sys))
+    frames_and_axes(sys, d);
+  else
+    kinematics(sys, d);
+}
+
+// The state (t, q, q̇) with the formulation's kinematics.
 void full_state(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
                 const Eigen::Ref<const VecX>& qd) {
   set_state(sys, d, t, q, qd);
-  kinematics(sys, d);
+  tree_kinematics(sys, d);
 }
 
 // ... and the free accelerations q̈.
@@ -50,7 +59,7 @@ void full_state(const System& sys, Data& d, double t, const Eigen::Ref<const Vec
   set_state(sys, d, t, q, qd);
   check_vector(qdd, sys.nq, "qdd", "nq");
   set_accelerations(sys, d, qdd);
-  kinematics(sys, d);
+  tree_kinematics(sys, d);
 }
 
 // d.load_factor = λ, which scales gravity, loads and applied generalised forces.
@@ -62,11 +71,8 @@ void set_load_factor(Data& d, double load_factor) {
 }  // namespace
 
 void dynamics_kinematics(const System& sys, Data& d) {
-  if (recursive(sys) && sys.nl == 0)
-    frames_and_axes(sys, d);
-  else
-    kinematics(sys, d);  // loops: T̈ and the twists U for g, G and γ (the axes come with them)
-  if (sys.nl > 0) constraint_equations(sys, d);
+  tree_kinematics(sys, d);
+  if (sys.nl > 0) constraint_equations(sys, d);  // g, G and γ from the same kinematics
 }
 
 void generalized_forces(const System& sys, Data& d) {
@@ -159,13 +165,12 @@ void close_loops(const System& sys, Data& d) {
 void loop_equations(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
                     const Eigen::Ref<const VecX>& qd) {
   set_state(sys, d, t, q, qd);
-  kinematics(sys, d);
-  constraint_equations(sys, d);
+  dynamics_kinematics(sys, d);
 }
 
 namespace {
 
-/// The factorisation of M at the state of d for solve_armature (kinematics with rates done).
+/// The factorisation of M at the state of d for solve_armature (after dynamics_kinematics).
 void factor_mass(const System& sys, Data& d) {
   if (recursive(sys)) spatial_kinematics(sys, d);
   factor_armature(sys, d, VecX::Zero(sys.nq));
@@ -232,7 +237,7 @@ const VecX& static_forces(const System& sys, Data& d, double t, const Eigen::Ref
                           double load_factor) {
   set_load_factor(d, load_factor);
   set_static_state(sys, d, t, q);
-  kinematics(sys, d);
+  tree_kinematics(sys, d);
   generalized_forces(sys, d);
   return d.f;
 }

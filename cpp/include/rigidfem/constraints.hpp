@@ -16,8 +16,10 @@
 
 namespace rigidfem {
 
-/// => d.g, d.gd, d.G (nl, nc), d.gamma at the state of d. Needs the kinematics with rates
-/// (kinematics(sys, d, true): T, Ṫ, T̈ at q̈_free = 0, and the twists U).
+/// => d.g, d.gd, d.G (nl, nc), d.gamma at the state of d (q̈_free = 0 in d.qdda). Needs the
+/// engine's kinematics (dynamics_kinematics): T and the axes for the recursive algorithms, whose
+/// spatial velocities and accelerations along each loop body's path give the rates; T, Ṫ, T̈ and
+/// the twists U for the Lagrange formulation.
 void constraint_equations(const System& sys, Data& d);
 
 /// The free columns of d.G (nl, nq).
