@@ -107,7 +107,7 @@ def kane(elements: int) -> Kane:
     model, handles = samples.kane_beam(omega=OMEGA, duration=SPIN_UP, elements=elements)
     system = model.compile()
     chain = hub_chain(system)
-    M = system.mass_matrix(np.zeros(system.nq), 0.0)
+    M = system.mass_matrix(0.0, np.zeros(system.nq))
     K = np.diag(system.stiffness)
     omega_max = float(np.sqrt(np.max(np.linalg.eigvals(np.linalg.solve(M, K)).real)))
     return Kane(elements, system, handles["beam"].tip, chain, omega_max, handles["hub"])

@@ -58,7 +58,7 @@ def step_cost(elements, ropes) -> Table:
             for _ in range(3):
                 r = rf.simulate(system, steps * 1e-4, method="implicit_spring", dt=1e-4, q0=q0)
                 best = min(best, r.stats["wall_time"] / r.stats["steps"])
-            M = system.mass_matrix(q0)
+            M = system.mass_matrix(0.0, q0)
             G = system.loop_constraints(0.0, q0, qd0)[2]
             K = np.block([[M, G.T], [G, np.zeros((m, m))]]) + np.diag(np.r_[np.zeros(system.nq), 1e-12 * np.ones(m)])
             rhs = np.ones(system.nq + m)

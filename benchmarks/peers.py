@@ -160,7 +160,7 @@ def agreement(system, q, qd, qdd) -> dict:
     the number of rfes: 9e5 at nq = 30, 1.4e8 at nq = 300, 2.3e9 at nq = 900).
     """
     reference = system.forward_dynamics(0.0, q, qd)
-    A, f = system.mass_matrix(q), system.generalized_forces(0.0, q, qd)
+    A, f = system.mass_matrix(0.0, q), system.generalized_forces(0.0, q, qd)
     eigenvalues = np.linalg.eigvalsh(A)
     return {"forward": float(np.linalg.norm(qdd - reference) / np.linalg.norm(reference)),
             "backward": float(np.max(np.abs(A @ qdd - f) / (np.abs(A) @ np.abs(qdd) + np.abs(f)))),
@@ -605,7 +605,7 @@ def stiff_beam_accuracy(scene: StiffBeam, rigidfem_methods=None, mujoco_methods=
     mujoco_methods = MUJOCO_METHODS if mujoco_methods is None else mujoco_methods
     check_mujoco(scene.system)
     ref = _rigidfem_run(scene, "dopri5", rtol=1e-10, atol=1e-12).position(scene.tip)
-    rest = scene.system.position(scene.tip, np.zeros(scene.system.nq))
+    rest = scene.system.position(scene.tip, 0.0, np.zeros(scene.system.nq))
     deflection = np.max(np.linalg.norm(ref - rest, axis=1))
     rows = []
 

@@ -61,7 +61,7 @@ def output_cost(elements=(10, 100, 1000), samples_per_run: int = 200) -> Table:
         tip = h["beam"].tip
         rows.append({"m": m, "nq": system.nq,
                      "position_s_per_sample": _least(lambda: result.position(tip), repeats=3) / samples_per_run,
-                     "centerline_s": _least(lambda: h["beam"].centerline(system, q, 0.0), repeats=3),
+                     "centerline_s": _least(lambda: h["beam"].centerline(system, q, t=0.0), repeats=3),
                      "forward_dynamics_cpp_s": cpp_seconds_per_call(system, q, q)})
     return Table(rows, ("m", "nq", "position_s_per_sample", "centerline_s", "forward_dynamics_cpp_s"))
 

@@ -185,11 +185,11 @@ def _calls(s, point):
     """name -> f(t, q, qd) calling one System method."""
     return {
         "forward_dynamics": lambda t, q, qd: s.forward_dynamics(t, q, qd),
-        "mass_matrix": lambda t, q, qd: s.mass_matrix(q, t),
-        "position": lambda t, q, qd: s.position(point, q, t),
-        "velocity": lambda t, q, qd: s.velocity(point, q, qd, t),
+        "mass_matrix": lambda t, q, qd: s.mass_matrix(t, q),
+        "position": lambda t, q, qd: s.position(point, t, q),
+        "velocity": lambda t, q, qd: s.velocity(point, t, q, qd),
         "rhs": lambda t, q, qd: s.rhs(t, np.concatenate([q, qd])),
-        "kinetic_energy": lambda t, q, qd: s.kinetic_energy(q, qd, t),
+        "kinetic_energy": lambda t, q, qd: s.kinetic_energy(t, q, qd),
         "generalized_forces": lambda t, q, qd: s.generalized_forces(t, q, qd),
     }
 

@@ -148,8 +148,8 @@ def test_springs_and_dampers_sit_on_the_right_coordinates(rng):
     cq = np.array([c[n.rsplit(".", 1)[1]] for n in system.coordinate_names])
     q = rng.uniform(-1e-3, 1e-3, system.nq)
     qd = rng.uniform(-1, 1, system.nq)
-    assert system.elastic_energy(q) == pytest.approx(0.5 * np.sum(cq * q**2), rel=1e-12)
-    assert system.dissipated_power(q, qd) == pytest.approx(mu * np.sum(cq * qd**2), rel=1e-12)
+    assert system.elastic_energy(0.0, q) == pytest.approx(0.5 * np.sum(cq * q**2), rel=1e-12)
+    assert system.dissipated_power(0.0, q, qd) == pytest.approx(mu * np.sum(cq * qd**2), rel=1e-12)
 
 
 def test_rfe_parameters_function_directly():
@@ -328,7 +328,7 @@ def test_tip_and_point_handles():
         lo, hi, x0 = pieces[i]
         assert lo - 1e-12 <= s <= hi + 1e-12, (s, i)
         np.testing.assert_allclose(p.r, [s - x0, 0, 0], atol=1e-14)
-        np.testing.assert_allclose(system.position(p, q0), [s, 0, 0], atol=1e-14)
+        np.testing.assert_allclose(system.position(p, 0.0, q0), [s, 0, 0], atol=1e-14)
     # interior points (away from rfe ends) pick the unique rfe
     assert beam.point(0.05).body == beam.rfes[0].index
     assert beam.point(0.3).body == beam.rfes[1].index
@@ -346,7 +346,7 @@ def test_points_follow_their_rfe_when_deformed():
     q[system.coordinate_index("b.rfe3.rz")] = phi
     xs = (3 - 0.5) * d  # sde 3
     for s in [0.1, 0.5, 0.9, 1.1, 1.5, 2.0]:
-        r = system.position(beam.point(s), q)
+        r = system.position(beam.point(s), 0.0, q)
         ref = [s, 0, 0] if s < xs else [xs + (s - xs) * math.cos(phi), (s - xs) * math.sin(phi), 0]
         np.testing.assert_allclose(r, ref, atol=1e-13)
 
@@ -411,7 +411,7 @@ def test_elastic_energy_of_a_chosen_subset(rng):
     c = {"x": mat.E * sec.A / d, "rz": mat.E * sec.Iz / d}
     cq = np.array([c[n.rsplit(".", 1)[1]] for n in system.coordinate_names])
     q = rng.uniform(-1e-3, 1e-3, system.nq)
-    assert system.elastic_energy(q) == pytest.approx(0.5 * np.sum(cq * q**2), rel=1e-12)
+    assert system.elastic_energy(0.0, q) == pytest.approx(0.5 * np.sum(cq * q**2), rel=1e-12)
 
 
 def test_linear_model_structure_mass_and_first_order_kinematics(rng):
@@ -428,7 +428,7 @@ def test_linear_model_structure_mass_and_first_order_kinematics(rng):
     q0 = np.zeros(s_nl.nq)
     np.testing.assert_allclose(li.centerline(s_li, q0), nl.centerline(s_nl, q0), atol=1e-14)
     # same mass matrix in the undeformed configuration (same first-order kinematics)
-    A_nl, A_li = s_nl.mass_matrix(q0), s_li.mass_matrix(q0)
+    A_nl, A_li = s_nl.mass_matrix(0.0, q0), s_li.mass_matrix(0.0, q0)
     np.testing.assert_allclose(A_li, A_nl, rtol=1e-9, atol=1e-9 * np.max(np.abs(A_nl)))
     # small deformations: the centre lines agree to second order
     q = rng.uniform(-1, 1, s_nl.nq) * 1e-5
@@ -448,7 +448,7 @@ def test_linear_model_is_linear_in_the_deformations():
     phi = 0.5
     q[system.coordinate_index("b.rfe2.rz")] = phi
     xs = 1.5 * d
-    np.testing.assert_allclose(system.position(beam.tip, q), [L, phi * (L - xs), 0], atol=1e-13)
+    np.testing.assert_allclose(system.position(beam.tip, 0.0, q), [L, phi * (L - xs), 0], atol=1e-13)
 
 
 # ----------------------------------------------------------------------------------------
@@ -473,13 +473,13 @@ def test_tip_mass_total_mass_and_centre_of_mass(offset, linear):
     z = lambda x, zl=0.0: z0 - math.sin(pitch) * x + math.cos(pitch) * zl  # noqa: E731
     ox, _, oz = offset
     V_ref = g * (mat.rho * sec.A * quad(z, 0, L)[0] + M0 * z(L + ox, oz))
-    assert system.gravity_energy(q0) == pytest.approx(V_ref, rel=1e-11)
+    assert system.gravity_energy(0.0, q0) == pytest.approx(V_ref, rel=1e-11)
     # without the tip mass the same beam has V = g ρA ∫ z ds: the difference is M0 g z_tip
     model2 = rf.Model(gravity=(0.0, 0.0, -g))
     model2.add_beam("b", model2.ground, L, mat, sec, m, linear=linear,
                     placement=rf.transform((0.5, -0.2, z0), (0.2, pitch, 0.0)))
-    V_bare = model2.compile().gravity_energy(q0)
-    assert system.gravity_energy(q0) - V_bare == pytest.approx(M0 * g * z(L + ox, oz), rel=1e-10)
+    V_bare = model2.compile().gravity_energy(0.0, q0)
+    assert system.gravity_energy(0.0, q0) - V_bare == pytest.approx(M0 * g * z(L + ox, oz), rel=1e-10)
 
 
 def test_tip_inertia_is_merged_into_the_last_rfe():
@@ -532,7 +532,7 @@ def tip_under_load(F, L=2.0, m=8, steps=1, **kw):
     system = model.compile()
     eq = rf.static_equilibrium(system, load_steps=steps)
     assert eq.converged
-    return system.position(beam.tip, eq.q)
+    return system.position(beam.tip, 0.0, eq.q)
 
 
 def test_small_tip_load_classical_modified_linear_nonlinear():

@@ -83,7 +83,7 @@ def test_dataframe_columns_and_values_are_the_result_arrays(run):
     np.testing.assert_array_equal(df.index.to_numpy(), res.t)
     np.testing.assert_array_equal(df[names].to_numpy(), res.q)
     np.testing.assert_array_equal(df[[n + ".dot" for n in names]].to_numpy(), res.qd)
-    tip = np.array([system.position(beam.tip, q, t) for t, q in zip(res.t, res.q)])
+    tip = np.array([system.position(beam.tip, t, q) for t, q in zip(res.t, res.q)])
     np.testing.assert_allclose(df[["tip.x", "tip.y", "tip.z"]].to_numpy(), tip, rtol=0, atol=1e-13)
 
 

@@ -84,7 +84,7 @@ def test_mass_matrix_and_accelerations_against_sympy(spatial, algorithm, rng):
     for _ in range(5):
         q = rng.uniform(-1.2, 1.2, system.nq)
         qd = rng.uniform(-3, 3, system.nq)
-        M = system.mass_matrix(q)
+        M = system.mass_matrix(0.0, q)
         np.testing.assert_allclose(M, M_ref(q), rtol=1e-12, atol=1e-13)
         np.testing.assert_allclose(system.generalized_forces(0.0, q, qd), f_ref(q, qd), rtol=1e-11, atol=1e-11)
         # Solving A q̈ = f amplifies round-off by cond(A) (~1e6 here: the rods' axial inertia is
@@ -127,4 +127,4 @@ def test_planar_mass_matrix_closed_form():
         a11 = M1 * L1**2 / 3 + M2 * L1**2 + M2 * L2**2 / 3 + M2 * L1 * L2 * c
         a12 = M2 * L2**2 / 3 + M2 * L1 * L2 * c / 2
         a22 = M2 * L2**2 / 3
-        np.testing.assert_allclose(system.mass_matrix([0.3, q2]), [[a11, a12], [a12, a22]], rtol=1e-13)
+        np.testing.assert_allclose(system.mass_matrix(0.0, [0.3, q2]), [[a11, a12], [a12, a22]], rtol=1e-13)

@@ -11,7 +11,7 @@ import rigidfem as rf
 
 def total_energy(system, y):
     n = system.nq
-    return np.array([system.kinetic_energy(x[:n], x[n:]) + system.potential_energy(x[:n]) for x in y.T])
+    return np.array([system.kinetic_energy(0.0, x[:n], x[n:]) + system.potential_energy(0.0, x[:n]) for x in y.T])
 
 
 def test_spatial_double_pendulum_keeps_energy_over_100_periods():
@@ -23,7 +23,7 @@ def test_spatial_double_pendulum_keeps_energy_over_100_periods():
     qd0 = [0.5, 0.0, 0.4, -0.8, 0.2, 0.1]
     sol = integrate(system, t_end, q0, qd0, t_eval=np.linspace(0, t_end, 2001))
     E = total_energy(system, sol.y)
-    scale = np.max([system.kinetic_energy(x[:6], x[6:]) for x in sol.y.T])  # energy exchanged in the motion
+    scale = np.max([system.kinetic_energy(0.0, x[:6], x[6:]) for x in sol.y.T])  # energy exchanged in the motion
     assert np.max(np.abs(E - E[0])) / scale < 1e-8
 
 
@@ -38,8 +38,8 @@ def test_spring_pendulum_chain_keeps_energy_over_100_periods():
     t_end = 100 * 2 * np.pi / np.sqrt(300.0 / 0.5) * 8
     sol = integrate(system, t_end, [0.4, 0.05], [0.0, 0.3], t_eval=np.linspace(0, t_end, 1001))
     E = total_energy(system, sol.y)
-    assert system.elastic_energy(sol.y[:2, 0]) > 0
-    scale = np.max([system.kinetic_energy(x[:2], x[2:]) for x in sol.y.T])
+    assert system.elastic_energy(0.0, sol.y[:2, 0]) > 0
+    scale = np.max([system.kinetic_energy(0.0, x[:2], x[2:]) for x in sol.y.T])
     assert np.max(np.abs(E - E[0])) / scale < 1e-8
 
 
@@ -61,9 +61,9 @@ def test_energy_lost_equals_dissipated_work():
                     atol=1e-12)
     E = total_energy(system, sol.y[:4])
     lost = E[0] - E
-    E_rest = system.potential_energy([0.0, -0.5 * 9.81 / 300.0])  # hanging still, spring sagged
+    E_rest = system.potential_energy(0.0, [0.0, -0.5 * 9.81 / 300.0])  # hanging still, spring sagged
     assert lost[-1] > 0.5 * (E[0] - E_rest)  # most of the free energy was dissipated
     np.testing.assert_allclose(lost, sol.y[4], rtol=1e-8, atol=1e-10)
     # The package's own dissipated power agrees with the test's.
     for y in sol.y.T[::20]:
-        assert system.dissipated_power(y[:2], y[2:4]) == pytest.approx(c1 * y[2] ** 2 + c2 * y[3] ** 2, rel=1e-14)
+        assert system.dissipated_power(0.0, y[:2], y[2:4]) == pytest.approx(c1 * y[2] ** 2 + c2 * y[3] ** 2, rel=1e-14)

@@ -25,13 +25,13 @@ def modal_tip(system, beam, t):
     K φ = ω² M φ, q = Σ φ_k (φ_kᵀ f₀/ω_k²)(1 − cos ω_k t)."""
     n = system.nq
     q, z = np.zeros(n), np.zeros(n)
-    M = system.mass_matrix(q)
+    M = system.mass_matrix(0.0, q)
     dfdq, _ = system.force_jacobians(0.0, q, z)
     w2, phi = scipy.linalg.eigh(-dfdq, M)  # φᵀ M φ = I
     f0 = system.generalized_forces(0.0, q, z)
     static = phi.T @ f0 / w2
     Q = ((1.0 - np.cos(np.outer(t, np.sqrt(w2)))) * static) @ phi.T
-    return np.array([system.position(beam.tip, qk) for qk in Q])
+    return np.array([system.position(beam.tip, 0.0, qk) for qk in Q])
 
 
 @pytest.fixture(scope="module")

@@ -18,8 +18,8 @@ def tip_in_hub_frame(system, hub, beam, sol):
     out = []
     for t, y in zip(sol.t, sol.y.T):
         q = y[: system.nq]
-        T = system.transform(hub.index, q, t)
-        out.append((rf.inverse(T) @ np.append(system.position(beam.tip, q, t), 1.0))[:3])
+        T = system.transform(hub.index, t, q)
+        out.append((rf.inverse(T) @ np.append(system.position(beam.tip, t, q), 1.0))[:3])
     return np.array(out)
 
 

@@ -97,7 +97,7 @@ def cantilever(m, gravity=None, material=MATERIAL, deform=("bend_z",)):
 
 def tip_rotation(system, beam, q):
     """Angle of the last rfe about z from its transform (checked against Σ q for a planar chain)."""
-    T = system.transform(beam.rfes[-1].index, q)
+    T = system.transform(beam.rfes[-1].index, 0.0, q)
     return np.arctan2(T[1, 0], T[0, 0])
 
 
@@ -109,7 +109,7 @@ def rfem_tip_force(m, k, follower):
     system = model.compile()
     eq = rf.static_equilibrium(system, load_steps=10, tol=1e-12)
     assert eq.converged
-    tip = system.position(beam.tip, eq.q)
+    tip = system.position(beam.tip, 0.0, eq.q)
     theta = np.sum(eq.q)
     assert abs(tip_rotation(system, beam, eq.q) - theta) < 1e-12  # θ < π here
     return np.array([tip[0] / L, tip[1] / L, theta])
@@ -156,11 +156,11 @@ def test_tip_moment_two_pi_rolls_a_full_circle(m):
     eq = rf.static_equilibrium(system, load_steps=8, tol=1e-12)
     # Each sde turns by M Δ/EI = 2π/m: the sdes are the vertices of a closed regular m-gon and the
     # half-length end rfes meet at the root: closure is exact, not only O(m⁻²).
-    tip = system.position(beam.tip, eq.q)
+    tip = system.position(beam.tip, 0.0, eq.q)
     assert np.linalg.norm(tip) < 1e-9 * L
     assert np.sum(eq.q) == pytest.approx(2 * np.pi, abs=1e-10)
     np.testing.assert_allclose(eq.q, 2 * np.pi / m, atol=1e-10)
-    T = system.transform(beam.rfes[-1].index, eq.q)
+    T = system.transform(beam.rfes[-1].index, 0.0, eq.q)
     np.testing.assert_allclose(T[:3, :3], np.eye(3), atol=1e-10)  # tangent back along +x
     # The sde points are the vertices of a regular m-gon of side Δ whose edge midpoint is the root:
     # centre (0, (Δ/2) cot(π/m)), circumradius (Δ/2)/sin(π/m) → the continuum's EI/M = L/2π as O(m⁻²).
@@ -178,7 +178,7 @@ def test_tip_moment_pi_bends_a_half_circle():
         model.add_torque(beam.rfes[-1], (0.0, 0.0, np.pi * EI / L))
         system = model.compile()
         eq = rf.static_equilibrium(system, load_steps=4, tol=1e-12)
-        tip = system.position(beam.tip, eq.q) / L
+        tip = system.position(beam.tip, 0.0, eq.q) / L
         assert np.sum(eq.q) == pytest.approx(np.pi, abs=1e-10)
         assert abs(tip[0]) < 1e-12 and tip[2] == 0.0
         # The polygon: y = Δ Σ_{j=1}^{m-1} sin(jπ/m) = (1/m) cot(π/2m) → 2/π as O(m⁻²).
@@ -224,7 +224,7 @@ def test_gravity_sag_matches_euler_bernoulli(plane):
         model, beam = cantilever(m, gravity=gravity, material=material, deform=deform)
         system = model.compile()
         eq = rf.static_equilibrium(system, load_steps=1, tol=1e-14)
-        tip = system.position(beam.tip, eq.q)
+        tip = system.position(beam.tip, 0.0, eq.q)
         rel.append((-tip[axis] - exact) / exact)
     rel = np.array(rel)
     # Measured −5.0e-3, −1.25e-3, −3.1e-4: exactly −1/(2m²), the midpoint rule's error on

@@ -65,7 +65,7 @@ def test_A_B_C_against_finite_differences_away_from_equilibrium():
     outputs = [("position", beam.tip, "y"), ("position", payload, d), ("velocity", beam.tip, "z"), "beam.rfe2.ry",
                "payload.ry.dot"]
     with pytest.warns(rf.NotAnEquilibriumWarning, match="not an equilibrium"):
-        ss = rf.linearize(system, q, qd, T0, inputs=inputs, outputs=outputs)
+        ss = rf.linearize(system, q, qd, t=T0, inputs=inputs, outputs=outputs)
 
     def qdd(s, x):
         return s.forward_dynamics(T0, x[:n], x[n:])
@@ -78,9 +78,9 @@ def test_A_B_C_against_finite_differences_away_from_equilibrium():
     B = np.column_stack([np.concatenate([np.zeros(n), qdd(s, x0) - qdd(system, x0)]) for s in loaded])
     close(ss.B, B)
     C = np.vstack([
-        np.concatenate([central(lambda x: system.position(beam.tip, x, T0), q)[1], np.zeros(n)]),
-        np.concatenate([d @ central(lambda x: system.position(payload, x, T0), q), np.zeros(n)]),
-        central(lambda x: system.velocity(beam.tip, x[:n], x[n:], T0), x0)[2],
+        np.concatenate([central(lambda x: system.position(beam.tip, T0, x), q)[1], np.zeros(n)]),
+        np.concatenate([d @ central(lambda x: system.position(payload, T0, x), q), np.zeros(n)]),
+        central(lambda x: system.velocity(beam.tip, T0, x[:n], x[n:]), x0)[2],
         np.eye(2 * n)[system.coordinate_index("beam.rfe2.ry")],
         np.eye(2 * n)[n + system.coordinate_index("payload.ry")],
     ])
@@ -89,7 +89,7 @@ def test_A_B_C_against_finite_differences_away_from_equilibrium():
     assert ss.input_names == ["F", "T", "Q"]
     assert ss.output_names[3:] == ["beam.rfe2.ry", "payload.ry.dot"]
     assert ss.state_names == system.coordinate_names + [c + ".dot" for c in system.coordinate_names]
-    np.testing.assert_allclose(ss.y0[0], system.position(beam.tip, q, T0)[1], rtol=1e-14)
+    np.testing.assert_allclose(ss.y0[0], system.position(beam.tip, T0, q)[1], rtol=1e-14)
 
 
 def damped_beam():

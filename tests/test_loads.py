@@ -39,8 +39,8 @@ def test_point_force_generalized_force_is_its_virtual_work(follower, rng):
     for _ in range(3):
         q = rng.uniform(-1, 1, system.nq)
         # A follower force turns with body c: global components R_c F.
-        F_global = system.transform(c.index, q)[:3, :3] @ F if follower else F
-        J = fd_jacobian(lambda x: system.position(point, x), q)  # ∂r/∂q (3, nq)
+        F_global = system.transform(c.index, 0.0, q)[:3, :3] @ F if follower else F
+        J = fd_jacobian(lambda x: system.position(point, 0.0, x), q)  # ∂r/∂q (3, nq)
         Q = system.generalized_forces(0.0, q, np.zeros(system.nq))
         np.testing.assert_allclose(Q, F_global @ J, rtol=1e-8, atol=1e-9)
 
@@ -52,7 +52,7 @@ def test_torque_generalized_force_is_its_virtual_work(rng):
     system = model.compile()
     q = rng.uniform(-1, 1, system.nq)
     # δθ_i from δR Rᵀ = S(δθ): columns of the rotation Jacobian of body b.
-    R = lambda x: system.transform(b.index, x)[:3, :3]  # noqa: E731
+    R = lambda x: system.transform(b.index, 0.0, x)[:3, :3]  # noqa: E731
     h = 1e-6
     Q_ref = []
     for i in range(system.nq):
@@ -67,7 +67,7 @@ def test_gravity_is_minus_the_gradient_of_its_potential(rng):
     model, _ = chain(gravity=(1.0, -2.0, -9.81))
     system = model.compile()
     q = rng.uniform(-1, 1, system.nq)
-    grad = fd_jacobian(lambda x: np.atleast_1d(system.gravity_energy(x)), q)[0]
+    grad = fd_jacobian(lambda x: np.atleast_1d(system.gravity_energy(0.0, x)), q)[0]
     np.testing.assert_allclose(system.generalized_forces(0.0, q, np.zeros(system.nq)), -grad, rtol=1e-8, atol=1e-9)
 
 
@@ -75,10 +75,10 @@ def test_kinetic_energy_is_the_quadratic_form_of_the_mass_matrix(rng):
     model, _ = chain()
     system = model.compile()
     q, qd = rng.uniform(-1, 1, (2, system.nq))
-    A = system.mass_matrix(q)
+    A = system.mass_matrix(0.0, q)
     np.testing.assert_allclose(A, A.T, rtol=1e-15, atol=1e-16)
     assert np.all(np.linalg.eigvalsh(A) > 0)
-    assert system.kinetic_energy(q, qd) == pytest.approx(0.5 * qd @ A @ qd, rel=1e-13)
+    assert system.kinetic_energy(0.0, q, qd) == pytest.approx(0.5 * qd @ A @ qd, rel=1e-13)
 
 
 def test_velocity_of_a_point_is_the_derivative_of_its_position(rng):
@@ -86,8 +86,8 @@ def test_velocity_of_a_point_is_the_derivative_of_its_position(rng):
     system = model.compile()
     point = b.point((0.1, 0.2, -0.3))
     q, qd = rng.uniform(-1, 1, (2, system.nq))
-    J = fd_jacobian(lambda x: system.position(point, x), q)
-    np.testing.assert_allclose(system.velocity(point, q, qd), J @ qd, rtol=1e-8, atol=1e-10)
+    J = fd_jacobian(lambda x: system.position(point, 0.0, x), q)
+    np.testing.assert_allclose(system.velocity(point, 0.0, q, qd), J @ qd, rtol=1e-8, atol=1e-10)
 
 
 def test_scaled_load_follows_its_profile():

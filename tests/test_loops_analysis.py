@@ -238,7 +238,7 @@ def test_boom_held_by_an_actuator_is_a_structure_without_modes(algorithm, driven
     if driven:  # the loop moves: q̇ = 0 does not follow it
         with pytest.raises(ValueError, match=r"^qd: expected rates that close every loop of \['cylinder'\]"):
             rf.modal_analysis(s, q=eq.q, t=t)
-    modes = rf.modal_analysis(s, q=eq.q, qd=s.assemble(eq.q, None, t)[1], t=t)
+    modes = rf.modal_analysis(s, q=eq.q, qd=s.assemble(eq.q, None, t=t)[1], t=t)
     assert modes.omega.shape == (0,) and modes.shapes.shape == (1, 0) and modes.stable
 
 

@@ -189,14 +189,14 @@ def test_six_dof_pose_ship_names_and_aliases(engine):
     system = model.compile(engine)
     assert system.nq == 0 and system.prescribed_names == ["deck." + c for c in ("x", "y", "z", "rz", "ry", "rx")]
     t = 1.7
-    T = system.transform(base, [], t=t)
+    T = system.transform(base, t, [])
     xyz = [dofs[k](t)[0] if not isinstance(dofs[k], float) else dofs[k] for k in ("surge", "sway", "heave")]
     np.testing.assert_allclose(T[:3, 3], np.add(xyz, (1.0, 0, 2.0)), atol=1e-14)
     np.testing.assert_allclose(T[:3, :3], rot_zyx(*(dofs[k](t)[0] for k in ("yaw", "pitch", "roll"))), atol=1e-14)
     # Coordinate names are aliases; missing degrees of freedom are held at 0.
     other = rf.Model()
     b2 = other.add_moving_base("deck", {"z": motion.harmonics(A, W, PH, C)})
-    np.testing.assert_allclose(other.compile(engine).transform(b2, [], t=t)[:3, 3], [0, 0, dofs["heave"](t)[0]],
+    np.testing.assert_allclose(other.compile(engine).transform(b2, t, [])[:3, 3], [0, 0, dofs["heave"](t)[0]],
                                atol=1e-15)
 
 
@@ -221,7 +221,7 @@ def test_base_excited_spring_mass_damper_steady_state(engine):
     u0, ud0 = x(0.0)[0] - 0.0, x(0.0)[1] - Y * Om  # relative to the base
     t = np.linspace(0.0, 3.0, 61)
     sol = integrate(system, 3.0, [u0], [ud0], t_eval=t)
-    z = [system.position(mass, sol.y[:1, j], t=t[j])[2] for j in range(len(t))]
+    z = [system.position(mass, t[j], sol.y[:1, j])[2] for j in range(len(t))]
     np.testing.assert_allclose(z, x(t)[0], atol=1e-9 * X)
     assert X / Y == pytest.approx(1.8526, abs=1e-4)  # r = 0.7, ζ = 0.15: amplified (isolation needs r > √2)
 

@@ -55,5 +55,5 @@ def test_tip_position_follows_the_joint_angle():
     system, h = pendulum()
     for theta in (0.0, 0.4, -2.0):
         # Revolute about y: R2(θ) (0, 0, −L) = (−L sin θ, 0, −L cos θ).
-        np.testing.assert_allclose(system.position(h["tip"], [theta]), [-L * np.sin(theta), 0, -L * np.cos(theta)],
+        np.testing.assert_allclose(system.position(h["tip"], 0.0, [theta]), [-L * np.sin(theta), 0, -L * np.cos(theta)],
                                    atol=1e-15)

@@ -66,7 +66,7 @@ def equal_systems(a, b, rng):
     assert a.coordinate_names == b.coordinate_names and a.prescribed_names == b.prescribed_names
     for _ in range(3):
         t, q, qd = rng.uniform(0, 2), rng.uniform(-0.3, 0.3, a.nq), rng.uniform(-1, 1, a.nq)
-        assert np.array_equal(a.mass_matrix(q, t=t), b.mass_matrix(q, t=t))
+        assert np.array_equal(a.mass_matrix(t, q), b.mass_matrix(t, q))
         assert np.array_equal(a.forward_dynamics(t, q, qd), b.forward_dynamics(t, q, qd))
         assert np.array_equal(a.loop_constraints(t, q, qd)[2], b.loop_constraints(t, q, qd)[2])
 
@@ -83,7 +83,7 @@ def test_model_and_system_round_trip_bit_for_bit():
     # The handles the original made name the same bodies of the copy, in models and systems.
     q = rng.uniform(-0.3, 0.3, system.nq)
     copied = pickle.loads(pickle.dumps(system))
-    assert np.array_equal(copied.position(arm.tip, q, t=0.5), system.position(arm.tip, q, t=0.5))
+    assert np.array_equal(copied.position(arm.tip, 0.5, q), system.position(arm.tip, 0.5, q))
     copy_model.add_spring_damper(tape.rfes[-1].origin, arm.tip, stiffness=1.0, length=0.1)
 
 
@@ -115,7 +115,7 @@ def test_handles_of_other_models_still_refused():
     model, _, arm = everything()
     other, _, _ = everything()
     with pytest.raises(ValueError, match="another model"):
-        pickle.loads(pickle.dumps(other.compile())).position(arm.tip, np.zeros(other.compile().nq), t=0.0)
+        pickle.loads(pickle.dumps(other.compile())).position(arm.tip, 0.0, np.zeros(other.compile().nq))
 
 
 def test_profiles_handles_and_joint_specs_round_trip():

@@ -88,7 +88,7 @@ def test_position_lines_are_the_point_positions(pendulum):
     assert (x.get_label(), z.get_label()) == ("tip x (m)", "tip z (m)") and ax.get_ylabel() == "position (m)"
     k = 17  # against System.position at one output
     np.testing.assert_allclose([x.get_ydata()[k], z.get_ydata()[k]],
-                               system.position(h["tip"], res.q[k])[[0, 2]], rtol=1e-12, atol=1e-14)
+                               system.position(h["tip"], 0.0, res.q[k])[[0, 2]], rtol=1e-12, atol=1e-14)
     np.testing.assert_array_equal(x.get_xdata(), res.t)
 
 
@@ -99,7 +99,7 @@ def test_energy_lines_add_up_to_the_total(pendulum):
     assert list(lines) == ["kinetic (J)", "gravity (J)", "elastic (J)", "total (J)"] == legend_texts(ax)
     assert ax.get_ylabel() == "energy (J)"
     k = 23
-    np.testing.assert_allclose(lines["kinetic (J)"].get_ydata()[k], system.kinetic_energy(res.q[k], res.qd[k]),
+    np.testing.assert_allclose(lines["kinetic (J)"].get_ydata()[k], system.kinetic_energy(0.0, res.q[k], res.qd[k]),
                                rtol=1e-12)
     parts = sum(lines[n].get_ydata() for n in ("kinetic (J)", "gravity (J)", "elastic (J)"))
     np.testing.assert_allclose(lines["total (J)"].get_ydata(), parts, rtol=1e-12, atol=1e-12)
@@ -133,7 +133,7 @@ def test_beam_centreline_is_drawn_through_the_rfe_origins_and_the_tip(cantilever
     line = lines_by_label(ax)["beam"]
     drawn = np.column_stack(line.get_data_3d() if plane is None else line.get_data())
     # modified formulation: the sdes are at the rfes' origins
-    expected = np.array([system.position(b.origin, q) for b in beam.rfes] + [system.position(beam.tip, q)])
+    expected = np.array([system.position(b.origin, 0.0, q) for b in beam.rfes] + [system.position(beam.tip, 0.0, q)])
     np.testing.assert_allclose(drawn, expected if plane is None else expected[:, [0, 2]], rtol=1e-12, atol=1e-15)
     labels = [ax.get_xlabel(), ax.get_ylabel()] + ([ax.get_zlabel()] if plane is None else [])
     assert labels == (["x (m)", "y (m)", "z (m)"] if plane is None else ["x (m)", "z (m)"])
@@ -147,14 +147,14 @@ def test_bodies_are_drawn_as_their_frames_and_links(pendulum):
     for a, name in enumerate(("_x axes", "_y axes", "_z axes")):
         X = np.column_stack(lines[name].get_data_3d())
         for n, body in enumerate((h["link1"], h["link2"])):
-            T = system.transform(body, q)
+            T = system.transform(body, 0.0, q)
             np.testing.assert_allclose(X[3 * n], T[:3, 3], atol=1e-14)  # from the origin ...
             np.testing.assert_allclose(X[3 * n + 1], T[:3, 3] + 0.1 * T[:3, a], atol=1e-14)  # ... along axis a
             assert np.all(np.isnan(X[3 * n + 2]))  # then a break
     links = np.column_stack(lines["_links"].get_data_3d())
     link2 = links[np.all(np.isfinite(links), axis=1)][-2:]  # link2's origin and centre of mass
-    np.testing.assert_allclose(link2, [system.transform(h["link2"], q)[:3, 3],
-                                       system.position(h["link2"].point(system.centres_of_mass[1]), q)], atol=1e-14)
+    np.testing.assert_allclose(link2, [system.transform(h["link2"], 0.0, q)[:3, 3],
+                                       system.position(h["link2"].point(system.centres_of_mass[1]), 0.0, q)], atol=1e-14)
     lo, hi = (np.array([getattr(ax, f"get_{c}lim")() for c in "xyz"]).T)
     np.testing.assert_allclose(hi - lo, (hi - lo)[0])  # equal aspect: a cube
 
@@ -165,9 +165,9 @@ def test_segments_join_their_two_points(pendulum):
     q = res.q[30]
     ax = plots.shape(system, q, segments=[(anchor, h["tip"]), (h["link1"], h["link2"].point((0.1, 0, 0)))])
     X = np.column_stack(lines_by_label(ax)["_segments"].get_data_3d())
-    np.testing.assert_allclose(X[[0, 1, 3, 4]], [(0.5, 0.2, 0.0), system.position(h["tip"], q),
-                                                 system.transform(h["link1"], q)[:3, 3],
-                                                 system.position(h["link2"].point((0.1, 0, 0)), q)], atol=1e-14)
+    np.testing.assert_allclose(X[[0, 1, 3, 4]], [(0.5, 0.2, 0.0), system.position(h["tip"], 0.0, q),
+                                                 system.transform(h["link1"], 0.0, q)[:3, 3],
+                                                 system.position(h["link2"].point((0.1, 0, 0)), 0.0, q)], atol=1e-14)
     assert np.all(np.isnan(X[[2, 5]]))
 
 
@@ -178,7 +178,7 @@ def test_plane_shape_has_equal_aspect_and_rfes_without_triads(kane):
     lines = lines_by_label(ax)
     x_axes = np.column_stack(lines["_x axes"].get_data())
     assert len(x_axes) == 3  # only the hub's triad; the beam's rfes are drawn as links
-    np.testing.assert_allclose(x_axes[0], system.transform(h["hub"], res.q[-1], t=res.t[-1])[:2, 3], atol=1e-14)
+    np.testing.assert_allclose(x_axes[0], system.transform(h["hub"], res.t[-1], res.q[-1])[:2, 3], atol=1e-14)
 
 
 def test_shapes_drawn_into_one_axes_all_stay_in_view(kane):
@@ -187,7 +187,7 @@ def test_shapes_drawn_into_one_axes_all_stay_in_view(kane):
     tips = []
     for k in (0, 12, 24):  # the beam turns from along x towards y
         plots.shape(system, res.q[k], t=res.t[k], plane="xy", ax=ax, beams=h["beam"])
-        tips.append(system.position(h["beam"].tip, res.q[k], t=res.t[k])[:2])
+        tips.append(system.position(h["beam"].tip, res.t[k], res.q[k])[:2])
     (x0, x1), (y0, y1) = ax.get_xlim(), ax.get_ylim()
     assert all(x0 < x < x1 and y0 < y < y1 for x, y in tips)
     assert x1 - x0 == pytest.approx(y1 - y0)
@@ -232,7 +232,7 @@ def test_animation_frames_and_growing_trail(kane):
         trail = np.column_stack(lines_by_label(ax)["trail 0"].get_data())
         np.testing.assert_allclose(trail, path[: i + 1, :2], atol=1e-14)  # the path so far, growing
         drawn = np.column_stack(lines_by_label(ax)["beam"].get_data())
-        np.testing.assert_allclose(drawn, beam.centerline(system, res.q[i], res.t[i])[:, :2], atol=1e-14)
+        np.testing.assert_allclose(drawn, beam.centerline(system, res.q[i], t=res.t[i])[:, :2], atol=1e-14)
         assert ax.texts[0].get_text() == f"t = {res.t[i]:.3f} s"
     html = anim.to_jshtml()
     assert "<img" in html or "animation" in html.lower()

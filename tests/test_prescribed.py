@@ -76,7 +76,7 @@ def test_driven_coordinate_leaves_the_unknowns_and_sets_the_pose():
     t = 0.8
     theta = 0.5 * np.sin(2.0 * t + 0.3)
     # Rod origin is at radius R on the hub: (R cos θ, R sin θ, 0).
-    np.testing.assert_allclose(system.position(rod, [0.0], t=t), [R * np.cos(theta), R * np.sin(theta), 0], atol=1e-15)
+    np.testing.assert_allclose(system.position(rod, t, [0.0]), [R * np.cos(theta), R * np.sin(theta), 0], atol=1e-15)
     assert system.coordinate_names == ["rod.ry"]
 
 

@@ -26,9 +26,9 @@ def test_recursive_equals_lagrange_on_random_trees(seed, nbodies):
     for _ in range(2):
         # Angles within ±1 rad keep every ZYX joint far from gimbal lock.
         q, qd, t = rng.uniform(-1, 1, rec.nq), rng.uniform(-2, 2, rec.nq), float(rng.uniform(0, 5))
-        A = lag.mass_matrix(q, t)
+        A = lag.mass_matrix(t, q)
         cond = np.linalg.cond(A)
-        np.testing.assert_allclose(rec.mass_matrix(q, t), A, rtol=0, atol=1e-12 * scale(A))
+        np.testing.assert_allclose(rec.mass_matrix(t, q), A, rtol=0, atol=1e-12 * scale(A))
         f = lag.generalized_forces(t, q, qd)
         np.testing.assert_allclose(rec.generalized_forces(t, q, qd), f, rtol=0, atol=1e-12 * scale(f))
         qdd = lag.forward_dynamics(t, q, qd)

@@ -165,13 +165,13 @@ def test_wrong_types_are_value_errors_naming_the_argument():
     q = np.zeros(2)
     calls = {
         "t": lambda: s.forward_dynamics(None, q, q),
-        "q": lambda: s.mass_matrix("q"),
+        "q": lambda: s.mass_matrix(0.0, "q"),
         "qd": lambda: s.generalized_forces(0.0, q, [None, 1]),
         "load_factor": lambda: s.static_forces(0.0, q, "1"),
         "static": lambda: s.force_jacobians(0.0, q, q, 1.0, "yes"),
         "y": lambda: s.rhs(0.0, None),
         "qdd": lambda: s.inverse_dynamics(0.0, q, q, {}),
-        "point": lambda: s.position(None, q, 0.0),
+        "point": lambda: s.position(None, 0.0, q),
         "data": lambda: rf.stages.kinematics(s, None),
     }
     for argument, call in calls.items():
@@ -228,7 +228,7 @@ def test_calls_reuse_a_workspace_without_changing_answers():
     inner = {}
 
     def law(t, x, v):
-        inner["energy"] = s2.kinetic_energy([x], [v], t)
+        inner["energy"] = s2.kinetic_energy(t, [x], [v])
         return 0.0
 
     m2.add_generalized_force(h2["block"], law)
@@ -242,8 +242,8 @@ def test_positions_of_many_points_in_one_pass():
     s = model.compile()
     q = np.linspace(0.0, 0.1, s.nq)
     points = h["beam"].points()
-    one_by_one = np.array([s.position(p, q, 0.0) for p in points])
-    np.testing.assert_allclose(s._positions(points, q, 0.0), one_by_one, rtol=0, atol=1e-15)
+    one_by_one = np.array([s.position(p, 0.0, q) for p in points])
+    np.testing.assert_allclose(s._positions(points, 0.0, q), one_by_one, rtol=0, atol=1e-15)
 
 
 def test_lagrange_jacobians_check_their_inputs_and_fixed_only_models_run():
@@ -258,4 +258,4 @@ def test_lagrange_jacobians_check_their_inputs_and_fixed_only_models_run():
     body = model.add_body("b", model.ground, rf.Joint.fixed(), 1.0, (1, 1, 1), placement=rf.transform((1, 2, 3)))
     fixed = model.compile()
     assert fixed.forward_dynamics(0.0, [], []).shape == (0,)
-    np.testing.assert_array_equal(fixed.position(body.point((1, 0, 0)), []), [2.0, 2.0, 3.0])
+    np.testing.assert_array_equal(fixed.position(body.point((1, 0, 0)), 0.0, []), [2.0, 2.0, 3.0])

@@ -35,7 +35,7 @@ def test_resolve_meets_the_elastica(k, tol):
 
     plan = rf.resolve(build, "tip", tol=tol, elements=2)
     ref = elastica_tip(k)
-    tip = plan.system.position(plan.handles["tip"], plan.solution.q)[:2]
+    tip = plan.system.position(plan.handles["tip"], 0.0, plan.solution.q)[:2]
     true = np.linalg.norm(tip - ref)
     assert true <= rf.resolution.SPACE * tol and 0.5 < plan.space_error / true < 2, (plan.space_error, true)
     assert np.linalg.norm(plan.limit["tip"][:2] - ref) < 0.1 * tol

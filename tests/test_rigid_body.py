@@ -36,15 +36,15 @@ def test_free_body_conserves_energy_and_momenta():
             inertia) @ R.T @ w
 
     p0, L0, T0 = momenta(sol.y[:, 0])
-    assert system.kinetic_energy(q0, qd0) == pytest.approx(T0, rel=1e-14)
+    assert system.kinetic_energy(0.0, q0, qd0) == pytest.approx(T0, rel=1e-14)
     for y in sol.y.T:
         p, L, T = momenta(y)
         np.testing.assert_allclose(p, p0, rtol=1e-10)
         np.testing.assert_allclose(L, L0, rtol=1e-9, atol=1e-9 * np.linalg.norm(L0))
         assert T == pytest.approx(T0, rel=1e-9)
-        assert system.kinetic_energy(y[:6], y[6:]) == pytest.approx(T, rel=1e-12)
+        assert system.kinetic_energy(0.0, y[:6], y[6:]) == pytest.approx(T, rel=1e-12)
     assert np.ptp(sol.y[3]) > 10.0  # it really turned: φ3 advanced by several radians
-    np.testing.assert_allclose(system.position(body, sol.y[:6, -1]), q0[:3] + 20.0 * qd0[:3], rtol=1e-10)
+    np.testing.assert_allclose(system.position(body, 0.0, sol.y[:6, -1]), q0[:3] + 20.0 * qd0[:3], rtol=1e-10)
 
 
 @pytest.mark.parametrize("theta", [np.pi / 3, 2 * np.pi / 5])

@@ -41,7 +41,7 @@ def test_spring_rest_value_and_applied_force_set_the_equilibrium():
     z_eq = rest + (F - m * 9.81) / k
     assert system.forward_dynamics(0.0, [z_eq], [0.0])[0] == pytest.approx(0.0, abs=1e-13)
     assert system.forward_dynamics(0.0, [z_eq + 0.01], [0.0])[0] == pytest.approx(-k * 0.01 / m, rel=1e-12)
-    assert system.elastic_energy([z_eq + 0.01]) == pytest.approx(0.5 * k * (z_eq + 0.01 - rest) ** 2, rel=1e-14)
+    assert system.elastic_energy(0.0, [z_eq + 0.01]) == pytest.approx(0.5 * k * (z_eq + 0.01 - rest) ** 2, rel=1e-14)
 
 
 def test_generalized_force_law_is_called_with_time_and_the_coordinate_state():

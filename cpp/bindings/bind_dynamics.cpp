@@ -215,11 +215,11 @@ void bind_dynamics(py::module_& m) {
           py::arg("t"), py::arg("q"), py::arg("qd"),
           "Accelerations qdd (nq,) solving A(q) qdd = f(q, qd, t); t in s, q in m/rad, qd in m/s, rad/s.")
       .def(
-          "mass_matrix", [](const System& s, const RefV& q, double t) {
+          "mass_matrix", [](const System& s, double t, const RefV& q) {
             Workspace d(s);
             return rigidfem::mass_matrix(s, *d, t, q);
           },
-          py::arg("q"), py::arg("t") = 0.0, "Mass matrix A(q) (nq, nq), a_ij = sum_p tr(T_p,i H_p T_p,j^T).")
+          py::arg("t"), py::arg("q"), "Mass matrix A(q) (nq, nq), a_ij = sum_p tr(T_p,i H_p T_p,j^T).")
       .def(
           "generalized_forces",
           [](const System& s, double t, const RefV& q, const RefV& qd, double load_factor) {
@@ -298,61 +298,61 @@ void bind_dynamics(py::module_& m) {
           "(dqdd/dq, dqdd/dqd), each (nq, nq): -A^-1 (dr/dq, dr/dqd) at the forward-dynamics qdd; with loop\n"
           "closures, of the constrained qdd (multipliers and constraint Jacobian varying too), by central differences.")
       .def(
-          "transform", [](const System& s, int body, const RefV& q, double t) {
+          "transform", [](const System& s, int body, double t, const RefV& q) {
             Workspace d(s);
             return body_pose(s, *d, body, t, q);
           },
-          py::arg("body"), py::arg("q"), py::arg("t") = 0.0, "Pose T_p (4, 4) of a body (by index) in the global frame.")
+          py::arg("body"), py::arg("t"), py::arg("q"), "Pose T_p (4, 4) of a body (by index) in the global frame.")
       .def(
-          "_position", [](const System& s, const Point& p, const RefV& q, double t) {
+          "_position", [](const System& s, const Point& p, double t, const RefV& q) {
             Workspace d(s);
             return point_position(s, *d, p, t, q);
           },
-          py::arg("point"), py::arg("q"), py::arg("t"))
+          py::arg("point"), py::arg("t"), py::arg("q"))
       .def(
           "_positions",
-          [](const System& s, const std::vector<Point>& points, const RefV& q, double t) {
+          [](const System& s, const std::vector<Point>& points, double t, const RefV& q) {
             Workspace d(s);
             return point_positions(s, *d, points, t, q);
           },
-          py::arg("points"), py::arg("q"), py::arg("t"))
+          py::arg("points"), py::arg("t"), py::arg("q"))
       .def(
-          "_velocity", [](const System& s, const Point& p, const RefV& q, const RefV& qd, double t) {
+          "_velocity", [](const System& s, const Point& p, double t, const RefV& q, const RefV& qd) {
             Workspace d(s);
             return point_velocity(s, *d, p, t, q, qd);
           },
-          py::arg("point"), py::arg("q"), py::arg("qd"), py::arg("t"))
+          py::arg("point"), py::arg("t"), py::arg("q"), py::arg("qd"))
       .def(
-          "kinetic_energy", [](const System& s, const RefV& q, const RefV& qd, double t) {
+          "kinetic_energy", [](const System& s, double t, const RefV& q, const RefV& qd) {
             Workspace d(s);
             return energies(s, *d, t, q, qd).kinetic;
           },
-          py::arg("q"), py::arg("qd"), py::arg("t") = 0.0, "Kinetic energy 1/2 sum tr(dT H dT^T) (J).")
+          py::arg("t"), py::arg("q"), py::arg("qd"), "Kinetic energy 1/2 sum tr(dT H dT^T) (J).")
       .def(
-          "gravity_energy", [](const System& s, const RefV& q, double t) {
+          "gravity_energy", [](const System& s, double t, const RefV& q) {
             Workspace d(s);
             return energies(s, *d, t, q, VecX::Zero(s.nq)).gravity;
           },
-          py::arg("q"), py::arg("t") = 0.0, "Potential energy of gravity -sum m g^T r_C (J).")
+          py::arg("t"), py::arg("q"), "Potential energy of gravity -sum m g^T r_C (J).")
       .def(
-          "elastic_energy", [](const System& s, const RefV& q, double t) {
+          "elastic_energy", [](const System& s, double t, const RefV& q) {
             Workspace d(s);
             return energies(s, *d, t, q, VecX::Zero(s.nq)).elastic;
           },
-          py::arg("q"), py::arg("t") = 0.0, "Energy of the joint springs 1/2 sum c (q - q_rest)^2 and of the force elements' springs\n"
+          py::arg("t"), py::arg("q"), "Energy of the joint springs 1/2 sum c (q - q_rest)^2 and of the force elements' springs\n"
           "1/2 sum k (l - l0)^2 (J).")
       .def(
-          "potential_energy", [](const System& s, const RefV& q, double t) {
+          "potential_energy", [](const System& s, double t, const RefV& q) {
             Workspace d(s);
             return energies(s, *d, t, q, VecX::Zero(s.nq)).potential();
           },
-          py::arg("q"), py::arg("t") = 0.0, "Gravity plus elastic energy (J).")
+          py::arg("t"), py::arg("q"), "Gravity plus elastic energy (J).")
       .def(
-          "dissipated_power", [](const System& s, const RefV& q, const RefV& qd, double t) {
+          "dissipated_power", [](const System& s, double t, const RefV& q, const RefV& qd) {
             Workspace d(s);
             return energies(s, *d, t, q, qd).dissipated;
           },
-          py::arg("q"), py::arg("qd"), py::arg("t") = 0.0, "Power dissipated by the joint dampers, sum b qd^2, and by the force elements' dampers,\n"
+          py::arg("t"), py::arg("q"), py::arg("qd"), "Power dissipated by the joint dampers, sum b qd^2, and by the force elements' dampers,\n"
           "sum c (dl/dt)^2 (W).")
       .def(
           "make_data", [](const System& s) { return std::make_unique<Data>(s); },

@@ -78,14 +78,13 @@ Track spatial_track(const System& sys, const Data& d, int p, const std::pair<Vec
   return tr;
 }
 
-/// The columns h = 0..3 of frame F in body p as tracks, by the engine's kinematics.
-std::array<Track, 4> frame_tracks(const System& sys, const Data& d, int p, const Mat4& F, int columns) {
+/// The columns h = 0..3 of frame F in body p as tracks, from the spatial kinematics or the 4x4 ones.
+std::array<Track, 4> frame_tracks(const System& sys, const Data& d, int p, const Mat4& F, int columns, bool spatial) {
   std::array<Track, 4> tr;
   if (p < 0) {  // the ground: F itself, at rest
     for (int h = 0; h < 4; ++h) tr[h] = {F.block<3, 1>(0, h), Vec3::Zero(), Vec3::Zero(), Mat3X::Zero(3, sys.nc)};
     return tr;
   }
-  const bool spatial = sys.algorithm == Algorithm::Recursive;
   const auto motion = spatial ? body_motion(sys, d, p) : std::pair<Vec6, Vec6>{};
   for (int h = 4 - columns; h < 4; ++h)
     tr[h] = spatial ? spatial_track(sys, d, p, motion, F, h) : homogeneous_track(sys, d, p, F, h);
@@ -144,14 +143,14 @@ void distance_row(Data& d, int r, const Track& x, const MotionState& l, const st
 
 }  // namespace
 
-void constraint_equations(const System& sys, Data& d) {
+void constraint_equations(const System& sys, Data& d, bool spatial) {
   for (std::size_t k = 0; k < sys.loops.size(); ++k) {
     const Loop& L = sys.loops[k];
     int r = sys.loop_row[k];
     // The origins (columns 3) and, for the joints, the axes (columns 0..2) of frames A and B.
     const int columns = L.kind == LoopKind::Distance ? 1 : 4;
-    const std::array<Track, 4> a = frame_tracks(sys, d, L.body_a, L.frame_a, columns),
-                               b = frame_tracks(sys, d, L.body_b, L.frame_b, columns);
+    const std::array<Track, 4> a = frame_tracks(sys, d, L.body_a, L.frame_a, columns, spatial),
+                               b = frame_tracks(sys, d, L.body_b, L.frame_b, columns, spatial);
     const Track dr = difference(b[3], a[3]);
     if (L.kind == LoopKind::Distance) {
       const MotionState l = L.drive ? L.drive->at(d.t) : MotionState{L.length, 0.0, 0.0};

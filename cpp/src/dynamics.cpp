@@ -37,15 +37,6 @@ std::pair<MatX, MatX> differenced(const System& sys, Data& d) {
   return {dq, dqd};
 }
 
-// The kinematics the formulation's dynamics read: T and the axes (recursive, exact joints: read off
-// the frames, no 4x4 twists or rates), or T, Ṫ, T̈ and the twists U (Lagrange, linear joints too).
-void tree_kinematics(const System& sys, Data& d) {
-  if (recursive(sys))
-    frames_and_axes(sys, d);
-  else
-    kinematics(sys, d);
-}
-
 // The state (t, q, q̇) with the formulation's kinematics.
 void full_state(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
                 const Eigen::Ref<const VecX>& qd) {
@@ -70,9 +61,16 @@ void set_load_factor(Data& d, double load_factor) {
 
 }  // namespace
 
+void tree_kinematics(const System& sys, Data& d) {
+  if (recursive(sys))
+    frames_and_axes(sys, d);
+  else
+    kinematics(sys, d);
+}
+
 void dynamics_kinematics(const System& sys, Data& d) {
   tree_kinematics(sys, d);
-  if (sys.nl > 0) constraint_equations(sys, d);  // g, G and γ from the same kinematics
+  if (sys.nl > 0) constraint_equations(sys, d, recursive(sys));  // g, G and γ from the same kinematics
 }
 
 void generalized_forces(const System& sys, Data& d) {

@@ -86,12 +86,11 @@ void ErrorMeasure::at(double t, const VecX& y) {
   t_ = t;
   y_ = y;
   set_state(sys_, d_, t, y.head(n), y.segment(n, n));
-  // T and the axes: read off the frames for the recursive algorithms' exact joints (no 4x4 twists),
-  // from the Lagrange kinematics for linear joints, with Ṫ where the elements' rates need it.
-  if (sys_.algorithm == Algorithm::Recursive && !need_elements_)
-    frames_and_axes(sys_, d_);
+  // T and the axes (the formulation's kinematics), with Ṫ where the elements' rates need it.
+  if (need_elements_)
+    kinematics(sys_, d_, true);
   else
-    kinematics(sys_, d_, need_elements_);
+    tree_kinematics(sys_, d_);
   for (int p = 0; p < sys_.nbodies; ++p) {
     xc_[p] = (d_.T[p] * d_.com[p].homogeneous()).head<3>();
     const double moved = (xc_[p] - xc0_[p]).norm();

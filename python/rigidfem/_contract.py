@@ -12,7 +12,7 @@ import functools
 
 import numpy as np
 
-from . import _checks
+from . import _checks, _deprecation
 from ._core import SimulationError, _System
 
 #: What each argument of the compiled methods expects, by name; sizes in terms of the system.
@@ -66,8 +66,10 @@ SIGNATURES = {name: tuple(p for p, _ in parameters) for name, parameters in _PAR
 #: The parameters that take vectors of real numbers, and how many per free coordinate.
 VECTORS = {"q": 1, "qd": 1, "qdd": 1, "y": 2}
 
-#: Methods whose t has a default (0) that only a system without prescribed coordinates may use.
-OPTIONAL_T = frozenset(name for name, parameters in _PARAMETERS.items() if ("t", True) in parameters)
+#: The state's parameters of version 0.1's methods that took t last (optional: 0 without prescribed
+#: coordinates), now t first: such calls are reordered with a DeprecationWarning (``_deprecation``).
+OLD_ORDERS = {"mass_matrix": ("q", "t"), "kinetic_energy": ("q", "qd", "t"), "gravity_energy": ("q", "t"),
+              "elastic_energy": ("q", "t"), "potential_energy": ("q", "t"), "dissipated_power": ("q", "qd", "t")}
 
 #: Vectors the compiled method ignores when a flag is set (it does not check them then): checked here.
 UNREAD = {"force_jacobians": ("qd", "static")}
@@ -183,14 +185,13 @@ def guard(function: str, compiled, parameters: tuple, method: bool = True):
     What the compiled conversion would take wrongly is refused before the call: booleans for t and
     load_factor (they convert to 0 and 1), numpy's complex scalars for them (their imaginary part
     dropped), vectors of complex numbers and (1, n) or (n, 1) arrays for q, qd, qdd and y, anything
-    but True or False for ``static``, t left out of a method of ``OPTIONAL_T`` of a system with
-    prescribed coordinates, and the vector ``UNREAD`` would leave unchecked."""
+    but True or False for ``static``, and the vector ``UNREAD`` would leave unchecked. Calls in the order of
+    ``OLD_ORDERS`` are reordered, with a DeprecationWarning."""
     offset = 1 if method else 0
+    old_order = OLD_ORDERS.get(function) if method else None
     # (position in args, name, kind): 0 a number, 1 a vector, 2 a flag
     checks = [(k + offset, p, 0 if p in ("t", "load_factor") else 1 if p in VECTORS else 2)
               for k, p in enumerate(parameters) if p in ("t", "load_factor", "static") or p in VECTORS]
-    t_default = function in OPTIONAL_T and method
-    t_at = parameters.index("t") + offset if t_default else -1
     unread = UNREAD.get(function)
     if unread:
         unread_at = (parameters.index(unread[0]) + offset, unread[0], parameters.index(unread[1]) + offset, unread[1])
@@ -198,6 +199,16 @@ def guard(function: str, compiled, parameters: tuple, method: bool = True):
 
     @functools.wraps(compiled)
     def call(*args, **kwargs):
+        if old_order is not None and args:
+            def default_time():  # a bad vector is named before the missing t
+                given = dict(zip(old_order, args[1:])) | kwargs
+                for p in old_order:
+                    if p in VECTORS and p in given and _problem(p, given[p], args[0]):
+                        raise _refuse(function, parameters, p, given[p], args, {})
+                return _checks.pose_time(args[0], None)
+
+            state, kwargs = _deprecation.time_first(function, old_order, parameters, args[1:], kwargs, default_time)
+            args = args[:1] + state
         n = len(args)
         converted = None
         for k, p, kind in checks:
@@ -227,12 +238,6 @@ def guard(function: str, compiled, parameters: tuple, method: bool = True):
                     raise _refuse(function, parameters, p, v, args, kwargs)
             elif not (v is True or v is False or v is _MISSING or isinstance(v, np.bool_)):
                 raise _refuse(function, parameters, p, v, args, kwargs)
-        if t_default and n <= t_at and "t" not in kwargs and args and args[0].np:
-            for k, p, kind in checks:  # a bad vector is named before the missing t
-                v = args[k] if k < n else kwargs.get(p, _MISSING)
-                if kind == 1 and v is not _MISSING and _problem(p, v, args[0]):
-                    raise _refuse(function, parameters, p, v, args, kwargs)
-            _checks.pose_time(args[0], None)  # raises: the drives make the answer depend on t
         if unread:
             k, p, j, flag = unread_at
             f = args[j] if j < n else kwargs.get(flag, False)

@@ -33,7 +33,7 @@ import scipy.linalg
 import scipy.optimize
 from scipy.linalg import lapack
 
-from . import _checks, _core, _interrupt, display, export
+from . import _checks, _core, _deprecation, _interrupt, display, export
 from ._core import SimulationError
 from .persistence import Versioned
 
@@ -200,7 +200,7 @@ def _constraint_stiffness(system, t: float, q: np.ndarray, lam: np.ndarray) -> n
 def _close_loops(system, q: np.ndarray, t: float, what: str) -> np.ndarray:
     """q assembled onto the loops (``System.assemble``), or the SimulationError naming the loop."""
     try:
-        return system.assemble(q, None, t)[0]
+        return system.assemble(q, None, t=t)[0]
     except SimulationError as err:
         raise SimulationError(f"{err} ({what} starts from the coordinates closed onto the loops "
                               f"{system.loop_names})") from err
@@ -250,7 +250,8 @@ def _integer_at_least_one(x, name: str) -> int:
     return v
 
 
-def static_equilibrium(system, q0=None, t: float = 0.0, load_steps: int = 10, tol: float = 1e-10,
+@_deprecation.keyword_only("t", "load_steps", "tol", "max_iterations")
+def static_equilibrium(system, q0=None, *, t: float = 0.0, load_steps: int = 10, tol: float = 1e-10,
                        max_iterations: int = 50) -> Equilibrium:
     """Solve f(q) = 0 by Newton's method with load stepping.
 
@@ -511,7 +512,8 @@ def _roots(W: np.ndarray, Kt: np.ndarray, Ct: np.ndarray, basis: np.ndarray):
     return ev[pick], Y[:, pick]
 
 
-def modal_analysis(system, q=None, qd=None, t: float = 0.0) -> Modes:
+@_deprecation.keyword_only("t")
+def modal_analysis(system, q=None, qd=None, *, t: float = 0.0) -> Modes:
     """Natural frequencies, damping ratios and mode shapes of the system linearised about (q, q̇) at t.
 
     M ẍ + C ẋ + K x = 0 with M = A(q), K = −∂f/∂q, C = −∂f/∂q̇ (``q`` in m and rad, default
@@ -559,7 +561,7 @@ def modal_analysis(system, q=None, qd=None, t: float = 0.0) -> Modes:
                       "out: K and C are those of the relaxed structure (E = E_inf); rigidfem.linearize keeps the arms' "
                       "forces as states (the eigenvalues of its A are the viscoelastic modes')", UserWarning,
                       stacklevel=2)
-    M = _core._System.mass_matrix(system, q, t)
+    M = _core._System.mass_matrix(system, t, q)
     dfdq, dfdqd = _core._System.force_jacobians(system, t, q, qd)
     K, C = -dfdq, -dfdqd
     _require_finite(t, "modal analysis", **{"mass matrix": M, "stiffness K = −∂f/∂q": K,
@@ -585,7 +587,7 @@ def _loop_tangent(system, q: np.ndarray, qd: np.ndarray, t: float, K: np.ndarray
             raise ValueError(
                 f"{name}: expected {'coordinates' if name == 'q' else 'rates'} that close every loop of "
                 f"{system.loop_names} (max |g{'' if name == 'q' else 'd'}| = {np.max(np.abs(v)):.3g} > {tol:g} in "
-                f"{_worst_loop(system, v)}); rigidfem.static_equilibrium or system.assemble(q, qd, t) finds them")
+                f"{_worst_loop(system, v)}); rigidfem.static_equilibrium or system.assemble(q, qd, t=t) finds them")
     c = _Constraints.of(G)
     f = system.generalized_forces(t, q, qd)
     _require_finite(t, what, **{"f(q, q̇)": f})

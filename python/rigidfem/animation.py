@@ -83,8 +83,8 @@ def animate(result, *, plane: str | None = None, beams=(), segments=(), trails=(
     interval = _real_time(t[indices]) if interval is None else _checks.scalar(interval, "interval", positive=True,
                                                                              unit="ms")
     skeleton = plots.Skeleton(result.system, beams, segments)
-    first = skeleton.pose(result.q[indices[0]], t[indices[0]], frame_size)
-    poses = [skeleton.pose(result.q[i], t[i], first.frame_size) for i in indices]
+    first = skeleton.pose(result.q[indices[0]], t=t[indices[0]], frame_size=frame_size)
+    poses = [skeleton.pose(result.q[i], t=t[i], frame_size=first.frame_size) for i in indices]
     paths = [result.position(p) for p in _points(trails)]
 
     ax = plots._shape_axes(ax, plane)

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _checks, _core
+from . import _checks, _core, _deprecation
 from ._core import Body, Point
 from .joints import Joint
 from .materials import Material, Section
@@ -306,7 +306,8 @@ class Beam:
         axis = result.position(last.point((1.0, 0.0, 0.0))) - origin
         return origin + axis * (self.length_at(result.t) / (2 * self.elements))[:, None]
 
-    def rates_at_rest(self, system, q, t: float = 0.0) -> np.ndarray:
+    @_deprecation.keyword_only("t")
+    def rates_at_rest(self, system, q, *, t: float = 0.0) -> np.ndarray:
         """Joint rates q̇ (nq,) that leave this beam's deformed shape in place at time ``t`` (s) while its
         material slides through the guide at v = L̇ (a link of varying length; zeros for a constant one).
 
@@ -326,16 +327,16 @@ class Beam:
         if not self.varying or n == 0:
             return np.zeros(n)
         step = 1e-7
-        X = self.centerline(system, q, t)
+        X = self.centerline(system, q, t=t)
         tangent = np.vstack([X[1] - X[0], X[2:] - X[:-2], X[-1] - X[-2]])
         tangent /= np.linalg.norm(tangent, axis=1)[:, None]
         across = np.eye(3)[None] - tangent[:, :, None] * tangent[:, None, :]   # (points, 3, 3): I − τ τᵀ
-        drives = (self.centerline(system, q, t + step) - self.centerline(system, q, t - step)) / (2 * step)
+        drives = (self.centerline(system, q, t=t + step) - self.centerline(system, q, t=t - step)) / (2 * step)
         J = np.empty((len(X), 3, n))
         for i in range(n):
             dq = np.zeros(n)
             dq[i] = step
-            J[:, :, i] = (self.centerline(system, q + dq, t) - self.centerline(system, q - dq, t)) / (2 * step)
+            J[:, :, i] = (self.centerline(system, q + dq, t=t) - self.centerline(system, q - dq, t=t)) / (2 * step)
         A = np.einsum("kab,kbi->kai", across[1:], J[1:]).reshape(-1, n)   # the root sits in the guide
         b = np.einsum("kab,kb->ka", across[1:], drives[1:]).ravel()
         return np.linalg.lstsq(A, -b, rcond=None)[0]
@@ -364,7 +365,8 @@ class Beam:
         sde = [self.rfes[i - 1].point((step[i - 1], 0.0, 0.0)) for i in range(1, self.elements + 1)]
         return (self.rfes[0].origin, *sde, self.tip)
 
-    def centerline(self, system, q, t: float | None = None) -> np.ndarray:
+    @_deprecation.keyword_only("t")
+    def centerline(self, system, q, *, t: float | None = None) -> np.ndarray:
         """Deformed centre line (m + 2, 3) in the global frame (m): root, sde points, tip, from one
         positions-only kinematics pass. ``t`` (s) is required when the system has prescribed
         coordinates, as for ``System.position``."""
@@ -372,10 +374,10 @@ class Beam:
         _checks.same_model(points[0], system, "system", "a system compiled from the beam's model")
         t = _checks.pose_time(system, t)
         if not self.varying:
-            return system._positions(list(points), q, t)
+            return system._positions(list(points), t, q)
         # The sdes are the rfes' origins; the tip lies L(t)/(2m) along the last rfe's axis.
         last = self.rfes[-1]
-        X = system._positions([b.origin for b in self.rfes] + [last.point((1.0, 0.0, 0.0))], q, t)
+        X = system._positions([b.origin for b in self.rfes] + [last.point((1.0, 0.0, 0.0))], t, q)
         tip = X[-2] + (X[-1] - X[-2]) * self.length_at(t) / (2 * self.elements)
         return np.vstack([X[:-1], tip])
 

@@ -19,8 +19,8 @@ def tip_deflection(system, hub, beam, t, Y) -> np.ndarray:
     out = []
     for tk, y in zip(t, Y.T):
         q = y[: system.nq]
-        p = np.append(system.position(beam.tip, q, tk), 1.0)
-        out.append((inverse(system.transform(hub.index, q, tk)) @ p)[1])
+        p = np.append(system.position(beam.tip, tk, q), 1.0)
+        out.append((inverse(system.transform(hub.index, tk, q)) @ p)[1])
     return np.array(out)
 
 

@@ -79,7 +79,7 @@ def _add(model, name, kind, ia, Fa, ib, Fb, length, drive) -> str:
     return model._add_loop("" if name is None else str(name), kind, ia, Fa, ib, Fb, length, drive)
 
 
-def assemble(system, q, qd=None, t: float | None = None, tol: float = 1e-12, max_iterations: int = 50):
+def assemble(system, q, qd=None, *, t: float | None = None, tol: float = 1e-12, max_iterations: int = 50):
     """Coordinates (q, q̇) on the loops' constraint manifold nearest to a guess (see
     ``System.assemble``)."""
     q = _checks.array(q, (system.nq,), "q")

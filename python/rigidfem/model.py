@@ -10,7 +10,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from . import _checks, _contract, _core, display, force_elements, joints, loops, persistence
+from . import _checks, _contract, _core, _deprecation, display, force_elements, joints, loops, persistence
 from ._core import Body, JointSpec, Point, Profile
 from .beams import add_beam
 from .frames import transform  # noqa: F401 (re-exported: rigidfem.model.transform)
@@ -456,36 +456,54 @@ class System(_core._System):
         unpickled (bitwise identical results in any process)."""
         return _system_from_state, (self._state,)
 
-    def position(self, point, q, t: float | None = None) -> np.ndarray:
-        """Global position (3,) in m of a ``Point`` (or a ``Body``'s origin) of this system's model.
-
-        ``t`` (s) is required when the system has prescribed coordinates (``np > 0``): their
-        drives place the bodies; without them it defaults to 0.
-        """
+    @_deprecation.required("q")
+    def position(self, point, t, q=_deprecation.MISSING) -> np.ndarray:
+        """Global position (3,) in m of a ``Point`` (or a ``Body``'s origin) of this system's model at
+        time ``t`` (s) and coordinates ``q`` (m, rad). (``position(point, q, t)``, the order of version
+        0.1, still works with a DeprecationWarning.)"""
         _checks.same_model(point, self, "point")
-        return self._position(point, q, _checks.pose_time(self, t))
+        t, q = self._time_first("position", ("q", "t"), t, q)
+        return self._position(point, t, q)
 
-    def velocity(self, point, q, qd, t: float | None = None) -> np.ndarray:
-        """Global velocity (3,) in m/s of a ``Point`` (or a ``Body``'s origin); ``t`` as in ``position``."""
+    @_deprecation.required("q", "qd")
+    def velocity(self, point, t, q=_deprecation.MISSING, qd=_deprecation.MISSING) -> np.ndarray:
+        """Global velocity (3,) in m/s of a ``Point`` (or a ``Body``'s origin) at time ``t`` (s),
+        coordinates ``q`` and rates ``qd`` (m/s, rad/s)."""
         _checks.same_model(point, self, "point")
-        return self._velocity(point, q, qd, _checks.pose_time(self, t))
+        t, q, qd = self._time_first("velocity", ("q", "qd", "t"), t, q, qd)
+        return self._velocity(point, t, q, qd)
 
-    def transform(self, body, q, t: float | None = None) -> np.ndarray:
-        """Pose T_p (4, 4) in the global frame of a body (a ``Body`` handle or its index); ``t`` as in
-        ``position``."""
+    @_deprecation.required("q")
+    def transform(self, body, t, q=_deprecation.MISSING) -> np.ndarray:
+        """Pose T_p (4, 4) in the global frame of a body (a ``Body`` handle or its index) at time ``t``
+        (s) and coordinates ``q``."""
         if isinstance(body, Body):
             _checks.same_model(body, self, "body", "a Body of the model this system was compiled from")
             body = body.index
-        return _transform(self, body, q, _checks.pose_time(self, t))
+        t, q = self._time_first("transform", ("q", "t"), t, q)
+        return _transform(self, body, t, q)
 
-    def assemble(self, q, qd=None, t: float | None = None, tol: float = 1e-12, max_iterations: int = 50):
+    def _time_first(self, name: str, old: tuple, *state):
+        """The state (t, q, ...) of a call, reordered from version 0.1's (q, ..., t) with a
+        DeprecationWarning when t holds a vector (``_deprecation.time_first``)."""
+        args = tuple(v for v in state if v is not _deprecation.MISSING)
+        new = ("t",) + old[:-1]
+        args, _ = _deprecation.time_first(name, old, new, args, {}, lambda: _checks.pose_time(self, None),
+                                          "body, " if name == "transform" else "point, ")
+        if len(args) < len(new):
+            missing = [p for p in new[len(args):]]
+            raise TypeError(f"{name}() missing the arguments {missing}: call {name}(..., {', '.join(new)})")
+        return args
+
+    @_deprecation.keyword_only("t", "tol", "max_iterations")
+    def assemble(self, q, qd=None, *, t: float | None = None, tol: float = 1e-12, max_iterations: int = 50):
         """(q, qd) closing every loop, nearest to the guess: Gauss–Newton on g(q, t) = 0 with
         mass-weighted least-norm corrections M⁻¹Gᵀ(G M⁻¹Gᵀ)⁺g while they gain (max |g| <= ``tol``
         required, m or the cosine of direction rows; up to 1e-9 accepted where G has lost rank), then
         the velocities projected onto G q̇ + ∂g/∂t = 0 in the mass metric (the kinetic energy never rises). Raises ``SimulationError`` naming the
-        loop that cannot be closed from this guess. ``t`` (s) for prescribed motions; q in m and
-        rad, qd per s (zero by default)."""
-        return loops.assemble(self, q, qd, t, tol, max_iterations)
+        loop that cannot be closed from this guess. ``t`` (s, keyword) for prescribed motions; q in m
+        and rad, qd per s (zero by default)."""
+        return loops.assemble(self, q, qd, t=t, tol=tol, max_iterations=max_iterations)
 
     def coordinate_index(self, name: str) -> int:
         """Index in q of the coordinate called ``name`` (e.g. ``"link1.rz"``)."""
@@ -516,4 +534,4 @@ def _system_from_state(state: dict) -> System:
 
 
 _contract.guard_methods(System)
-_transform = _contract.guard("transform", _core._System.transform, ("body", "q", "t"))
+_transform = _contract.guard("transform", _core._System.transform, ("body", "t", "q"))

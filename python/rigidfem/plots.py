@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _checks
+from . import _checks, _deprecation
 from ._core import Body, Point
 from .beams import Beam
 
@@ -236,7 +236,8 @@ class Skeleton:
         self.fixed[row] = r
         return row
 
-    def pose(self, q, t: float | None = None, frame_size: float | None = None) -> Pose:
+    @_deprecation.keyword_only("t", "frame_size")
+    def pose(self, q, *, t: float | None = None, frame_size: float | None = None) -> Pose:
         """The points at the state ``q`` (m, rad) and time ``t`` (s; required with drives).
         ``frame_size``: the triads' length in m; default 8 % of the shape's extent."""
         t = _checks.pose_time(self.system, t)
@@ -245,11 +246,11 @@ class Skeleton:
         X = np.empty((self.rows, 3))
         on_bodies = np.setdiff1d(np.arange(self.rows), list(self.fixed))
         if self.points:
-            X[on_bodies] = self.system._positions(self.points, q, t)
+            X[on_bodies] = self.system._positions(self.points, t, q)
         for row, r in self.fixed.items():
             X[row] = r
         links, segments = _polylines([X[k] for k in self.links]), _polylines([X[k] for k in self.segments])
-        beams = [beam.centerline(self.system, q, t) for beam in self.beams]
+        beams = [beam.centerline(self.system, q, t=t) for beam in self.beams]
         if frame_size is None:
             frame_size = 0.08 * _extent(np.vstack([links, segments, *beams]))
         triads = [_polylines([[X[o], X[o] + frame_size * (X[x + a] - X[o])] for o, x in self.triads])
@@ -364,7 +365,8 @@ def drawn(ax) -> np.ndarray:
     return np.vstack(rows) if rows else np.zeros((0, 3 if three else 2))
 
 
-def shape(system, q, t: float | None = None, *, ax=None, plane: str | None = None, beams=(), segments=(),
+@_deprecation.keyword_only("t")
+def shape(system, q, *, t: float | None = None, ax=None, plane: str | None = None, beams=(), segments=(),
           frame_size: float | None = None):
     """Draw ``system`` at the state ``q`` (m, rad) and time ``t`` (s; required when the system
     has drives, as for ``System.position``).
@@ -383,7 +385,7 @@ def shape(system, q, t: float | None = None, *, ax=None, plane: str | None = Non
     """
     plane = _plane(plane)
     skeleton = Skeleton(system, beams, segments)
-    pose = skeleton.pose(q, t, frame_size)
+    pose = skeleton.pose(q, t=t, frame_size=frame_size)
     ax = _shape_axes(ax, plane)
     ShapeArtists(ax, plane, [b.name for b in skeleton.beams]).set(pose)
     set_limits(ax, drawn(ax))
@@ -411,12 +413,12 @@ def modes(system, modes, which=(0, 1, 2), *, scale: float | None = None, t: floa
     elif len(ax) != len(k):
         raise ValueError(f"ax: expected {len(k)} Axes (one per mode in which), got {len(ax)}")
     skeleton = Skeleton(system, beams)
-    reference = skeleton.pose(modes.q, t)
+    reference = skeleton.pose(modes.q, t=t)
     names = [b.name for b in skeleton.beams]
     for a, i in zip(ax, k):
         phi = modes.shapes[:, i]
         s = _mode_scale(skeleton, modes.q, reference, phi, t) if scale is None else _checks.scalar(scale, "scale")
-        deformed = skeleton.pose(modes.q + s * phi, t, reference.frame_size)
+        deformed = skeleton.pose(modes.q + s * phi, t=t, frame_size=reference.frame_size)
         _shape_axes(a, plane)
         ShapeArtists(a, plane, [f"_{n} reference" for n in names], color="0.7", alpha=0.8).set(reference)
         ShapeArtists(a, plane, names).set(deformed)
@@ -437,7 +439,7 @@ def _mode_scale(skeleton: Skeleton, q: np.ndarray, reference: Pose, phi: np.ndar
     """The scale s that moves the drawn points of the ``reference`` pose at q by 10 % of its
     extent at q + s φ (from the linearised motion)."""
     eps = 1e-6
-    moved = skeleton.pose(q + eps * phi, t, reference.frame_size)
+    moved = skeleton.pose(q + eps * phi, t=t, frame_size=reference.frame_size)
     a, b = reference.points(), moved.points()
     rate = np.max(np.linalg.norm(b - a, axis=1)) / eps if len(a) else 0.0
     return 0.1 * _extent(a) / rate if rate > 0 else 1.0

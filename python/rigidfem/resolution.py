@@ -277,7 +277,7 @@ class _Job:
             h = handles[n]
             if isinstance(h, (Point, Body)):
                 point = h.origin if isinstance(h, Body) else h
-                out.append(solution.position(point) if self.t_end is not None else system.position(point, solution.q))
+                out.append(solution.position(point) if self.t_end is not None else system.position(point, 0.0, solution.q))
             else:
                 out.append(np.asarray(h(system, solution), dtype=float))
         return out

@@ -77,12 +77,13 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _checks, _core, _interrupt, display, error_control, export
+from . import _checks, _core, _deprecation, _interrupt, display, error_control, export
+from . import options as options_
 from ._progress import ProgressBar
 from .persistence import Versioned
 from ._core import Body, Point
 
-SCIPY_METHODS = ("Radau", "BDF", "LSODA", "RK45", "DOP853")
+SCIPY_METHODS = tuple(m[len("scipy:"):] for m in options_.SCIPY)  # the families: rigidfem.options
 
 
 @dataclass
@@ -252,14 +253,19 @@ def load_npz(path, system=None) -> Result:
     return Result(system, **export.read_npz(path, system))
 
 
-def simulate(system, t_end: float, method: str = "auto", dt: float | None = None, rtol=1e-6,
-             atol=1e-9, t_eval=None, q0=None, qd0=None, t0: float = 0.0, progress: bool = False,
-             first_step: float | None = None, stiffness_warning: bool = True,
-             max_steps: int = 1_000_000, max_step: float = np.inf, adaptive: bool | None = None, beta: float = 0.25,
-             gamma: float = 0.5, alpha: float = -0.05, rho_inf: float = 0.8, newton_tol: float = 1e-10,
-             newton_max_iterations: int = 10, iteration_matrix: str = "auto", stop=None, s0=None,
-             error_on=None, error_estimate: bool = False) -> Result:
+@_deprecation.keyword_only("dt", "rtol", "atol", "t_eval", "q0", "qd0", "t0", "progress", "first_step",
+                           "stiffness_warning", "max_steps", "max_step", "adaptive", "beta", "gamma", "alpha",
+                           "rho_inf", "newton_tol", "newton_max_iterations", "iteration_matrix", "stop", "s0",
+                           "error_on", "error_estimate")
+def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=None, qd0=None, s0=None,
+             t_eval=None, progress: bool = False, stop=None, error_estimate: bool = False, **options) -> Result:
     """Integrate ``system`` from ``t0`` to ``t_end`` (s) in C++ (no Python per step).
+
+    The run's arguments come by name after ``method``; the integrator's ``**options`` (``dt``,
+    ``rtol``, ``atol``, ``error_on``, ...) are listed once, with their defaults, units and the methods
+    that read them, in ``rigidfem.integrator_options`` (below, and
+    ``rigidfem.integrator_options(method)`` for one method's). An unknown option is a TypeError; one
+    the method does not read is left unused, so one set of options can drive several methods.
 
     Parameters
     ----------
@@ -297,78 +303,14 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
         whose Newton matrix holds only the coordinates' springs and dampers,
         M + diag(γ'h b + β'h² c): the articulated-body algorithm solves it in O(n), so a stiff beam
         takes steps far beyond the explicit stability limit at O(n) per Newton iteration.
-    dt : float
-        Step (s) of the fixed-step methods: steps end on t0 + k·dt exactly, the last on t_end. Given to an
-        adaptive method (dopri5, rkf45, esdirk43, radau5, auto) it sets only the first step, with a
-        UserWarning saying so (``adaptive=False`` runs those at fixed steps of dt).
-    rtol, atol : float or (2 nq,) array
-        Error control of adaptive methods. On outputs (``error_on``) each output's local error is held
-        to atol + rtol × scale: for points and bodies the model's size L (m, ``stats["model_size"]``: the
-        diagonal of the box holding the bodies' origins and centres of mass at t0), or the farthest a
-        centre of mass has moved from where it started if that is larger (a motion that outgrows the
-        model stays relative to itself), so that rtol is relative to the model and atol is in m; the
-        largest magnitude reached so far for coordinates, element forces and loop reactions. On the state, per component of y = [q, q̇] (m, rad; per s):
-        atol_i + rtol_i |y_i|, with atol = 0 a purely relative tolerance (an exactly zero component
-        counts as exact); (2 nq,) arrays are per component and imply ``error_on="state"``. SciPy's
-        methods raise rtol to their floor 100 ε; scipy:Radau and scipy:BDF take one rtol, the
-        smallest given.
-    error_on : None, "bodies", "state" or list, optional
-        What the adaptive C++ methods measure their local error on (``rigidfem.error_control``):
-        a list of points and bodies (their positions, m), coordinate names or indices (m or rad),
-        force element names (their axial force, N) and loop names (their multipliers, N or N·m), each
-        error mapped from the state's through the output's Jacobian, a velocity's held as the
-        displacement it makes over the step. ``None`` (the default): "bodies" — every body's
-        displacement, the RMS over its material √(|δc|² + δθᵀ I_C δθ/m) — for radau5, the adaptive
-        Newmark family and auto's radau5; "state" for dopri5, rkf45, esdirk43 and auto's dopri5 phase
-        (an explicit method's stability rests on holding every component; esdirk43's filtered
-        estimate hides most of what it damps). On outputs a mode that no output sees is not resolved:
-        the L-stable radau5 damps it (the released strip of 1 m, m = 32: 2,800 steps to 1e-6 m
-        instead of 177,000). radau5 counts 10 times an oscillation that a step neither resolves nor
-        damps (its error adds up over the steps that follow): the largest tip error of the benchmark's
-        scenes is then 0.02-2 times rtol × L (``python -m benchmarks accuracy``).
-    error_estimate : bool
-        Compute ``Result.error_estimate`` with the run (a second run at tolerances / 10, or at dt / 2
-        for fixed steps); it is computed on first use otherwise.
-    first_step : float, optional
-        First step (s) of an adaptive run (scipy: methods too); estimated (Hairer's rule) by
-        default. scipy: methods check dt, adaptive, beta, ... like the others but do not use them.
-    stiffness_warning : bool
-        dopri5 and rkf45 run Hairer's stiffness test (h ρ > 3.25, rkf45 2.95, over 15 accepted
-        steps; ρ from two stages at t + h): the step is then bounded by stability, so it costs
-        ~t ω_max/3.3 steps, and at loose tolerances the stiff modes keep errors ~rtol ω_max/ω —
-        or grow: measured on Kane's beam (m = 20), rkf45 at rtol = 1e-3 returned a tip error of
-        5.9 m where 1e-3 m was asked. It warns (RuntimeWarning) and records the time in
-        ``stats["stiff_at"]``; ``False`` keeps the record and drops the warning.
+    t0 : float
+        Start time (s).
     t_eval : array, optional
         Output times (within [t0, t_end]) by dense output; default: every step.
     q0, qd0 : (nq,) arrays
         Initial state (m, rad; per s); zeros by default.
     progress : bool
         Show a progress bar (tqdm when installed).
-    max_steps, max_step
-        Limits: a run that needs more steps (accepted and rejected) raises SimulationError, which
-        carries the partial result.
-    adaptive : bool, optional
-        Step-size control: on by default for dopri5, rkf45, esdirk43 and radau5 (``False`` runs them at
-        the fixed step ``dt``), off by default for the Newmark family (``True`` switches on its
-        local error estimate).
-    beta, gamma, alpha, rho_inf
-        Newmark's β, γ; HHT's α ∈ [−1/3, 0]; generalised-α's spectral radius ρ∞ ∈ [0, 1].
-    newton_tol, newton_max_iterations
-        Newton stops when the increments of q and q̇ fall below newton_tol (1 + |q|); adaptive
-        esdirk43 and radau5 runs stop it at 0.03 of the error weights instead (newton_tol is for
-        their fixed steps).
-    iteration_matrix : str
-        Newton matrix of the implicit methods: "tangent" (the exact tangent
-        M + γ'h ∂r/∂q̇ + β'h² ∂r/∂q, analytic for recursive systems, formed and factorised by dense
-        LU: O(n³); γh and (γh)² for esdirk43, h d_k for radau5's blocks), "krylov" (the same
-        tangent, never formed: its products are directional derivatives of the inverse dynamics
-        and its solves GMRES preconditioned by the spring matrix, O(n) per iteration; recursive
-        systems), "spring" (the O(n) matrix of "implicit_spring": M + diag(γ'h b + β'h² c), the
-        rest of the tangent left to Newton's iterations) or "auto" (spring for implicit_spring,
-        else krylov for a recursive system of more than 200 coordinates and tangent below).
-        radau5 takes the tangent, dense or krylov. ``stats["linear_iterations"]`` counts the
-        GMRES iterations (one inverse dynamics and one articulated-body solve each).
     stop : threading.Event, optional
         Checked about every 0.05 s of wall time: once set, the run stops and returns its partial
         result (with a RuntimeWarning). The way to stop a run in a worker thread, which Ctrl-C
@@ -380,6 +322,14 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
         them in y = [q, q̇, s], the Newmark family advances them exactly for q linear over each
         step (s ← e^{−h/τ} s + k (1 − e^{−h/τ})/(h/τ) Δq), esdirk43 as stages. Errors are
         controlled on [q, q̇].
+
+    error_estimate : bool
+        Compute ``Result.error_estimate`` with the run (a second run at tolerances / 10, or at dt / 2
+        for fixed steps); it is computed on first use otherwise.
+    **options
+        The integrator's options (``rigidfem.integrator_options``):
+
+{options}
 
     Returns
     -------
@@ -406,6 +356,11 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
     Ctrl-C in the main thread — in the C++ loop, in a Python drive or force law, or in a
     ``scipy:`` method — returns the partial result with a RuntimeWarning (``result.interrupted``).
     """
+    o = options_.resolve(options)
+    dt, rtol, atol, error_on, first_step = o["dt"], o["rtol"], o["atol"], o["error_on"], o["first_step"]
+    max_step, max_steps, adaptive, stiffness_warning = o["max_step"], o["max_steps"], o["adaptive"], o["stiffness_warning"]
+    beta, gamma, alpha, rho_inf = o["beta"], o["gamma"], o["alpha"], o["rho_inf"]
+    newton_tol, newton_max_iterations, iteration_matrix = o["newton_tol"], o["newton_max_iterations"], o["iteration_matrix"]
     if not isinstance(system, _core._System):
         got = type(system).__name__ if isinstance(system, _core._Model) else _checks._short(system)
         raise ValueError(f"system: expected a compiled System (call model.compile()), got {got}")
@@ -512,6 +467,9 @@ def simulate(system, t_end: float, method: str = "auto", dt: float | None = None
     return result
 
 
+
+simulate.__doc__ = simulate.__doc__.replace("{options}", options_.docstring())
+
 #: A coordinate that grows this many times beyond its start (the larger of 1, |q0| and |qd0| × the run's
 #: length) is reported: a model run far outside its range or an unstable system, not an answer.
 GROWTH_WARNING = 1e6
@@ -574,18 +532,18 @@ def _check_closed(system, t0, q0, qd0, tol=1e-8):
         if np.max(np.abs(v)) > tol:
             raise ValueError(f"{what}: expected initial {'coordinates' if what == 'q0' else 'rates'} that close every "
                              f"loop of {names} (max |g{'' if what == 'q0' else 'd'}| = {np.max(np.abs(v)):.3g} > {tol:g}); "
-                             "system.assemble(q0, qd0, t0) finds the nearest ones")
+                             "system.assemble(q0, qd0, t=t0) finds the nearest ones")
 
 
 #: The methods that run at a fixed step unless told otherwise (adaptive=True: the Newmark family).
-_FIXED_STEP = ("euler", "symplectic_euler", "rk4", "newmark", "hht", "generalized_alpha", "implicit_spring")
+_FIXED_STEP = options_.EXPLICIT_FIXED + options_.NEWMARK
 
 #: The largest initial coordinate (m or rad) simulate takes: beyond it the steps of a coordinate drown in its
 #: rounding (scipy: methods then crawled for minutes at q0 = 1e300; the C++ ones returned q frozen at q0).
 _LARGEST_COORDINATE = 1e15
 
 #: The methods that control their step by default (a dt given to them sets only the first step).
-_ADAPTIVE = ("auto", "dopri5", "rkf45", "esdirk43", "radau5")
+_ADAPTIVE = ("auto",) + options_.EXPLICIT_ADAPTIVE + options_.IMPLICIT_RK
 
 
 def _reactions_source(own, method: str) -> str:

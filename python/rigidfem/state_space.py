@@ -40,7 +40,7 @@ import warnings
 import numpy as np
 import scipy.signal
 
-from . import _checks, _core, _interrupt
+from . import _checks, _core, _deprecation, _interrupt
 from ._core import Body, Point
 from .analysis import _EPS, _loop_tangent, _require_finite
 from .export import RATE
@@ -60,7 +60,8 @@ class NotAnEquilibriumWarning(UserWarning):
     for small deviations along the trajectory through that state only."""
 
 
-def linearize(system, q, qd=None, t: float = 0.0, inputs=(), outputs=None, dt: float | None = None):
+@_deprecation.keyword_only("t", "inputs", "outputs", "dt")
+def linearize(system, q, qd=None, *, t: float = 0.0, inputs=(), outputs=None, dt: float | None = None):
     """The system linearised about (q, q̇) at t: a ``scipy.signal.StateSpace`` (A, B, C, D).
 
     Parameters
@@ -111,7 +112,7 @@ def linearize(system, q, qd=None, t: float = 0.0, inputs=(), outputs=None, dt: f
     dt = None if dt is None else _checks.scalar(dt, "dt", positive=True, unit="s")
     in_names, Q = _inputs(system, q, t, inputs)
     out_names, Cq, Cv, y0 = _outputs(system, q, qd, t, outputs)
-    M = _core._System.mass_matrix(system, q, t)
+    M = _core._System.mass_matrix(system, t, q)
     if system.nl:
         A, B, N, C = _reduced(system, q, qd, t, M, Q, Cq, Cv)
         states = [f"y[{k}]" for k in range(N.shape[1])]
@@ -236,15 +237,15 @@ def _point_jacobian(system, point: Point, q, t) -> np.ndarray:
     """J (3, nq) = ∂v/∂q̇ of a point: v = J(q) q̇ + ∂p/∂t is linear in q̇, so column j is
     v(q, e_j) − v(q, 0) (exact)."""
     n = len(q)
-    v0 = system.velocity(point, q, np.zeros(n), t)
-    return np.column_stack([system.velocity(point, q, e, t) - v0 for e in np.eye(n)]).reshape(3, n)
+    v0 = system.velocity(point, t, q, np.zeros(n))
+    return np.column_stack([system.velocity(point, t, q, e) - v0 for e in np.eye(n)]).reshape(3, n)
 
 
 def _rotation_jacobian(system, body: Body, q, t) -> np.ndarray:
     """J_ω (3, nq) with ω = J_ω q̇ (+ drives) the body's angular velocity, global: from the points
     at the body's unit axes a_k = R e_k, whose velocities differ from the origin's by ω × a_k, so
     ω = ½ Σ_k a_k × (v_k − v_0) (Σ_k a_k × (ω × a_k) = 3ω − ω)."""
-    R = system.transform(body, q, t)[:3, :3]
+    R = system.transform(body, t, q)[:3, :3]
     J0 = _point_jacobian(system, body.origin, q, t)
     Jk = [_point_jacobian(system, body.point(e), q, t) - J0 for e in np.eye(3)]
     return 0.5 * sum(np.cross(R[:, k][:, None], Jk[k], axis=0) for k in range(3))
@@ -295,10 +296,10 @@ def _outputs(system, q, qd, t, outputs):
             d, label = _direction(spec[2], what)
             J = _point_jacobian(system, p, q, t)
             if spec[0] == "position":  # δp = J δq
-                row_q, value, auto = d @ J, d @ system.position(p, q, t), f"{_label(system, p)}.{label}"
+                row_q, value, auto = d @ J, d @ system.position(p, t, q), f"{_label(system, p)}.{label}"
             else:  # δv = ∂v/∂q δq + J δq̇
                 row_q, row_v = d @ _velocity_derivative(system, p, q, qd, t), d @ J
-                value, auto = d @ system.velocity(p, q, qd, t), f"{_label(system, p)}.{label}{RATE}"
+                value, auto = d @ system.velocity(p, t, q, qd), f"{_label(system, p)}.{label}{RATE}"
         else:
             raise ValueError(f"{what}: expected a coordinate name, '<name>{RATE}', ('position', point, axis) or "
                              f"('velocity', point, axis), got {spec!r}")
@@ -322,6 +323,6 @@ def _velocity_derivative(system, point, q, qd, t) -> np.ndarray:
         qp, qm = q.copy(), q.copy()
         qp[j] += h
         qm[j] -= h
-        cols.append((system.velocity(point, qp, qd, t) - system.velocity(point, qm, qd, t)) / (qp[j] - qm[j]))
+        cols.append((system.velocity(point, t, qp, qd) - system.velocity(point, t, qm, qd)) / (qp[j] - qm[j]))
     return np.column_stack(cols).reshape(3, n)
 

@@ -298,7 +298,7 @@ def discretisation_error(elements=(5, 10, 20, 40, 80), modes: int = 3) -> Table:
         w = modal_analysis(model.compile()).omega[:modes]
         model.add_force(beam.tip, (0.0, k * E * sec.Iz / L**2, 0.0))
         system = model.compile()
-        tip = system.position(beam.tip, static_equilibrium(system, load_steps=5).q)[:2]
+        tip = system.position(beam.tip, 0.0, static_equilibrium(system, load_steps=5).q)[:2]
         errors = np.r_[np.abs(w / w_ref - 1), np.linalg.norm(tip - tip_ref) / L]
         row = {"m": m, **{f"mode{j + 1}_rel_error": errors[j] for j in range(modes)}, "elastica_tip_error_L": errors[-1]}
         if previous is not None:

@@ -16,11 +16,12 @@
 
 namespace rigidfem {
 
-/// => d.g, d.gd, d.G (nl, nc), d.gamma at the state of d (q̈_free = 0 in d.qdda). Needs the
-/// engine's kinematics (dynamics_kinematics): T and the axes for the recursive algorithms, whose
-/// spatial velocities and accelerations along each loop body's path give the rates; T, Ṫ, T̈ and
-/// the twists U for the Lagrange formulation.
-void constraint_equations(const System& sys, Data& d);
+/// => d.g, d.gd, d.G (nl, nc), d.gamma at the state of d (the accelerations in d.qdda). `spatial`:
+/// from T and the axes (frames_and_axes, exact joints: the recursive algorithms' kinematics), the
+/// rates from the spatial velocities and accelerations walked along each loop body's path; else from
+/// T, Ṫ, T̈ and the twists U (kinematics with rates: the Lagrange formulation's, linear joints too).
+/// The dynamics layer chooses (dynamics_kinematics).
+void constraint_equations(const System& sys, Data& d, bool spatial);
 
 /// The free columns of d.G (nl, nq).
 MatX free_jacobian(const System& sys, const Data& d);

@@ -12,9 +12,11 @@
 
 namespace rigidfem {
 
-/// The kinematics the system's formulation needs: T_p and the axes (recursive), or T_p, Ṫ_p, T̈_p
-/// and the twists U_u (Lagrange, and every system with loops, whose constraint equations it then
-/// evaluates: g, ġ and G; γ when the free accelerations in d.qdda are zero).
+/// The kinematics the system's formulation reads: T_p and the axes (recursive: read off the frames,
+/// no 4x4 twists or rates), or T_p, Ṫ_p, T̈_p and the twists U_u (Lagrange, linear joints too).
+void tree_kinematics(const System& sys, Data& d);
+/// tree_kinematics, and with loops their constraint equations from the same kinematics: g, ġ and G;
+/// γ when the free accelerations in d.qdda are zero.
 void dynamics_kinematics(const System& sys, Data& d);
 /// Whether ∂r/∂(q, q̇) is analytic (recursive) rather than differenced (4 nq residuals, Lagrange).
 inline bool analytic_derivatives(const System& sys) { return sys.algorithm == Algorithm::Recursive; }

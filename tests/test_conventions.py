@@ -1,0 +1,125 @@
+"""One argument order and one list of options (README, "Conventions").
+
+A state is passed as (t, q, qd, qdd), t first, in every method of a System and every function that
+evaluates the system at a state; analyses about an operating point take t by keyword; simulate takes
+its integrator options by keyword from one table (``rigidfem.options``). Version 0.1's orders still
+work, with a DeprecationWarning, and give the same numbers.
+"""
+
+import inspect
+import re
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+import rigidfem as rf
+from rigidfem import _contract, options
+
+README = Path(__file__).resolve().parents[1] / "README.md"
+
+
+def pendulum(prescribed: bool = False):
+    """A double pendulum (spherical joint and a revolute), its second joint prescribed if asked."""
+    m = rf.Model(gravity=(0, 0, -9.81))
+    a = m.add_body("a", m.ground, rf.Joint.revolute("x"), mass=1.0, inertia=(0.1, 0.1, 0.02), com=(0, 0, -0.5))
+    b = m.add_body("b", a, rf.Joint.revolute("y"), mass=0.5, inertia=(0.05, 0.05, 0.01), com=(0.1, 0, -0.4),
+                   placement=rf.transform((0, 0, -1.0)))
+    m.add_spring_damper(b.point((0, 0, -0.8)), m.ground.point((0.3, 0.2, 0.0)), stiffness=50.0, length=1.5,
+                        damping=0.3)
+    if prescribed:
+        m.prescribe(b, rf.motion.polynomial([0.1, 0.5]))
+    return m.compile(), a, b
+
+
+def test_every_compiled_method_takes_t_before_the_state():
+    """The parameters of every guarded System method (read from the binding): t, then q, qd, qdd."""
+    for name, parameters in _contract.SIGNATURES.items():
+        state = [p for p in parameters if p in ("t", "q", "qd", "qdd", "y")]
+        if "t" in state:
+            assert state[0] == "t", (name, parameters)
+
+
+def test_functions_about_an_operating_point_take_t_by_keyword():
+    system, _, _ = pendulum()
+    beam_model, handles = rf.samples.cantilever(elements=2)
+    beam = handles["beam"]
+    functions = [rf.modal_analysis, rf.linearize, rf.static_equilibrium, system.assemble, rf.plots.shape,
+                 beam.centerline, beam.rates_at_rest]
+    for f in functions:
+        t = inspect.signature(f).parameters["t"]
+        assert t.kind is inspect.Parameter.KEYWORD_ONLY, f.__name__
+    for f in (system.position, system.velocity, system.transform):
+        names = list(inspect.signature(f).parameters)
+        assert names.index("t") < names.index("q"), f.__name__
+
+
+def test_the_order_of_version_0_1_still_works_with_a_deprecation_warning():
+    system, a, b = pendulum()
+    q, qd = np.array([0.3, -0.4]), np.array([1.0, 0.5])
+    new = {"mass_matrix": system.mass_matrix(0.0, q), "kinetic_energy": system.kinetic_energy(0.0, q, qd),
+           "gravity_energy": system.gravity_energy(0.0, q), "elastic_energy": system.elastic_energy(0.0, q),
+           "potential_energy": system.potential_energy(0.0, q),
+           "dissipated_power": system.dissipated_power(0.0, q, qd),
+           "position": system.position(b.point((0, 0, -0.8)), 0.0, q),
+           "velocity": system.velocity(b.point((0, 0, -0.8)), 0.0, q, qd), "transform": system.transform(b, 0.0, q)}
+    old = {"mass_matrix": lambda: system.mass_matrix(q), "kinetic_energy": lambda: system.kinetic_energy(q, qd, 0.0),
+           "gravity_energy": lambda: system.gravity_energy(q=q), "elastic_energy": lambda: system.elastic_energy(q, t=0.0),
+           "potential_energy": lambda: system.potential_energy(q), "dissipated_power": lambda: system.dissipated_power(q, qd),
+           "position": lambda: system.position(b.point((0, 0, -0.8)), q),
+           "velocity": lambda: system.velocity(b.point((0, 0, -0.8)), q, qd, 0.0),
+           "transform": lambda: system.transform(b, q)}
+    for name, call in old.items():
+        with pytest.warns(DeprecationWarning, match=rf"{name}\(.*\) is deprecated: call {name}\(.*t, q"):
+            value = call()
+        np.testing.assert_array_equal(value, new[name], err_msg=name)
+    with pytest.warns(DeprecationWarning, match="pass t= by keyword"):
+        modes = rf.modal_analysis(system, q, None, 0.0)
+    np.testing.assert_array_equal(modes.omega, rf.modal_analysis(system, q, t=0.0).omega)
+    with pytest.warns(DeprecationWarning, match="pass dt= and rtol= by keyword"):
+        r = rf.simulate(system, 0.1, "rk4", 1e-3, 1e-6, q0=q)
+    np.testing.assert_array_equal(r.q, rf.simulate(system, 0.1, "rk4", dt=1e-3, q0=q).q)
+
+
+def test_the_old_order_without_t_keeps_its_rule_for_prescribed_coordinates():
+    """Version 0.1 took t = 0 when left out, which only a system without prescribed coordinates allows."""
+    system, _, b = pendulum(prescribed=True)
+    with pytest.warns(DeprecationWarning), pytest.raises(ValueError, match="t: required because the system has "
+                                                                           "prescribed coordinates"):
+        system.mass_matrix(np.array([0.3]))
+    with pytest.warns(DeprecationWarning):
+        np.testing.assert_array_equal(system.position(b, np.array([0.3]), 0.5), system.position(b, 0.5, [0.3]))
+
+
+def test_simulate_takes_the_options_of_the_table_and_names_an_unknown_one():
+    system, _, _ = pendulum()
+    q0 = np.array([0.3, -0.4])
+    with pytest.raises(TypeError, match=r"unexpected options \['rtool'\].*'rtol'"):
+        rf.simulate(system, 0.1, q0=q0, rtool=1e-8)
+    # the defaults of the table are simulate's: the same run bit for bit when they are given
+    for method in ("dopri5", "generalized_alpha", "radau5"):
+        given = {name: o.default for name, o in rf.integrator_options(method).items() if name != "dt"}
+        step = {"dt": 1e-3} if method == "generalized_alpha" else {}
+        a = rf.simulate(system, 0.2, method, q0=q0, **step)
+        b = rf.simulate(system, 0.2, method, q0=q0, **step, **given)
+        np.testing.assert_array_equal(a.q, b.q)
+        assert a.stats["steps"] == b.stats["steps"]
+    # an option is read by the methods the table says: rho_inf changes generalized_alpha, not rk4
+    base = rf.simulate(system, 0.2, "generalized_alpha", dt=1e-2, q0=q0).q
+    assert np.abs(rf.simulate(system, 0.2, "generalized_alpha", dt=1e-2, q0=q0, rho_inf=0.3).q - base).max() > 1e-8
+    rk4 = rf.simulate(system, 0.2, "rk4", dt=1e-2, q0=q0).q
+    np.testing.assert_array_equal(rf.simulate(system, 0.2, "rk4", dt=1e-2, q0=q0, rho_inf=0.3).q, rk4)
+    assert "rho_inf" in rf.integrator_options("generalized_alpha") and "rho_inf" not in rf.integrator_options("rk4")
+
+
+def test_integrator_options_names_an_unknown_method():
+    with pytest.raises(ValueError, match="method: expected one of"):
+        rf.integrator_options("rk5")
+
+
+def test_every_option_is_documented_once_in_simulate_and_in_the_readme():
+    doc = rf.simulate.__doc__
+    readme = README.read_text()
+    for o in options.OPTIONS:
+        assert len(re.findall(rf"^ +{o.name} : default", doc, flags=re.M)) == 1, o.name
+    assert options.table() in readme
