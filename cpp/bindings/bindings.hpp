@@ -24,14 +24,15 @@ inline std::string arg_repr(const py::handle& x) {
   return s.size() > 80 ? s.substr(0, 77) + "..." : s;
 }
 
-/// A real number (Python int or float, a numpy real scalar or 0-d array); not a bool, complex
-/// number, string or None. NaN and inf pass (the caller checks what it needs).
+/// A real number (Python int or float, a numpy real scalar or 0-d array, or another number with
+/// __float__ such as Fraction and Decimal); not a bool, complex number, string, None or sequence.
+/// NaN and inf pass (the caller checks what it needs).
 inline double real_arg(const py::handle& x, const std::string& name, const std::string& expected) {
   PyObject* o = x.ptr();
   if (PyFloat_Check(o)) return PyFloat_AS_DOUBLE(o);
   bool ok = !PyBool_Check(o) && !PyComplex_Check(o) && !PyUnicode_Check(o) && !PyBytes_Check(o) && !x.is_none();
-  if (ok && !PyLong_Check(o)) {  // numpy scalars and 0-d arrays of real numbers
-    ok = py::hasattr(x, "dtype") && py::hasattr(x, "ndim") && x.attr("ndim").cast<int>() == 0;
+  if (ok && !PyLong_Check(o) && py::hasattr(x, "dtype")) {  // numpy scalars and 0-d arrays of real numbers
+    ok = py::hasattr(x, "ndim") && x.attr("ndim").cast<int>() == 0;
     if (ok) {
       const std::string kind = py::str(x.attr("dtype").attr("kind"));
       ok = kind == "f" || kind == "i" || kind == "u";
@@ -100,6 +101,37 @@ inline VecX vector_arg(const py::handle& x, const std::string& name, const std::
   bad(name, expected, arg_repr(x));
 }
 
+/// An array of real numbers of any shape (a numpy array, a nested sequence or a scalar) as float64:
+/// booleans and integers converted, complex numbers, strings, None and objects that are not numbers
+/// (ragged sequences, Python ints beyond the doubles) refused. Values are not looked at.
+inline py::array_t<double> real_array_arg(const py::handle& x, const std::string& name, const std::string& expected) {
+  PyObject* o = x.ptr();
+  if (!x.is_none() && !PyUnicode_Check(o) && !PyBytes_Check(o)) {
+    py::array a;
+    try {
+      a = py::array::ensure(x);
+    } catch (const py::error_already_set&) {  // a sequence numpy cannot take (raising __len__, ...)
+    }
+    if (!a) PyErr_Clear();
+    const char kind = a ? a.dtype().kind() : 'x';
+    if (kind == 'c') bad(name, expected + " (real numbers)", "complex values " + arg_repr(x));
+    if (kind == 'f' || kind == 'i' || kind == 'u' || kind == 'b' || kind == 'O') {
+      auto f = py::array_t<double, py::array::forcecast>::ensure(a);  // objects: each must be a real number
+      if (f && (kind != 'O' || [&a] {
+            for (const py::handle item : a.attr("ravel")()) {
+              PyObject* p = item.ptr();
+              if (PyBool_Check(p) || PyComplex_Check(p) || PyUnicode_Check(p) || PyBytes_Check(p) || item.is_none())
+                return false;
+            }
+            return true;
+          }()))
+        return f;
+      PyErr_Clear();
+    }
+  }
+  bad(name, expected, arg_repr(x));
+}
+
 /// A list of strings (names), each refused with the argument's name if it is not a string.
 inline std::vector<std::string> names_arg(const py::handle& x, const std::string& name, const std::string& expected) {
   if (PyUnicode_Check(x.ptr()) || !py::isinstance<py::sequence>(x)) bad(name, expected, arg_repr(x));
@@ -111,6 +143,7 @@ inline std::vector<std::string> names_arg(const py::handle& x, const std::string
   return out;
 }
 
+void bind_arguments(py::module_& m);
 void bind_transforms(py::module_& m);
 void bind_model(py::module_& m);
 void bind_dynamics(py::module_& m);

@@ -12,6 +12,27 @@
 
 namespace rigidfem::bindings {
 
+/// The argument conversions of bindings.hpp for the Python layer (rigidfem._checks, rigidfem._contract):
+/// one rule for what counts as a real number, an integer or an array of reals, wherever it is checked.
+void bind_arguments(py::module_& m) {
+  m.def(
+      "_real", [](const py::object& x, const std::string& name, const std::string& expected) {
+        return real_arg(x, name, expected);
+      },
+      py::arg("x"), py::arg("name"), py::arg("expected"),
+      "x as a float: a real number (int, float, numpy real scalar or 0-d array), else ValueError\n"
+      "'<name>: expected <expected>, got <repr>'. NaN and inf pass.");
+  m.def(
+      "_integer",
+      [](const py::object& x, const std::string& name, const std::string& expected, long long lo, long long hi) {
+        return int_arg(x, name, expected, lo, hi);
+      },
+      py::arg("x"), py::arg("name"), py::arg("expected"), py::arg("lo"), py::arg("hi"),
+      "x as an int in [lo, hi]: a Python or numpy integer (not a bool or float), else the ValueError.");
+  m.def("_real_array", &real_array_arg, py::arg("x"), py::arg("name"), py::arg("expected"),
+        "x as a float64 array of any shape (bindings.hpp's real_array_arg), else the ValueError.");
+}
+
 void bind_transforms(py::module_& m) {
   // Arguments as py::object: a wrong type is a ValueError naming it (NaN in, NaN out is fine here).
   const auto angle = [](const py::object& x, const char* name) { return real_arg(x, name, "an angle in rad"); };
@@ -213,6 +234,7 @@ PYBIND11_MODULE(_core, m) {
       "A numerical failure, a RuntimeError whose message names the time (s) and the cause: a singular mass or "
       "iteration matrix, a step size below the minimum, a NaN or inf state, Newton divergence in a step or a load "
       "step of the statics, max_steps, gimbal lock of ZYX Euler angles.";
+  bind_arguments(m);
   bind_transforms(m);
   bind_profiles(m);
   bind_model(m);

@@ -1,4 +1,9 @@
-"""Argument checks shared by the Python layer: clear ValueErrors naming the argument."""
+"""Argument checks shared by the Python layer: clear ValueErrors naming the argument.
+
+What counts as a real number or an array of them is the C++ bindings' rule (``bindings.hpp``:
+``real_arg``, ``real_array_arg``, reached as ``_core._real`` and ``_core._real_array``), the one
+conversion layer of the package; these functions add the checks of values (finite, positive, shape).
+"""
 
 from __future__ import annotations
 
@@ -6,25 +11,14 @@ import math
 
 import numpy as np
 
+from . import _core
 from ._core import Body, Point
 
 
 def _floats(x, name: str, expected: str) -> np.ndarray:
-    """``x`` as a float array; complex numbers (numpy would drop their imaginary parts) and strings
-    (numpy would parse them) are refused, like anything else that is not a number."""
-    try:
-        a = np.asarray(x)
-    except (TypeError, ValueError, OverflowError):  # ragged nested sequences
-        a = None
-    kind = "" if a is None else a.dtype.kind
-    if kind == "c":
-        raise ValueError(f"{name}: expected real numbers ({expected}), got complex values {_short(x)}")
-    if kind in ("f", "i", "u", "b", "O"):
-        try:
-            return np.asarray(a, dtype=float)
-        except (TypeError, ValueError, OverflowError):  # objects that are not numbers, ints beyond floats
-            pass
-    raise ValueError(f"{name}: expected {expected}, got {_short(x)}")
+    """``x`` as a float array by the bindings' rule: complex numbers (numpy would drop their imaginary
+    parts), strings (numpy would parse them), None and whatever else is not a number are refused."""
+    return _core._real_array(x, name, expected)
 
 
 def _short(x) -> str:
@@ -61,12 +55,7 @@ def scalar(x, name: str, *, positive: bool = False, nonnegative: bool = False, u
     if asked; ``unit`` goes into the messages."""
     expected = ("positive " if positive else "non-negative " if nonnegative else "") + "number" + \
         (f" in {unit}" if unit else "")
-    if isinstance(x, (str, bytes, bool, np.bool_, complex, np.complexfloating)):
-        raise ValueError(f"{name}: expected a {expected}, got {x!r}")
-    try:
-        v = float(x)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name}: expected a {expected}, got {x!r}") from None
+    v = _core._real(x, name, f"a {expected}")
     if not math.isfinite(v):
         raise ValueError(f"{name}: expected a finite {expected}, got {v}")
     if (positive and not v > 0.0) or (nonnegative and not v >= 0.0):
@@ -110,11 +99,11 @@ def per_coordinate(x, n: int, name: str, *, nonnegative: bool = False) -> list[f
 
 
 def integer(x, name: str, *, minimum: int | None = None, maximum: int | None = None) -> int:
-    """``x`` as an int (an integral number, not a bool) within [minimum, maximum]."""
-    if isinstance(x, (bool, np.bool_)) or not isinstance(x, (int, np.integer, float, np.floating)) or \
-            not math.isfinite(float(x)) or float(x) != int(x):
+    """``x`` as an int (an integral real number by the bindings' rule, not a bool) within [minimum, maximum]."""
+    v = _core._real(x, name, "an integer")
+    if not math.isfinite(v) or v != int(v):
         raise ValueError(f"{name}: expected an integer, got {x!r}")
-    v = int(x)
+    v = int(x) if isinstance(x, (int, np.integer)) else int(v)
     if (minimum is not None and v < minimum) or (maximum is not None and v > maximum):
         raise ValueError(f"{name}: expected an integer in [{minimum}, {maximum}], got {v}")
     return v
@@ -129,10 +118,7 @@ def boolean(x, name: str) -> bool:
 
 def step_limit(x, name: str) -> float:
     """A positive step limit in s, inf for none."""
-    try:
-        v = float(x)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name}: expected a positive number of s (inf for no limit), got {x!r}") from None
+    v = _core._real(x, name, "a positive number of s (inf for no limit)")
     if not v > 0.0:  # NaN fails too
         raise ValueError(f"{name}: expected a positive number of s (inf for no limit), got {v}")
     return v

@@ -12,7 +12,7 @@ import functools
 
 import numpy as np
 
-from . import _checks, _deprecation
+from . import _checks, _core, _deprecation
 from ._core import SimulationError, _System
 
 #: What each argument of the compiled methods expects, by name; sizes in terms of the system.
@@ -77,36 +77,24 @@ UNREAD = {"force_jacobians": ("qd", "static")}
 _MISSING = object()
 
 
-def _numeric(value) -> bool:
-    """Numbers or an array of them (not strings, not booleans, not None)."""
+def _real_number(value) -> float | None:
+    """``value`` as a float if it is a real number by the bindings' rule (``_core._real``: not a bool,
+    string, None, complex number or array), else None."""
     try:
-        kind = np.asarray(value).dtype.kind
-    except (TypeError, ValueError):
-        return False
-    return kind in "iuf"
+        return _core._real(value, "", "")
+    except ValueError:
+        return None
 
 
 def _real_vector(value) -> tuple[np.ndarray | None, str | None]:
-    """``value`` as a 1-D array of real numbers the compiled conversion takes without loss (floats,
-    integers, also Python ints beyond int64, booleans), or None and what is wrong with it: complex
-    values (numpy would drop their imaginary parts), strings, other objects, another shape (a (1, n)
-    or (n, 1) array would be taken for a vector). Its size is not looked at."""
-    if isinstance(value, (str, bytes)) or value is None:
-        return None, f"{value!r}"
+    """``value`` as a 1-D float array by the bindings' rule (``_core._real_array``: real numbers, also
+    booleans and Python ints beyond int64), or None and what is wrong with it: complex values (numpy
+    would drop their imaginary parts), strings, other objects, another shape (a (1, n) or (n, 1) array
+    would be taken for a vector). Its size is not looked at."""
     try:
-        a = np.asarray(value)
-    except Exception:  # noqa: BLE001 -- a sequence numpy cannot take (ragged, raising __len__, ...)
-        return None, f"{value!r}"
-    kind = a.dtype.kind
-    if kind == "c":
-        return None, "complex values (expected real numbers)"
-    if kind == "O":  # Python ints beyond int64 are fine; None, strings, complex, lists are not
-        if a.ndim == 1 and all(isinstance(x, (int, float, np.integer, np.floating)) and not isinstance(x, bool)
-                               for x in a):
-            return a, None
-        return None, f"{value!r}"
-    if kind not in "fiub":
-        return None, f"{value!r}"
+        a = _core._real_array(value, "", "")
+    except ValueError as e:
+        return None, "complex values (expected real numbers)" if "complex values" in str(e) else f"{value!r}"
     if a.ndim != 1:
         return None, f"shape {a.shape}"
     return a, None
@@ -118,7 +106,8 @@ def _problem(name: str, value, system) -> str | None:
 
     nq = getattr(system, "nq", 0)
     if name in ("t", "load_factor"):
-        return None if _numeric(value) and np.ndim(value) == 0 and np.isfinite(value) else "bad"
+        v = _real_number(value)
+        return None if v is not None and np.isfinite(v) else "bad"
     if name in VECTORS:
         n = VECTORS[name] * nq
         a, problem = _real_vector(value)
@@ -276,7 +265,8 @@ def _finite(function: str, result, parameters: tuple, args: tuple, kwargs: dict)
         return result
     given = dict(zip(parameters, args)) | kwargs
     t = given.get("t", 0.0)
-    t = float(t) if _numeric(t) and np.ndim(t) == 0 else 0.0
+    t = _real_number(t)
+    t = 0.0 if t is None else t
     sizes = ", ".join(f"largest |{p}| = {np.max(np.abs(np.asarray(given[p], dtype=float))):.3g}"
                       for p in parameters if p in VECTORS and p in given and np.size(given[p]))
     error = SimulationError(f"at t = {t:.10g} s: {function}() overflowed: finite inputs ({sizes}) gave NaN or inf, "

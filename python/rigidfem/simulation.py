@@ -376,8 +376,8 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
     t_eval = np.zeros(0) if t_eval is None else _checks.vector(t_eval, "t_eval")
     if not isinstance(method, str):
         raise ValueError(f"method: expected a method name such as 'dopri5' (see rigidfem.simulate), got {method!r}")
-    max_steps = _checks.integer(max_steps, "max_steps", minimum=1, maximum=2**62)
-    max_step = _checks.step_limit(max_step, "max_step")
+    max_steps = _checks.integer(max_steps, "max_steps", minimum=-2**62, maximum=2**62)  # its value: C++'s check
+    max_step = _core._real(max_step, "max_step", "a positive number of s (inf for no limit)")
     rtol, atol = _tolerance(rtol, "rtol", n, 1e-6), _tolerance(atol, "atol", n, 1e-9)
     per_component = np.size(rtol) > 1 or np.size(atol) > 1
     if per_component and error_on is not None and not (isinstance(error_on, str) and error_on == "state"):
@@ -556,20 +556,24 @@ def _reactions_source(own, method: str) -> str:
 
 def _options(method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, beta, gamma, alpha, rho_inf,
              newton_tol, newton_max_iterations, iteration_matrix):
-    """The C++ integrator's options, each checked and converted."""
+    """The C++ integrator's options, converted by the bindings' rule (``_core._real``, ``_checks.integer``
+    within the C++ field's range); their values are checked once, by ``_core._check_options``. Only a
+    given step is checked here: the C++ options hold 0 for "none", so it must be positive on its way in."""
+    real = _core._real
     opt = _core.IntegratorOptions()
     opt.method = method
     opt.dt = 0.0 if dt is None else _checks.scalar(dt, "dt", positive=True)
     if first_step is not None:
         opt.dt = _checks.scalar(first_step, "first_step", positive=True)
     opt.rtol, opt.atol = rtol, atol
-    opt.max_step, opt.max_steps = max_step, max_steps
+    opt.max_step = real(max_step, "max_step", "a positive number of s (inf for no limit)")
+    opt.max_steps = max_steps
     opt.adaptive = -1 if adaptive is None else int(_checks.boolean(adaptive, "adaptive"))
-    opt.beta, opt.gamma = _checks.scalar(beta, "beta"), _checks.scalar(gamma, "gamma")
-    opt.alpha, opt.rho_inf = _checks.scalar(alpha, "alpha"), _checks.scalar(rho_inf, "rho_inf")
-    opt.newton_tol = _checks.scalar(newton_tol, "newton_tol", positive=True)
-    opt.newton_max_iterations = _checks.integer(newton_max_iterations, "newton_max_iterations", minimum=1,
-                                                maximum=10**6)
+    opt.beta, opt.gamma = real(beta, "beta", "a number"), real(gamma, "gamma", "a number")
+    opt.alpha, opt.rho_inf = real(alpha, "alpha", "a number"), real(rho_inf, "rho_inf", "a number")
+    opt.newton_tol = real(newton_tol, "newton_tol", "a positive finite tolerance")
+    opt.newton_max_iterations = _checks.integer(newton_max_iterations, "newton_max_iterations",
+                                                minimum=-2**31, maximum=2**31 - 1)
     if not isinstance(iteration_matrix, str):
         raise ValueError(f"iteration_matrix: expected 'auto', 'tangent', 'spring' or 'krylov', got {iteration_matrix!r}")
     opt.iteration_matrix = iteration_matrix
@@ -607,13 +611,11 @@ def _keep_going(bar, stop, t0):
 def _tolerance(x, name, n, default) -> np.ndarray:
     """One tolerance or 2 nq of them (an empty array when nq = 0: then ``default``, which no
     component uses)."""
-    try:
-        tol = np.atleast_1d(_checks.array(x, np.shape(x), name))  # real numbers (not complex, not strings)
-    except ValueError:
-        tol = None
-    if tol is None or tol.ndim != 1 or tol.size not in (1, 2 * n) or not np.all(np.isfinite(tol)) or np.any(tol < 0):
-        raise ValueError(f"{name}: expected a non-negative number or {2 * n} (2 nq) of them, got {_checks._short(x)}")
-    return np.array([default]) if tol.size == 0 else tol
+    expected = f"a non-negative number or {2 * n} (2 nq) of them"
+    tol = np.atleast_1d(_checks._floats(x, name, expected))  # real numbers (not complex, not strings)
+    if tol.ndim != 1:
+        raise ValueError(f"{name}: expected {expected}, got shape {tol.shape}")
+    return np.array([default]) if tol.size == 0 else tol  # the values: _core._check_options
 
 
 class _NonFinite(Exception):
