@@ -74,8 +74,10 @@ def animate(result, *, plane: str | None = None, beams=(), segments=(), trails=(
     ax : matplotlib Axes, optional
         3D for plane=None.
 
-    Returns an ``Animation`` (a ``FuncAnimation``): ``anim.to_jshtml()`` in a notebook,
-    ``save(anim, "movie.gif")`` to a file.
+    Returns
+    -------
+    matplotlib.animation.FuncAnimation
+        ``anim.to_jshtml()`` shows it in a notebook, ``save(anim, "movie.gif")`` writes it to a file.
     """
     plane = plots._plane(plane)
     t = np.asarray(result.t)

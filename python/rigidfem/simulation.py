@@ -345,6 +345,8 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
         Result up to the last accepted step, ``time`` and ``cause`` the failure's time (s) and
         cause.
 
+    Notes
+    -----
     Systems with loop closures (``Model.add_loop_joint``, ``add_actuator``): q0 and qd0 must close
     every loop (``System.assemble`` finds them); explicit methods project every accepted step back
     onto the loops (closure residual <= 1e-12), the Newmark family solves the index-3 equations

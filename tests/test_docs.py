@@ -1,0 +1,59 @@
+"""The documentation site builds with Sphinx, warnings as errors (``docs/``; the README's link).
+
+Checks what a reader opens: a page for every public name (from its docstring), the notebooks with
+the figures they were committed with, and the table of simulate's options written from its one source.
+"""
+
+import json
+import re
+import subprocess
+import sys
+from pathlib import Path
+
+import pytest
+
+import rigidfem as rf
+from rigidfem import options
+
+ROOT = Path(__file__).resolve().parents[1]
+
+
+@pytest.fixture(scope="module")
+def site(tmp_path_factory):
+    out = tmp_path_factory.mktemp("html")
+    run = subprocess.run([sys.executable, "-m", "sphinx", "-W", "--keep-going", "-q", "-b", "html",
+                          str(ROOT / "docs"), str(out)], capture_output=True, text=True, timeout=600)
+    assert run.returncode == 0, run.stderr[-4000:]
+    return out
+
+
+def text(path: Path) -> str:
+    """The visible text of a page's article."""
+    page = path.read_text(encoding="utf-8")
+    page = page[page.find("<article"):page.find("</article>")]
+    return re.sub(r"\s+", " ", re.sub(r"<[^>]+>", " ", page))
+
+
+def test_every_public_name_has_a_page_from_its_docstring(site):
+    for name in rf.__all__:
+        page = site / "api" / f"rigidfem.{name}.html"
+        assert page.exists(), name
+        doc = getattr(rf, name).__doc__ or ""
+        first = re.sub(r"``|\*", "", doc.strip().splitlines()[0]).split("(")[0].split(":")[0][:30].strip()
+        assert first.split()[0] in text(page), name
+
+
+def test_the_notebooks_are_pages_with_their_figures(site):
+    for nb in sorted((ROOT / "notebooks").glob("*.ipynb")):
+        page = site / "notebooks" / f"{nb.stem}.html"
+        assert page.exists(), nb.name
+        figures = sum("image/png" in out.get("data", {}) for cell in json.loads(nb.read_text())["cells"]
+                      if cell["cell_type"] == "code" for out in cell.get("outputs", []))
+        assert page.read_text(encoding="utf-8").count("<img") >= figures, nb.name
+
+
+def test_the_options_table_is_the_one_of_rigidfem_options(site):
+    page = text(site / "conventions.html")
+    for o in options.OPTIONS:
+        assert f" {o.name} " in page, o.name
+    assert "rho_inf" in text(site / "api" / "rigidfem.simulate.html")
