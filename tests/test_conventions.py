@@ -123,3 +123,15 @@ def test_every_option_is_documented_once_in_simulate_and_in_the_readme():
     for o in options.OPTIONS:
         assert len(re.findall(rf"^ +{o.name} : default", doc, flags=re.M)) == 1, o.name
     assert options.table() in readme
+
+
+def test_a_bad_t_of_the_new_order_is_named_t_not_read_as_the_old_order():
+    """Found by scripts/fuzz.py: a vector t (of another size than nq, or with a vector where the old order
+    had t) is the new order's bad t, and the ValueError names t."""
+    system, a, b = pendulum()
+    q, qd = np.zeros(2), np.zeros(2)
+    for call in (lambda: system.dissipated_power(np.ones(3), q, qd), lambda: system.kinetic_energy(q, q, qd),
+                 lambda: system.mass_matrix(np.ones(5), q), lambda: system.transform(b, np.ones(3), q),
+                 lambda: system.position(b, [0.1, 0.2, 0.3], q), lambda: system.velocity(b, q, q, qd)):
+        with pytest.raises(ValueError, match=r"^t: expected a finite time"):
+            call()

@@ -196,7 +196,8 @@ def guard(function: str, compiled, parameters: tuple, method: bool = True):
                         raise _refuse(function, parameters, p, given[p], args, {})
                 return _checks.pose_time(args[0], None)
 
-            state, kwargs = _deprecation.time_first(function, old_order, parameters, args[1:], kwargs, default_time)
+            state, kwargs = _deprecation.time_first(function, old_order, parameters, args[1:], kwargs, default_time,
+                                                    nq=getattr(args[0], "nq", None))
             args = args[:1] + state
         n = len(args)
         converted = None

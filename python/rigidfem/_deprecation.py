@@ -35,14 +35,24 @@ def is_state_vector(value) -> bool:
         return True
 
 
-def time_first(name: str, old: tuple, new: tuple, args: tuple, kwargs: dict, default_time, lead: str = ""):
+def time_first(name: str, old: tuple, new: tuple, args: tuple, kwargs: dict, default_time, lead: str = "",
+               nq: int | None = None):
     """(args, kwargs) of a call of ``name`` in the order ``new`` (t first) when it was made in the order
     ``old`` of version 0.1 (the state first, t last and optional), with a DeprecationWarning: recognised
     by a vector where t now comes, or by q given by keyword without t. ``default_time()`` gives t when the
     old call left it out (0 without prescribed coordinates, else its ValueError). ``args`` and
     ``kwargs`` hold the state's arguments only (``lead``: how the message shows the ones before them);
-    calls in the new order are returned as they are."""
+    calls in the new order are returned as they are. A call reads as the old order only where it could
+    be one: its first argument a vector of ``nq`` values (when given) and no vector where the old order has
+    t, so that a bad t of the new order is named as t."""
     first_is_vector = bool(args) and is_state_vector(args[0])
+    if first_is_vector and nq is not None and np.size(args[0]) != nq:
+        first_is_vector = False
+    if first_is_vector and "t" in old:
+        k = old.index("t")
+        t_old = args[k] if len(args) > k else kwargs.get("t")
+        if t_old is not None and is_state_vector(t_old):
+            first_is_vector = False
     if not (first_is_vector or (not args and "t" not in kwargs and "q" in kwargs)):
         return args, kwargs
     _warn(f"{name}({lead}{', '.join(old)}) is deprecated: call {name}({lead}{', '.join(new)}), t first as in "

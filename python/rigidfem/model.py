@@ -489,7 +489,7 @@ class System(_core._System):
         args = tuple(v for v in state if v is not _deprecation.MISSING)
         new = ("t",) + old[:-1]
         args, _ = _deprecation.time_first(name, old, new, args, {}, lambda: _checks.pose_time(self, None),
-                                          "body, " if name == "transform" else "point, ")
+                                          "body, " if name == "transform" else "point, ", nq=self.nq)
         if len(args) < len(new):
             missing = [p for p in new[len(args):]]
             raise TypeError(f"{name}() missing the arguments {missing}: call {name}(..., {', '.join(new)})")
