@@ -1,4 +1,4 @@
-"""One argument order and one list of options (README, "Conventions").
+"""One argument order and one list of options (docs/conventions.md).
 
 A state is passed as (t, q, qd, qdd), t first, in every method of a System and every function that
 evaluates the system at a state; analyses about an operating point take t by keyword; simulate takes
@@ -16,7 +16,7 @@ import pytest
 import rigidfem as rf
 from rigidfem import _contract, options
 
-README = Path(__file__).resolve().parents[1] / "README.md"
+DOCS = Path(__file__).resolve().parents[1] / "docs"
 
 
 def pendulum(prescribed: bool = False):
@@ -117,12 +117,15 @@ def test_integrator_options_names_an_unknown_method():
         rf.integrator_options("rk5")
 
 
-def test_every_option_is_documented_once_in_simulate_and_in_the_readme():
+def test_every_option_is_documented_once_in_simulate_and_on_the_site():
+    """simulate's docstring lists each option once; the site's pages include the table written from
+    rigidfem.options at build time (tests/test_docs.py checks the built page), never a copy of it."""
     doc = rf.simulate.__doc__
-    readme = README.read_text()
     for o in options.OPTIONS:
         assert len(re.findall(rf"^ +{o.name} : default", doc, flags=re.M)) == 1, o.name
-    assert options.table() in readme
+    for page in ("conventions.md", "simulation.md"):
+        text = (DOCS / page).read_text()
+        assert "{include} _generated/options.md" in text and "| option | default |" not in text, page
 
 
 def test_a_bad_t_of_the_new_order_is_named_t_not_read_as_the_old_order():

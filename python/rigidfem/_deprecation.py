@@ -1,7 +1,7 @@
 """The argument orders of version 0.1, kept working for one more release with a DeprecationWarning
 that shows the new call.
 
-The convention (README, "Conventions"): a state is passed as (t, q, qd, qdd), t first, as in SciPy's
+The convention (docs/conventions.md): a state is passed as (t, q, qd, qdd), t first, as in SciPy's
 ``rhs(t, y)``, in every method that evaluates the system at a state; after the object it is about
 where there is one (``position(point, t, q)``). Functions about an operating point whose t has a
 default (``assemble``, ``modal_analysis``, ``linearize``, ``static_equilibrium``, ``centerline``,
