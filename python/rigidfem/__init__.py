@@ -44,6 +44,7 @@ from .state_space import NotAnEquilibriumWarning, linearize  # noqa: E402
 from .sweep import sweep
 from .resolution import Plan, ResolveError, resolve  # noqa: E402 (rf.resolve: elements and deformations for a tolerance)
 from .error_control import ErrorEstimate  # noqa: E402
+from .viewer import Viewer, view  # noqa: E402 (the 3D viewer: notebooks and HTML files)
 
 __version__ = "0.1.0"
 
@@ -110,4 +111,6 @@ __all__ = [
     "study",
     "sweep",
     "transform",
+    "view",
+    "Viewer",
 ]

@@ -1,0 +1,116 @@
+"""The 3D viewer (rf.view): the scene it writes, its size, and the page in a real browser.
+
+The browser tests open the exported file in headless Chromium (Debian's package; .ci/run installs it
+and sets RIGIDFEM_REQUIRE_BROWSER, so that CI cannot skip them), move the time slider by script, and
+read what the page recorded in its body's data attributes: no JavaScript error, the frame shown, and
+the pixels of the picture (how many are not background, and their hash).
+"""
+
+import os
+import re
+import shutil
+import subprocess
+
+import numpy as np
+import pytest
+
+import rigidfem as rf
+
+BROWSER = shutil.which("chromium") or shutil.which("chromium-browser")
+
+
+@pytest.fixture(scope="module")
+def kane(tmp_path_factory):
+    model, h = rf.samples.kane_beam(omega=6.0, duration=15.0, elements=20)
+    system = model.compile()
+    result = rf.simulate(system, 20.0, t_eval=np.linspace(0.0, 20.0, 401))
+    viewer = rf.view(system, result, trails=[h["beam"].tip])
+    path = viewer.to_html(tmp_path_factory.mktemp("view") / "kane.html")
+    return system, h, result, viewer, path
+
+
+def test_the_scene_holds_every_frame_and_the_beam(kane):
+    system, h, result, viewer, path = kane
+    d = viewer.data
+    assert viewer.frames == 401 and len(d["bodies"]) == system.nbodies == 22
+    assert [b["bodies"] for b in d["beams"]] == [[system.body_names.index(f"beam.rfe{k}") for k in range(21)]]
+    # the poses are the system's transforms (float32)
+    import base64
+    poses = np.frombuffer(base64.b64decode(d["poses"]), dtype="<f4").reshape(401, 22, 12)
+    k, b = 137, 9
+    T = system.transform(b, result.t[k], result.q[k])
+    np.testing.assert_allclose(poses[k, b, :9], T[:3, :3].ravel(), atol=1e-6)
+    np.testing.assert_allclose(poses[k, b, 9:], T[:3, 3], rtol=1e-6, atol=1e-6)
+    # the tube ends at the tip: the last rfe's origin plus the tip offset is the beam's tip
+    last = d["beams"][0]["bodies"][-1]
+    T = system.transform(last, result.t[k], result.q[k])
+    tip = T[:3, :3] @ d["beams"][0]["tip"] + T[:3, 3]
+    np.testing.assert_allclose(tip, system.position(h["beam"].tip, result.t[k], result.q[k]), atol=1e-12)
+
+
+def test_the_page_is_offline_and_small(kane):
+    *_, viewer, path = kane
+    page = path.read_text(encoding="utf-8")
+    assert not re.search(r'(src|href)\s*=\s*["\']?(https?:)?//', page), "the page fetches something"
+    size = path.stat().st_size
+    assert size < 5e6, size  # the issue's bound for this run (a 20 s Kane run, m = 20, 401 frames)
+    # poses: 48 bytes per frame and body, 4/3 in base64; the rest is three.js and the viewer
+    assert abs(len(viewer.data["poses"]) - 4 / 3 * 48 * 401 * 22) < 4
+
+
+def test_other_scenes_and_one_state():
+    m = rf.Model(gravity=(0.0, 0.0, -9.81))
+    crank = m.add_body("crank", m.ground, rf.Joint.revolute("z"), mass=1.0, inertia=(1e-3, 0.01, 0.01),
+                       com=(0.15, 0, 0))
+    rocker = m.add_body("rocker", m.ground, rf.Joint.revolute("z"), mass=1.0, inertia=(1e-3, 0.03, 0.03),
+                        com=(0.3, 0, 0), placement=rf.transform((0.7, 0, 0)))
+    m.add_spring_damper(crank.point((0.3, 0, 0)), rocker.point((0.6, 0, 0)), stiffness=100.0, length=0.5)
+    m.add_loop_joint("distance", crank.point((0.3, 0, 0)), rocker.point((0.6, 0, 0)), length=0.55)
+    s = m.compile()
+    v = rf.view(s, q=np.zeros(s.nq))
+    assert v.frames == 1 and [seg["kind"] for seg in v.data["segments"]] == ["spring", "loop"]
+    assert v.data["segments"][0]["a"] == [crank.index, [0.3, 0.0, 0.0]]
+    assert "iframe" in v._repr_html_() and "RIGIDFEM" in v.html()
+
+
+@pytest.mark.parametrize("call, name", [
+    (lambda s, r: rf.view("system"), "system"),
+    (lambda s, r: rf.view(s, "result"), "result"),
+    (lambda s, r: rf.view(s, r, trails=["tip"]), "trails"),
+    (lambda s, r: rf.view(s, r, frames=0), "frames"),
+    (lambda s, r: rf.view(s, q=[1.0, 2.0, 3.0, 4.0]), "q"),
+    (lambda s, r: rf.view(s, r, q=np.zeros(s.nq)), "q"),
+    (lambda s, r: rf.view(s, r, height=10), "height"),
+])
+def test_bad_input_is_named(call, name):
+    model, h = rf.samples.pendulum()
+    s = model.compile()
+    r = rf.simulate(s, 0.1, method="rk4", dt=0.01, q0=[0.3])
+    with pytest.raises(ValueError, match=rf"^{name}"):
+        call(s, r)
+
+
+def _open(path, fragment):
+    """The body's data attributes after the page ran (headless Chromium, software WebGL)."""
+    if BROWSER is None:
+        if os.environ.get("RIGIDFEM_REQUIRE_BROWSER"):
+            pytest.fail("RIGIDFEM_REQUIRE_BROWSER is set but no chromium was found")
+        pytest.skip("no chromium on this machine (.ci/run installs Debian's)")
+    run = subprocess.run([BROWSER, "--headless", "--no-sandbox", "--use-gl=angle", "--use-angle=swiftshader",
+                          "--enable-unsafe-swiftshader", "--virtual-time-budget=5000", "--window-size=800,600",
+                          "--dump-dom", f"{path.as_uri()}#{fragment}"], capture_output=True, text=True, timeout=120)
+    body = re.search(r"<body([^>]*)>", run.stdout)
+    assert body, run.stderr[-2000:]
+    return dict(re.findall(r'data-([\w-]+)="([^"]*)"', body.group(1)))
+
+
+def test_the_page_renders_and_the_slider_moves_the_scene(kane):
+    *_, path = kane
+    start = _open(path, "probe=1")
+    moved = _open(path, "slide=200&probe=1")
+    for state in (start, moved):
+        assert "error" not in state, state.get("error")
+        assert state.get("ready") == "1"
+        assert int(state["ink"]) > 500, state  # the scene is drawn, not a blank canvas
+    assert (start["frame"], moved["frame"]) == ("0", "200") and moved["time"] == "10.000000"
+    assert start["hash"] != moved["hash"]  # the beam moved between t = 0 and t = 10 s
