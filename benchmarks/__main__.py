@@ -1,4 +1,4 @@
-"""``python -m benchmarks {scaling,peers,scale,loops,implicit_step,sweep,kane_peers,orders,tolerance,accuracy} [--quick] [--output DIR]``, from the root of a checkout."""
+"""``python -m benchmarks {scaling,peers,scale,loops,implicit_step,sweep,kane_peers,orders,tolerance,accuracy,viewer} [--quick] [--output DIR]``, from the root of a checkout."""
 
 from __future__ import annotations
 
@@ -18,6 +18,7 @@ COMMANDS = {
     "orders": "speed against error on Kane's beam: esdirk43, radau5, generalised-α and dopri5",
     "tolerance": "Kane's beam (m = 20): tip error delivered against rtol asked, every adaptive method; fixed-step failures",
     "accuracy": "the default asked for a tip error against the best of every method: strips, tapes, the bench's scenes",
+    "viewer": "the 3D viewer: build time, HTML size and time per frame in headless Chromium (needs chromium)",
 }
 
 

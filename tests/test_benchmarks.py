@@ -135,3 +135,14 @@ def test_accuracy_study_quick(tmp_path, capsys):
         assert row["best_error_m"] <= row["target_m"] and row["auto_over_best"] > 0
     assert {r["method"] for r in runs.rows} >= {"auto", "radau5", "radau5 (state)", "esdirk43", "generalized_alpha"}
     assert (tmp_path / "accuracy.csv").exists() and "| scene | target_m | auto_error_m |" in capsys.readouterr().out
+
+
+def test_viewer_benchmark_quick(tmp_path, capsys):
+    """python -m benchmarks viewer --quick: the table of build time, file size and time per frame."""
+    from benchmarks import viewer
+
+    table = viewer.run(tmp_path, quick=True)["viewer_scaling"]
+    row = table.rows[0]
+    assert (row["m"], row["bodies"], row["frames"]) == (20, 22, 101)
+    assert 0.9 < row["file_MB"] < 5 and (tmp_path / "viewer_scaling.csv").exists()
+    assert "ms_per_frame" in capsys.readouterr().out

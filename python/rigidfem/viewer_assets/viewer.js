@@ -186,5 +186,11 @@
     slider.dispatchEvent(new Event("input"));
   }
   if (hash.get("probe") === "1") window.rigidfemProbe();
+  if (hash.get("bench") === "1") {  // every frame shown once, as playing does: ms per frame
+    const t0 = performance.now();
+    for (let k = 0; k < nf; ++k) show(k);
+    renderer.getContext().finish();
+    status.msPerFrame = ((performance.now() - t0) / nf).toFixed(2);
+  }
   status.ready = "1";
 })();

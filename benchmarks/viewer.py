@@ -1,0 +1,60 @@
+"""The 3D viewer at scale: ``python -m benchmarks viewer [--quick]``.
+
+For Kane's spin-up beam with m rfes and F output frames: the time to build the scene (s), the size of
+the exported HTML file (MB), and the time to show one frame (ms: every frame shown once, as playing
+does, in headless Chromium with software WebGL, SwiftShader, 800 × 600; a GPU is faster). Needs
+Debian's ``chromium`` on the PATH.
+"""
+
+from __future__ import annotations
+
+import re
+import shutil
+import subprocess
+import tempfile
+import time
+from pathlib import Path
+
+import numpy as np
+
+import rigidfem as rf
+from rigidfem.study import Table
+
+from ._common import machine, report
+
+CASES = ((20, 401), (80, 401), (20, 2001), (320, 401))
+QUICK_CASES = ((20, 101),)
+
+
+def _ms_per_frame(path: Path) -> float:
+    browser = shutil.which("chromium") or shutil.which("chromium-browser")
+    if browser is None:
+        return float("nan")
+    run = subprocess.run([browser, "--headless", "--no-sandbox", "--use-gl=angle", "--use-angle=swiftshader",
+                          "--enable-unsafe-swiftshader", "--window-size=800,600", "--dump-dom",
+                          f"{path.as_uri()}#bench=1"], capture_output=True, text=True, timeout=600)
+    found = re.search(r'data-ms-per-frame="([\d.]+)"', run.stdout)
+    return float(found.group(1)) if found else float("nan")
+
+
+def viewer_scaling(cases=CASES) -> Table:
+    rows = []
+    with tempfile.TemporaryDirectory() as folder:
+        for m, frames in cases:
+            model, h = rf.samples.kane_beam(omega=6.0, duration=15.0, elements=m)
+            system = model.compile()
+            result = rf.simulate(system, 20.0, method="generalized_alpha", dt=0.01,
+                                 t_eval=np.linspace(0.0, 20.0, frames))
+            t0 = time.perf_counter()
+            viewer = rf.view(system, result, trails=[h["beam"].tip])
+            path = viewer.to_html(Path(folder) / f"kane_{m}_{frames}.html")
+            build = time.perf_counter() - t0
+            rows.append({"m": m, "bodies": system.nbodies, "frames": frames, "build_s": build,
+                         "file_MB": path.stat().st_size / 1e6, "ms_per_frame": _ms_per_frame(path)})
+    return Table(rows, ("m", "bodies", "frames", "build_s", "file_MB", "ms_per_frame"))
+
+
+def run(output_dir="bench", quick: bool = False) -> dict:
+    print(machine(), flush=True)
+    return report({"viewer_scaling": ("The 3D viewer: build time, file size, time per frame shown",
+                                      viewer_scaling(QUICK_CASES if quick else CASES))}, output_dir)
