@@ -114,3 +114,50 @@ def test_the_page_renders_and_the_slider_moves_the_scene(kane):
         assert int(state["ink"]) > 500, state  # the scene is drawn, not a blank canvas
     assert (start["frame"], moved["frame"]) == ("0", "200") and moved["time"] == "10.000000"
     assert start["hash"] != moved["hash"]  # the beam moved between t = 0 and t = 10 s
+
+
+def test_the_widget_holds_the_page_and_checks_its_frame():
+    anywidget = pytest.importorskip("anywidget")
+    model, h = rf.samples.pendulum()
+    s = model.compile()
+    r = rf.simulate(s, 1.0, method="rk4", dt=0.01, q0=[0.3])
+    w = rf.view(s, r).widget()
+    assert isinstance(w, anywidget.AnyWidget) and w.frames == 101 and w.frame == 0 and "RIGIDFEM" in w.page
+    w.frame = 100
+    import traitlets
+    with pytest.raises(traitlets.TraitError, match="frame: expected an index in"):
+        w.frame = 101
+
+
+def test_the_widget_and_the_page_follow_each_other_in_a_browser(kane, tmp_path):
+    """widget.js run in Chromium with a stand-in for anywidget's model: setting ``frame`` from the
+    Python side shows that frame in the page, and moving the page's slider sets ``frame``."""
+    import json
+
+    from rigidfem.viewer import ASSETS
+
+    *_, viewer, _ = kane
+    esm = (ASSETS / "widget.js").read_text(encoding="utf-8")
+    host = tmp_path / "host.html"
+    host.write_text("""<!DOCTYPE html><html><body><div id="host"></div>
+<script type="module">
+const esm = %s;
+const url = URL.createObjectURL(new Blob([esm], {type: "text/javascript"}));
+const widget = (await import(url)).default;
+const state = {page: %s, height: 300, frames: %d, frame: 0}, on = {};
+const model = {get: (k) => state[k], set: (k, v) => { state[k] = v; }, on: (e, f) => { on[e] = f; },
+               save_changes: () => { document.body.dataset.saved = state.frame; }};
+window.addEventListener("message", (e) => { if (e.data && e.data.rigidfem === "shown") document.body.dataset.shown = e.data.frame; });
+widget.render({model, el: document.getElementById("host")});
+const iframe = document.querySelector("iframe");
+setTimeout(() => { state.frame = 150; on["change:frame"](); }, 1500);
+setTimeout(() => {
+  document.body.dataset.inner = iframe.contentDocument.body.dataset.frame;
+  const slider = iframe.contentDocument.getElementById("rf-slider");
+  slider.value = 300; slider.dispatchEvent(new Event("input"));
+}, 2500);
+</script></body></html>""" % (*(json.dumps(x).replace("</", "<\\/") for x in (esm, viewer.html())), viewer.frames),
+                    encoding="utf-8")
+    state = _open(host, "")
+    assert state.get("inner") == "150"  # the Python side's frame, shown by the page
+    assert state.get("saved") == "300" and state.get("shown") == "300"  # the slider's frame, back in the model

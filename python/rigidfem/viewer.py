@@ -82,6 +82,12 @@ body {{ margin: 0; font: 13px sans-serif; }}
         path.write_text(self.html(), encoding="utf-8")
         return path
 
+    def widget(self):
+        """The viewer as a Jupyter widget (anywidget: ``pip install anywidget``, in the ``notebooks``
+        extra): the same page, with its frame synchronised to the widget's ``frame`` (an int; set it
+        from Python to move the slider, read it to know which frame the slider shows)."""
+        return _widget_class()(page=self.html(), height=self.height, frames=self.frames)
+
     def _repr_html_(self) -> str:
         """In a notebook: the page in an iframe (its scripts run apart from the notebook's)."""
         return (f'<iframe srcdoc="{html.escape(self.html(), quote=True)}" style="width: 100%; '
@@ -218,3 +224,37 @@ def _scene(system, times, states, trails, title) -> dict:
             "centre": ((lo + hi) / 2).tolist(), "up": up, "bodies": bodies, "beams": beams, "segments": segments,
             "trails": [dict(zip(("body", "r"), _point(p))) for p in trails],
             "poses": base64.b64encode(poses.astype("<f4").tobytes()).decode("ascii")}
+
+
+_WIDGET = None
+
+
+def _widget_class():
+    """The anywidget class of the viewer, made on first use (anywidget is optional)."""
+    global _WIDGET
+    if _WIDGET is None:
+        try:
+            import anywidget
+            import traitlets
+        except ImportError as e:
+            raise ImportError("Viewer.widget() needs anywidget: pip install anywidget (or pip install "
+                              "\"rigidfem[notebooks]\"); the viewer shows without it as an iframe") from e
+
+        class ViewerWidget(anywidget.AnyWidget):
+            """rigidfem's 3D viewer in a notebook: ``frame`` follows the slider and moves it."""
+
+            _esm = (ASSETS / "widget.js").read_text(encoding="utf-8")
+            page = traitlets.Unicode().tag(sync=True)
+            height = traitlets.Int(420).tag(sync=True)
+            frames = traitlets.Int(1).tag(sync=True)
+            frame = traitlets.Int(0).tag(sync=True)
+
+            @traitlets.validate("frame")
+            def _frame_in_range(self, proposal):
+                k = proposal["value"]
+                if not 0 <= k < self.frames:
+                    raise traitlets.TraitError(f"frame: expected an index in [0, {self.frames - 1}], got {k}")
+                return k
+
+        _WIDGET = ViewerWidget
+    return _WIDGET

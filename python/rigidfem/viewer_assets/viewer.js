@@ -123,6 +123,8 @@
     status.frame = frame;
     status.time = D.t[frame].toFixed(6);
     render();
+    // in an iframe (the notebook widget): tell the page around which frame is shown
+    if (window.parent !== window) window.parent.postMessage({ rigidfem: "shown", frame }, "*");
   }
 
   function render() { renderer.render(scene, camera); status.rendered = (+status.rendered || 0) + 1; }
@@ -173,6 +175,13 @@
     status.ink = ink; status.hash = hash; status.pixels = px.length / 4;
     return { ink, hash };
   };
+
+  // the page around (the notebook widget) picks the frame: {rigidfem: "frame", frame: K}
+  window.addEventListener("message", (e) => {
+    if (e.data && e.data.rigidfem === "frame" && +e.data.frame !== frame) {
+      playing = false; play.textContent = "play"; show(+e.data.frame);
+    }
+  });
 
   // #frame=K or #t=T picks the frame shown first (links, tests); #probe=1 records the pixels
   const hash = new URLSearchParams(window.location.hash.slice(1));
