@@ -5,7 +5,11 @@
   "use strict";
   const D = window.RIGIDFEM;
   const status = document.body.dataset;
+  // what the page logs as an error is recorded where a test (or a teacher's console) sees it
   window.addEventListener("error", (e) => { status.error = String(e.message || e); });
+  window.addEventListener("unhandledrejection", (e) => { status.error = String(e.reason); });
+  const consoleError = console.error.bind(console);
+  console.error = (...args) => { status.error = args.map(String).join(" "); consoleError(...args); };
 
   // poses: frames x bodies x 12 (R row by row, then the origin), little-endian float32
   const raw = atob(D.poses);
