@@ -138,3 +138,13 @@ def test_a_bad_t_of_the_new_order_is_named_t_not_read_as_the_old_order():
                  lambda: system.position(b, [0.1, 0.2, 0.3], q), lambda: system.velocity(b, q, q, qd)):
         with pytest.raises(ValueError, match=r"^t: expected a finite time"):
             call()
+
+
+def test_one_bad_option_is_named_before_a_pair_that_is_wrong_only_together():
+    """Found by scripts/fuzz.py: with rtol = atol = 0 (wrong together) and max_steps = 0, the ValueError
+    named atol; the options are checked one at a time first (C++ check_options)."""
+    system, _, _ = pendulum()
+    with pytest.raises(ValueError, match="^max_steps: expected a positive number of steps, got 0"):
+        rf.simulate(system, 0.01, method="scipy:Radau", dt=0.01, rtol=0.0, atol=0.0, max_steps=0)
+    with pytest.raises(ValueError, match="^atol: expected positive values when rtol is zero"):
+        rf.simulate(system, 0.01, rtol=0.0, atol=0.0)

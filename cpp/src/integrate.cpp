@@ -364,6 +364,16 @@ void check_options(const System& sys, double t0, double t_end, const VecX& q0, c
   if (!is_adaptive(o) && !(o.dt > 0.0 && std::isfinite(o.dt)))
     throw std::invalid_argument(std::string("dt: expected a positive step in s for the fixed-step method '") + m.name +
                                 "', got " + num(o.dt));
+  // one option at a time first, then the tolerances (whose rtol = atol = 0 is wrong only together)
+  if (!(o.max_step > 0.0))
+    throw std::invalid_argument("max_step: expected a positive step in s (inf for no limit), got " + num(o.max_step));
+  if (o.max_steps < 1)
+    throw std::invalid_argument("max_steps: expected a positive number of steps, got " + std::to_string(o.max_steps));
+  if (!(o.newton_tol > 0.0 && std::isfinite(o.newton_tol)))
+    throw std::invalid_argument("newton_tol: expected a positive finite tolerance, got " + num(o.newton_tol));
+  if (o.newton_max_iterations < 1 || o.newton_max_iterations > 1000000)
+    throw std::invalid_argument("newton_max_iterations: expected an integer in [1, 1000000], got " +
+                                std::to_string(o.newton_max_iterations));
   for (const auto& [tol, name] : {std::pair<const VecX*, const char*>{&o.rtol, "rtol"}, {&o.atol, "atol"}})
     if (tol->size() == 0 || (tol->size() != 1 && tol->size() != 2 * sys.nq) || !(tol->minCoeff() >= 0.0) ||
         !tol->allFinite())
@@ -378,15 +388,6 @@ void check_options(const System& sys, double t0, double t_end, const VecX& q0, c
                                 "got " + std::to_string(o.rtol.size()) + " and " + std::to_string(o.atol.size()));
   if (o.rtol.maxCoeff() == 0.0 && o.atol.minCoeff() == 0.0)
     throw std::invalid_argument("atol: expected positive values when rtol is zero");
-  if (!(o.max_step > 0.0))
-    throw std::invalid_argument("max_step: expected a positive step in s (inf for no limit), got " + num(o.max_step));
-  if (o.max_steps < 1)
-    throw std::invalid_argument("max_steps: expected a positive number of steps, got " + std::to_string(o.max_steps));
-  if (!(o.newton_tol > 0.0 && std::isfinite(o.newton_tol)))
-    throw std::invalid_argument("newton_tol: expected a positive finite tolerance, got " + num(o.newton_tol));
-  if (o.newton_max_iterations < 1 || o.newton_max_iterations > 1000000)
-    throw std::invalid_argument("newton_max_iterations: expected an integer in [1, 1000000], got " +
-                                std::to_string(o.newton_max_iterations));
   if (o.method == Method::Newmark && !(o.gamma >= 0.5 && o.beta >= 0.25 * (0.5 + o.gamma) * (0.5 + o.gamma) - 1e-15))
     throw std::invalid_argument("beta, gamma: expected the unconditionally stable range gamma >= 1/2, "
                                 "beta >= (gamma + 1/2)^2 / 4, got beta = " + num(o.beta) + ", gamma = " + num(o.gamma));
