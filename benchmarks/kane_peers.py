@@ -60,7 +60,7 @@ from rigidfem.study import Table
 from ._common import machine, report
 from .peers import Chain, Link, _require, to_mjcf
 
-INSTALL_HINT = "pip install exudyn mujoco"
+INSTALL_HINT = 'pip install ".[benchmarks]" (or: pip install exudyn mujoco)'
 OMEGA, SPIN_UP, T_END, OUTPUTS = 6.0, 15.0, 20.0, 201
 INTERVAL = T_END / (OUTPUTS - 1)  #: 0.1 s between outputs; every fixed step divides it
 HUB_INERTIA = 1e10                #: kg·m², the peers' flywheel hub

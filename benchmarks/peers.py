@@ -40,7 +40,7 @@ from rigidfem.study import Table, cheapest
 
 from ._common import cpp_seconds_per_call, machine, report
 
-INSTALL_HINT = "pip install pin mujoco"
+INSTALL_HINT = 'pip install ".[benchmarks]" (or: pip install pin mujoco)'
 
 #: rigidfem's integrators in the accuracy study: (method, setting, values[, extra keyword arguments]).
 #: A method this build does not know yet is skipped with a note, so a new one is one line here.
