@@ -114,11 +114,3 @@ def boolean(x, name: str) -> bool:
     if not isinstance(x, (bool, np.bool_)):
         raise ValueError(f"{name}: expected True or False, got {x!r}")
     return bool(x)
-
-
-def step_limit(x, name: str) -> float:
-    """A positive step limit in s, inf for none."""
-    v = _core._real(x, name, "a positive number of s (inf for no limit)")
-    if not v > 0.0:  # NaN fails too
-        raise ValueError(f"{name}: expected a positive number of s (inf for no limit), got {v}")
-    return v

@@ -491,8 +491,8 @@ class System(_core._System):
         args, _ = _deprecation.time_first(name, old, new, args, {}, lambda: _checks.pose_time(self, None),
                                           "body, " if name == "transform" else "point, ", nq=self.nq)
         if len(args) < len(new):
-            missing = [p for p in new[len(args):]]
-            raise TypeError(f"{name}() missing the arguments {missing}: call {name}(..., {', '.join(new)})")
+            raise TypeError(f"{name}() missing the arguments {list(new[len(args):])}: call {name}(..., "
+                            f"{', '.join(new)})")
         return args
 
     @_deprecation.keyword_only("t", "tol", "max_iterations")

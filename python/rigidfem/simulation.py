@@ -568,8 +568,7 @@ def _options(method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, 
     if first_step is not None:
         opt.dt = _checks.scalar(first_step, "first_step", positive=True)
     opt.rtol, opt.atol = rtol, atol
-    opt.max_step = real(max_step, "max_step", "a positive number of s (inf for no limit)")
-    opt.max_steps = max_steps
+    opt.max_step, opt.max_steps = max_step, max_steps  # converted by simulate
     opt.adaptive = -1 if adaptive is None else int(_checks.boolean(adaptive, "adaptive"))
     opt.beta, opt.gamma = real(beta, "beta", "a number"), real(gamma, "gamma", "a number")
     opt.alpha, opt.rho_inf = real(alpha, "alpha", "a number"), real(rho_inf, "rho_inf", "a number")
