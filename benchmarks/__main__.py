@@ -1,4 +1,4 @@
-"""``python -m benchmarks {scaling,peers,scale,loops,implicit_step,sweep,kane_peers,orders,tolerance,accuracy,viewer} [--quick] [--output DIR]``, from the root of a checkout."""
+"""``python -m benchmarks {scaling,peers,scale,loops,implicit_step,sweep,kane_peers,orders,tolerance,accuracy,viewer,sensitivities} [--quick] [--output DIR]``, from the root of a checkout."""
 
 from __future__ import annotations
 
@@ -19,6 +19,7 @@ COMMANDS = {
     "tolerance": "Kane's beam (m = 20): tip error delivered against rtol asked, every adaptive method; fixed-step failures",
     "accuracy": "the default asked for a tip error against the best of every method: strips, tapes, the bench's scenes",
     "viewer": "the 3D viewer: build time, HTML size and time per frame in headless Chromium (needs chromium)",
+    "sensitivities": "forward sensitivities: cost per parameter against the run, strips of m = 20, 80, 320",
 }
 
 

@@ -73,12 +73,12 @@ LAYERS = [
     {"errors", "transforms", "profiles"},
     {"joint_motion", "loops", "force_elements", "flows"},
     {"model"},
-    {"system"},
+    {"system", "parameters"},                  # a compiled system, and its copies with other constants
     {"arms"},                                  # internal variables of the state (system level)
     {"kinematics", "constraints"},
     {"lagrange", "recursive", "derivatives"},  # the formulations
     {"dynamics"},                              # the only place that chooses one
-    {"error_measure"},                         # the outputs an error is measured on
+    {"error_measure", "sensitivities"},        # the outputs an error is measured on; the sensitivity equations
     {"integrators", "stepper", "newton_matrix", "outputs", "timing", "auto_method"},
 ]
 RANK = {name: k for k, layer in enumerate(LAYERS) for name in layer}

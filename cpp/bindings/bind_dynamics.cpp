@@ -8,6 +8,7 @@
 #include "rigidfem/dynamics.hpp"
 #include "rigidfem/kinematics.hpp"
 #include "rigidfem/outputs.hpp"
+#include "rigidfem/parameters.hpp"
 
 namespace rigidfem::bindings {
 
@@ -93,6 +94,22 @@ void bind_dynamics(py::module_& m) {
              return std::const_pointer_cast<System>(model.compile(a));
            }),
            py::arg("model"), py::arg("algorithm"))
+      .def(py::init([](const System& base, const std::vector<std::tuple<int, int, double, double, double>>& coordinates,
+                       const std::vector<std::pair<int, Mat4>>& bodies,
+                       const std::vector<std::tuple<int, std::string, double>>& elements,
+                       const std::vector<std::tuple<int, Vec3, Vec3>>& loads,
+                       const std::vector<std::tuple<std::string, int, int, ProfilePtr>>& profiles) {
+             // a copy of `base` with new constants and profiles (parameters.hpp): what named parameters set
+             ConstantChanges c;
+             for (const auto& [what, body, index, profile] : profiles) c.profiles.push_back({what, body, index, profile});
+             for (const auto& [body, slot, k, b, F] : coordinates) c.coordinates.push_back({body, slot, k, b, F});
+             for (const auto& [body, H] : bodies) c.bodies.push_back({body, H});
+             for (const auto& [element, name, value] : elements) c.elements.push_back({element, name, value});
+             for (const auto& [load, F, tau] : loads) c.loads.push_back({load, F, tau});
+             return with_constants(base, c);
+           }),
+           py::arg("base"), py::arg("coordinates"), py::arg("bodies"), py::arg("elements"), py::arg("loads"),
+           py::arg("profiles"))
       .def_property_readonly(
           "algorithm", [](const System& s) { return s.algorithm == Algorithm::Recursive ? "recursive" : "lagrange"; },
           "'recursive' (O(n): RNEA, CRBA, ABA) or 'lagrange' (the book's formulation; always for linear joints).")

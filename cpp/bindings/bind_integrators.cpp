@@ -6,6 +6,7 @@
 #include "rigidfem/errors.hpp"
 #include "rigidfem/integrators.hpp"
 #include "rigidfem/outputs.hpp"
+#include "rigidfem/parameters.hpp"
 
 namespace rigidfem::bindings {
 
@@ -66,6 +67,13 @@ void bind_integrators(py::module_& m) {
             }
           },
           py::arg("outputs"), "The outputs the error is measured on: (kind, index, r) each; [] for the state.")
+      .def(
+          "add_sensitivity",
+          [](IntegratorOptions& o, std::shared_ptr<System> plus, std::shared_ptr<System> minus, double h,
+             const VecX& S0) { o.sensitivities.push_back({plus, minus, h, S0}); },
+          py::arg("plus"), py::arg("minus"), py::arg("h"), py::arg("S0"),
+          "A direction of the forward sensitivities: the system at p + h and, for a central difference, at p - h "
+          "(None, None: an initial value), and [dq0/dp, dqd0/dp] (2 nq).")
       .def_property(
           "stiff_method", [](const IntegratorOptions& o) { return method_name(o.stiff_method); },
           [](IntegratorOptions& o, const std::string& name) { o.stiff_method = parse_method(name); });
@@ -133,7 +141,8 @@ void bind_integrators(py::module_& m) {
         stats["model_size"] = st.model_size;
         return py::make_tuple(VecX(Eigen::Map<const VecX>(tr.t.data(), tr.t.size())), stack(tr.q, s.nq),
                               stack(tr.qd, s.nq), stats, tr.interrupted, failure, stack(tr.s, s.nz),
-                              multipliers(tr.lambda, s.nl));
+                              multipliers(tr.lambda, s.nl),
+                              stack(tr.sensitivities, 2 * s.nq * static_cast<int>(o.sensitivities.size())));
       },
       py::arg("system"), py::arg("t0"), py::arg("t_end"), py::arg("q0"), py::arg("qd0"), py::arg("t_eval"),
       py::arg("options"), py::arg("keep_going"));

@@ -257,6 +257,8 @@ void bind_model(py::module_& m) {
           py::arg("placements"), py::arg("masses"), py::arg("coms"), py::arg("inertias"),
           "Adds bodies in order, each with `joint` but its own row of stiffness and damping; all are checked\n"
           "before any is added. placements and inertias are row-major 4x4 and 3x3 per row.")
+      .def("_coordinate_name", &Model::coordinate_name, py::arg("body"), py::arg("coordinate"),
+           "'body.axis' of coordinate `coordinate` (-1: the joint's only one) of a body's joint.")
       .def("_truncate", &Model::truncate, py::arg("n"), "Removes the bodies n, n + 1, ... (undo of a failed builder).")
       .def("_prescribe", &Model::prescribe, py::arg("body"), py::arg("coordinate"), py::arg("motion"))
       .def(
@@ -353,6 +355,9 @@ void bind_model(py::module_& m) {
       .def("_coordinate_index", &Model::coordinate_index, py::arg("body"), py::arg("coordinate"))
       .def_property("gravity", &Model::gravity, &Model::set_gravity, "Gravitational acceleration (m/s^2), global.")
       .def_property_readonly("nbodies", [](const Model& model) { return model.bodies().size(); })
+      .def_property_readonly("_nelements", [](const Model& model) { return model.force_elements().size(); })
+      .def_property_readonly("_nloads", [](const Model& model) { return model.loads().size(); })
+      .def_property_readonly("_nloops", [](const Model& model) { return model.loops().size(); })
       .def_property_readonly("body_names", [](const Model& model) {
         std::vector<std::string> names;
         for (const auto& b : model.bodies()) names.push_back(b.name);

@@ -166,15 +166,10 @@ void loop_equations(const System& sys, Data& d, double t, const Eigen::Ref<const
   dynamics_kinematics(sys, d);
 }
 
-namespace {
-
-/// The factorisation of M at the state of d for solve_armature (after dynamics_kinematics).
 void factor_mass(const System& sys, Data& d) {
   if (recursive(sys)) spatial_kinematics(sys, d);
   factor_armature(sys, d, VecX::Zero(sys.nq));
 }
-
-}  // namespace
 
 double project_onto_loops(const System& sys, Data& d, double t, VecX& q, VecX& qd, double tol, int max_iterations) {
   if (sys.nl == 0) return 0.0;

@@ -38,6 +38,7 @@
 #include "rigidfem/errors.hpp"
 #include "rigidfem/kinematics.hpp"
 #include "rigidfem/newton_matrix.hpp"
+#include "rigidfem/sensitivities.hpp"
 #include "rigidfem/stepper.hpp"
 
 namespace rigidfem {
@@ -99,7 +100,9 @@ class ImplicitRk : public Stepper {
   ImplicitRk(const System& sys, const IntegratorOptions& o, IntegratorStats& stats)
       : sys_(sys), d_(sys), stats_(stats), n_(sys.nq), newton_tol_(o.newton_tol), max_it_(o.newton_max_iterations),
         q_(n_), v_(n_), a_(n_), qp_(n_), vp_(n_), ap_(n_), q1_(n_), v1_(n_), a1_(n_), r_(n_), y_(2 * n_),
-        y1_(2 * n_), dy_(2 * n_), sc_(2 * n_), zero_(VecX::Zero(n_)), matrix_(NewtonMatrix::make(sys, o, stats)) {}
+        y1_(2 * n_), dy_(2 * n_), sc_(2 * n_), zero_(VecX::Zero(n_)), matrix_(NewtonMatrix::make(sys, o, stats)) {
+    if (!o.sensitivities.empty()) sens_ = std::make_unique<SensitivityEquations>(sys, o.sensitivities);
+  }
 
   /// The initial acceleration, q̈_0 = M⁻¹ f at (t0, q0, q̇0, s0).
   void start(double t0, const VecX& y0) override {
@@ -110,6 +113,12 @@ class ImplicitRk : public Stepper {
     lambda_ = d_.lambda;  // with loops, the multipliers of the initial state too
     y_ << q_, v_;
     ys_ = y0;
+    if (sens_) {
+      const int P = sens_->count(), k0 = 2 * n_ + sys_.nz;
+      Sq_.resize(n_, P), Sv_.resize(n_, P);
+      for (int j = 0; j < P; ++j) Sq_.col(j) = y0.segment(k0 + 2 * n_ * j, n_), Sv_.col(j) = y0.segment(k0 + 2 * n_ * j + n_, n_);
+      sensitivity_accelerations(t0);
+    }
   }
 
   /// Loops: (q, q̇) onto the constraint manifold at t after each accepted step (closure residual
@@ -121,7 +130,17 @@ class ImplicitRk : public Stepper {
     a_ = forward_dynamics(sys_, d_, t, q_, v_);
     lambda_ = d_.lambda;
     y_ << q_, v_;
-    ys_ << y_, s_;
+    if (sens_) {  // onto the tangent of the loops, and S̈ of the next step's first stage with q̈ there
+      VecX S(2 * n_);
+      for (int j = 0; j < sens_->count(); ++j) {
+        S << Sq_.col(j), Sv_.col(j);
+        sens_->project(t, q_, v_, S);
+        Sq_.col(j) = S.head(n_), Sv_.col(j) = S.tail(n_);
+      }
+      forward_dynamics(sys_, d_, t, q_, v_);
+      sensitivity_accelerations(t);
+    }
+    ys_ << y_, s_, sensitivity_blocks();
   }
 
   /// Hairer's first guess 0.01 ‖y‖/‖ẏ‖ in the error weights (1e-6 s when either is negligible).
@@ -160,7 +179,11 @@ class ImplicitRk : public Stepper {
     qp_ = q_, vp_ = v_, ap_ = a_, sp_ = s_;
     q_ = q1_, v_ = v1_, a_ = a1_, s_ = s1_;
     y_ = y1_;
-    ys_ << y_, s_;
+    if (sens_) {
+      Sqp_ = Sq_, Svp_ = Sv_, Sap_ = Sa_;
+      Sq_ = Sq1_, Sv_ = Sv1_, Sa_ = Sa1_;
+    }
+    ys_ << y_, s_, sensitivity_blocks();
     jacobian_fresh_ = false;
     if (slow_) jacobian_valid_ = false;  // Newton contracted slowly: a new tangent for the next step
     accepted();
@@ -175,6 +198,13 @@ class ImplicitRk : public Stepper {
     arm_rates(sys_, vp_, sp_, sdp);
     arm_rates(sys_, v_, s_, sd);
     out << y, hermite((t - t_) / h_, h_, sp_, sdp, s_, sd);
+    if (sens_) {  // each [S_q, S_q̇] by the same quintic Hermite rule
+      out.conservativeResize(2 * n_ + sys_.nz + 2 * n_ * sens_->count());
+      for (int j = 0; j < sens_->count(); ++j) {
+        hermite5((t - t_) / h_, h_, Sqp_.col(j), Svp_.col(j), Sap_.col(j), Sq_.col(j), Sv_.col(j), Sa_.col(j), y);
+        out.segment(2 * n_ + sys_.nz + 2 * n_ * j, 2 * n_) = y;
+      }
+    }
     return out;
   }
 
@@ -191,6 +221,61 @@ class ImplicitRk : public Stepper {
   /// The tolerances the estimate is held to, for the tolerances asked.
   virtual const Tolerances& controlled(const Tolerances& asked) { return asked; }
   virtual void accepted() {}
+
+  /// [S_q, S_q̇] of each parameter in turn (2 nq P; empty without sensitivities).
+  VecX sensitivity_blocks() const {
+    if (!sens_) return VecX();
+    VecX S(2 * n_ * sens_->count());
+    for (int j = 0; j < sens_->count(); ++j) S.segment(2 * n_ * j, 2 * n_) << Sq_.col(j), Sv_.col(j);
+    return S;
+  }
+
+  /// Sa_ = S̈ of each parameter at (t, q_, v_) from the differentiated forward dynamics, d_ holding the forward
+  /// dynamics there (the step's first stage: q̈_n).
+  void sensitivity_accelerations(double t) {
+    const int P = sens_->count();
+    VecX S = sensitivity_blocks(), Sd(2 * n_ * P);
+    sens_->rates(d_, t, q_, v_, S, Sd);
+    Sa_.resize(n_, P);
+    for (int j = 0; j < P; ++j) Sa_.col(j) = Sd.segment(2 * n_ * j + n_, n_);
+  }
+
+  /// The staggered direct method at one stage: δA solving the stage's differentiated equations
+  ///   R(δA) = K δQ + C δV + M δA − ∂(Gᵀλ)/∂q δQ − Gᵀδλ + ∂r/∂p = 0,  δV = δv̂ + γh δA, δQ = δq̂ + γh δV
+  /// (loops also G δA = D(γ − G A)[δQ, δV]) by corrections with the stage's Newton matrix (`correct`: −S⁻¹R
+  /// with the loops' Schur step), until they move δQ and δV by less than 1e-9 of them or reach the
+  /// differences' noise (1e-6 of δA) after a fresh tangent at the stage (`refresh`, once). dA holds the first
+  /// iterate on entry; dV, dQ, dl are the stage's on return.
+  template <class Correct, class Refresh>
+  void sensitivity_stage(int j, double ti, double gh, const VecX& Q, const VecX& V, const VecX& A, const VecX& lambda,
+                         const VecX& dqhat, const VecX& dvhat, Eigen::Ref<VecX> dA, VecX& dV, VecX& dQ, VecX& dl,
+                         Correct&& correct, Refresh&& refresh) {
+    double previous = 0.0;
+    bool refreshed = false;
+    dl = VecX::Zero(sys_.nl);
+    for (int it = 0;; ++it) {
+      interruption_point();
+      dV = dvhat + gh * dA;
+      dQ = dqhat + gh * dV;
+      if (it == std::max(20, max_it_))
+        step_failure(t_, h_, "the sensitivities' corrections did not converge with the Newton matrix");
+      const VecX R = sens_->residual_derivative(j, ti, Q, V, A, lambda, dQ, dV, dA, dl);
+      VecX dx(n_), dlambda;
+      correct(R, dQ, dV, dA, dx, dlambda);
+      if (sys_.nl > 0) dl += dlambda;
+      dA += dx;
+      if (!dA.allFinite()) step_failure(t_, h_, "the sensitivities became NaN or inf");
+      const double change = max_abs(dx);
+      if (gh * gh * change <= 1e-9 * max_abs(dQ) && gh * change <= 1e-9 * max_abs(dV)) break;
+      if (it > 0 && change > 0.5 * previous) {
+        if (change <= 1e-6 * max_abs(VecX(dA))) break;
+        if (!refreshed) refreshed = true, refresh();
+      }
+      previous = change;
+    }
+    dV = dvhat + gh * dA;
+    dQ = dqhat + gh * dV;
+  }
 
   /// r_ = M(Q) A − f(Q, V, t) at a stage: inverse dynamics, O(n) for recursive systems.
   void residual(double t, const Eigen::Ref<const VecX>& Q, const Eigen::Ref<const VecX>& V,
@@ -313,6 +398,8 @@ class ImplicitRk : public Stepper {
   VecX rhs_, band_, band2_;  // (nq) a filter's right-hand side; (2 nq) the band-pass of output_error
   VecX xq_, xv_, zero_;      // (nq) a filter's directions
   std::unique_ptr<NewtonMatrix> matrix_;  // the tangent's Newton matrix (dense or Krylov)
+  std::unique_ptr<SensitivityEquations> sens_;  // forward sensitivities, or null
+  MatX Sq_, Sv_, Sa_, Sqp_, Svp_, Sap_, Sq1_, Sv1_, Sa1_;  // (nq, P) their q, q̇, q̈: now, at the last step's start, its end
   bool jacobian_valid_ = false, jacobian_fresh_ = false, slow_ = false;
   double eta_ = 1.0;          // Newton's η of the last converged stage
   double t_ = 0.0, h_ = 1.0;  // the last attempted step
@@ -343,6 +430,7 @@ class Esdirk final : public ImplicitRk {
     if (!spring_ && (tangent(t) || gh != gh_)) factor(t, gh);
     slow_ = false;
     V_.col(0) = v_, A_.col(0) = a_;
+    if (sys_.nl > 0) Lam_.resize(sys_.nl, T::s), Lam_.col(0) = lambda_;
     arm_rates(sys_, v_, s_, Sd_.col(0));
     for (int i = 1; i < T::s; ++i) {
       // v̂_i = q̇_n + h Σ_{j<i} a_ij A_j, q̂_i = q_n + h Σ_{j<i} a_ij V_j
@@ -360,7 +448,65 @@ class Esdirk final : public ImplicitRk {
       if (!newton(t + T::c[i] * h, gh, tol, i)) return false;
     }
     q1_ = Q_, v1_ = V_.col(T::s - 1), a1_ = A_.col(T::s - 1), s1_ = S_arm_;
+    if (sens_) stage_sensitivities(t, h);
     return true;
+  }
+
+  /// The sensitivities' stages (the staggered direct method, sensitivity_stage) after the state's have
+  /// converged: δv̂_i = δq̇_n + h Σ_{k<i} a_ik δA_k, δq̂_i = δq_n + h Σ_{k<i} a_ik δV_k; the last stage is the
+  /// step's end.
+  void stage_sensitivities(double t, double h) {
+    const double gh = T::gamma * h;
+    const int P = sens_->count();
+    Sq1_.resize(n_, P), Sv1_.resize(n_, P), Sa1_.resize(n_, P);
+    MatX dV(n_, T::s), dA(n_, T::s);
+    VecX qhat(n_), dqhat(n_), dvhat(n_), Q(n_), dVi, dQi, dl;
+    bool tangent_here = !spring_;  // a refreshed stage tangent replaces the spring matrix
+    for (int j = 0; j < P; ++j) {
+      dV.col(0) = Sv_.col(j), dA.col(0) = Sa_.col(j);
+      for (int i = 1; i < T::s; ++i) {
+        qhat = q_, dqhat = Sq_.col(j), dvhat = Sv_.col(j);
+        for (int k = 0; k < i; ++k) {
+          if (T::a[i][k] == 0.0) continue;
+          qhat += (h * T::a[i][k]) * V_.col(k);
+          dvhat += (h * T::a[i][k]) * dA.col(k);
+          dqhat += (h * T::a[i][k]) * dV.col(k);
+        }
+        Q = qhat + gh * V_.col(i);
+        const double ti = t + T::c[i] * h;
+        const VecX Vi = V_.col(i), Ai = A_.col(i), li = sys_.nl ? VecX(Lam_.col(i)) : VecX();
+        dA.col(i) = dA.col(i - 1);
+        auto correct = [&](const VecX& R, const VecX& dq, const VecX& dv, const VecX& a, VecX& dx, VecX& dlambda) {
+          if (tangent_here) {
+            matrix_->solve(R, dx);
+          } else {
+            set_state(sys_, d_, ti, Q, Vi);  // the spring matrix at the stage
+            set_accelerations(sys_, d_, Ai);
+            dynamics_kinematics(sys_, d_);
+            spring_armature(sys_, d_, gh, gh * gh, armature_);
+            factor_armature(sys_, d_, armature_);
+            solve_armature(sys_, d_, R, dx);
+          }
+          dx = -dx;
+          if (sys_.nl == 0) return;
+          loop_equations(sys_, d_, ti, Q, Vi);
+          const MatX G = free_jacobian(sys_, d_);
+          const MatX Y = tangent_here ? matrix_->solve(MatX(G.transpose())) : solve_armature(sys_, d_, G.transpose());
+          const VecX c = sens_->acceleration_constraint_derivative(ti, Q, Vi, Ai, dq, dv);
+          dlambda = least_norm(G * Y, c - G * (a + dx));
+          dx += Y * dlambda;
+        };
+        auto refresh = [&] {
+          matrix_->linearize(ti, Q, Vi, Ai, s_);
+          factor(ti, gh);
+          jacobian_valid_ = false;  // the next step linearises at its own start again
+          tangent_here = true;
+        };
+        sensitivity_stage(j, ti, gh, Q, Vi, Ai, li, dqhat, dvhat, dA.col(i), dVi, dQi, dl, correct, refresh);
+        dV.col(i) = dVi;
+      }
+      Sq1_.col(j) = dQi, Sv1_.col(j) = dV.col(T::s - 1), Sa1_.col(j) = dA.col(T::s - 1);
+    }
   }
 
   /// The stage's arm forces S_i = (ŝ_i + γh k V_i)/(1 + γh/τ) into S_arm_ and d_, and (rates) Ṡ_i.
@@ -434,6 +580,7 @@ class Esdirk final : public ImplicitRk {
     V = vhat_ + gh * A;
     Q_ = qhat_ + gh * V;
     stage_arms(gh, V, i, true);
+    if (sys_.nl > 0) Lam_.col(i) = lambda_;
     return true;
   }
 
@@ -483,6 +630,7 @@ class Esdirk final : public ImplicitRk {
   double h_previous_ = 1.0;  // the last accepted step
   bool have_previous_ = false;
   MatX G_;  // (nl, nq) the loops' Jacobian at the iterate
+  MatX Lam_;  // (nl, s) the stages' multipliers
 };
 
 /// Radau IIA of order 5 (Ehle; Hairer & Wanner IV.5, IV.8): c = ((4 − √6)/10, (4 + √6)/10, 1),

@@ -107,19 +107,25 @@ namespace {
 /// Newmark family, which hold g(q) = 0 only to Newton's tolerance and the rates to O(h²).
 class Recorder {
  public:
-  Recorder(const System& sys, Trajectory& traj, const Eigen::Ref<const VecX>& t_eval)
+  Recorder(const System& sys, Trajectory& traj, const Eigen::Ref<const VecX>& t_eval, const IntegratorOptions& o)
       : sys_(sys), traj_(traj), t_eval_(t_eval), nq_(sys.nq) {
     if (sys.nl > 0) d_ = std::make_unique<Data>(sys);
+    if (sys.nl > 0 && !o.sensitivities.empty())
+      sens_ = std::make_unique<SensitivityEquations>(sys, o.sensitivities);
   }
-  /// y = [q, q̇, s] at t; the stepper's own multipliers there, if any (Stepper::multipliers).
+  /// y = [q, q̇, s, S_1 .. S_P] at t; the stepper's own multipliers there, if any (Stepper::multipliers).
   void push(double t, const VecX& y, const Stepper* stepper = nullptr) {
     traj_.t.push_back(t);
     traj_.lambda.emplace_back();
     if (stepper && !stepper->multipliers(t, traj_.lambda.back())) traj_.lambda.back().resize(0);
     traj_.q.push_back(y.head(nq_));
     traj_.qd.push_back(y.segment(nq_, nq_));
-    traj_.s.push_back(y.tail(sys_.nz));
+    const int m = 2 * nq_ + sys_.nz;
+    traj_.s.push_back(y.segment(2 * nq_, sys_.nz));
+    traj_.sensitivities.push_back(y.tail(y.size() - m));
     if (d_) project_onto_loops(sys_, *d_, t, traj_.q.back(), traj_.qd.back(), 1e-12, 10);
+    for (int j = 0; sens_ && j < sens_->count(); ++j)
+      sens_->project(t, traj_.q.back(), traj_.qd.back(), traj_.sensitivities.back().segment(2 * nq_ * j, 2 * nq_));
   }
   void start(double t0, const VecX& y0, const Stepper& stepper) {
     if (t_eval_.size() == 0) {
@@ -131,6 +137,7 @@ class Recorder {
   /// Forgets every output (a run that starts again from t0).
   void clear() {
     traj_.t.clear(), traj_.q.clear(), traj_.qd.clear(), traj_.s.clear(), traj_.lambda.clear();
+    traj_.sensitivities.clear();
     next_ = 0;
   }
   /// After an accepted step ending at t1: the requested times in (t0, t1] by dense output.
@@ -151,6 +158,7 @@ class Recorder {
   const Eigen::Ref<const VecX>& t_eval_;
   int nq_;
   std::unique_ptr<Data> d_;
+  std::unique_ptr<SensitivityEquations> sens_;  // with loops: projects the outputs' sensitivities
   Eigen::Index next_ = 0;
 };
 
@@ -234,15 +242,20 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
          VecX& last_q) {
   auto last_check = Clock::now();
   IntegratorStats& stats = traj.stats;
-  Recorder out(sys, traj, t_eval);
+  Recorder out(sys, traj, t_eval, o);
   const int n = sys.nq;
   const bool adaptive = is_adaptive(o);
   std::unique_ptr<ErrorMeasure> measure;  // the outputs the error is measured on (error_measure.hpp), or none
   const Tolerances asked = run_tolerances(sys, o, t0, t_end, q0, measure, stats);
   const double span = t_end - t0, grid = std::min(o.dt, o.max_step), near_end = t_end - 1e-12 * span;
 
-  VecX y0(2 * n + sys.nz);
-  y0 << q0, qd0, (o.s0.size() ? o.s0 : VecX::Zero(sys.nz));
+  VecX y0(2 * n + sys.nz + 2 * n * static_cast<int>(o.sensitivities.size()));
+  y0 << q0, qd0, (o.s0.size() ? o.s0 : VecX::Zero(sys.nz)),
+      (o.sensitivities.empty() ? VecX() : SensitivityEquations(sys, o.sensitivities).initial());
+  if (sys.nl > 0 && !o.sensitivities.empty()) {  // initial values move along the loops (as assemble() would)
+    SensitivityEquations sens(sys, o.sensitivities);
+    for (int j = 0; j < sens.count(); ++j) sens.project(t0, q0, qd0, y0.segment(2 * n + sys.nz + 2 * n * j, 2 * n));
+  }
   // method="auto": its policy (auto_method.hpp) picks the first method and, after each step, whether to change
   std::unique_ptr<AutoChoice> choice;
   if (o.method == Method::Auto) choice = std::make_unique<AutoChoice>(sys, o, asked, t0, y0, stats);
@@ -337,6 +350,33 @@ SimulationError explained(const SimulationError& e, const System& sys, const Vec
   return SimulationError(e.time, e.cause + gimbal_lock_hint(sys, last_q, 1e-3));
 }
 
+/// std::invalid_argument unless the run's sensitivities fit the system and a method that integrates them.
+void check_sensitivities(const System& sys, const IntegratorOptions& o) {
+  if (o.sensitivities.empty()) return;
+  const Method m = o.method;
+  const bool integrates = method_info(m).make == make_newmark || m == Method::Esdirk43 ||
+                          (method_info(m).make == make_runge_kutta && m != Method::Auto);
+  if (!integrates)
+    throw std::invalid_argument(std::string("method: expected a method that integrates sensitivities (euler, "
+                                            "symplectic_euler, rk4, dopri5, rkf45, newmark, hht, generalized_alpha, "
+                                            "implicit_spring, esdirk43), got '") + method_name(m) + "'");
+  if (sys.nz > 0)
+    throw std::invalid_argument("sensitivities: not available for a system with Maxwell arms (it has " +
+                                std::to_string(sys.nz) + " arm forces as internal variables)");
+  for (std::size_t j = 0; j < o.sensitivities.size(); ++j) {
+    const SensitivityParameter& p = o.sensitivities[j];
+    check_vector(p.S0, 2 * sys.nq, "sensitivities", "2 nq initial sensitivities");
+    if (p.plus && !(p.h != 0.0 && std::isfinite(p.h)))
+      throw std::invalid_argument("sensitivities: expected a finite non-zero step h, got " + num(p.h));
+    if (!p.plus && p.minus) throw std::invalid_argument("sensitivities: expected a system at p + h with one at p - h");
+    for (const auto& other : {p.plus, p.minus})
+      if (other && (other->nq != sys.nq || other->nbodies != sys.nbodies || other->nl != sys.nl ||
+                    other->np != sys.np || other->algorithm != sys.algorithm))
+        throw std::invalid_argument("sensitivities: expected systems with this system's coordinates (parameter " +
+                                    std::to_string(j) + ")");
+  }
+}
+
 }  // namespace
 
 void check_options(const System& sys, double t0, double t_end, const VecX& q0, const VecX& qd0,
@@ -401,6 +441,7 @@ void check_options(const System& sys, double t0, double t_end, const VecX& q0, c
                                    stiff == Method::RKF45 || stiff == Method::Auto))
     throw std::invalid_argument(std::string("stiff_method: expected an implicit method with an error estimate, got '") +
                                 method_name(stiff) + "'");
+  check_sensitivities(sys, o);
   for (Eigen::Index k = 0; k < t_eval.size(); ++k)
     if (!(t_eval(k) >= t0 && t_eval(k) <= t_end) || (k > 0 && !(t_eval(k) > t_eval(k - 1))))
       throw std::invalid_argument("t_eval: expected increasing times within [t0, t_end] = [" + num(t0) + ", " +

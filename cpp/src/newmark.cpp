@@ -17,6 +17,7 @@
 #include "rigidfem/errors.hpp"
 #include "rigidfem/kinematics.hpp"
 #include "rigidfem/newton_matrix.hpp"
+#include "rigidfem/sensitivities.hpp"
 #include "rigidfem/stepper.hpp"
 
 namespace rigidfem {
@@ -26,6 +27,7 @@ namespace {
 struct NewmarkState {
   VecX q, v, qdd, a, lambda;  // lambda (nl): the loops' multipliers at the same time
   VecX s;                     // (nz) the Maxwell arms' forces
+  MatX Sq, Sv, Sqdd, Sa, Slambda;  // (nq, P) and (nl, P): their derivatives by each parameter (sensitivities.hpp)
 };
 
 class NewmarkFamily final : public Stepper {
@@ -41,6 +43,7 @@ class NewmarkFamily final : public Stepper {
         armature_(sys.nq),
         arm_stiffness_(VecX::Zero(sys.nq)),
         matrix_(NewtonMatrix::make(sys, o, stats)) {
+    if (!o.sensitivities.empty()) sens_ = std::make_unique<SensitivityEquations>(sys, o.sensitivities);
     if (o.method == Method::Newmark) {
       am_ = af_ = 0.0;
       beta_ = o.beta;
@@ -66,7 +69,8 @@ class NewmarkFamily final : public Stepper {
     const VecX q0 = y0.head(n), qd0 = y0.segment(n, n), s0 = y0.tail(sys_.nz);
     set_arm_forces(sys_, d_, s0);
     const VecX qdd = forward_dynamics(sys_, d_, t0, q0, qd0);
-    s_ = {q0, qd0, qdd, qdd, d_.lambda, s0};
+    s_ = {q0, qd0, qdd, qdd, d_.lambda, s0, {}, {}, {}, {}, {}};
+    if (sens_) start_sensitivities(t0, y0);
     y_ = y0;
     t_ = t0, h_step_ = 1.0, lambda_a_ = s_.lambda;  // multipliers(t0): λ_0
   }
@@ -84,6 +88,7 @@ class NewmarkFamily final : public Stepper {
     }
     if (!newton(t, h)) return false;
     if (!s1_.q.allFinite() || !s1_.v.allFinite()) step_failure(t, h, "the state became NaN or inf");
+    if (sens_) step_sensitivities(t, h);
     if (!tol) return true;
     // Local error estimate of q over the step, h² (β − 1/6)(a_{n+1} − a_n), per unit step: a second-order
     // method propagates the solution it estimates, so the steps' errors add up (coherently, in the phase
@@ -108,8 +113,10 @@ class NewmarkFamily final : public Stepper {
     fa_ << s_.v, s_.qdd;
     yb_ << s1_.q, s1_.v;
     fb_ << s1_.v, s1_.qdd;
-    y_ << yb_, s1_.s;
+    y_.resize(2 * n + sys_.nz + 2 * n * sensitivity_count());
+    y_ << yb_, s1_.s, sensitivity_blocks(s1_);
     sa_ = s_.s;
+    if (sens_) sens_a_ = s_;
     lambda_a_ = s_.lambda;
     s_ = s1_;
   }
@@ -121,7 +128,17 @@ class NewmarkFamily final : public Stepper {
     VecX y(2 * n + sys_.nz), s;
     y.head(2 * n) = hermite((t - t_) / h_step_, h_step_, ya_, fa_, yb_, fb_);
     arm_step(sys_, t - t_, sa_, ya_.head(n), y.head(n), s);
-    y.tail(sys_.nz) = s;
+    y.segment(2 * n, sys_.nz) = s;
+    if (sens_) {  // each [S_q, S_q̇] by the same Hermite rule from [S_q, S_q̇] and [S_q̇, S_q̈] at both ends
+      VecX Sy;
+      y.conservativeResize(2 * n + sys_.nz + 2 * n * sensitivity_count());
+      for (int j = 0; j < sensitivity_count(); ++j) {
+        Sy = hermite((t - t_) / h_step_, h_step_, pair(sens_a_.Sq.col(j), sens_a_.Sv.col(j)),
+                     pair(sens_a_.Sv.col(j), sens_a_.Sqdd.col(j)), pair(s_.Sq.col(j), s_.Sv.col(j)),
+                     pair(s_.Sv.col(j), s_.Sqdd.col(j)));
+        y.segment(2 * n + sys_.nz + 2 * n * j, 2 * n) = Sy;
+      }
+    }
     return y;
   }
   /// λ by linear interpolation of λ_n, λ_{n+1} (second order, as the method).
@@ -212,11 +229,16 @@ class NewmarkFamily final : public Stepper {
   /// its Schur complement. dx = −S⁻¹ r on entry; Y = S⁻¹ Gᵀ by nl solves with the iteration
   /// matrix, (G Y) Δλ = −g/(β'h²) − G dx, then dx += Y Δλ and λ += Δλ. O(n·nl + nl³).
   void close_loops_correction(double bh2, NewmarkState& s1, VecX& dx) {
+    VecX dl;
+    close_loops_correction(bh2, d_.g, dx, dl);
+    s1.lambda += dl;
+  }
+  /// The same with the constraints' residual g given, Δλ into dl.
+  void close_loops_correction(double bh2, const VecX& g, VecX& dx, VecX& dl) {
     const MatX G = free_jacobian(sys_, d_);
     const MatX Y = spring_now_ ? solve_armature(sys_, d_, G.transpose()) : matrix_->solve(MatX(G.transpose()));
-    const VecX dl = least_norm(G * Y, -d_.g / bh2 - G * dx);
+    dl = least_norm(G * Y, -g / bh2 - G * dx);
     dx += Y * dl;
-    s1.lambda += dl;
   }
 
   /// Newton: −S⁻¹ r with the tangent S = M + γ' h ∂r/∂q̇ + β' h² ∂r/∂q (newton_matrix.hpp: dense, or
@@ -255,9 +277,99 @@ class NewmarkFamily final : public Stepper {
     return dx;
   }
 
+  int sensitivity_count() const { return sens_ ? sens_->count() : 0; }
+  static VecX pair(const VecX& a, const VecX& b) {
+    VecX ab(a.size() + b.size());
+    ab << a, b;
+    return ab;
+  }
+  /// [S_q, S_q̇] of each parameter in turn (2 nq P).
+  VecX sensitivity_blocks(const NewmarkState& s) const {
+    const int n = sys_.nq;
+    VecX S(2 * n * sensitivity_count());
+    for (int j = 0; j < sensitivity_count(); ++j) S.segment(2 * n * j, 2 * n) = pair(s.Sq.col(j), s.Sv.col(j));
+    return S;
+  }
+
+  /// S(t0) from y0, S̈(t0) from the differentiated forward dynamics (a_0 = q̈_0 as for the state).
+  void start_sensitivities(double t0, const VecX& y0) {
+    const int n = sys_.nq, P = sensitivity_count(), k0 = 2 * n + sys_.nz;
+    forward_dynamics(sys_, d_, t0, s_.q, s_.v);
+    VecX Sd(2 * n * P);
+    sens_->rates(d_, t0, s_.q, s_.v, y0.tail(2 * n * P), Sd);
+    s_.Sq.resize(n, P), s_.Sv.resize(n, P), s_.Sqdd.resize(n, P), s_.Slambda = MatX::Zero(sys_.nl, P);
+    for (int j = 0; j < P; ++j) {
+      s_.Sq.col(j) = y0.segment(k0 + 2 * n * j, n);
+      s_.Sv.col(j) = y0.segment(k0 + 2 * n * j + n, n);
+      s_.Sqdd.col(j) = Sd.segment(2 * n * j + n, n);
+    }
+    s_.Sa = s_.Sqdd;
+  }
+
+  /// The staggered direct method: the step's equations differentiated by each parameter are linear in
+  /// δq̈_{n+1} (and δλ_{n+1}) with the Newton matrix S = M + γ'h C + β'h² K as their matrix,
+  ///   R(δq̈) = ∂r/∂q δq_{n+1} + ∂r/∂q̇ δq̇_{n+1} + M δq̈ − ∂(Gᵀλ)/∂q δq_{n+1} − Gᵀ δλ + ∂r/∂p = 0,  G δq_{n+1} = 0,
+  /// with δq_{n+1}, δq̇_{n+1} from the method's update. Solved by corrections with the step's own iteration matrix
+  /// (exact tangent: one correction to the differences' accuracy; spring matrix: a few) until they are below
+  /// 1e-10 of δq̈.
+  void step_sensitivities(double t, double h) {
+    const int P = sensitivity_count();
+    const double bp = beta_ * (1.0 - af_) / (1.0 - am_), gp = gamma_ * (1.0 - af_) / (1.0 - am_);
+    NewmarkState& s1 = s1_;
+    s1.Sq.resize(sys_.nq, P), s1.Sv.resize(sys_.nq, P), s1.Sqdd.resize(sys_.nq, P), s1.Sa.resize(sys_.nq, P);
+    s1.Slambda = s_.Slambda;
+    const int max_it = std::max(20, max_it_);
+    for (int j = 0; j < P; ++j) {
+      VecX dqdd = s_.Sqdd.col(j), dl = s_.Slambda.col(j), dq, dv, da;
+      double previous = 0.0;
+      bool spring = spring_now_, refreshed = false;
+      for (int it = 0;; ++it) {
+        interruption_point();
+        da = ((1.0 - af_) * dqdd + af_ * s_.Sqdd.col(j) - am_ * s_.Sa.col(j)) / (1.0 - am_);
+        dq = s_.Sq.col(j) + h * s_.Sv.col(j) + (h * h) * ((0.5 - beta_) * s_.Sa.col(j) + beta_ * da);
+        dv = s_.Sv.col(j) + h * ((1.0 - gamma_) * s_.Sa.col(j) + gamma_ * da);
+        if (it == max_it)
+          step_failure(t, h, "the sensitivities' corrections did not converge in " + std::to_string(max_it) +
+                                 " iterations with the Newton matrix");
+        const VecX R = sens_->residual_derivative(j, t + h, s1.q, s1.v, s1.qdd, s1.lambda, dq, dv, dqdd, dl);
+        const bool spring_matrix = spring_now_;
+        spring_now_ = spring;  // the loops' correction solves with the matrix used here
+        VecX dx = spring ? spring_correction(h, R, bp, gp) : tangent_correction(t + h, h, R, bp, gp, false);
+        if (sys_.nl > 0) {
+          const MatX G = free_jacobian(sys_, d_);
+          VecX dlambda;
+          close_loops_correction(h * h * bp, G * dq, dx, dlambda);
+          dl += dlambda;
+        }
+        spring_now_ = spring_matrix;
+        dqdd += dx;
+        if (!dqdd.allFinite()) step_failure(t, h, "the sensitivities became NaN or inf");
+        // Converged when the correction moves δq_{n+1} and δq̇_{n+1} by less than 1e-9 of them. A correction that
+        // no longer halves has either reached the central differences' noise (below 1e-6 of δq̈: measured 1e-8 to
+        // 1e-7 on beams and ropes, whose axial stiffness dwarfs the transverse one) or meets a matrix too far
+        // from this step's tangent (an older one, or the spring matrix): then the exact tangent is formed here,
+        // once, and the corrections go on with it.
+        const double change = max_abs(dx);
+        if (bp * h * h * change <= 1e-9 * max_abs(dq) && gp * h * change <= 1e-9 * max_abs(dv)) break;
+        if (it > 0 && change > 0.5 * previous) {
+          if (change <= 1e-6 * max_abs(dqdd)) break;
+          if (!refreshed) refreshed = true, spring = false, valid_ = false;
+        }
+        previous = change;
+      }
+      s1.Sqdd.col(j) = dqdd;
+      s1.Sa.col(j) = ((1.0 - af_) * dqdd + af_ * s_.Sqdd.col(j) - am_ * s_.Sa.col(j)) / (1.0 - am_);
+      s1.Sq.col(j) = s_.Sq.col(j) + h * s_.Sv.col(j) + (h * h) * ((0.5 - beta_) * s_.Sa.col(j) + beta_ * s1.Sa.col(j));
+      s1.Sv.col(j) = s_.Sv.col(j) + h * ((1.0 - gamma_) * s_.Sa.col(j) + gamma_ * s1.Sa.col(j));
+      s1.Slambda.col(j) = dl;
+    }
+  }
+
   const System& sys_;
   Data d_;
   IntegratorStats& stats_;
+  std::unique_ptr<SensitivityEquations> sens_;
+  NewmarkState sens_a_;  // the state before the last accepted step (its sensitivities: dense output)
   double tol_;
   int max_it_;
   bool spring_;

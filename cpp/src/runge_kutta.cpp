@@ -6,40 +6,55 @@
 #include "rigidfem/arms.hpp"
 #include "rigidfem/dynamics.hpp"
 #include "rigidfem/errors.hpp"
+#include "rigidfem/sensitivities.hpp"
 #include "rigidfem/stepper.hpp"
 
 namespace rigidfem {
 
 namespace {
 
-/// y = [q, q̇, s] as a first-order system ẏ = [q̇, q̈(t, q, q̇, s), ṡ(q̇, s)] (s the Maxwell arms'
-/// forces, arms.hpp), counting evaluations.
+/// y = [q, q̇, s, S_1 .. S_P] as a first-order system ẏ = [q̇, q̈(t, q, q̇, s), ṡ(q̇, s), Ṡ_1 .. Ṡ_P] (s the Maxwell
+/// arms' forces, arms.hpp; S_j = [∂q/∂p_j, ∂q̇/∂p_j] the forward sensitivities, sensitivities.hpp), counting
+/// evaluations.
 class FirstOrder {
  public:
-  FirstOrder(const System& sys, IntegratorStats& stats) : sys_(sys), d_(sys), stats_(stats) {}
+  FirstOrder(const System& sys, const IntegratorOptions& o, IntegratorStats& stats)
+      : sys_(sys), d_(sys), stats_(stats) {
+    if (!o.sensitivities.empty()) sens_ = std::make_unique<SensitivityEquations>(sys, o.sensitivities);
+  }
   void eval(double t, const VecX& y, VecX& ydot) {
-    if (!y.allFinite()) throw SimulationError(t, "the state became NaN or inf: the step was unstable");
+    if (!y.allFinite())
+      throw SimulationError(t, "the state became NaN or inf: the step was unstable");
     ++stats_.rhs_evaluations;
     const int n = sys_.nq, nz = sys_.nz;
-    ydot.resize(2 * n + nz);
+    ydot.resize(y.size());
     ydot.head(n) = y.segment(n, n);
-    set_arm_forces(sys_, d_, y.tail(nz));
+    set_arm_forces(sys_, d_, y.segment(2 * n, nz));
     ydot.segment(n, n) = forward_dynamics(sys_, d_, t, y.head(n), y.segment(n, n));
-    arm_rates(sys_, y.segment(n, n), y.tail(nz), ydot.tail(nz));
+    arm_rates(sys_, y.segment(n, n), y.segment(2 * n, nz), ydot.segment(2 * n, nz));
+    if (!sens_) return;
+    const int k = state_size();
+    sens_->rates(d_, t, y.head(n), y.segment(n, n), y.tail(y.size() - k), ydot.tail(y.size() - k));
   }
-  /// [q, q̇] of y onto the loops' constraint manifold at t (closure residual <= 1e-12).
+  /// [q, q̇] of y onto the loops' constraint manifold at t (closure residual <= 1e-12), and the
+  /// sensitivities onto its tangent there.
   void project(double t, VecX& y) {
     const int n = sys_.nq;
     VecX q = y.head(n), qd = y.segment(n, n);
     project_onto_loops(sys_, d_, t, q, qd, 1e-12, 10);
     y.head(n) = q, y.segment(n, n) = qd;
+    for (int j = 0; sens_ && j < sens_->count(); ++j) sens_->project(t, q, qd, y.segment(state_size() + 2 * n * j, 2 * n));
   }
   int controlled() const { return 2 * sys_.nq; }  ///< the error is controlled on y's first 2 nq: [q, q̇]
+  int state_size() const { return 2 * sys_.nq + sys_.nz; }  ///< [q, q̇, s]; the sensitivities follow
+  /// The sensitivities' blocks, each [S_q, S_q̇] (symplectic Euler's rule treats them as [q, q̇]).
+  int sensitivity_count() const { return sens_ ? sens_->count() : 0; }
 
  private:
   const System& sys_;
   Data d_;
   IntegratorStats& stats_;
+  std::unique_ptr<SensitivityEquations> sens_;
 };
 
 struct Tableau {
@@ -101,8 +116,8 @@ const Tableau& tableau(Method method) {
 /// semi-implicit (symplectic) Euler rule.
 class RungeKutta final : public Stepper {
  public:
-  RungeKutta(const System& sys, Method method, IntegratorStats& stats)
-      : ode_(sys, stats), tab_(tableau(method)), k_(tab_.b.size()), dopri_(method == Method::Dopri5),
+  RungeKutta(const System& sys, const IntegratorOptions& o, Method method, IntegratorStats& stats)
+      : ode_(sys, o, stats), tab_(tableau(method)), k_(tab_.b.size()), dopri_(method == Method::Dopri5),
         rkf_(method == Method::RKF45), symplectic_(method == Method::SymplecticEuler) {}
 
   void start(double t0, const VecX& y0) override {
@@ -140,6 +155,10 @@ class RungeKutta final : public Stepper {
       const int n = ode_.controlled() / 2;
       y1_ = y0_ + h * f0_;
       y1_.head(n) = y0_.head(n) + h * y1_.segment(n, n);
+      for (int j = 0; j < ode_.sensitivity_count(); ++j) {  // their [S_q, S_q̇] alike
+        const int k = ode_.state_size() + 2 * n * j;
+        y1_.segment(k, n) = y0_.segment(k, n) + h * y1_.segment(k + n, n);
+      }
       ode_.eval(t + h, y1_, f1_);
       return true;
     }
@@ -169,8 +188,9 @@ class RungeKutta final : public Stepper {
       const VecX& ya = dopri_ ? y_stage6_ : y_stage_;
       const VecX& ka = dopri_ ? k_[5] : k_[4];
       const VecX& kb = dopri_ ? k_[6] : f1_;
-      const double den = (y1_ - ya).squaredNorm();
-      h_rho_ = den > 0.0 ? h * std::sqrt((kb - ka).squaredNorm() / den) : 0.0;
+      const int m = ode_.controlled();
+      const double den = (y1_ - ya).head(m).squaredNorm();
+      h_rho_ = den > 0.0 ? h * std::sqrt((kb - ka).head(m).squaredNorm() / den) : 0.0;
     }
     if (dopri_) {
       // Shampine's continuous extension of order 4 (as in Hairer's dopri5).
@@ -228,7 +248,7 @@ class RungeKutta final : public Stepper {
 }  // namespace
 
 std::unique_ptr<Stepper> make_runge_kutta(const System& sys, const IntegratorOptions& o, IntegratorStats& stats) {
-  return std::make_unique<RungeKutta>(sys, o.method == Method::Auto ? Method::Dopri5 : o.method, stats);
+  return std::make_unique<RungeKutta>(sys, o, o.method == Method::Auto ? Method::Dopri5 : o.method, stats);
 }
 
 }  // namespace rigidfem

@@ -45,6 +45,8 @@ from .sweep import sweep
 from .resolution import Plan, ResolveError, resolve  # noqa: E402 (rf.resolve: elements and deformations for a tolerance)
 from .error_control import ErrorEstimate  # noqa: E402
 from .viewer import Viewer, view  # noqa: E402 (the 3D viewer: notebooks and HTML files)
+from . import parameters, sensitivities  # noqa: E402 (named parameters; forward sensitivities)
+from .parameters import Parameter  # noqa: E402
 
 __version__ = "0.1.0"
 
@@ -73,6 +75,7 @@ __all__ = [
     "ForceLawError",
     "Model",
     "NotAnEquilibriumWarning",
+    "Parameter",
     "Modes",
     "Plan",
     "Point",
@@ -99,11 +102,13 @@ __all__ = [
     "load_npz",
     "modal_analysis",
     "motion",
+    "parameters",
     "resolve",
     "rfe_parameters",
     "sde_parameters",
     "samples",
     "sea",
+    "sensitivities",
     "simulate",
     "skew",
     "stages",

@@ -33,7 +33,7 @@ import scipy.linalg
 import scipy.optimize
 from scipy.linalg import lapack
 
-from . import _checks, _core, _deprecation, _interrupt, display, export
+from . import _checks, _core, _deprecation, _interrupt, analysis_sensitivities, display, export
 from ._core import SimulationError
 from .persistence import Versioned
 
@@ -223,6 +223,14 @@ class Equilibrium(Versioned):
     #: gives the reactions (force and torque) when the drives are at rest at t.
     multipliers: np.ndarray = field(default_factory=lambda: np.zeros(0))
     constraint_residual: float = 0.0  #: max |g(q, t)| at the end (m, or cosines), 0 without loops
+    #: {name: dq/dp (nq,)} of ``static_equilibrium(sensitivities=...)`` (m or rad per unit of the parameter)
+    sensitivities: dict = field(default_factory=dict, repr=False)
+
+    def sensitivity(self, name: str) -> np.ndarray:
+        """dq/dp (nq,) of the equilibrium by the parameter ``name`` (``static_equilibrium(sensitivities=...)``)."""
+        if name not in self.sensitivities:
+            raise ValueError(f"name: expected one of the sensitivities asked for {list(self.sensitivities)}, got {name!r}")
+        return self.sensitivities[name]
 
 
 def _solve_tangent(K: np.ndarray, f: np.ndarray):
@@ -252,7 +260,7 @@ def _integer_at_least_one(x, name: str) -> int:
 
 @_deprecation.keyword_only("t", "load_steps", "tol", "max_iterations")
 def static_equilibrium(system, q0=None, *, t: float = 0.0, load_steps: int = 10, tol: float = 1e-10,
-                       max_iterations: int = 50) -> Equilibrium:
+                       max_iterations: int = 50, sensitivities=None) -> Equilibrium:
     """Solve f(q) = 0 by Newton's method with load stepping.
 
     Gravity, point forces, torques and applied generalised forces are scaled together
@@ -275,7 +283,26 @@ def static_equilibrium(system, q0=None, *, t: float = 0.0, load_steps: int = 10,
     loop), or when the tangent stiffness K = −∂f/∂q (with loops: K_t in the motions the loops
     allow) is singular: the message then names the coordinates nothing resists (a mechanism,
     e.g. the yaw of a hanging payload, or a buckling/limit point).
+
+    ``sensitivities``: named parameters (``System.parameters``) whose derivatives dq/dp of the
+    equilibrium come with it, K_t dq/dp = ∂f/∂p (``Equilibrium.sensitivity(name)``;
+    ``rigidfem.analysis_sensitivities``).
     """
+    names = analysis_sensitivities.check_names(system, sensitivities)
+    eq = _static_equilibrium(system, q0, t, load_steps, tol, max_iterations)
+    if names:
+        t, q = _checks.scalar(t, "t"), eq.q
+        Kt = -_core._System.force_jacobians(system, t, q, np.zeros(system.nq), 1.0, True)[0]
+        N = None
+        if system.nl:
+            Kt = Kt + _constraint_stiffness(system, t, q, eq.multipliers)
+            N = _Constraints.of(_loop_jacobian(system, t, q)[1]).N
+        eq.sensitivities = analysis_sensitivities.static(system, names, Kt, N,
+                                                         lambda s: _core._System.static_forces(s, t, q, 1.0))
+    return eq
+
+
+def _static_equilibrium(system, q0, t, load_steps, tol, max_iterations) -> Equilibrium:
     t = _checks.scalar(t, "t")
     n = system.nq
     q = np.zeros(n) if q0 is None else _checks.array(q0, (n,), "q0").copy()
@@ -420,6 +447,14 @@ class Modes(Versioned):
     basis: np.ndarray | None = field(default=None, repr=False)
     #: (nl,) the loops' multipliers λ (least squares of f + Gᵀλ = 0) in the geometric stiffness; empty without loops
     multipliers: np.ndarray = field(default_factory=lambda: np.zeros(0), repr=False)
+    #: {name: (dω/dp, dζ/dp)} of ``modal_analysis(sensitivities=...)``, each (k,): rad/s and 1 per unit of the parameter
+    sensitivities: dict = field(default_factory=dict, repr=False)
+
+    def sensitivity(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        """(dω/dp, dζ/dp), each (k,), by the parameter ``name`` (``modal_analysis(sensitivities=...)``)."""
+        if name not in self.sensitivities:
+            raise ValueError(f"name: expected one of the sensitivities asked for {list(self.sensitivities)}, got {name!r}")
+        return self.sensitivities[name]
 
     def _repr_html_(self) -> str:
         """Notebook display: the frequency table (``rigidfem.display``)."""
@@ -513,7 +548,7 @@ def _roots(W: np.ndarray, Kt: np.ndarray, Ct: np.ndarray, basis: np.ndarray):
 
 
 @_deprecation.keyword_only("t")
-def modal_analysis(system, q=None, qd=None, *, t: float = 0.0) -> Modes:
+def modal_analysis(system, q=None, qd=None, *, t: float = 0.0, sensitivities=None) -> Modes:
     """Natural frequencies, damping ratios and mode shapes of the system linearised about (q, q̇) at t.
 
     M ẍ + C ẋ + K x = 0 with M = A(q), K = −∂f/∂q, C = −∂f/∂q̇ (``q`` in m and rad, default
@@ -548,7 +583,33 @@ def modal_analysis(system, q=None, qd=None, *, t: float = 0.0) -> Modes:
     a bad argument (q or qd that do not close the loops, naming them) and ``SimulationError``
     (naming t) when the mass matrix is singular (it names the coordinates, e.g. Euler angles in
     gimbal lock) or the matrices are not finite.
+
+    ``sensitivities``: named parameters (``System.parameters``) whose derivatives (dω/dp, dζ/dp) at
+    this (q, q̇) come with the modes (``Modes.sensitivity(name)``; symmetric problems: no gyroscopic or
+    circulatory terms; ``rigidfem.analysis_sensitivities``).
     """
+    names = analysis_sensitivities.check_names(system, sensitivities)
+    modes = _modal_analysis(system, q, qd, t)
+    if names:
+        n = system.nq
+        qd = np.zeros(n) if qd is None else _checks.array(qd, (n,), "qd")
+        modes.sensitivities = analysis_sensitivities.modal(
+            system, names, lambda s: _modal_matrices(s, modes.q, qd, _checks.scalar(t, "t"), modes.basis), _undamped)
+    return modes
+
+
+def _modal_matrices(system, q, qd, t, basis):
+    """(M, K, C) as modal_analysis forms them (loops: K_t, all in the basis N of the allowed motions)."""
+    M = _core._System.mass_matrix(system, t, q)
+    dfdq, dfdqd = _core._System.force_jacobians(system, t, q, qd)
+    K, C = -dfdq, -dfdqd
+    if basis is None:
+        return M, K, C
+    Kt = _loop_tangent(system, q, qd, t, K, "modal analysis")[1]
+    return basis.T @ M @ basis, basis.T @ Kt @ basis, basis.T @ C @ basis
+
+
+def _modal_analysis(system, q, qd, t) -> Modes:
     t = _checks.scalar(t, "t")
     n = system.nq
     q = np.zeros(n) if q is None else _checks.array(q, (n,), "q")
@@ -560,7 +621,7 @@ def modal_analysis(system, q=None, qd=None, *, t: float = 0.0) -> Modes:
         warnings.warn(f"rigidfem.modal_analysis: the system's {system.nz} Maxwell arms (Zener/Prony sde laws) are left "
                       "out: K and C are those of the relaxed structure (E = E_inf); rigidfem.linearize keeps the arms' "
                       "forces as states (the eigenvalues of its A are the viscoelastic modes')", UserWarning,
-                      stacklevel=2)
+                      stacklevel=3)
     M = _core._System.mass_matrix(system, t, q)
     dfdq, dfdqd = _core._System.force_jacobians(system, t, q, qd)
     K, C = -dfdq, -dfdqd

@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _checks, _core, _deprecation
+from . import _checks, _core, _deprecation, parameters
 from ._core import Body, Point
 from .joints import Joint
 from .materials import Material, Section
@@ -439,11 +439,13 @@ def add_beam(
     if taken:
         raise ValueError(f"name: expected a beam name whose rfe bodies are not in the model yet, got {name!r} "
                          f"({sorted(taken)[0]} exists)")
+    H_beam, H_tip = H.copy(), np.zeros_like(H)  # the parts a density and section set, and what they leave
     if tip_m > 0.0:
         # A concentrated body at the tip (offset from s = L in beam axes) joins the last rfe.
         inertia = _tip_inertia(tip_inertia)
         offset = _checks.vec3(tip_offset, "tip_offset") + [L - frames[-1], 0.0, 0.0]
-        H[-1] = H[-1] + _core.pseudo_inertia(tip_m, offset, inertia)
+        H_tip[-1] = _core.pseudo_inertia(tip_m, offset, inertia)
+        H[-1] = H[-1] + H_tip[-1]
     rfe = _RfeTable(H)
 
     # The sde joints: the chosen deformations' coordinates in the book's order, each with its column
@@ -455,7 +457,7 @@ def add_beam(
         columns = [SDE_DEFORMATIONS.index("axial"), *columns]
         sde = _SdeTable(sde.stiffness.copy(), sde.damping.copy())
         sde.stiffness[:, columns[0]] = sde.damping[:, columns[0]] = 0.0
-    first = model.nbodies
+    first, groups = model.nbodies, dict(model._parameter_groups)
     try:
         root = model.add_body(names[0], parent, joint if joint is not None else Joint.fixed(), mass=rfe.mass[0],
                               com=rfe.com[0], inertia=rfe.inertia[0], placement=placement)
@@ -481,7 +483,17 @@ def add_beam(
             model._add_flow(flow, root.index, m)
     except BaseException:
         model._truncate(first)  # nothing half-added
+        model._parameter_groups = groups
         raise
+    # the rfes' masses (and the sdes' springs, bodies of the linear model) are the beam's parameters' to set
+    sde_coordinates = {f"{n}.{c}" for n in names[1:] for c in template.coordinates}
+    for prefix in [p for p in model._parameter_groups if p in names or p in sde_coordinates]:
+        del model._parameter_groups[prefix]
+    if isinstance(material, Material) and isinstance(section, Section):
+        parameters.register(model, parameters.BeamGroup(
+            name, material, section, bool(prony), [b.index for b in bodies], H_beam, H_tip,
+            [b.index for b in bodies[1:]], range(len(columns)), [SDE_DEFORMATIONS[c] for c in columns],
+            sde.stiffness[:, columns]))
     return Beam(name, L, m, formulation, tuple(deform), bool(linear), bodies, frames, _Rows(rfe, m + 1),
                 _Rows(sde, m), flow)
 

@@ -28,7 +28,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _checks
+from . import _checks, parameters
 from ._core import Body, Point, Profile
 
 
@@ -68,8 +68,14 @@ def add_force_element(model, a, b, *, stiffness: float = 0.0, damping: float = 0
     damping = _checks.scalar(damping, "damping", nonnegative=True, unit="N s/m")
     length = _checks.scalar(length, "length", nonnegative=True, unit="m")
     constant, profile, law = _force(force)
-    return model._add_force_element("" if name is None else str(name), ia, ra, ib, rb, stiffness, damping, length,
+    name = model._add_force_element("" if name is None else str(name), ia, ra, ib, rb, stiffness, damping, length,
                                     constant, profile, law)
+    parameters.register(model, parameters.ElementGroup(name, model._nelements - 1, {
+        "stiffness": stiffness, "damping": damping, "force": constant}))
+    if profile is not None:
+        parameters.register(model, parameters.ProfileGroup(f"{name}.profile", "element", -1, model._nelements - 1,
+                                                           profile, "the force profile's (N, s, rad/s)"))
+    return name
 
 
 def add_rope(model, a, b, *, EA: float, length, damping: float = 0.0, name: str | None = None) -> str:
@@ -82,6 +88,13 @@ def add_rope(model, a, b, *, EA: float, length, damping: float = 0.0, name: str 
         lu = length(0.0)[0]
         if not (np.isfinite(lu) and lu > 0.0):
             raise ValueError(f"length: expected a profile l_u(t) with a positive length at t = 0 in m, got {lu}")
-        return model._add_rope("" if name is None else str(name), ia, ra, ib, rb, EA, DA, 0.0, length)
-    return model._add_rope("" if name is None else str(name), ia, ra, ib, rb, EA, DA,
-                           _checks.scalar(length, "length", positive=True, unit="m"), None)
+        name = model._add_rope("" if name is None else str(name), ia, ra, ib, rb, EA, DA, 0.0, length)
+    else:
+        name = model._add_rope("" if name is None else str(name), ia, ra, ib, rb, EA, DA,
+                               _checks.scalar(length, "length", positive=True, unit="m"), None)
+    parameters.register(model, parameters.ElementGroup(name, model._nelements - 1, {"EA": EA, "damping": DA},
+                                                       rope=True))
+    if isinstance(length, Profile):
+        parameters.register(model, parameters.ProfileGroup(f"{name}.length", "element", -1, model._nelements - 1,
+                                                           length, "the winch's (m, s, m/s)"))
+    return name

@@ -27,7 +27,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from . import _checks, _core
+from . import _checks, parameters, _core
 from ._core import Point, Profile
 from .force_elements import point_of
 
@@ -70,7 +70,10 @@ def add_actuator(model, a, b, length, *, name: str | None = None) -> str:
     ia, Fa = _frame(model, a, None, "a")
     ib, Fb = _frame(model, b, None, "b")
     if isinstance(length, Profile):
-        return _add(model, name, "distance", ia, Fa, ib, Fb, 0.0, length)
+        name = _add(model, name, "distance", ia, Fa, ib, Fb, 0.0, length)
+        parameters.register(model, parameters.ProfileGroup(f"{name}.length", "loop", -1, model._nloops - 1, length,
+                                                           "the actuator's (m, s, m/s)"))
+        return name
     return _add(model, name, "distance", ia, Fa, ib, Fb, _checks.scalar(length, "length", positive=True), None)
 
 

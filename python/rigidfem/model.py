@@ -10,7 +10,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from . import _checks, _contract, _core, _deprecation, display, force_elements, joints, loops, persistence
+from . import _checks, _contract, _core, _deprecation, display, force_elements, joints, loops, parameters, persistence
 from ._core import Body, JointSpec, Point, Profile
 from .beams import add_beam
 from .frames import transform  # noqa: F401 (re-exported: rigidfem.model.transform)
@@ -80,6 +80,7 @@ class Model(_core._Model):
         g = np.zeros(3) if gravity is None else _checks.vec3(gravity, "gravity")
         super().__init__(g)
         self._gravity0, self._calls, self._building = np.array(g, dtype=float), [], False  # the recipe (pickling)
+        self._parameter_groups = {}  # prefix -> parameters.Group: the named parameters the builders declared
 
     @property
     def gravity(self) -> np.ndarray:
@@ -169,15 +170,20 @@ class Model(_core._Model):
         if not isinstance(joint, JointSpec):
             raise ValueError(f"joint: expected a joint from rigidfem.Joint, got {joint!r}")
         B = np.eye(4) if placement is None else _checks.array(placement, (4, 4), "placement")
-        return self._add_body(
-            str(name),
-            self._parent_index(parent),
-            joint,
-            B,
-            _checks.scalar(mass, "mass"),
-            _checks.vec3(com, "com"),
-            _inertia(inertia),
-        )
+        mass, com, inertia = _checks.scalar(mass, "mass"), _checks.vec3(com, "com"), _inertia(inertia)
+        body = self._add_body(str(name), self._parent_index(parent), joint, B, mass, com, inertia)
+        parameters.register(self, parameters.BodyGroup(body.name, body.index, mass, com, inertia))
+        self._declare_coordinates(body, joint)
+        return body
+
+    def _declare_coordinates(self, body: Body, joint: JointSpec) -> None:
+        """The named parameters stiffness, damping and force of each coordinate of a body's joint."""
+        for slot, c in enumerate(joint.coordinates):
+            rotation = c.startswith("r")
+            units = ("N m/rad", "N m s/rad", "N m") if rotation else ("N/m", "N s/m", "N")
+            parameters.register(self, parameters.CoordinateGroup(f"{body.name}.{c}", body.index, slot,
+                                                                 joint.stiffness[slot], joint.damping[slot], 0.0,
+                                                                 units))
 
     def _coordinate(self, body: Body, coordinate: str | None) -> int:
         if not isinstance(body, Body) or body.index < 0 or not self._owns(body):
@@ -199,6 +205,9 @@ class Model(_core._Model):
             raise ValueError(f"motion: expected a profile from rigidfem.motion, got {motion!r}")
         k = self._coordinate(body, coordinate)
         self._prescribe(body.index, k, motion)
+        name = self._coordinate_name(body.index, k)
+        parameters.register(self, parameters.ProfileGroup(f"{name}.drive", "drive", body.index, max(k, 0), motion,
+                                                          "the drive's (m or rad, s, rad/s: rigidfem.motion)"))
 
     @recorded
     def add_moving_base(self, name: str, motion=None, *, mass: float = 1e-6, inertia=(1e-6, 1e-6, 1e-6),
@@ -251,7 +260,11 @@ class Model(_core._Model):
         if callable(force):
             self._add_generalized_force(body.index, k, 0.0, force)
         else:
-            self._add_generalized_force(body.index, k, _checks.scalar(force, "force"), None)
+            value = _checks.scalar(force, "force")
+            self._add_generalized_force(body.index, k, value, None)
+            group = self._parameter_groups.get(self._coordinate_name(body.index, k))
+            if group is not None:  # the total constant force on the coordinate
+                parameters.register(self, group.with_force(group.parameters["force"].value + value))
 
     @recorded
     def add_maxwell_arm(self, body: Body, stiffness: float, tau: float, coordinate: str | None = None) -> None:
@@ -272,21 +285,36 @@ class Model(_core._Model):
         self._add_maxwell_arms([body.index], [k], [stiffness], [tau])
 
     @recorded
-    def add_force(self, point, force, *, follower: bool = False, scale: Profile | None = None) -> None:
+    def add_force(self, point, force, *, follower: bool = False, scale: Profile | None = None,
+                  name: str | None = None) -> str:
         """Apply a point force (N) at ``point`` (a ``Point`` or a ``Body``'s origin).
 
         ``force`` has global components, or body components turning with the body
         when ``follower=True``. ``scale`` (a ``rigidfem.motion`` profile) multiplies
-        it by its value q(t).
+        it by its value q(t). Returns its ``name`` ("load<k>" by default), whose parameter
+        ``"<name>.force"`` is its magnitude (``System.parameters``).
         """
         p = self._point(point)
-        self._add_load(p.body, p.r, _checks.vec3(force, "force"), np.zeros(3), bool(follower), _scale(scale))
+        return self._load(name, p.body, p.r, _checks.vec3(force, "force"), np.zeros(3), follower, scale)
 
     @recorded
-    def add_torque(self, body: Body, torque, *, follower: bool = False, scale: Profile | None = None) -> None:
-        """Apply a torque (N·m) on ``body``: global components, or body ones if ``follower``."""
+    def add_torque(self, body: Body, torque, *, follower: bool = False, scale: Profile | None = None,
+                   name: str | None = None) -> str:
+        """Apply a torque (N·m) on ``body``: global components, or body ones if ``follower``. Returns its
+        ``name`` ("load<k>" by default), whose parameter ``"<name>.torque"`` is its magnitude."""
         p = self._point(body)
-        self._add_load(p.body, np.zeros(3), np.zeros(3), _checks.vec3(torque, "torque"), bool(follower), _scale(scale))
+        return self._load(name, p.body, np.zeros(3), np.zeros(3), _checks.vec3(torque, "torque"), follower, scale)
+
+    def _load(self, name, body, r, force, torque, follower, scale) -> str:
+        name = f"load{self._nloads}" if name is None else name
+        if not isinstance(name, str) or name in self._parameter_groups:
+            raise ValueError(f"name: expected a new name (str) for the load, got {name!r}")
+        self._add_load(body, r, force, torque, bool(follower), _scale(scale))
+        parameters.register(self, parameters.LoadGroup(name, self._nloads - 1, force, torque))
+        if scale is not None:
+            parameters.register(self, parameters.ProfileGroup(f"{name}.scale", "load", -1, self._nloads - 1, scale,
+                                                              "the scale's (rigidfem.motion)"))
+        return name
 
     def _point(self, point) -> Point:
         if isinstance(point, Body):
@@ -449,7 +477,27 @@ class System(_core._System):
         super().__init__(model, algorithm)
         self._model_id = model.id  # handles of other models are refused (_checks.same_model)
         self._state = {"rigidfem_state": persistence.STATE_VERSION, "model": persistence.model_state(model),
-                       "algorithm": algorithm}
+                       "algorithm": algorithm, "parameters": {}}
+        self._parameters = parameters.Parameters(model._parameter_groups)
+
+    @property
+    def parameters(self) -> dict:
+        """The named parameters (``rigidfem.parameters``: ``"<beam>.E"``, ``"<body>.mass"``, ...) with their
+        values at which this system was made, units and what they set: a dict of name to ``Parameter``."""
+        return self._parameters.listing()
+
+    def with_parameters(self, values: dict) -> System:
+        """This system with the named parameters ``values`` ({name: value}, units of ``System.parameters``)
+        changed: a new System (O(n), the model is not compiled again) that simulates exactly as the model
+        built with those values. ValueError naming an unknown parameter or a value out of its range."""
+        values = self._parameters.checked(values)
+        new = System.__new__(System)
+        changes = self._parameters.changes(values)
+        _core._System.__init__(new, self, *changes.arguments())
+        new._model_id = self._model_id
+        new._state = {**self._state, "parameters": {**self._state["parameters"], **values}}
+        new._parameters = self._parameters.updated(values)
+        return new
 
     def __reduce__(self):
         """Pickled as its model's recipe at compile time and the algorithm; compiled again when
@@ -530,7 +578,8 @@ def _model_from_state(state: dict) -> Model:
 def _system_from_state(state: dict) -> System:
     """Unpickling: a System compiled again from the recipe of its model at compile time."""
     persistence.check_version(state, "System")
-    return _model_from_state(state["model"]).compile(state["algorithm"])
+    system = _model_from_state(state["model"]).compile(state["algorithm"])
+    return system.with_parameters(state["parameters"]) if state.get("parameters") else system
 
 
 _contract.guard_methods(System)

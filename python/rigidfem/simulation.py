@@ -71,6 +71,7 @@ with its own G_i) and projects likewise.
 
 from __future__ import annotations
 
+import dataclasses
 import functools
 import warnings
 from dataclasses import dataclass, field
@@ -78,6 +79,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from . import _checks, _core, _deprecation, _interrupt, display, error_control, export
+from . import sensitivities as sensitivities_
 from . import options as options_
 from ._progress import ProgressBar
 from .persistence import Versioned
@@ -116,6 +118,8 @@ class Result(Versioned):
     multipliers: np.ndarray = field(default=None, repr=False)
     run: dict = field(default=None, repr=False)        #: the arguments of the simulate call that made it
     estimate: object = field(default=None, repr=False)  #: the ErrorEstimate, once computed
+    #: {name: (len(t), 2 nq)} the forward sensitivities [∂q/∂p, ∂q̇/∂p] of ``simulate(sensitivities=...)``
+    sensitivities: dict = field(default_factory=dict, repr=False)
 
     def __post_init__(self):
         if self.arm_forces is None:
@@ -214,6 +218,30 @@ class Result(Versioned):
         return _core._point_positions(self.system, point.body, point.r, -1 if frame is None else frame.index,
                                       self.t, self.q)
 
+    def sensitivity(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        """(∂q/∂p, ∂q̇/∂p), each (len(t), nq), by the parameter or initial value ``name`` the run was asked
+        for (``simulate(sensitivities=...)``; units of q and q̇ per unit of the parameter)."""
+        if name not in self.sensitivities:
+            raise ValueError(f"name: expected one of the sensitivities of this run {list(self.sensitivities)}, "
+                             f"got {name!r}")
+        S = self.sensitivities[name]
+        n = self.system.nq
+        return S[:, :n], S[:, n:]
+
+    def position_sensitivity(self, point, name: str, frame: Body | None = None) -> np.ndarray:
+        """∂x/∂p (len(t), 3) of a point's position x (``position``: global, or in ``frame``'s axes) by
+        ``name``: (∂x/∂q) ∂q/∂p, by a central difference of x along ∂q/∂p at each output (about 1e-10
+        relative; m per unit of the parameter)."""
+        dq, _ = self.sensitivity(name)
+        size = np.max(np.abs(dq), axis=1) / np.maximum(1.0, np.max(np.abs(self.q), axis=1, initial=0.0))
+        eps = np.where(size > 0.0, 6e-6 / np.where(size > 0.0, size, 1.0), 0.0)
+        shifted = {}
+        for sign in (1.0, -1.0):
+            moved = dataclasses.replace(self, q=self.q + sign * eps[:, None] * dq)
+            shifted[sign] = moved.position(point, frame)
+        return np.where(eps[:, None] > 0.0, (shifted[1.0] - shifted[-1.0]) / (2.0 * np.where(eps > 0.0, eps, 1.0)
+                                                                            )[:, None], 0.0)
+
     def __repr__(self) -> str:
         s = self.stats
         chosen = f" ({s['method']})" if s.get("method", self.method) != self.method else ""
@@ -258,7 +286,8 @@ def load_npz(path, system=None) -> Result:
                            "rho_inf", "newton_tol", "newton_max_iterations", "iteration_matrix", "stop", "s0",
                            "error_on", "error_estimate")
 def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=None, qd0=None, s0=None,
-             t_eval=None, progress: bool = False, stop=None, error_estimate: bool = False, **options) -> Result:
+             t_eval=None, progress: bool = False, stop=None, error_estimate: bool = False, sensitivities=None,
+             **options) -> Result:
     """Integrate ``system`` from ``t0`` to ``t_end`` (s) in C++ (no Python per step).
 
     The run's arguments come by name after ``method``; the integrator's ``**options`` (``dt``,
@@ -326,6 +355,11 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
     error_estimate : bool
         Compute ``Result.error_estimate`` with the run (a second run at tolerances / 10, or at dt / 2
         for fixed steps); it is computed on first use otherwise.
+    sensitivities : list of str, optional
+        Forward sensitivities by these named parameters (``System.parameters``) or initial values
+        (``"q0[<coordinate>]"``, ``"qd0[<coordinate>]"``), integrated with the state by the explicit
+        methods, the Newmark family and esdirk43 (``rigidfem.sensitivities``); ``Result.sensitivity(name)`` and
+        ``Result.position_sensitivity(point, name)`` return them.
     **options
         The integrator's options (``rigidfem.integrator_options``):
 
@@ -408,6 +442,10 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
         opt.adaptive = -1  # SciPy's solvers are adaptive whatever it says (checked above for its type)
     opt.s0 = s0
     opt.set_error_on(outputs)
+    if sensitivities is not None and scipy:
+        raise ValueError(f"method: expected a C++ method that integrates sensitivities (dopri5, rk4, generalized_alpha, "
+                         f"...), got {method!r}")
+    names = sensitivities_.directions(system, sensitivities, opt, t0, t_end)
     _core._check_options(system, t0, t_end, q0, qd0, t_eval, opt)
     _check_closed(system, t0, q0, qd0)
     if system.nl and scipy:
@@ -434,7 +472,7 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
         if bar is not None:
             bar.close()
     t, q, qd, stats, interrupted, failure, *extra = run
-    arms, own = extra if extra else (np.zeros((len(t), 0)), None)
+    arms, own, raw = extra if extra else (np.zeros((len(t), 0)), None, None)
     if own is not None and not (system.nl and np.isfinite(own).all()):
         own = None  # the method has no multipliers of its own (NaN rows from _core._integrate)
     if scipy:
@@ -446,7 +484,8 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
                 adaptive=adaptive, beta=beta, gamma=gamma, alpha=alpha, rho_inf=rho_inf, newton_tol=newton_tol,
                 newton_max_iterations=newton_max_iterations, iteration_matrix=iteration_matrix, error_on=error_on)
     result = Result(system, t, q, qd, stats, method, interrupted, arms, own,
-                    dict(call, outputs=bool(outputs), fixed=fixed))
+                    dict(call, outputs=bool(outputs), fixed=fixed),
+                    sensitivities=sensitivities_.split(system, names, raw) if names else {})
     if failure is not None:
         message, time, cause = failure
         error = _core.SimulationError(message)

@@ -20,6 +20,10 @@ void tree_kinematics(const System& sys, Data& d);
 void dynamics_kinematics(const System& sys, Data& d);
 /// Whether ∂r/∂(q, q̇) is analytic (recursive) rather than differenced (4 nq residuals, Lagrange).
 inline bool analytic_derivatives(const System& sys) { return sys.algorithm == Algorithm::Recursive; }
+/// iteration_matrix=auto takes Krylov for recursive systems above this many free coordinates, the
+/// dense tangent below (measured: the dense factorisation is the cheaper up to about this size); the
+/// sensitivities use the analytic tangent up to it (sensitivities.hpp).
+constexpr int krylov_from_nq = 200;
 /// Whether M + diag δ has the O(n) articulated-body factorisation (recursive systems): the matrix-free
 /// Newton matrix's preconditioner (newton_matrix.hpp).
 inline bool articulated(const System& sys) { return sys.algorithm == Algorithm::Recursive; }
@@ -99,6 +103,8 @@ double project_onto_loops(const System& sys, Data& d, double t, VecX& q, VecX& q
 /// Factorises M + diag(δ) (δ (nq) ≥ 0) at the state of the last inverse_dynamics: O(n) by the
 /// articulated-body algorithm with δ as armature (recursive), dense Cholesky (Lagrange).
 void factor_armature(const System& sys, Data& d, const VecX& armature);
+/// The factorisation of M at the state of d for solve_armature (after dynamics_kinematics).
+void factor_mass(const System& sys, Data& d);
 /// After factor_armature: x = (M + diag δ)⁻¹ b (x may be b).
 void solve_armature(const System& sys, Data& d, const VecX& b, VecX& x);
 /// After factor_armature (or a forward dynamics, which leaves δ = 0 factorised): X = (M + diag δ)⁻¹ B,

@@ -44,7 +44,17 @@ class ElementLaw {
   /// The energy (J) it stores at length l, and the power (W) it dissipates at (l, l̇) with the force F.
   virtual double energy(double t, double l) const = 0;
   virtual double power(double t, double l, double ld, double F) const = 0;
+  /// A copy with the constant `name` set to `value` (a named parameter: parameters.hpp), unchecked;
+  /// std::invalid_argument for a name the law does not have.
+  virtual std::shared_ptr<const ElementLaw> with_constant(const std::string& name, double value) const = 0;
+  /// A copy with its profile (a cylinder's F(t), a winch's l_u(t)) replaced; std::invalid_argument if it has none.
+  virtual std::shared_ptr<const ElementLaw> with_profile(ProfilePtr profile) const = 0;
 };
+
+/// std::invalid_argument for a constant a law does not have.
+[[noreturn]] inline void unknown_constant(const std::string& name, const char* constants) {
+  bad("name", std::string("a constant of the element's law (") + constants + ")", "'" + name + "'");
+}
 
 /// A spring-damper (or a cylinder under force control):
 ///   F = −k (l − l₀) − c l̇ + λ (F₀ + F(t) + F_law(t, l, l̇)),  stores ½ k (l − l₀)², dissipates c l̇².
@@ -80,6 +90,20 @@ class SpringDamper final : public ElementLaw {
   bool dissipative() const override { return c_ != 0.0; }
   double energy(double, double l) const override { return 0.5 * k_ * std::pow(l - l0_, 2); }
   double power(double, double, double ld, double) const override { return c_ * std::pow(ld, 2); }
+  std::shared_ptr<const ElementLaw> with_constant(const std::string& name, double value) const override {
+    auto law = std::make_shared<SpringDamper>(*this);
+    if (name == "stiffness") law->k_ = value;
+    else if (name == "damping") law->c_ = value;
+    else if (name == "force") law->F0_ = value;
+    else unknown_constant(name, "stiffness, damping, force");
+    return law;
+  }
+  std::shared_ptr<const ElementLaw> with_profile(ProfilePtr profile) const override {
+    if (!profile_) bad("profile", "an element with a force profile F(t)", "one without");
+    auto law = std::make_shared<SpringDamper>(*this);
+    law->profile_ = std::move(profile);
+    return law;
+  }
 
  private:
   double k_;   ///< N/m
@@ -128,6 +152,19 @@ class Rope final : public ElementLaw {
   double power(double t, double, double ld, double F) const override {
     const auto [lu, lud] = unstretched_length(t);
     return F < 0.0 ? DA_ / lu * (ld - lud) * (ld - lud) : 0.0;
+  }
+  std::shared_ptr<const ElementLaw> with_constant(const std::string& name, double value) const override {
+    auto law = std::make_shared<Rope>(*this);
+    if (name == "EA") law->EA_ = value;
+    else if (name == "damping") law->DA_ = value;
+    else unknown_constant(name, "EA, damping");
+    return law;
+  }
+  std::shared_ptr<const ElementLaw> with_profile(ProfilePtr profile) const override {
+    if (!unstretched_) bad("profile", "a rope paid out by a winch (a profile l_u(t))", "one of constant length");
+    auto law = std::make_shared<Rope>(*this);
+    law->unstretched_ = std::move(profile);
+    return law;
   }
   /// l_u and l̇_u at t (m, m/s).
   std::pair<double, double> unstretched_length(double t) const {

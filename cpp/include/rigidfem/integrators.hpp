@@ -13,6 +13,7 @@
 #include <vector>
 
 #include "rigidfem/error_measure.hpp"
+#include "rigidfem/sensitivities.hpp"
 #include "rigidfem/system.hpp"
 
 namespace rigidfem {
@@ -70,6 +71,9 @@ struct IntegratorOptions {
   /// The outputs an adaptive method measures its local error on (error_measure.hpp), held to the
   /// scalars atol and rtol; empty: every component of the state [q, q̇] to its atol_i + rtol_i |y_i|.
   std::vector<OutputSpec> error_on;
+  /// Forward sensitivities (sensitivities.hpp) integrated with the state by the explicit Runge–Kutta methods
+  /// and the Newmark family; their error is not controlled (the steps are the state's).
+  std::vector<SensitivityParameter> sensitivities;
 };
 
 struct IntegratorStats {
@@ -99,6 +103,8 @@ struct Trajectory {
   /// (len t) x (nl) the multipliers the method solved for itself at each output (Stepper::multipliers:
   /// the Newmark family's), a row of size 0 where it has none (the forward dynamics' then stand).
   std::vector<VecX> lambda;
+  /// (len t) x (2 nq P) the sensitivities [S_q, S_q̇] of each parameter in turn; empty rows without them.
+  std::vector<VecX> sensitivities;
   IntegratorStats stats;
   bool interrupted = false;  ///< the monitor asked to stop: the trajectory ends early
   /// The exception that ended the run early — a SimulationError (numerical failure, max_steps),

@@ -164,6 +164,7 @@ class Model {
   const std::vector<Loop>& loops() const { return loops_; }
   const std::vector<Flow>& flows() const { return flows_; }
   const std::vector<ForceElement>& force_elements() const { return elements_; }
+  const std::vector<Load>& loads() const { return loads_; }
   /// Unique among the Models of this process (never 0): the `model` of the handles it makes.
   std::uint64_t id() const { return id_; }
   /// Takes the id of the model this one is a copy of (unpickling), before any body is added.

@@ -1,0 +1,57 @@
+/// A compiled system with some of its constants or profiles changed, without compiling its model again: what
+/// a named parameter of the Python API (rigidfem/parameters.py) sets. The constants are those the equations of
+/// motion are linear in — a body's pseudo-inertia H, a coordinate's spring k, damper c and applied force, a
+/// force element's constants, a load's force and torque — so a parameter's derivative of the residual
+/// r = M q̈ − f is the difference of two such systems' residuals (sensitivities.hpp). The profiles — a
+/// coordinate's drive, a force element's profile (a winch's l_u(t), a cylinder's F(t)), a load's scale and an
+/// actuator's length — carry the coefficients of the motions (the residual is not linear in those).
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "rigidfem/system.hpp"
+
+namespace rigidfem {
+
+/// New values of some constants of a System. NaN in a coordinate's field keeps its value.
+struct ConstantChanges {
+  struct CoordinateValues {
+    int body = -1, slot = 0;  ///< the coordinate: slot `slot` of body `body`'s joint
+    double stiffness = 0.0, damping = 0.0, force = 0.0;  ///< k (N/m, N·m/rad), c (N·s/m, N·m·s/rad), Q (N, N·m)
+  };
+  struct BodyInertia {
+    int body = -1;
+    Mat4 H = Mat4::Zero();  ///< pseudo-inertia ∫ r rᵀ dm, body frame (kg, kg·m, kg·m²)
+  };
+  struct ElementConstant {
+    int element = -1;
+    std::string name;  ///< the law's constant ("stiffness", "damping", "force"; a rope's "EA", "damping")
+    double value = 0.0;
+  };
+  struct LoadValues {
+    int load = -1;
+    Vec3 force = Vec3::Zero(), torque = Vec3::Zero();  ///< N, N·m
+  };
+  /// A new profile for what had one: "drive" (the coordinate at slot `index` of body `body`), "element", "load"
+  /// or "loop" (number `index`).
+  struct NewProfile {
+    std::string what;
+    int body = -1, index = -1;
+    ProfilePtr profile;
+  };
+  std::vector<CoordinateValues> coordinates;
+  std::vector<BodyInertia> bodies;
+  std::vector<ElementConstant> elements;
+  std::vector<LoadValues> loads;
+  std::vector<NewProfile> profiles;
+};
+
+/// A copy of sys with the changes applied (O(n): the tables are copied). std::invalid_argument naming the
+/// change that does not fit the system (a body, coordinate, element or load it does not have, an unknown
+/// constant, a pseudo-inertia without positive mass). Signs are not checked: the central differences of
+/// sensitivities.hpp step a constant at zero to both sides.
+std::shared_ptr<System> with_constants(const System& sys, const ConstantChanges& changes);
+
+}  // namespace rigidfem

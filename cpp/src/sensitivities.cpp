@@ -1,0 +1,171 @@
+// The sensitivity equations' directional derivatives and projection (sensitivities.hpp).
+#include "rigidfem/sensitivities.hpp"
+
+#include <algorithm>
+#include <tuple>
+
+#include "rigidfem/constraints.hpp"
+#include "rigidfem/dynamics.hpp"
+#include "rigidfem/kinematics.hpp"
+
+namespace rigidfem {
+
+namespace {
+
+double max_abs(const VecX& v) { return v.size() ? v.cwiseAbs().maxCoeff() : 0.0; }
+
+// The step ε of a central difference along (δq, δq̇): the largest relative change of q or q̇ is 6e-6, relative
+// to max(1, |x|) (0: the direction is zero).
+double direction_step(const VecX& q, const VecX& qd, const VecX& dq, const VecX& dqd) {
+  const double size = std::max(max_abs(dq) / std::max(1.0, max_abs(q)), max_abs(dqd) / std::max(1.0, max_abs(qd)));
+  return size > 0.0 ? 6e-6 / size : 0.0;
+}
+
+// R = M q̈ − f − Gᵀλ (nq) at (t, q, q̇, q̈, λ) on the workspace d of sys; with loops g, G, γ left in d.
+VecX step_residual(const System& sys, Data& d, double t, const VecX& q, const VecX& qd, const VecX& qdd,
+                   const VecX& lambda) {
+  set_state(sys, d, t, q, qd);
+  set_accelerations(sys, d, qdd);
+  dynamics_kinematics(sys, d);
+  VecX r = inverse_dynamics(sys, d);
+  if (sys.nl > 0) r -= free_jacobian(sys, d).transpose() * lambda;
+  return r;
+}
+
+// γ − G q̈ (nl) at (t, q, q̇) for the free accelerations q̈: the constraints' acceleration residual.
+VecX acceleration_constraint(const System& sys, Data& d, double t, const VecX& q, const VecX& qd, const VecX& qdd) {
+  loop_equations(sys, d, t, q, qd);
+  return d.gamma - free_jacobian(sys, d) * qdd;
+}
+
+}  // namespace
+
+SensitivityEquations::SensitivityEquations(const System& sys, const std::vector<SensitivityParameter>& parameters)
+    : sys_(sys), parameters_(parameters), d_(sys), e_(sys),
+      analytic_(analytic_derivatives(sys) && sys.nq <= krylov_from_nq) {
+  for (const SensitivityParameter& p : parameters_) {
+    plus_.push_back(p.plus ? std::make_unique<Data>(*p.plus) : nullptr);
+    minus_.push_back(p.minus ? std::make_unique<Data>(*p.minus) : nullptr);
+  }
+}
+
+VecX SensitivityEquations::initial() const {
+  const int m = 2 * sys_.nq;
+  VecX S(m * count());
+  for (int j = 0; j < count(); ++j) S.segment(m * j, m) = parameters_[j].S0;
+  return S;
+}
+
+void SensitivityEquations::rates(Data& fd, double t, const VecX& q, const VecX& qd, const Eigen::Ref<const VecX>& S,
+                                 Eigen::Ref<VecX> Sd) {
+  const int n = sys_.nq, nl = sys_.nl;
+  const VecX qdd = fd.qdd, lambda = nl ? VecX(fd.lambda) : VecX();
+  MatX G, Y, GY;
+  if (nl > 0) {  // Y = A⁻¹ Gᵀ with the forward dynamics' factorisation
+    G = free_jacobian(sys_, fd);
+    Y = solve_armature(sys_, fd, G.transpose());
+    GY = G * Y;
+  }
+  const VecX zero = VecX::Zero(n);
+  for (int j = 0; j < count(); ++j) {
+    const VecX dq = S.segment(2 * n * j, n), dqd = S.segment(2 * n * j + n, n);
+    VecX b = residual_derivative(j, t, q, qd, qdd, lambda, dq, dqd, zero, VecX::Zero(nl));
+    VecX x(n);
+    solve_armature(sys_, fd, -b, x);
+    if (nl > 0) x += Y * least_norm(GY, acceleration_constraint_derivative(t, q, qd, qdd, dq, dqd) - G * x);
+    Sd.segment(2 * n * j, n) = dqd;
+    Sd.segment(2 * n * j + n, n) = x;
+  }
+}
+
+VecX SensitivityEquations::residual_derivative(int j, double t, const VecX& q, const VecX& qd, const VecX& qdd,
+                                               const VecX& lambda, const VecX& dq, const VecX& dqd,
+                                               const VecX& dqdd, const VecX& dlambda) {
+  VecX R = VecX::Zero(sys_.nq);
+  if (analytic_) {
+    R = tangent_product(t, q, qd, qdd, dq, dqd, dqdd);
+    if (sys_.nl > 0) {  // −∂(Gᵀλ)/∂q δq by a central difference of G(q)ᵀλ (constraint forces: small terms), −Gᵀδλ
+      if (const double eps = direction_step(q, qd, dq, VecX::Zero(sys_.nq)); eps > 0.0) {
+        loop_equations(sys_, e_, t, q + eps * dq, qd);
+        const VecX up = free_jacobian(sys_, e_).transpose() * lambda;
+        loop_equations(sys_, e_, t, q - eps * dq, qd);
+        R -= (up - free_jacobian(sys_, e_).transpose() * lambda) / (2.0 * eps);
+      }
+      loop_equations(sys_, e_, t, q, qd);
+      R -= free_jacobian(sys_, e_).transpose() * dlambda;
+    }
+  } else {
+    // ∂R/∂(q, q̇, q̈) and ∂R/∂λ along the direction: one central difference, its step set by q and q̇ alone (R is
+    // linear in q̈ and λ: their terms have no truncation error, and a larger step keeps their round-off small)
+    double eps = direction_step(q, qd, dq, dqd);
+    if (eps == 0.0) {
+      const double size = std::max(max_abs(dqdd) / std::max(1.0, max_abs(qdd)),
+                                   dlambda.size() ? max_abs(dlambda) / std::max(1.0, max_abs(lambda)) : 0.0);
+      eps = size > 0.0 ? 1.0 / size : 0.0;
+    }
+    if (eps > 0.0) {
+      const VecX up = step_residual(sys_, e_, t, q + eps * dq, qd + eps * dqd, qdd + eps * dqdd,
+                                    sys_.nl ? VecX(lambda + eps * dlambda) : lambda);
+      R = (up - step_residual(sys_, e_, t, q - eps * dq, qd - eps * dqd, qdd - eps * dqdd,
+                              sys_.nl ? VecX(lambda - eps * dlambda) : lambda)) /
+          (2.0 * eps);
+    }
+  }
+  // ∂R/∂p = (R(p + h) − R(p))/h: R is linear in the constants the parameter sets; a profile's coefficient by
+  // the central difference (R(p + h) − R(p − h))/(2h)
+  const SensitivityParameter& p = parameters_[j];
+  if (p.plus) {
+    const VecX up = step_residual(*p.plus, *plus_[j], t, q, qd, qdd, lambda);
+    if (p.minus)
+      R += (up - step_residual(*p.minus, *minus_[j], t, q, qd, qdd, lambda)) / (2.0 * p.h);
+    else
+      R += (up - step_residual(sys_, e_, t, q, qd, qdd, lambda)) / p.h;
+  }
+  return R;
+}
+
+VecX SensitivityEquations::acceleration_constraint_derivative(double t, const VecX& q, const VecX& qd,
+                                                               const VecX& qdd, const VecX& dq, const VecX& dqd) {
+  VecX c = VecX::Zero(sys_.nl);
+  if (const double eps = direction_step(q, qd, dq, dqd); eps > 0.0) {
+    const VecX up = acceleration_constraint(sys_, e_, t, q + eps * dq, qd + eps * dqd, qdd);
+    c = (up - acceleration_constraint(sys_, e_, t, q - eps * dq, qd - eps * dqd, qdd)) / (2.0 * eps);
+  }
+  return c;
+}
+
+VecX SensitivityEquations::tangent_product(double t, const VecX& q, const VecX& qd, const VecX& qdd, const VecX& dq,
+                                           const VecX& dqd, const VecX& dqdd) {
+  if (K_.size() == 0 || t != tangent_t_ || q != tangent_q_ || qd != tangent_qd_ || qdd != tangent_qdd_) {
+    std::tie(K_, C_) = inverse_dynamics_derivatives(sys_, d_, t, q, qd, qdd);
+    M_ = mass_matrix(sys_, d_, t, q);
+    tangent_t_ = t, tangent_q_ = q, tangent_qd_ = qd, tangent_qdd_ = qdd;
+  }
+  return K_ * dq + C_ * dqd + M_ * dqdd;
+}
+
+void SensitivityEquations::project(double t, const VecX& q, const VecX& qd, Eigen::Ref<VecX> S) {
+  if (sys_.nl == 0) return;
+  const int n = sys_.nq;
+  VecX dq = S.head(n), dqd = S.tail(n);
+  loop_equations(sys_, d_, t, q, qd);
+  const MatX G = free_jacobian(sys_, d_);
+  factor_mass(sys_, d_);
+  const MatX Y = solve_armature(sys_, d_, G.transpose());
+  const MatX GY = G * Y;
+  dq -= Y * least_norm(GY, G * dq);
+  // ∂ġ/∂q δq along the projected δq, by a central difference of ġ(q ± ε δq, q̇)
+  VecX dgd_dq = VecX::Zero(sys_.nl);
+  const VecX zero = VecX::Zero(n);
+  if (const double eps = direction_step(q, qd, dq, zero); eps > 0.0) {
+    loop_equations(sys_, e_, t, q + eps * dq, qd);
+    const VecX up = e_.gd;
+    loop_equations(sys_, e_, t, q - eps * dq, qd);
+    dgd_dq = (up - e_.gd) / (2.0 * eps);
+  }
+  dqd -= Y * least_norm(GY, G * dqd + dgd_dq);
+  S.head(n) = dq;
+  S.tail(n) = dqd;
+}
+
+}  // namespace rigidfem
