@@ -114,7 +114,7 @@ AutoChoice::AutoChoice(const System& sys, const IntegratorOptions& o, const Tole
     explicit_tol_.measure = nullptr;
     explicit_tol_.atol = tighten * (o.atol.size() == 1 ? VecX::Constant(2 * n, o.atol(0)) : o.atol);
   }
-  stats.omega_max = spectral_radius(sys, t0, y0.head(n), y0.segment(n, n), y0.tail(sys.nz), stats.rhs_evaluations);
+  stats.omega_max = spectral_radius(sys, t0, y0.head(n), y0.segment(n, n), y0.segment(2 * n, sys.nz), stats.rhs_evaluations);
   IntegratorOptions stiff = o_;
   stiff.method = o_.stiff_method;
   direct_ = std::isfinite(stats.omega_max) && span_ * stats.omega_max >= direct_steps * dopri5_stability;

@@ -106,7 +106,7 @@ void ErrorMeasure::at(double t, const VecX& y) {
     }
   if (need_loops_) {
     if (!dl_) dl_ = std::make_unique<Data>(sys_);
-    set_arm_forces(sys_, *dl_, y.tail(sys_.nz));
+    set_arm_forces(sys_, *dl_, y.segment(2 * n, sys_.nz));
     forward_dynamics(sys_, *dl_, t, y.head(n), y.segment(n, n));
     lambda_ = dl_->lambda;
   }
@@ -175,7 +175,7 @@ double ErrorMeasure::norm(const Eigen::Ref<const VecX>& e, double h, double atol
         if (size == 0.0) break;
         const double s = 1e-7 * (1.0 + y_.head(2 * n).cwiseAbs().maxCoeff()) / size;
         ye_ = y_.head(2 * n) + s * e.head(2 * n);
-        set_arm_forces(sys_, *dl_, y_.tail(sys_.nz));
+        set_arm_forces(sys_, *dl_, y_.segment(2 * n, sys_.nz));
         forward_dynamics(sys_, *dl_, t_, ye_.head(n), ye_.tail(n));
         const int r0 = sys_.loop_row[o.index], rows = sys_.loop_row[o.index + 1] - r0;
         eps = ((dl_->lambda.segment(r0, rows) - lambda_.segment(r0, rows)) / s).cwiseAbs().maxCoeff();

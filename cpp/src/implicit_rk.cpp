@@ -107,7 +107,7 @@ class ImplicitRk : public Stepper {
   /// The initial acceleration, q̈_0 = M⁻¹ f at (t0, q0, q̇0, s0).
   void start(double t0, const VecX& y0) override {
     ++stats_.rhs_evaluations;
-    q_ = y0.head(n_), v_ = y0.segment(n_, n_), s_ = y0.tail(sys_.nz);
+    q_ = y0.head(n_), v_ = y0.segment(n_, n_), s_ = y0.segment(2 * n_, sys_.nz);
     set_arm_forces(sys_, d_, s_);
     a_ = forward_dynamics(sys_, d_, t0, q_, v_);
     lambda_ = d_.lambda;  // with loops, the multipliers of the initial state too
@@ -712,7 +712,67 @@ class Radau5 final : public ImplicitRk {
     }
     stage_values(h);
     q1_ = Q_.col(2), v1_ = V_.col(2), a1_ = A_.col(2);
+    if (sens_) stage_sensitivities(t, h);
     return true;
+  }
+
+  /// The sensitivities' stages (the staggered direct method) after the state's have converged: δA (nq, 3) with
+  /// δV = δq̇_n 1ᵀ + h δA aᵀ, δQ = δq_n 1ᵀ + h δV aᵀ solving each stage's differentiated equations
+  ///   R_i = K δQ_i + C δV_i + M δA_i − ∂(G_iᵀλ_i)/∂q δQ_i − G_iᵀ δλ_i + ∂r/∂p = 0   (loops: G_i δA_i = D(γ_i − G_i A_i))
+  /// by simplified Newton with the step's matrix (solve_stages and, with loops, close_loops_correction), until
+  /// the corrections move δQ and δV by less than 1e-9 of them or stall at the differences' noise (1e-6 of δA).
+  void stage_sensitivities(double t, double h) {
+    const int P = sens_->count(), nl = sys_.nl;
+    Sq1_.resize(n_, P), Sv1_.resize(n_, P), Sa1_.resize(n_, P);
+    const MatX A = A_, V = V_, Q = Q_, L = L_;  // the converged stages (the loop correction below reuses L_, D_)
+    if (nl > 0)
+      for (int i = 0; i < 3; ++i) loop_equations(sys_, d_, t + tab_.c(i) * h, Q.col(i), V.col(i)), G_[i] = free_jacobian(sys_, d_);
+    MatX dA(n_, 3), dV(n_, 3), dQ(n_, 3), R(n_, 3), dL = MatX::Zero(nl, 3);
+    for (int j = 0; j < P; ++j) {
+      dA.colwise() = VecX(Sa_.col(j));
+      dL.setZero();
+      double previous = 0.0;
+      for (int it = 0;; ++it) {
+        interruption_point();
+        dV.noalias() = h * dA * tab_.a.transpose();
+        dV.colwise() += VecX(Sv_.col(j));
+        dQ.noalias() = h * dV * tab_.a.transpose();
+        dQ.colwise() += VecX(Sq_.col(j));
+        if (it == std::max(20, max_it_))
+          step_failure(t, h, "the sensitivities' corrections did not converge with the Newton matrix");
+        for (int i = 0; i < 3; ++i) {
+          const double ti = t + tab_.c(i) * h;
+          R.col(i) = sens_->residual_derivative(j, ti, Q.col(i), V.col(i), A.col(i), nl ? VecX(L.col(i)) : VecX(),
+                                                dQ.col(i), dV.col(i), dA.col(i), nl ? VecX(dL.col(i)) : VecX());
+          if (nl > 0)
+            Cres_.col(i) = sens_->acceleration_constraint_derivative(ti, Q.col(i), V.col(i), A.col(i), dQ.col(i),
+                                                                     dV.col(i)) - G_[i] * dA.col(i);
+        }
+        solve_stages(R, D_);
+        D_ = -D_;
+        if (nl > 0) {
+          L_ = dL;
+          close_loops_correction();
+          dL = L_;
+        }
+        dA += D_;
+        if (!dA.allFinite()) step_failure(t, h, "the sensitivities became NaN or inf");
+        // the increments (ΔV, ΔQ) = (h ΔA aᵀ, h ΔV aᵀ) against the stages' δV, δQ
+        const double change = D_.cwiseAbs().maxCoeff();
+        const MatX incV = h * D_ * tab_.a.transpose(), incQ = h * incV * tab_.a.transpose();
+        if (incQ.cwiseAbs().maxCoeff() <= 1e-9 * dQ.cwiseAbs().maxCoeff() &&
+            incV.cwiseAbs().maxCoeff() <= 1e-9 * dV.cwiseAbs().maxCoeff())
+          break;
+        if (it > 0 && change > 0.5 * previous && change <= 1e-6 * dA.cwiseAbs().maxCoeff()) break;
+        previous = change;
+      }
+      dV.noalias() = h * dA * tab_.a.transpose();
+      dV.colwise() += VecX(Sv_.col(j));
+      dQ.noalias() = h * dV * tab_.a.transpose();
+      dQ.colwise() += VecX(Sq_.col(j));
+      Sq1_.col(j) = dQ.col(2), Sv1_.col(j) = dV.col(2), Sa1_.col(j) = dA.col(2);
+    }
+    L_ = L;
   }
 
   /// The multipliers' first iterate, as predict's for A: the last step's stage multipliers continued

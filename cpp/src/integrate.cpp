@@ -350,16 +350,9 @@ SimulationError explained(const SimulationError& e, const System& sys, const Vec
   return SimulationError(e.time, e.cause + gimbal_lock_hint(sys, last_q, 1e-3));
 }
 
-/// std::invalid_argument unless the run's sensitivities fit the system and a method that integrates them.
+/// std::invalid_argument unless the run's sensitivities fit the system (every C++ method integrates them).
 void check_sensitivities(const System& sys, const IntegratorOptions& o) {
   if (o.sensitivities.empty()) return;
-  const Method m = o.method;
-  const bool integrates = method_info(m).make == make_newmark || m == Method::Esdirk43 ||
-                          (method_info(m).make == make_runge_kutta && m != Method::Auto);
-  if (!integrates)
-    throw std::invalid_argument(std::string("method: expected a method that integrates sensitivities (euler, "
-                                            "symplectic_euler, rk4, dopri5, rkf45, newmark, hht, generalized_alpha, "
-                                            "implicit_spring, esdirk43), got '") + method_name(m) + "'");
   if (sys.nz > 0)
     throw std::invalid_argument("sensitivities: not available for a system with Maxwell arms (it has " +
                                 std::to_string(sys.nz) + " arm forces as internal variables)");

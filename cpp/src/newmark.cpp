@@ -66,7 +66,7 @@ class NewmarkFamily final : public Stepper {
   void start(double t0, const VecX& y0) override {
     ++stats_.rhs_evaluations;
     const int n = sys_.nq;
-    const VecX q0 = y0.head(n), qd0 = y0.segment(n, n), s0 = y0.tail(sys_.nz);
+    const VecX q0 = y0.head(n), qd0 = y0.segment(n, n), s0 = y0.segment(2 * n, sys_.nz);
     set_arm_forces(sys_, d_, s0);
     const VecX qdd = forward_dynamics(sys_, d_, t0, q0, qd0);
     s_ = {q0, qd0, qdd, qdd, d_.lambda, s0, {}, {}, {}, {}, {}};

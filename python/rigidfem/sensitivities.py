@@ -9,8 +9,9 @@ value, ``"q0[<coordinate>]"`` or ``"qd0[<coordinate>]"``. Differentiating A(q; p
 
 (with closed loops also Gᵀ δλ and G S̈ = δγ). The explicit Runge–Kutta methods integrate S with the same
 stages as the state, so S is the derivative of their discrete solution at the same steps; the Newmark family
-(newmark, hht, generalized_alpha, implicit_spring) and esdirk43 solve each step's (stage's) differentiated
-equations with their own Newton matrix after the step has converged (the staggered direct method). ∂r/∂p = (r(p + h) − r(p))/h with
+(newmark, hht, generalized_alpha, implicit_spring), esdirk43 and radau5 solve each step's (stages')
+differentiated equations with their own Newton matrix after the step has converged (the staggered direct
+method); auto carries them through its probe and hand-over. ∂r/∂p = (r(p + h) − r(p))/h with
 the system at p + h (``System.with_parameters``: the constants a parameter sets enter the residual linearly,
 so this is exact to round-off; a profile's number by a central difference); the derivatives along S are the
 analytic tangent's K S_q + C S_q̇ (recursive systems up to 200 coordinates: O(n²) per state, shared by the
@@ -22,8 +23,8 @@ state (the derivative of its projection); an initial value moves along the loops
 closes them.
 
 ``Result.sensitivity(name)`` returns (∂q/∂p, ∂q̇/∂p), each (len t, nq); ``Result.position_sensitivity(point,
-name)`` the derivative (len t, 3) of a point's position. Not yet: radau5 and auto (ValueError
-naming the methods that integrate them), Maxwell arms, an actuator's length profile.
+name)`` the derivative (len t, 3) of a point's position. Not yet: Maxwell arms, an actuator's length
+profile.
 """
 
 from __future__ import annotations

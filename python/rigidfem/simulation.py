@@ -357,8 +357,8 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
         for fixed steps); it is computed on first use otherwise.
     sensitivities : list of str, optional
         Forward sensitivities by these named parameters (``System.parameters``) or initial values
-        (``"q0[<coordinate>]"``, ``"qd0[<coordinate>]"``), integrated with the state by the explicit
-        methods, the Newmark family and esdirk43 (``rigidfem.sensitivities``); ``Result.sensitivity(name)`` and
+        (``"q0[<coordinate>]"``, ``"qd0[<coordinate>]"``), integrated with the state by every C++
+        method (``rigidfem.sensitivities``); ``Result.sensitivity(name)`` and
         ``Result.position_sensitivity(point, name)`` return them.
     **options
         The integrator's options (``rigidfem.integrator_options``):
