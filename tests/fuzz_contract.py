@@ -1804,6 +1804,16 @@ class Gen:
         if self.chance(0.1):
             kw["first_step"] = A(self.choice(["0.0", "-1.0", "nan"]), bad=True) if self.chance(0.3) and checked else \
                 A(fl(span / 100))
+        if self.chance(0.1):
+            # sensitivities by up to two parameters or an initial value (a system with Maxwell arms refuses them:
+            # soft), or a bad list
+            if self.chance(0.7):
+                kw["sensitivities"] = A(self.choice(["list(system.parameters)[:2]", "list(system.parameters)[-1:]",
+                                                     "['q0[' + system.coordinate_names[0] + ']'] if system.nq else []"]),
+                                        soft=True, names=("sensitivities", "method"))
+            else:
+                kw["sensitivities"] = A(self.choice(["['nope']", "'x'", "[3]", "list(system.parameters)[:1] * 2 or ['z']"]),
+                                        bad=True, names=("sensitivities",))
         if self.chance(0.05):
             kw["stiffness_warning"] = A("False")
         if self.chance(0.03):
@@ -1920,7 +1930,18 @@ class Gen:
                 self.emit(f"rf.stages.{name}", [A("system"), da], ["system", "data"], label=f"stages.{name}")
 
     def misc_call(self):
-        kind = self.choice(["coordinate_index", "beam", "profile", "centerline"])
+        kind = self.choice(["coordinate_index", "beam", "profile", "centerline", "parameters"])
+        if kind == "parameters":
+            # every parameter scaled by 1.5 keeps its sign (a valid change), or one unknown, NaN or a non-dict
+            if self.chance(0.6):
+                # (a profile's numbers scaled may leave what its maker takes: a ValueError naming values)
+                e = "{n: p.value * 1.5 for n, p in system.parameters.items()}"
+                return self.emit("system.with_parameters", [A(e, soft=True, names=("values",))], ["values"],
+                                 label="with_parameters")
+            e = self.choice(["{'nope': 1.0}", "{next(iter(system.parameters), 'nope'): nan}", "[('x', 1.0)]",
+                             "{next(iter(system.parameters), 'nope'): 'x'}"])
+            return self.emit("system.with_parameters", [A(e, bad=True, names=("values",), soft=False)], ["values"],
+                             label="with_parameters")
         if kind == "coordinate_index":
             e = self.choice(["'nope'", "3", "None"] + [f"'{b['name']}.{c}'" for b in self.bodies for c in b["coords"]
                                                        if c not in b["prescribed"]][:4])

@@ -59,6 +59,52 @@ def test_inverse_dynamics_derivatives_on_random_trees(seed, nbodies):
                                system.mass_matrix(t, q) @ qdd, rtol=0, atol=1e-10 * max(1, np.abs(qdd).max()))
 
 
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), nbodies=st.integers(1, 7))
+def test_directional_derivative_is_the_tangent_along_a_direction(seed, nbodies):
+    """The RNEA's forward mode along (δq, δq̇, δq̈), O(n), is K δq + C δq̇ + A δq̈ of the analytic matrices (each
+    checked against differences above) to round-off: random trees with every joint, drives, loads and a
+    force law."""
+    model, rng = loaded_random_tree(seed, nbodies)
+    system = model.compile("recursive")
+    n = system.nq
+    if n == 0:
+        return
+    t = float(rng.uniform(0, 3))
+    q, qd, qdd = rng.uniform(-1, 1, n), rng.uniform(-2, 2, n), rng.normal(0, 3, n)
+    dq, dqd, dqdd = rng.normal(0, 1, n), rng.normal(0, 1, n), rng.normal(0, 1, n)
+    K, C = system.inverse_dynamics_derivatives(t, q, qd, qdd)
+    expected = K @ dq + C @ dqd + system.mass_matrix(t, q) @ dqdd
+    got = system._inverse_dynamics_direction(t, q, qd, qdd, dq, dqd, dqdd)
+    np.testing.assert_allclose(got, expected, rtol=0, atol=1e-10 * max(1.0, np.abs(expected).max()))
+
+
+def test_directional_derivative_with_elements_flows_and_beams():
+    """The same on what random trees lack: force elements and a rope, a link of varying length, a beam."""
+    model = rf.Model(gravity=(0.0, -9.81, 0.0))
+    hub = model.add_body("hub", model.ground, rf.Joint.revolute("z"), 1.0, (1.0, 1.0, 1.0))
+    model.prescribe(hub, rf.motion.harmonic(0.6, 2.0, 0.3))
+    tape = model.add_beam("tape", hub, rf.motion.polynomial([0.5, 0.8, -0.3]), rf.Material(E=2.1e9, rho=7850.0),
+                          rf.Section.rectangle(0.02, 0.004), 4, deform=("bend_y", "bend_z", "torsion"),
+                          joint=rf.Joint.revolute("y", stiffness=30.0), placement=rf.transform((0.1, 0.0, 0.0)))
+    arm = model.add_beam("arm", model.ground, 1.0, rf.Material(E=2e9, rho=2700.0), rf.Section.rectangle(0.02, 0.01), 3,
+                         joint=rf.Joint.spherical(), placement=rf.transform((0.0, 1.0, 0.0)))
+    model.add_spring_damper(tape.tip, arm.tip, stiffness=50.0, damping=2.0, length=0.3)
+    model.add_rope(arm.point(0.5), model.ground, EA=1e4, damping=10.0, length=0.5)
+    model.add_force(arm.tip, (0.0, 1.0, 2.0), follower=True)
+    system = model.compile()
+    rng = np.random.default_rng(2)
+    n = system.nq
+    for _ in range(3):
+        t = float(rng.uniform(0, 1))
+        q, qd, qdd = rng.uniform(-0.3, 0.3, n), rng.uniform(-1, 1, n), rng.normal(0, 3, n)
+        dq, dqd, dqdd = rng.normal(0, 1, n), rng.normal(0, 1, n), rng.normal(0, 1, n)
+        K, C = system.inverse_dynamics_derivatives(t, q, qd, qdd)
+        expected = K @ dq + C @ dqd + system.mass_matrix(t, q) @ dqdd
+        got = system._inverse_dynamics_direction(t, q, qd, qdd, dq, dqd, dqdd)
+        np.testing.assert_allclose(got, expected, rtol=0, atol=1e-10 * np.abs(expected).max())
+
+
 @settings(max_examples=15, deadline=None)
 @given(seed=st.integers(0, 2**32 - 1), nbodies=st.integers(1, 6))
 def test_acceleration_derivatives_and_jacobian_on_random_trees(seed, nbodies):

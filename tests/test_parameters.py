@@ -94,13 +94,13 @@ def test_bad_values():
     s = build()
     with pytest.raises(ValueError, match="values: expected a parameter of this system .*'strip.E'.*got 'strip.e'"):
         s.with_parameters({"strip.e": 1.0})
-    with pytest.raises(ValueError, match="strip.rho: expected a finite value > 0 in kg/m³"):
+    with pytest.raises(ValueError, match="values: expected strip.rho to be a finite value > 0 in kg/m³"):
         s.with_parameters({"strip.rho": -1.0})
-    with pytest.raises(ValueError, match="hub.mass: expected a finite value > 0"):
+    with pytest.raises(ValueError, match="values: expected hub.mass to be a finite value > 0"):
         s.with_parameters({"hub.mass": float("nan")})
-    with pytest.raises(ValueError, match="spring.stiffness: expected a finite value >= 0"):
+    with pytest.raises(ValueError, match="values: expected spring.stiffness to be a finite value >= 0"):
         s.with_parameters({"spring.stiffness": -3.0})
-    with pytest.raises(ValueError, match="strip.E"):
+    with pytest.raises(ValueError, match="values: expected strip.E to be .*got 'stiff'"):
         s.with_parameters({"strip.E": "stiff"})
     with pytest.raises(ValueError, match="values: expected a dict"):
         s.with_parameters([("strip.E", 1.0)])
@@ -130,5 +130,5 @@ def test_profile_numbers_are_parameters():
                                  ("jack.profile.amplitude", 20.0, "amplitude"), ("gust.scale.coefficients[0]", 4.0, "scale")]:
         np.testing.assert_array_equal(s.with_parameters({name: value}).forward_dynamics(1.5, q, qd),
                                       crane(**{keyword: value}).forward_dynamics(1.5, q, qd))
-    with pytest.raises(ValueError, match=r"boom.rz.drive.parts\[0\].omega: expected a finite value in"):
+    with pytest.raises(ValueError, match=r"values: expected boom.rz.drive.parts\[0\].omega to be a finite value in"):
         s.with_parameters({"boom.rz.drive.parts[0].omega": float("inf")})

@@ -306,6 +306,17 @@ void bind_dynamics(py::module_& m) {
           "(dr/dq, dr/dqd), each (nq, nq), of r = A qdd - f: analytic through the RNEA for recursive\n"
           "systems (O(n) per column), central differences for algorithm='lagrange'.")
       .def(
+          "_inverse_dynamics_direction",
+          [](const System& s, double t, const RefV& q, const RefV& qd, const RefV& qdd, const VecX& dq, const VecX& dqd,
+             const VecX& dqdd) {
+            check_vector(dq, s.nq, "dq", "nq"), check_vector(dqd, s.nq, "dqd", "nq"), check_vector(dqdd, s.nq, "dqdd", "nq");
+            Workspace d(s);
+            return rigidfem::inverse_dynamics_direction(s, *d, t, q, qd, qdd, dq, dqd, dqdd);
+          },
+          py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("dq"), py::arg("dqd"), py::arg("dqdd"),
+          "(dr/dq) dq + (dr/dqd) dqd + A dqdd (nq): the RNEA's forward-mode derivative along one direction (recursive:\n"
+          "exact, O(n)), central differences (lagrange).")
+      .def(
           "acceleration_derivatives",
           [](const System& s, double t, const RefV& q, const RefV& qd) {
             Workspace d(s);

@@ -25,11 +25,14 @@ double law_derivative(const Coordinate& c, const Data& d, int i, bool rate) {
   return (up - down) / (2.0 * h);
 }
 
-// Tangents of the RNEA quantities along one direction (one coordinate's q or q̇).
+// Tangents of the RNEA quantities along one direction (one coordinate's q or q̇, or any (δq, δq̇, δq̈)).
 struct Tangent {
-  explicit Tangent(const System& sys) : inside(sys.nbodies), v(sys.nbodies), a(sys.nbodies), f(sys.nbodies) {}
-  std::vector<char> inside;  // body in the subtree carried by the coordinate
-  std::vector<Vec6> v, a, f;  // δv_p, δa_p, δf̄_p
+  explicit Tangent(const System& sys)
+      : inside(sys.nbodies), W(sys.nbodies, Vec6::Zero()), v(sys.nbodies, Vec6::Zero()), a(sys.nbodies),
+        f(sys.nbodies) {}
+  std::vector<char> inside;  // body moved by the direction (its frame, or its velocity)
+  std::vector<Vec6> W;       // the twist δT_p T_p⁻¹ that carries body p's frame (zero: it stays)
+  std::vector<Vec6> v, a, f;  // δv_p, δa_p, δf̄_p (v zero for a body the direction leaves)
 };
 
 // A load on a body (the load's own point moving with it: the geometric term of the tangent).
@@ -39,13 +42,12 @@ struct BodyLoad {
   AppliedLoad load;
 };
 
-// δ(r, ṙ) of a point x (global) of body b along the direction of the tangent w: a point carried
-// by the coordinate moves by δx = s_v + s_ω × x (position), and its velocity ṙ = v_O + ω × x
-// changes by δv_O + δω × x + ω × δx.
-std::pair<Vec3, Vec3> point_tangent(const Data& d, const Tangent& w, int b, const Vec3& x, const Vec6& s,
-                                    bool position) {
+// δ(r, ṙ) of a point x (global) of body b along the direction of the tangent w: a point of a body carried by
+// the twist W_b moves by δx = W_v + W_ω × x, and its velocity ṙ = v_O + ω × x changes by δv_O + δω × x + ω × δx.
+std::pair<Vec3, Vec3> point_tangent(const Data& d, const Tangent& w, int b, const Vec3& x) {
   if (b < 0 || !w.inside[b]) return {Vec3::Zero(), Vec3::Zero()};
-  const Vec3 dx = position ? Vec3(s.tail<3>() + s.head<3>().cross(x)) : Vec3::Zero();
+  const Vec6& W = w.W[b];
+  const Vec3 dx = W.tail<3>() + W.head<3>().cross(x);
   return {dx, w.v[b].tail<3>() + w.v[b].head<3>().cross(x) + d.v[b].head<3>().cross(dx)};
 }
 
@@ -53,10 +55,9 @@ std::pair<Vec3, Vec3> point_tangent(const Data& d, const Tangent& w, int b, cons
 // under the fixed force is the geometric term of BodyLoad): with δd = δr_B − δr_A,
 //   δe = (1 − e eᵀ) δd / l,  δl = e·δd,  δl̇ = δe·ḋ + e·δḋ,  δf_B = (F_l δl + F_l̇ δl̇) e + F δe,
 // applied at r_B and r_A as −δf_ext.
-void element_tangent(const System& sys, const Data& d, const ForceElement& E, const ElementState& st, const Vec6& s,
-                     bool position, Tangent& w) {
-  const auto [dxb, dvb] = point_tangent(d, w, E.body_b, st.xb, s, position);
-  const auto [dxa, dva] = point_tangent(d, w, E.body_a, st.xa, s, position);
+void element_tangent(const Data& d, const ForceElement& E, const ElementState& st, Tangent& w) {
+  const auto [dxb, dvb] = point_tangent(d, w, E.body_b, st.xb);
+  const auto [dxa, dva] = point_tangent(d, w, E.body_a, st.xa);
   const Vec3 dd = dxb - dxa, ddd = dvb - dva;
   if (dd.isZero(0.0) && ddd.isZero(0.0)) return;
   const Vec3 de = (dd - st.e * st.e.dot(dd)) / st.l;
@@ -71,20 +72,53 @@ void element_tangent(const System& sys, const Data& d, const ForceElement& E, co
 }
 
 // The change of the loads of the flowing material on one rfe (flow_loads) along the tangent (the
-// motion of their points under fixed forces is the geometric term of BodyLoad): its axis turns,
-// δe = s_ω × e when carried (position), and its angular velocity changes by δω;
+// motion of their points under fixed forces is the geometric term of BodyLoad): its axis turns with the
+// rfe's twist, δe = W_ω × e, and its angular velocity changes by δω;
 //   δF_C = −m (2 α (δω × e + ω × δe) + β δe) at x_C,  δF_turn = −ρA α² (δe − δe_prev) at the origin.
-void flow_tangent(const FlowTerm& f, const Vec6& s, bool position, Tangent& w) {
+void flow_tangent(const FlowTerm& f, Tangent& w) {
   const bool carried = w.inside[f.body];
-  const bool prev_carried = position && f.prev >= 0 && w.inside[f.prev];
+  const bool prev_carried = f.prev >= 0 && w.inside[f.prev];
   if (!carried && !prev_carried) return;
-  const Vec3 de = position && carried ? Vec3(s.head<3>().cross(f.e)) : Vec3::Zero();
-  const Vec3 de_prev = prev_carried ? Vec3(s.head<3>().cross(f.e_prev)) : Vec3::Zero();
+  const Vec3 de = carried ? Vec3(w.W[f.body].head<3>().cross(f.e)) : Vec3::Zero();
+  const Vec3 de_prev = prev_carried ? Vec3(w.W[f.prev].head<3>().cross(f.e_prev)) : Vec3::Zero();
   const Vec3 dw = carried ? Vec3(w.v[f.body].head<3>()) : Vec3::Zero();
   const Vec3 dF_c = -f.m * (2.0 * f.alpha * (dw.cross(f.e) + f.omega.cross(de)) + f.beta * de);
   const Vec3 dF_turn = -f.rhoA * f.alpha * f.alpha * (de - de_prev);
   w.f[f.body].head<3>() -= f.xc.cross(dF_c) + f.origin.cross(dF_turn);
   w.f[f.body].tail<3>() -= dF_c + dF_turn;
+}
+
+// The loads, element states and flowing rfes' terms at the state of d (after the RNEA): what the tangents of
+// the loads' and elements' forces start from.
+struct LoadTerms {
+  std::vector<BodyLoad> loads;
+  std::vector<ElementState> elements;
+  std::vector<FlowTerm> flows;
+  LoadTerms(const System& sys, const Data& d) {
+    for_each_body_load(sys, d, true, [&](int body, const AppliedLoad& a, bool follower) {
+      loads.push_back({body, follower, a});
+    });
+    for (const ForceElement& E : sys.elements) elements.push_back(element_state(d, E, true));
+    for_each_flow_term(sys, d, true, [&](const FlowTerm& f) { flows.push_back(f); });
+  }
+};
+
+// The loads' change along the tangent: a follower load turns with its body's twist W, δf = W ×* f; a fixed
+// one keeps its force while its point moves by δx = W_v + W_ω × x: the moment δx × F.
+void loads_tangent(const std::vector<BodyLoad>& loads, Tangent& w) {
+  for (const BodyLoad& L : loads) {
+    if (!w.inside[L.body]) continue;
+    const Vec6& W = w.W[L.body];
+    const AppliedLoad& l = L.load;
+    if (L.follower) {
+      Vec6 fl;
+      fl << l.x.cross(l.F) + l.tau, l.F;
+      w.f[L.body] -= crossf(W, fl);
+    } else {
+      const Vec3 dx = W.tail<3>() + W.head<3>().cross(l.x);
+      w.f[L.body].head<3>() -= dx.cross(l.F);
+    }
+  }
 }
 
 // Column ∂r/∂q_j (position) or ∂r/∂q̇_j (rate) for the coordinate j with use uj on body bj,
@@ -101,8 +135,12 @@ void tangent_column(const System& sys, const Data& d, const std::vector<BodyLoad
   auto turned = [&](int p, int u) { return position && w.inside[p] && (p != bj || u > uj); };
   for (int p = 0; p < sys.nbodies; ++p) {
     w.inside[p] = p == bj || (p > bj && sys.parent[p] >= 0 && w.inside[sys.parent[p]]);  // parent[p] < p
+    // the frame of a body after the coordinate's use turns with s (its own body: the uses after it do, the
+    // frame itself does too: the body frame is after all its joint's uses)
+    w.W[p] = position && w.inside[p] ? s : Vec6::Zero();
     if (!w.inside[p]) {
       w.f[p].setZero();
+      w.v[p].setZero();
       continue;
     }
     const int lam = sys.parent[p];
@@ -127,23 +165,9 @@ void tangent_column(const System& sys, const Data& d, const std::vector<BodyLoad
     w.f[p] = I * da + crossf(dv, I * d.v[p]) + crossf(d.v[p], I * dv);
     if (position) w.f[p] += turned_inertia_times(s, I, d.a[p]) + crossf(d.v[p], turned_inertia_times(s, I, d.v[p]));
   }
-  // Loads on carried bodies: a point fixed in the body moves with velocity v_s + ω_s × x;
-  // a follower load turns with the body, δf = s ×* f.
-  for (std::size_t k = 0; position && k < loads.size(); ++k) {
-    const BodyLoad& L = loads[k];
-    if (!w.inside[L.body]) continue;
-    const AppliedLoad& l = L.load;
-    if (L.follower) {
-      Vec6 fl;
-      fl << l.x.cross(l.F) + l.tau, l.F;
-      w.f[L.body] -= crossf(s, fl);
-    } else {
-      const Vec3 dx = s.tail<3>() + s.head<3>().cross(l.x);
-      w.f[L.body].head<3>() -= dx.cross(l.F);
-    }
-  }
-  for (std::size_t k = 0; k < elements.size(); ++k) element_tangent(sys, d, sys.elements[k], elements[k], s, position, w);
-  for (const FlowTerm& f : flows) flow_tangent(f, s, position, w);
+  loads_tangent(loads, w);
+  for (std::size_t k = 0; k < elements.size(); ++k) element_tangent(d, sys.elements[k], elements[k], w);
+  for (const FlowTerm& f : flows) flow_tangent(f, w);
   accumulate_subtrees(sys, w.f);
   for (int k = 0; k < sys.nq; ++k) {
     const int b = sys.coords[sys.free_coords[k]].body, u = sys.q_use[k];
@@ -153,19 +177,60 @@ void tangent_column(const System& sys, const Data& d, const std::vector<BodyLoad
 
 }  // namespace
 
+VecX rnea_directional_derivative(const System& sys, Data& d, const VecX& dq, const VecX& dqd, const VecX& dqdd) {
+  spatial_kinematics(sys, d);
+  rnea_pass(sys, d);
+  const LoadTerms terms(sys, d);
+  Tangent w(sys);
+  std::vector<Vec6> W_before(sys.nuses);  // the twist carrying each use's axis: δs_u = W ×m s_u
+  static const Vec6 O6 = Vec6::Zero();
+  for (int p = 0; p < sys.nbodies; ++p) {
+    Vec6 W = parent_value(sys, w.W, p, O6), v = parent_value(sys, d.v, p, O6);
+    Vec6 dv = parent_value(sys, w.v, p, O6), da = parent_value(sys, w.a, p, O6);
+    for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) {
+      const int i = sys.use_coord[u], k = sys.use_q[u];
+      const Vec6& s = d.axes[u];
+      const double qd = d.qda(i), dqu = k >= 0 ? dq(k) : 0.0, dqdu = k >= 0 ? dqd(k) : 0.0;
+      const double dqddu = k >= 0 ? dqdd(k) : 0.0;
+      W_before[u] = W;
+      const Vec6 ds = crossm(W, s);
+      // c += (v ×m s) q̇ and a += s q̈, v += s q̇ (v: the velocity before this use), differentiated
+      da += (crossm(dv, s) + crossm(v, ds)) * qd + ds * d.qdda(i) + crossm(v, s) * dqdu + s * dqddu;
+      dv += ds * qd + s * dqdu;
+      v += s * qd;
+      W += s * dqu;
+    }
+    w.inside[p] = true;
+    w.W[p] = W, w.v[p] = dv, w.a[p] = da;
+    const Mat6& I = d.I[p];
+    // δf = I δa + δv ×* I v + v ×* I δv + δI a + v ×* δI v, δI the inertia turned by W
+    w.f[p] = I * da + crossf(dv, I * d.v[p]) + crossf(d.v[p], I * dv) + turned_inertia_times(W, I, d.a[p]) +
+             crossf(d.v[p], turned_inertia_times(W, I, d.v[p]));
+  }
+  loads_tangent(terms.loads, w);
+  for (std::size_t k = 0; k < terms.elements.size(); ++k) element_tangent(d, sys.elements[k], terms.elements[k], w);
+  for (const FlowTerm& f : terms.flows) flow_tangent(f, w);
+  accumulate_subtrees(sys, w.f);
+  VecX out(sys.nq);
+  for (int k = 0; k < sys.nq; ++k) {
+    const int i = sys.free_coords[k], b = sys.coords[i].body, u = sys.q_use[k];
+    out(k) = d.axes[u].dot(w.f[b]) + crossm(W_before[u], d.axes[u]).dot(d.sf[b]);
+    // −δQ of the coordinate's own spring, damper and force law
+    const Coordinate& c = sys.coords[i];
+    out(k) += d.spring_scale(i) * (c.stiffness * dq(k) + c.damping * dqd(k));
+    if (c.force_law)
+      out(k) -= d.load_factor * (law_derivative(c, d, i, false) * dq(k) + law_derivative(c, d, i, true) * dqd(k));
+  }
+  return out;
+}
+
 std::pair<MatX, MatX> rnea_derivatives(const System& sys, Data& d) {
   spatial_kinematics(sys, d);
   rnea_pass(sys, d);
   // The loads (their geometric term) and the states of the elements and flowing rfes whose forces
   // change with the state.
-  std::vector<BodyLoad> loads;
-  for_each_body_load(sys, d, true, [&](int body, const AppliedLoad& a, bool follower) {
-    loads.push_back({body, follower, a});
-  });
-  std::vector<ElementState> elements;
-  for (const ForceElement& E : sys.elements) elements.push_back(element_state(d, E, true));
-  std::vector<FlowTerm> flows;
-  for_each_flow_term(sys, d, true, [&](const FlowTerm& f) { flows.push_back(f); });
+  const LoadTerms terms(sys, d);
+  const auto& [loads, elements, flows] = terms;
   MatX dq(sys.nq, sys.nq), dqd(sys.nq, sys.nq);
   Tangent w(sys);
   for (int j = 0; j < sys.nq; ++j) {

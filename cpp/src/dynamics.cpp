@@ -255,6 +255,21 @@ std::pair<MatX, MatX> inverse_dynamics_derivatives(const System& sys, Data& d, d
   return inverse_dynamics_derivatives(sys, d);
 }
 
+VecX inverse_dynamics_direction(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                                const Eigen::Ref<const VecX>& qd, const Eigen::Ref<const VecX>& qdd, const VecX& dq,
+                                const VecX& dqd, const VecX& dqdd) {
+  if (recursive(sys)) {
+    full_state(sys, d, t, q, qd, qdd);
+    return rnea_directional_derivative(sys, d, dq, dqd, dqdd);
+  }
+  // r is linear in q̈; along (δq, δq̇) a central difference with the largest relative change 6e-6
+  const double size = std::max(dq.size() ? dq.cwiseAbs().maxCoeff() / std::max(1.0, q.cwiseAbs().maxCoeff()) : 0.0,
+                               dqd.size() ? dqd.cwiseAbs().maxCoeff() / std::max(1.0, qd.cwiseAbs().maxCoeff()) : 0.0);
+  const double eps = size > 0.0 ? 6e-6 / size : 1.0;
+  const VecX up = inverse_dynamics(sys, d, t, q + eps * dq, qd + eps * dqd, qdd + eps * dqdd);
+  return (up - inverse_dynamics(sys, d, t, q - eps * dq, qd - eps * dqd, qdd - eps * dqdd)) / (2.0 * eps);
+}
+
 std::pair<MatX, MatX> acceleration_derivatives(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
                                                const Eigen::Ref<const VecX>& qd) {
   if (sys.nl > 0) {

@@ -2,7 +2,6 @@
 #include "rigidfem/sensitivities.hpp"
 
 #include <algorithm>
-#include <tuple>
 
 #include "rigidfem/constraints.hpp"
 #include "rigidfem/dynamics.hpp"
@@ -42,7 +41,7 @@ VecX acceleration_constraint(const System& sys, Data& d, double t, const VecX& q
 
 SensitivityEquations::SensitivityEquations(const System& sys, const std::vector<SensitivityParameter>& parameters)
     : sys_(sys), parameters_(parameters), d_(sys), e_(sys),
-      analytic_(analytic_derivatives(sys) && sys.nq <= krylov_from_nq) {
+      analytic_(analytic_derivatives(sys)) {
   for (const SensitivityParameter& p : parameters_) {
     plus_.push_back(p.plus ? std::make_unique<Data>(*p.plus) : nullptr);
     minus_.push_back(p.minus ? std::make_unique<Data>(*p.minus) : nullptr);
@@ -116,10 +115,17 @@ VecX SensitivityEquations::residual_derivative(int j, double t, const VecX& q, c
   const SensitivityParameter& p = parameters_[j];
   if (p.plus) {
     const VecX up = step_residual(*p.plus, *plus_[j], t, q, qd, qdd, lambda);
-    if (p.minus)
+    if (p.minus) {
       R += (up - step_residual(*p.minus, *minus_[j], t, q, qd, qdd, lambda)) / (2.0 * p.h);
-    else
-      R += (up - step_residual(sys_, e_, t, q, qd, qdd, lambda)) / p.h;
+    } else {
+      // the base residual once per state, for every parameter
+      if (!(base_r_.size() && t == base_t_ && q == base_q_ && qd == base_qd_ && qdd == base_qdd_ &&
+            lambda == base_lambda_)) {
+        base_r_ = step_residual(sys_, e_, t, q, qd, qdd, lambda);
+        base_t_ = t, base_q_ = q, base_qd_ = qd, base_qdd_ = qdd, base_lambda_ = lambda;
+      }
+      R += (up - base_r_) / p.h;
+    }
   }
   return R;
 }
@@ -136,12 +142,7 @@ VecX SensitivityEquations::acceleration_constraint_derivative(double t, const Ve
 
 VecX SensitivityEquations::tangent_product(double t, const VecX& q, const VecX& qd, const VecX& qdd, const VecX& dq,
                                            const VecX& dqd, const VecX& dqdd) {
-  if (K_.size() == 0 || t != tangent_t_ || q != tangent_q_ || qd != tangent_qd_ || qdd != tangent_qdd_) {
-    std::tie(K_, C_) = inverse_dynamics_derivatives(sys_, d_, t, q, qd, qdd);
-    M_ = mass_matrix(sys_, d_, t, q);
-    tangent_t_ = t, tangent_q_ = q, tangent_qd_ = qd, tangent_qdd_ = qdd;
-  }
-  return K_ * dq + C_ * dqd + M_ * dqdd;
+  return inverse_dynamics_direction(sys_, e_, t, q, qd, qdd, dq, dqd, dqdd);
 }
 
 void SensitivityEquations::project(double t, const VecX& q, const VecX& qd, Eigen::Ref<VecX> S) {

@@ -1,7 +1,7 @@
 """The options of ``rigidfem.simulate``'s integrators, each written once: its default, its unit and the
 methods that read it.
 
-``simulate(system, t_end, method="auto", *, t0, q0, qd0, s0, t_eval, progress, stop, error_estimate,
+``simulate(system, t_end, method="auto", *, t0, q0, qd0, s0, t_eval, progress, stop, error_estimate, sensitivities,
 **options)`` takes the run's arguments by name and the integrator's options as ``**options``, checked
 against this table: an unknown name is a TypeError listing the options; an option the chosen method
 does not read is accepted and left unused (one set of options can drive a comparison of methods),
@@ -124,7 +124,7 @@ def resolve(options: dict) -> dict:
     if unknown:
         raise TypeError(f"simulate() got unexpected options {unknown}; the integrators' options are "
                         f"{list(_BY_NAME)} (rigidfem.integrator_options(method) lists those a method reads), "
-                        "and the run's arguments t0, q0, qd0, s0, t_eval, progress, stop, error_estimate")
+                        "and the run's arguments t0, q0, qd0, s0, t_eval, progress, stop, error_estimate, sensitivities")
     return {name: options.get(name, o.default) for name, o in _BY_NAME.items()}
 
 

@@ -54,18 +54,16 @@ class Parameter:
     #: whether the equations are linear in it (the constants; not a profile's numbers)
     linear: bool = field(default=True, repr=False)
 
-    def check(self, value) -> float:
-        """The value as a float, or ValueError naming the parameter and the values it takes."""
+    def check(self, value, argument: str = "values") -> float:
+        """The value as a float, or ValueError naming ``argument``, the parameter and the values it takes."""
+        bound = f" > {self.minimum:g}" if self.positive else "" if self.minimum == -math.inf else f" >= {self.minimum:g}"
+        expected = f"{argument}: expected {self.name} to be a finite value{bound} in {self.unit} ({self.description})"
         try:
-            x = _core._real(value, self.name, f"a finite {'positive' if self.positive else 'non-negative'} "
-                                             f"value in {self.unit}")
-        except (TypeError, ValueError) as e:
-            raise ValueError(str(e)) from None
+            x = _core._real(value, argument, "a number")
+        except (TypeError, ValueError):
+            raise ValueError(f"{expected}, got {value!r}") from None
         if not math.isfinite(x) or (x <= self.minimum if self.positive else x < self.minimum):
-            bound = f" > {self.minimum:g}" if self.positive else "" if self.minimum == -math.inf else \
-                f" >= {self.minimum:g}"
-            raise ValueError(f"{self.name}: expected a finite value{bound} in {self.unit} ({self.description}), "
-                             f"got {value!r}")
+            raise ValueError(f"{expected}, got {value!r}")
         return x
 
 
@@ -411,5 +409,5 @@ class ProfileGroup(Group):
         try:
             profile = remade(self.profile, values)
         except (TypeError, ValueError) as e:
-            raise ValueError(f"{self.prefix}: expected numbers its profile takes, got {values} ({e})") from None
+            raise ValueError(f"values: expected numbers the profile of {self.prefix} takes, got {values} ({e})") from None
         return Changes(profiles=[(self.what, self.body, self.index, profile)])

@@ -442,11 +442,11 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
         opt.adaptive = -1  # SciPy's solvers are adaptive whatever it says (checked above for its type)
     opt.s0 = s0
     opt.set_error_on(outputs)
-    if sensitivities is not None and scipy:
-        raise ValueError(f"method: expected a C++ method that integrates sensitivities (dopri5, rk4, generalized_alpha, "
-                         f"...), got {method!r}")
     names = sensitivities_.directions(system, sensitivities, opt, t0, t_end)
     _core._check_options(system, t0, t_end, q0, qd0, t_eval, opt)
+    if names and scipy:  # the options are checked first: a bad one is named whatever the method
+        raise ValueError(f"method: expected a C++ method that integrates sensitivities (dopri5, rk4, generalized_alpha, "
+                         f"...), got {method!r}")
     _check_closed(system, t0, q0, qd0)
     if system.nl and scipy:
         raise ValueError(f"method: expected a C++ method for a system with loop closures ({system.nl} constraint rows), "

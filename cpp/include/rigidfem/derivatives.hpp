@@ -38,4 +38,9 @@ VecX central_difference(G&& g, VecX& x, int j) {
 /// central differences of their scalar functions.
 std::pair<MatX, MatX> rnea_derivatives(const System& sys, Data& d);
 
+/// Needs what rnea_derivatives needs: (∂r/∂q) δq + (∂r/∂q̇) δq̇ + A δq̈ (nq) along one direction, exact, in O(n)
+/// (forward mode: each body's frame carried by the twist W_p = Σ_{uses u on its path} s_u δq_u, so
+/// δs_u = W_before ×m s_u and δI_p = W_p ×* I_p − I_p W_p ×m; the RNEA's passes differentiated along it).
+VecX rnea_directional_derivative(const System& sys, Data& d, const VecX& dq, const VecX& dqd, const VecX& dqdd);
+
 }  // namespace rigidfem

@@ -20,10 +20,6 @@ void tree_kinematics(const System& sys, Data& d);
 void dynamics_kinematics(const System& sys, Data& d);
 /// Whether ∂r/∂(q, q̇) is analytic (recursive) rather than differenced (4 nq residuals, Lagrange).
 inline bool analytic_derivatives(const System& sys) { return sys.algorithm == Algorithm::Recursive; }
-/// iteration_matrix=auto takes Krylov for recursive systems above this many free coordinates, the
-/// dense tangent below (measured: the dense factorisation is the cheaper up to about this size); the
-/// sensitivities use the analytic tangent up to it (sensitivities.hpp).
-constexpr int krylov_from_nq = 200;
 /// Whether M + diag δ has the O(n) articulated-body factorisation (recursive systems): the matrix-free
 /// Newton matrix's preconditioner (newton_matrix.hpp).
 inline bool articulated(const System& sys) { return sys.algorithm == Algorithm::Recursive; }
@@ -66,6 +62,11 @@ VecX inverse_dynamics(const System& sys, Data& d, double t, const Eigen::Ref<con
 std::pair<MatX, MatX> inverse_dynamics_derivatives(const System& sys, Data& d, double t,
                                                    const Eigen::Ref<const VecX>& q, const Eigen::Ref<const VecX>& qd,
                                                    const Eigen::Ref<const VecX>& qdd);
+/// (∂r/∂q) δq + (∂r/∂q̇) δq̇ + A δq̈ (nq) at (t, q, q̇, q̈) along one direction: the RNEA's forward-mode
+/// derivative (recursive: exact, O(n)); central differences of r (Lagrange).
+VecX inverse_dynamics_direction(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                                const Eigen::Ref<const VecX>& qd, const Eigen::Ref<const VecX>& qdd, const VecX& dq,
+                                const VecX& dqd, const VecX& dqdd);
 /// ∂q̈/∂q and ∂q̈/∂q̇ (nq, nq) at (t, q, q̇): −A⁻¹ (∂r/∂q, ∂r/∂q̇) at the forward-dynamics q̈; with loops, of
 /// the constrained q̈ (λ(q, q̇) and G(q) varying too) by central differences.
 std::pair<MatX, MatX> acceleration_derivatives(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,

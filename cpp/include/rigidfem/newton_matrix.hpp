@@ -18,7 +18,6 @@
 #include <complex>
 #include <memory>
 
-#include "rigidfem/dynamics.hpp"
 #include "rigidfem/integrators.hpp"
 #include "rigidfem/system.hpp"
 
@@ -27,6 +26,9 @@ namespace rigidfem {
 using cplx = std::complex<double>;
 using VecXc = Eigen::VectorXcd;
 
+/// iteration_matrix=auto takes Krylov for recursive systems above this many free coordinates, the
+/// dense tangent below (measured: the dense factorisation is the cheaper up to about this size).
+constexpr int krylov_from_nq = 200;
 
 /// Whether the exact tangent of the run's implicit method is matrix-free (Krylov) rather than dense.
 bool krylov_tangent(const System& sys, const IntegratorOptions& o);

@@ -7,10 +7,10 @@
 /// (parameters.hpp: only constants the residual is linear in differ, so ∂r/∂p = (r(p + h) − r(p))/h exactly,
 /// to round-off, whatever h: h = |p| keeps the round-off at that of r; a profile's coefficient, which the
 /// residual is not linear in, by a central difference of the systems at p ± h), an initial value as S_j(t0). The
-/// derivatives along (S_q, S_q̇) are K δq + C δq̇ + M δq̈ with the analytic tangent (recursive systems of at most
-/// krylov_from_nq coordinates: O(n²) per state, shared by the parameters; exact), or else central differences of
-/// the residual along the direction, scaled so that the largest relative change of q or q̇ is 6e-6 (near 1e-10
-/// relative, but 1e-7 where an axial stiffness dwarfs a transverse one: a taut rope, a beam's axial spring), then
+/// derivatives along (S_q, S_q̇) are K δq + C δq̇ + M δq̈ by the RNEA's forward-mode derivative (recursive systems:
+/// exact, O(n) per direction, inverse_dynamics_direction), or else central differences of the residual along
+/// the direction, scaled so that the largest relative change of q or q̇ is 6e-6 (near 1e-10 relative, but 1e-7
+/// where an axial stiffness dwarfs a transverse one: a taut rope, a beam's axial spring), then
 /// S̈ = −A⁻¹(…) with the forward dynamics' factorisation (O(n): the articulated-body algorithm's) and, with
 /// loops, the multipliers' change by the Schur complement G A⁻¹ Gᵀ as in close_loops: O(n) per direction.
 #pragma once
@@ -60,17 +60,16 @@ class SensitivityEquations {
   void project(double t, const VecX& q, const VecX& qd, Eigen::Ref<VecX> S);
 
  private:
-  /// K δq + C δq̇ + M δq̈ with the analytic tangent at (t, q, q̇, q̈), formed once per state.
+  /// K δq + C δq̇ + M δq̈ at (t, q, q̇, q̈) by the RNEA's forward mode.
   VecX tangent_product(double t, const VecX& q, const VecX& qd, const VecX& qdd, const VecX& dq, const VecX& dqd,
                        const VecX& dqdd);
 
   const System& sys_;
   std::vector<SensitivityParameter> parameters_;
   Data d_, e_;                                // workspaces on sys
-  bool analytic_;                             // the tangent's matrices, not central differences, along S
-  double tangent_t_ = 0.0;                    // the state of the matrices below
-  VecX tangent_q_, tangent_qd_, tangent_qdd_;
-  MatX K_, C_, M_;                            // ∂r/∂q, ∂r/∂q̇ and M there
+  bool analytic_;                             // the RNEA's forward mode, not central differences, along S
+  double base_t_ = 0.0;                       // the state of the last base residual R(p)
+  VecX base_q_, base_qd_, base_qdd_, base_lambda_, base_r_;
   std::vector<std::unique_ptr<Data>> plus_, minus_;  // on each parameter's systems at p ± h
 };
 
