@@ -317,6 +317,15 @@ void bind_dynamics(py::module_& m) {
           "(dr/dq) dq + (dr/dqd) dqd + A dqdd (nq): the RNEA's forward-mode derivative along one direction (recursive:\n"
           "exact, O(n)), central differences (lagrange).")
       .def(
+          "_inverse_dynamics_vjp",
+          [](const System& s, double t, const RefV& q, const RefV& qd, const RefV& qdd, const VecX& mu) {
+            check_vector(mu, s.nq, "mu", "nq");
+            Workspace d(s);
+            return rigidfem::inverse_dynamics_vjp(s, *d, t, q, qd, qdd, mu);
+          },
+          py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("mu"),
+          "((dr/dq)^T mu, (dr/dqd)^T mu, A mu), each (nq): the RNEA's reverse mode (recursive systems), O(n).")
+      .def(
           "acceleration_derivatives",
           [](const System& s, double t, const RefV& q, const RefV& qd) {
             Workspace d(s);

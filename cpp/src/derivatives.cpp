@@ -2,6 +2,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <stdexcept>
 #include <tuple>
 #include <utility>
 #include <vector>
@@ -220,6 +221,110 @@ VecX rnea_directional_derivative(const System& sys, Data& d, const VecX& dq, con
     out(k) += d.spring_scale(i) * (c.stiffness * dq(k) + c.damping * dqd(k));
     if (c.force_law)
       out(k) -= d.load_factor * (law_derivative(c, d, i, false) * dq(k) + law_derivative(c, d, i, true) * dqd(k));
+  }
+  return out;
+}
+
+ResidualVjp rnea_vector_jacobian_product(const System& sys, Data& d, const VecX& mu) {
+  if (!sys.flows.empty())
+    throw std::invalid_argument("system: expected no link of varying length (its terms' transpose is not implemented)");
+  spatial_kinematics(sys, d);
+  rnea_pass(sys, d);
+  const LoadTerms terms(sys, d);
+  ResidualVjp out{VecX::Zero(sys.nq), VecX::Zero(sys.nq), VecX::Zero(sys.nq)};
+  const int nb = sys.nbodies;
+  // the velocity before each use (the forward pass's state)
+  std::vector<Vec6> v_before(sys.nuses);
+  for (int p = 0; p < nb; ++p) {
+    Vec6 v = sys.parent[p] >= 0 ? d.v[sys.parent[p]] : Vec6::Zero();
+    for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) v_before[u] = v, v += d.axes[u] * d.qda(sys.use_coord[u]);
+  }
+  // δr_k = s_uᵀ δf̄_b + (W_before ×m s_u)ᵀ f̄_b + passive: the adjoint G of each subtree sum and of each W_before
+  std::vector<Vec6> G(nb, Vec6::Zero()), Wu(sys.nuses, Vec6::Zero());
+  for (int k = 0; k < sys.nq; ++k) {
+    const int i = sys.free_coords[k], b = sys.coords[i].body, u = sys.q_use[k];
+    const Coordinate& c = sys.coords[i];
+    G[b] += d.axes[u] * mu(k);
+    Wu[u] += mu(k) * crossf(d.axes[u], d.sf[b]);  // (W ×m s)·f = W·(s ×* f)
+    out.q(k) += d.spring_scale(i) * c.stiffness * mu(k);
+    out.qd(k) += d.spring_scale(i) * c.damping * mu(k);
+    if (c.force_law) {
+      out.q(k) -= d.load_factor * law_derivative(c, d, i, false) * mu(k);
+      out.qd(k) -= d.load_factor * law_derivative(c, d, i, true) * mu(k);
+    }
+  }
+  // subtree sums transposed: each body's δf meets the adjoints of its own and its ancestors' sums
+  std::vector<Vec6> H(nb);
+  for (int p = 0; p < nb; ++p) H[p] = G[p] + (sys.parent[p] >= 0 ? H[sys.parent[p]] : Vec6::Zero());
+  // adjoints of each body's W, δv and δa at the end of its joint
+  std::vector<Vec6> Wb(nb, Vec6::Zero()), vb(nb, Vec6::Zero()), ab(nb, Vec6::Zero());
+  auto point_adjoint = [&](int b, const Vec3& x, const Vec3& dx_bar, const Vec3& dvel_bar) {
+    if (b < 0) return;
+    // dvel = δv_O + δω × x + ω × dx, dx = W_v + W_ω × x
+    vb[b].tail<3>() += dvel_bar;
+    vb[b].head<3>() += x.cross(dvel_bar);
+    const Vec3 dx = dx_bar + dvel_bar.cross(d.v[b].head<3>());
+    Wb[b].tail<3>() += dx;
+    Wb[b].head<3>() += x.cross(dx);
+  };
+  for (std::size_t k = 0; k < terms.elements.size(); ++k) {
+    const ForceElement& E = sys.elements[k];
+    const ElementState& st = terms.elements[k];
+    // δf_b −= (x_b × df, df), δf_a += (x_a × df, df)
+    Vec3 df = Vec3::Zero();
+    if (E.body_b >= 0) df += st.xb.cross(H[E.body_b].head<3>()) - H[E.body_b].tail<3>();
+    if (E.body_a >= 0) df -= st.xa.cross(H[E.body_a].head<3>()) - H[E.body_a].tail<3>();
+    const auto [Fl, Fld] = E.law->derivatives(d.t, st.l, st.ld, d.load_factor);
+    // df = (F_l δl + F_l̇ δl̇) e + F δe; δl̇ = δe·(v_b − v_a) + e·δḋ; δl = e·δd; δe = (1 − e eᵀ) δd / l
+    const double ed = st.e.dot(df);
+    const double dl_bar = Fl * ed, dld_bar = Fld * ed;
+    const Vec3 de_bar = st.F * df + (st.vb - st.va) * dld_bar;
+    const Vec3 ddd_bar = st.e * dld_bar;
+    const Vec3 dd_bar = st.e * dl_bar + (de_bar - st.e * st.e.dot(de_bar)) / st.l;
+    point_adjoint(E.body_b, st.xb, dd_bar, ddd_bar);
+    point_adjoint(E.body_a, st.xa, -dd_bar, -ddd_bar);
+  }
+  for (const BodyLoad& L : terms.loads) {
+    const AppliedLoad& l = L.load;
+    const Vec6& h = H[L.body];
+    if (L.follower) {  // δf −= W ×* f: W̄ += h ×* f
+      Vec6 fl;
+      fl << l.x.cross(l.F) + l.tau, l.F;
+      Wb[L.body] += crossf(h, fl);
+    } else {  // δf_ω −= δx × F, δx = W_v + W_ω × x
+      const Vec3 dx = h.head<3>().cross(l.F);
+      Wb[L.body].tail<3>() += dx;
+      Wb[L.body].head<3>() += l.x.cross(dx);
+    }
+  }
+  // δf_p = I δa + δv ×* I v + v ×* I δv + δI a + v ×* δI v, δI x = W ×* I x − I (W ×m x), transposed
+  for (int p = 0; p < nb; ++p) {
+    const Mat6& I = d.I[p];
+    const Vec6& h = H[p];
+    const Vec6& v = d.v[p];
+    const Vec6 z = crossm(v, h);
+    ab[p] += I * h;
+    vb[p] += -crossf(h, I * v) - I * z;
+    Wb[p] += -crossf(h, I * d.a[p]) - crossf(d.a[p], I * h) + crossf(z, I * v) + crossf(v, I * z);
+  }
+  // the forward sweep transposed, leaves to root, each body's uses last to first
+  for (int p = nb - 1; p >= 0; --p) {
+    Vec6 W = Wb[p], dv = vb[p], da = ab[p];
+    for (int u = sys.use_start[p + 1] - 1; u >= sys.use_start[p]; --u) {
+      const int i = sys.use_coord[u], k = sys.use_q[u];
+      const Vec6& s = d.axes[u];
+      const Vec6& v = v_before[u];
+      const double qd = d.qda(i), qdd = d.qdda(i);
+      if (k >= 0) out.q(k) += s.dot(W);        // W += s δq
+      Vec6 ds = qd * dv;                         // δv += δs q̇ + s δq̇
+      if (k >= 0) out.qd(k) += s.dot(dv);
+      // δa += (δv ×m s + v ×m δs) q̇ + δs q̈ + (v ×m s) δq̇ + s δq̈
+      dv += qd * crossf(s, da);
+      ds += -qd * crossf(v, da) + qdd * da;
+      if (k >= 0) out.qd(k) += crossm(v, s).dot(da), out.qdd(k) += s.dot(da);
+      W += crossf(s, ds) + Wu[u];                // δs = W ×m s
+    }
+    if (sys.parent[p] >= 0) Wb[sys.parent[p]] += W, vb[sys.parent[p]] += dv, ab[sys.parent[p]] += da;
   }
   return out;
 }
