@@ -59,50 +59,75 @@ def test_inverse_dynamics_derivatives_on_random_trees(seed, nbodies):
                                system.mass_matrix(t, q) @ qdd, rtol=0, atol=1e-10 * max(1, np.abs(qdd).max()))
 
 
-@settings(max_examples=25, deadline=None)
-@given(seed=st.integers(0, 2**32 - 1), nbodies=st.integers(1, 7))
-def test_directional_derivative_is_the_tangent_along_a_direction(seed, nbodies):
-    """The RNEA's forward mode along (δq, δq̇, δq̈), O(n), is K δq + C δq̇ + A δq̈ of the analytic matrices (each
-    checked against differences above) to round-off: random trees with every joint, drives, loads and a
-    force law."""
-    model, rng = loaded_random_tree(seed, nbodies)
-    system = model.compile("recursive")
+def tangent_at_random_state(system, rng, spread=1.0):
+    """A random state (t, q, q̇, q̈), a direction (δq, δq̇, δq̈) and μ, and the analytic K, C and A there."""
     n = system.nq
-    if n == 0:
-        return
     t = float(rng.uniform(0, 3))
-    q, qd, qdd = rng.uniform(-1, 1, n), rng.uniform(-2, 2, n), rng.normal(0, 3, n)
-    dq, dqd, dqdd = rng.normal(0, 1, n), rng.normal(0, 1, n), rng.normal(0, 1, n)
+    q, qd, qdd = rng.uniform(-spread, spread, n), rng.uniform(-2 * spread, 2 * spread, n), rng.normal(0, 3, n)
+    direction, mu = tuple(rng.normal(0, 1, (3, n))), rng.normal(0, 1, n)
     K, C = system.inverse_dynamics_derivatives(t, q, qd, qdd)
-    expected = K @ dq + C @ dqd + system.mass_matrix(t, q) @ dqdd
-    got = system._inverse_dynamics_direction(t, q, qd, qdd, dq, dqd, dqdd)
+    return (t, q, qd, qdd), direction, mu, (K, C, system.mass_matrix(t, q))
+
+
+def check_both_modes(system, rng, spread=1.0):
+    """The RNEA's forward mode along a direction is K δq + C δq̇ + A δq̈, its reverse mode for μ is (Kᵀμ, Cᵀμ, Aμ),
+    of the analytic matrices (each checked against differences above), to round-off."""
+    state, direction, mu, (K, C, A) = tangent_at_random_state(system, rng, spread)
+    expected = K @ direction[0] + C @ direction[1] + A @ direction[2]
+    got = system._inverse_dynamics_direction(*state, *direction)
     np.testing.assert_allclose(got, expected, rtol=0, atol=1e-10 * max(1.0, np.abs(expected).max()))
+    for g, e in zip(system._inverse_dynamics_vjp(*state, mu), (K.T @ mu, C.T @ mu, A @ mu)):
+        np.testing.assert_allclose(g, e, rtol=0, atol=1e-10 * max(1.0, np.abs(e).max()))
+    return state, mu
 
 
-def test_directional_derivative_with_elements_flows_and_beams():
-    """The same on what random trees lack: force elements and a rope, a link of varying length, a beam."""
-    model = rf.Model(gravity=(0.0, -9.81, 0.0))
+def sprung_beams(gravity=(0.0, -9.81, 0.0), flowing=True):
+    """What random trees lack: beams (one flowing out of its guide on a driven hub if ``flowing``), a
+    spring-damper and a rope between them, follower and fixed forces and a follower torque."""
+    model = rf.Model(gravity=gravity)
     hub = model.add_body("hub", model.ground, rf.Joint.revolute("z"), 1.0, (1.0, 1.0, 1.0))
     model.prescribe(hub, rf.motion.harmonic(0.6, 2.0, 0.3))
-    tape = model.add_beam("tape", hub, rf.motion.polynomial([0.5, 0.8, -0.3]), rf.Material(E=2.1e9, rho=7850.0),
-                          rf.Section.rectangle(0.02, 0.004), 4, deform=("bend_y", "bend_z", "torsion"),
-                          joint=rf.Joint.revolute("y", stiffness=30.0), placement=rf.transform((0.1, 0.0, 0.0)))
+    tape = model.add_beam("tape", hub, rf.motion.polynomial([0.5, 0.8, -0.3]) if flowing else 0.6,
+                          rf.Material(E=2.1e9, rho=7850.0), rf.Section.rectangle(0.02, 0.004), 4,
+                          deform=("bend_y", "bend_z", "torsion"), joint=rf.Joint.revolute("y", stiffness=30.0),
+                          placement=rf.transform((0.1, 0.0, 0.0)))
     arm = model.add_beam("arm", model.ground, 1.0, rf.Material(E=2e9, rho=2700.0), rf.Section.rectangle(0.02, 0.01), 3,
                          joint=rf.Joint.spherical(), placement=rf.transform((0.0, 1.0, 0.0)))
     model.add_spring_damper(tape.tip, arm.tip, stiffness=50.0, damping=2.0, length=0.3)
     model.add_rope(arm.point(0.5), model.ground, EA=1e4, damping=10.0, length=0.5)
     model.add_force(arm.tip, (0.0, 1.0, 2.0), follower=True)
-    system = model.compile()
+    model.add_force(tape.tip, (1.0, 0.0, -2.0))
+    model.add_torque(arm.rfes[1], (0.3, 0.0, 0.1), follower=True)
+    return model
+
+
+@settings(max_examples=25, deadline=None)
+@given(seed=st.integers(0, 2**32 - 1), nbodies=st.integers(1, 7))
+def test_both_modes_on_random_trees(seed, nbodies):
+    """Both modes of the RNEA (O(n) each) on random trees with every joint, drives, loads and a force law."""
+    model, rng = loaded_random_tree(seed, nbodies)
+    system = model.compile("recursive")
+    if system.nq:
+        check_both_modes(system, rng)
+
+
+def test_both_modes_with_elements_flows_and_beams():
+    """Both modes on beams with force elements, a rope and loads; the forward mode with a flowing link too,
+    whose terms the reverse mode does not cover (ValueError naming the system), nor the Lagrange formulation."""
     rng = np.random.default_rng(2)
-    n = system.nq
+    flowing = sprung_beams().compile()
     for _ in range(3):
-        t = float(rng.uniform(0, 1))
-        q, qd, qdd = rng.uniform(-0.3, 0.3, n), rng.uniform(-1, 1, n), rng.normal(0, 3, n)
-        dq, dqd, dqdd = rng.normal(0, 1, n), rng.normal(0, 1, n), rng.normal(0, 1, n)
-        K, C = system.inverse_dynamics_derivatives(t, q, qd, qdd)
-        expected = K @ dq + C @ dqd + system.mass_matrix(t, q) @ dqdd
-        got = system._inverse_dynamics_direction(t, q, qd, qdd, dq, dqd, dqdd)
-        np.testing.assert_allclose(got, expected, rtol=0, atol=1e-10 * np.abs(expected).max())
+        state, direction, _, (K, C, A) = tangent_at_random_state(flowing, rng, 0.3)
+        expected = K @ direction[0] + C @ direction[1] + A @ direction[2]
+        np.testing.assert_allclose(flowing._inverse_dynamics_direction(*state, *direction), expected, rtol=0,
+                                   atol=1e-10 * np.abs(expected).max())
+    with pytest.raises(ValueError, match="system: expected no link of varying length"):
+        flowing._inverse_dynamics_vjp(*state, np.ones(flowing.nq))
+    model = sprung_beams(flowing=False)
+    for _ in range(3):
+        state, mu = check_both_modes(model.compile(), rng, 0.3)
+    with pytest.raises(ValueError, match="system: expected a system compiled with algorithm='recursive'"):
+        model.compile("lagrange")._inverse_dynamics_vjp(*state, mu)
 
 
 @settings(max_examples=15, deadline=None)
@@ -236,51 +261,3 @@ def test_implicit_spring_on_a_lagrange_system_agrees():
     lag = stiff_beam(elements=5, algorithm="lagrange")[0]
     kw = dict(t_eval=np.linspace(0, 0.02, 5), q0=q0, dt=2e-4, method="implicit_spring", newton_tol=1e-12)
     np.testing.assert_allclose(rf.simulate(rec, 0.02, **kw).q, rf.simulate(lag, 0.02, **kw).q, rtol=0, atol=1e-9)
-
-
-@settings(max_examples=25, deadline=None)
-@given(seed=st.integers(0, 2**32 - 1), nbodies=st.integers(1, 7))
-def test_reverse_mode_is_the_transposed_tangent(seed, nbodies):
-    """The RNEA's reverse mode (an adjoint's building block), O(n): (Kᵀμ, Cᵀμ, Aμ) of the analytic matrices to
-    round-off, on random trees with every joint, drives, loads and a force law."""
-    model, rng = loaded_random_tree(seed, nbodies)
-    system = model.compile("recursive")
-    n = system.nq
-    if n == 0:
-        return
-    t = float(rng.uniform(0, 3))
-    q, qd, qdd, mu = rng.uniform(-1, 1, n), rng.uniform(-2, 2, n), rng.normal(0, 3, n), rng.normal(0, 1, n)
-    K, C = system.inverse_dynamics_derivatives(t, q, qd, qdd)
-    got = system._inverse_dynamics_vjp(t, q, qd, qdd, mu)
-    for g, expected in zip(got, (K.T @ mu, C.T @ mu, system.mass_matrix(t, q) @ mu)):
-        np.testing.assert_allclose(g, expected, rtol=0, atol=1e-10 * max(1.0, np.abs(expected).max()))
-
-
-def test_reverse_mode_with_elements_and_beams():
-    """The same with force elements, a rope and follower and fixed loads on beams; a link of varying length and
-    the Lagrange formulation are refused, naming the system."""
-    model = rf.Model(gravity=(0.0, -9.81, 0.0))
-    hub = model.add_body("hub", model.ground, rf.Joint.revolute("z"), 1.0, (1.0, 1.0, 1.0))
-    model.prescribe(hub, rf.motion.harmonic(0.6, 2.0, 0.3))
-    tape = model.add_beam("tape", hub, 0.6, rf.Material(E=2.1e9, rho=7850.0), rf.Section.rectangle(0.02, 0.004), 4,
-                          deform=("bend_y", "bend_z", "torsion"), joint=rf.Joint.revolute("y", stiffness=30.0),
-                          placement=rf.transform((0.1, 0.0, 0.0)))
-    arm = model.add_beam("arm", model.ground, 1.0, rf.Material(E=2e9, rho=2700.0), rf.Section.rectangle(0.02, 0.01), 3,
-                         joint=rf.Joint.spherical(), placement=rf.transform((0.0, 1.0, 0.0)))
-    model.add_spring_damper(tape.tip, arm.tip, stiffness=50.0, damping=2.0, length=0.3)
-    model.add_rope(arm.point(0.5), model.ground, EA=1e4, damping=10.0, length=0.5)
-    model.add_force(arm.tip, (0.0, 1.0, 2.0), follower=True)
-    model.add_force(tape.tip, (1.0, 0.0, -2.0))
-    model.add_torque(arm.rfes[1], (0.3, 0.0, 0.1), follower=True)
-    system = model.compile()
-    rng = np.random.default_rng(4)
-    n = system.nq
-    for _ in range(3):
-        t = float(rng.uniform(0, 1))
-        q, qd, qdd, mu = rng.uniform(-0.3, 0.3, n), rng.uniform(-1, 1, n), rng.normal(0, 3, n), rng.normal(0, 1, n)
-        K, C = system.inverse_dynamics_derivatives(t, q, qd, qdd)
-        got = system._inverse_dynamics_vjp(t, q, qd, qdd, mu)
-        for g, expected in zip(got, (K.T @ mu, C.T @ mu, system.mass_matrix(t, q) @ mu)):
-            np.testing.assert_allclose(g, expected, rtol=0, atol=1e-10 * np.abs(expected).max())
-    with pytest.raises(ValueError, match="system: expected a system compiled with algorithm='recursive'"):
-        model.compile("lagrange")._inverse_dynamics_vjp(0.0, q, qd, qdd, mu)

@@ -73,7 +73,7 @@ def _converges(system, names, method, t, steps=(1e-2, 1e-3, 1e-4), floor=1e-6, *
                   for rel in steps]
         assert errors[-1] <= floor, (name, errors)
         for coarse, fine in zip(errors, errors[1:]):
-            assert fine <= coarse / 50 or fine <= 10 * floor / 100, (name, errors)
+            assert fine <= coarse / 50 or fine <= floor / 10, (name, errors)
     return r
 
 

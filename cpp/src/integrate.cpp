@@ -250,11 +250,12 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
   const double span = t_end - t0, grid = std::min(o.dt, o.max_step), near_end = t_end - 1e-12 * span;
 
   VecX y0(2 * n + sys.nz + 2 * n * static_cast<int>(o.sensitivities.size()));
-  y0 << q0, qd0, (o.s0.size() ? o.s0 : VecX::Zero(sys.nz)),
-      (o.sensitivities.empty() ? VecX() : SensitivityEquations(sys, o.sensitivities).initial());
-  if (sys.nl > 0 && !o.sensitivities.empty()) {  // initial values move along the loops (as assemble() would)
+  y0.head(2 * n + sys.nz) << q0, qd0, (o.s0.size() ? o.s0 : VecX::Zero(sys.nz));
+  if (!o.sensitivities.empty()) {
     SensitivityEquations sens(sys, o.sensitivities);
-    for (int j = 0; j < sens.count(); ++j) sens.project(t0, q0, qd0, y0.segment(2 * n + sys.nz + 2 * n * j, 2 * n));
+    y0.tail(2 * n * sens.count()) = sens.initial();
+    for (int j = 0; sys.nl > 0 && j < sens.count(); ++j)  // initial values move along the loops (as assemble() would)
+      sens.project(t0, q0, qd0, y0.segment(2 * n + sys.nz + 2 * n * j, 2 * n));
   }
   // method="auto": its policy (auto_method.hpp) picks the first method and, after each step, whether to change
   std::unique_ptr<AutoChoice> choice;

@@ -40,8 +40,7 @@ VecX acceleration_constraint(const System& sys, Data& d, double t, const VecX& q
 }  // namespace
 
 SensitivityEquations::SensitivityEquations(const System& sys, const std::vector<SensitivityParameter>& parameters)
-    : sys_(sys), parameters_(parameters), d_(sys), e_(sys),
-      analytic_(analytic_derivatives(sys)) {
+    : sys_(sys), parameters_(parameters), d_(sys), e_(sys) {
   for (const SensitivityParameter& p : parameters_) {
     plus_.push_back(p.plus ? std::make_unique<Data>(*p.plus) : nullptr);
     minus_.push_back(p.minus ? std::make_unique<Data>(*p.minus) : nullptr);
@@ -80,35 +79,17 @@ void SensitivityEquations::rates(Data& fd, double t, const VecX& q, const VecX& 
 VecX SensitivityEquations::residual_derivative(int j, double t, const VecX& q, const VecX& qd, const VecX& qdd,
                                                const VecX& lambda, const VecX& dq, const VecX& dqd,
                                                const VecX& dqdd, const VecX& dlambda) {
-  VecX R = VecX::Zero(sys_.nq);
-  if (analytic_) {
-    R = tangent_product(t, q, qd, qdd, dq, dqd, dqdd);
-    if (sys_.nl > 0) {  // −∂(Gᵀλ)/∂q δq by a central difference of G(q)ᵀλ (constraint forces: small terms), −Gᵀδλ
-      if (const double eps = direction_step(q, qd, dq, VecX::Zero(sys_.nq)); eps > 0.0) {
-        loop_equations(sys_, e_, t, q + eps * dq, qd);
-        const VecX up = free_jacobian(sys_, e_).transpose() * lambda;
-        loop_equations(sys_, e_, t, q - eps * dq, qd);
-        R -= (up - free_jacobian(sys_, e_).transpose() * lambda) / (2.0 * eps);
-      }
-      loop_equations(sys_, e_, t, q, qd);
-      R -= free_jacobian(sys_, e_).transpose() * dlambda;
+  // K δq + C δq̇ + M δq̈: the RNEA's forward mode (recursive), central differences (Lagrange)
+  VecX R = inverse_dynamics_direction(sys_, e_, t, q, qd, qdd, dq, dqd, dqdd);
+  if (sys_.nl > 0) {  // −∂(Gᵀλ)/∂q δq by a central difference of G(q)ᵀλ (constraint forces: small terms), −Gᵀδλ
+    if (const double eps = direction_step(q, qd, dq, VecX::Zero(sys_.nq)); eps > 0.0) {
+      loop_equations(sys_, e_, t, q + eps * dq, qd);
+      const VecX up = free_jacobian(sys_, e_).transpose() * lambda;
+      loop_equations(sys_, e_, t, q - eps * dq, qd);
+      R -= (up - free_jacobian(sys_, e_).transpose() * lambda) / (2.0 * eps);
     }
-  } else {
-    // ∂R/∂(q, q̇, q̈) and ∂R/∂λ along the direction: one central difference, its step set by q and q̇ alone (R is
-    // linear in q̈ and λ: their terms have no truncation error, and a larger step keeps their round-off small)
-    double eps = direction_step(q, qd, dq, dqd);
-    if (eps == 0.0) {
-      const double size = std::max(max_abs(dqdd) / std::max(1.0, max_abs(qdd)),
-                                   dlambda.size() ? max_abs(dlambda) / std::max(1.0, max_abs(lambda)) : 0.0);
-      eps = size > 0.0 ? 1.0 / size : 0.0;
-    }
-    if (eps > 0.0) {
-      const VecX up = step_residual(sys_, e_, t, q + eps * dq, qd + eps * dqd, qdd + eps * dqdd,
-                                    sys_.nl ? VecX(lambda + eps * dlambda) : lambda);
-      R = (up - step_residual(sys_, e_, t, q - eps * dq, qd - eps * dqd, qdd - eps * dqdd,
-                              sys_.nl ? VecX(lambda - eps * dlambda) : lambda)) /
-          (2.0 * eps);
-    }
+    loop_equations(sys_, e_, t, q, qd);
+    R -= free_jacobian(sys_, e_).transpose() * dlambda;
   }
   // ∂R/∂p = (R(p + h) − R(p))/h: R is linear in the constants the parameter sets; a profile's coefficient by
   // the central difference (R(p + h) − R(p − h))/(2h)
@@ -138,11 +119,6 @@ VecX SensitivityEquations::acceleration_constraint_derivative(double t, const Ve
     c = (up - acceleration_constraint(sys_, e_, t, q - eps * dq, qd - eps * dqd, qdd)) / (2.0 * eps);
   }
   return c;
-}
-
-VecX SensitivityEquations::tangent_product(double t, const VecX& q, const VecX& qd, const VecX& qdd, const VecX& dq,
-                                           const VecX& dqd, const VecX& dqdd) {
-  return inverse_dynamics_direction(sys_, e_, t, q, qd, qdd, dq, dqd, dqdd);
 }
 
 void SensitivityEquations::project(double t, const VecX& q, const VecX& qd, Eigen::Ref<VecX> S) {

@@ -29,6 +29,8 @@ from __future__ import annotations
 
 import numpy as np
 
+from . import parameters as parameters_
+
 
 def _changed(system, name: str, argument: str):
     """(system at p + h, h) of a named parameter; ValueError naming ``argument`` for an unknown one or one of a
@@ -37,18 +39,13 @@ def _changed(system, name: str, argument: str):
     if not params.parameter(name, argument).linear:
         raise ValueError(f"{argument}: expected a constant's parameter (statics and modes at one t), got the "
                          f"profile's {name!r}")
-    p, h = params.values[name], params.step(name)
-    return params.changes({name: p + h}).apply(system), h
+    h = params.step(name)
+    return params.shifted(system, name, h), h
 
 
 def check_names(system, names, argument: str = "sensitivities") -> list[str]:
-    if names is None:
-        return []
-    if isinstance(names, str) or not hasattr(names, "__iter__"):
-        raise ValueError(f"{argument}: expected a list of parameter names (System.parameters), got {names!r}")
-    names = list(names)
-    if len(set(names)) != len(names):
-        raise ValueError(f"{argument}: expected each name once, got {names}")
+    """The parameters' names of a ``sensitivities`` argument; ValueError naming it for anything else."""
+    names = parameters_.names_argument(names, argument)
     for name in names:
         system._parameters.parameter(name, argument)
     return names

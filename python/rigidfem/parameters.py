@@ -33,6 +33,7 @@ from __future__ import annotations
 
 import difflib
 import math
+from collections.abc import Sequence
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -235,6 +236,20 @@ def register(model, group: Group) -> None:
     model._parameter_groups[group.prefix] = group
 
 
+def names_argument(names, argument: str, expected: str = "parameter names (System.parameters)") -> list[str]:
+    """The list of distinct names (str) an argument gives (None: none); ValueError naming ``argument`` otherwise."""
+    if names is None:
+        return []
+    if isinstance(names, str) or not isinstance(names, Sequence):
+        raise ValueError(f"{argument}: expected a list of {expected}, got {names!r}")
+    for name in names:
+        if not isinstance(name, str):
+            raise ValueError(f"{argument}: expected {expected} (str), got {name!r}")
+    if len(set(names)) != len(names):
+        raise ValueError(f"{argument}: expected each name once, got {list(names)}")
+    return list(names)
+
+
 def initial_value(system, name: str):
     """(part, index) of an initial-value parameter "q0[<coordinate>]" or "qd0[<coordinate>]", or None."""
     for part in ("q0", "qd0"):
@@ -301,6 +316,10 @@ class Parameters:
         copy = Parameters.__new__(Parameters)
         copy.groups, copy.where, copy.values = self.groups, self.where, {**self.values, **values}
         return copy
+
+    def shifted(self, base, name: str, h: float) -> _core._System:
+        """The compiled system ``base`` with the parameter ``name`` at its value + h (unchecked: a difference's)."""
+        return self.changes({name: self.values[name] + h}).apply(base)
 
     def step(self, name: str) -> float:
         """The step h of the parameter's difference (R(p + h) − R(p))/h: the constants it sets enter the

@@ -29,8 +29,6 @@ profile.
 
 from __future__ import annotations
 
-from collections.abc import Sequence
-
 import numpy as np
 
 from . import parameters as parameters_
@@ -40,18 +38,10 @@ def directions(system, names, options, t0: float, t1: float) -> list[str]:
     """Adds each named direction's systems at p + h (and p − h for a profile's number) and initial sensitivity
     to the C++ ``options`` for a run over [t0, t1] (s); returns the names. ValueError naming what is not a
     parameter or an initial value of the system."""
-    if names is None:
-        return []
-    if isinstance(names, str) or not isinstance(names, Sequence):
-        raise ValueError(f"sensitivities: expected a list of parameter names (System.parameters) or initial values "
-                         f"'q0[<coordinate>]', 'qd0[<coordinate>]', got {names!r}")
-    names = list(names)
-    if len(set(names)) != len(names):
-        raise ValueError(f"sensitivities: expected each name once, got {names}")
+    names = parameters_.names_argument(names, "sensitivities", "parameter names (System.parameters) or initial "
+                                                              "values 'q0[<coordinate>]', 'qd0[<coordinate>]'")
     n = system.nq
     for name in names:
-        if not isinstance(name, str):
-            raise ValueError(f"sensitivities: expected parameter names (str), got {name!r}")
         S0 = np.zeros(2 * n)
         initial = parameters_.initial_value(system, name)
         if initial is not None:
@@ -61,18 +51,16 @@ def directions(system, names, options, t0: float, t1: float) -> list[str]:
             continue
         params = system._parameters
         parameter = params.parameter(name, "sensitivities")  # ValueError naming an unknown one
-        p = params.values[name]
         if parameter.linear:
             h = params.step(name)
-            options.add_sensitivity(params.changes({name: p + h}).apply(system), None, h, S0)
+            options.add_sensitivity(params.shifted(system, name, h), None, h, S0)
             continue
         if isinstance(params.groups[params.where[name][0]], parameters_.ProfileGroup) and \
                 params.groups[params.where[name][0]].what == "loop":
             raise ValueError(f"sensitivities: expected no actuator's profile (its loop's g(q, t; p) would need "
                              f"∂g/∂p, not implemented yet), got {name!r}")
         h = params.profile_step(name, t0, t1)
-        options.add_sensitivity(params.changes({name: p + h}).apply(system),
-                                params.changes({name: p - h}).apply(system), h, S0)
+        options.add_sensitivity(params.shifted(system, name, h), params.shifted(system, name, -h), h, S0)
     return names
 
 

@@ -60,14 +60,9 @@ class SensitivityEquations {
   void project(double t, const VecX& q, const VecX& qd, Eigen::Ref<VecX> S);
 
  private:
-  /// K δq + C δq̇ + M δq̈ at (t, q, q̇, q̈) by the RNEA's forward mode.
-  VecX tangent_product(double t, const VecX& q, const VecX& qd, const VecX& qdd, const VecX& dq, const VecX& dqd,
-                       const VecX& dqdd);
-
   const System& sys_;
   std::vector<SensitivityParameter> parameters_;
   Data d_, e_;                                // workspaces on sys
-  bool analytic_;                             // the RNEA's forward mode, not central differences, along S
   double base_t_ = 0.0;                       // the state of the last base residual R(p)
   VecX base_q_, base_qd_, base_qdd_, base_lambda_, base_r_;
   std::vector<std::unique_ptr<Data>> plus_, minus_;  // on each parameter's systems at p ± h
