@@ -321,10 +321,12 @@ void bind_dynamics(py::module_& m) {
           [](const System& s, double t, const RefV& q, const RefV& qd, const RefV& qdd, const VecX& mu) {
             check_vector(mu, s.nq, "mu", "nq");
             Workspace d(s);
-            return rigidfem::inverse_dynamics_vjp(s, *d, t, q, qd, qdd, mu);
+            const ResidualVjp r = rigidfem::inverse_dynamics_vjp(s, *d, t, q, qd, qdd, mu);
+            return py::make_tuple(r.q, r.qd, r.qdd, r.pq, r.pqd, r.pqdd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("mu"),
-          "((dr/dq)^T mu, (dr/dqd)^T mu, A mu), each (nq): the RNEA's reverse mode (recursive systems), O(n).")
+          "((dr/dq)^T mu, (dr/dqd)^T mu, A mu), each (nq), and d(mu^T r)/d of the prescribed coordinates' q, qd,\n"
+          "qdd, each (np): the RNEA's reverse mode (recursive systems), O(n).")
       .def(
           "acceleration_derivatives",
           [](const System& s, double t, const RefV& q, const RefV& qd) {

@@ -2,6 +2,7 @@
 #include <limits>
 
 #include "bindings.hpp"
+#include "rigidfem/adjoint.hpp"
 #include "rigidfem/auto_method.hpp"
 #include "rigidfem/errors.hpp"
 #include "rigidfem/integrators.hpp"
@@ -146,6 +147,49 @@ void bind_integrators(py::module_& m) {
       },
       py::arg("system"), py::arg("t0"), py::arg("t_end"), py::arg("q0"), py::arg("qd0"), py::arg("t_eval"),
       py::arg("options"), py::arg("keep_going"));
+
+  // The adjoint (adjoint.hpp): one forward run, then backward sweeps; Ctrl-C stops either (the GIL is held).
+  py::class_<NewmarkAdjoint>(m, "_NewmarkAdjoint")
+      .def(py::init([](std::shared_ptr<const System> s, const IntegratorOptions& o,
+                       const std::vector<std::tuple<std::string, int, Vec3>>& outputs, double memory) {
+             std::vector<OutputSpec> specs;
+             for (const auto& [kind, index, r] : outputs) {
+               if (kind != "point" && kind != "coordinate") bad("outputs", "points and coordinates", kind);
+               specs.push_back({kind == "point" ? OutputSpec::Kind::Point : OutputSpec::Kind::Coordinate, index, r});
+             }
+             return std::make_unique<NewmarkAdjoint>(s, o, specs, memory);
+           }),
+           py::arg("system"), py::arg("options"), py::arg("outputs"), py::arg("memory"))
+      .def(
+          "forward",
+          [](NewmarkAdjoint& a, double t0, double t_end, const VecX& q0, const VecX& qd0) {
+            InterruptScope interrupt([] {
+              if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+            });
+            a.forward(t0, t_end, q0, qd0);
+            return py::make_tuple(VecX(Eigen::Map<const VecX>(a.times().data(), a.times().size())), a.outputs());
+          },
+          py::arg("t0"), py::arg("t_end"), py::arg("q0"), py::arg("qd0"), "(t (N + 1), y (N + 1, K)) of the run.")
+      .def(
+          "backward",
+          [](NewmarkAdjoint& a, const Eigen::Ref<const RowMatX>& ybar) {
+            InterruptScope interrupt([] {
+              if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+            });
+            VecX grad = a.backward(ybar);
+            const AdjointStats& st = a.stats();
+            py::dict stats;
+            stats["steps"] = st.steps;
+            stats["recomputed_steps"] = st.recomputed_steps;
+            stats["checkpoints"] = st.checkpoints;
+            stats["checkpoint_interval"] = st.interval;
+            stats["gmres_iterations"] = st.gmres_iterations;
+            stats["preconditioner_refreshes"] = st.preconditioner_refreshes;
+            stats["forward_time"] = st.forward_time;
+            stats["backward_time"] = st.backward_time;
+            return py::make_tuple(grad, a.q0bar(), a.qd0bar(), stats);
+          },
+          py::arg("ybar"), "(dJ/dp, dJ/dq0, dJ/dqd0, stats) for ybar = dJ/dy (N + 1, K).");
 
   m.def(
       "_evaluate_outputs",

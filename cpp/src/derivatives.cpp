@@ -231,7 +231,8 @@ ResidualVjp rnea_vector_jacobian_product(const System& sys, Data& d, const VecX&
   spatial_kinematics(sys, d);
   rnea_pass(sys, d);
   const LoadTerms terms(sys, d);
-  ResidualVjp out{VecX::Zero(sys.nq), VecX::Zero(sys.nq), VecX::Zero(sys.nq)};
+  ResidualVjp out{VecX::Zero(sys.nq), VecX::Zero(sys.nq), VecX::Zero(sys.nq),
+                  VecX::Zero(sys.np), VecX::Zero(sys.np), VecX::Zero(sys.np)};
   const int nb = sys.nbodies;
   // the velocity before each use (the forward pass's state)
   std::vector<Vec6> v_before(sys.nuses);
@@ -311,17 +312,18 @@ ResidualVjp rnea_vector_jacobian_product(const System& sys, Data& d, const VecX&
   for (int p = nb - 1; p >= 0; --p) {
     Vec6 W = Wb[p], dv = vb[p], da = ab[p];
     for (int u = sys.use_start[p + 1] - 1; u >= sys.use_start[p]; --u) {
-      const int i = sys.use_coord[u], k = sys.use_q[u];
+      const int i = sys.use_coord[u], k = sys.use_q[u], j = sys.use_drive[u];
       const Vec6& s = d.axes[u];
       const Vec6& v = v_before[u];
       const double qd = d.qda(i), qdd = d.qdda(i);
-      if (k >= 0) out.q(k) += s.dot(W);        // W += s δq
-      Vec6 ds = qd * dv;                         // δv += δs q̇ + s δq̇
-      if (k >= 0) out.qd(k) += s.dot(dv);
-      // δa += (δv ×m s + v ×m δs) q̇ + δs q̈ + (v ×m s) δq̇ + s δq̈
+      // W += s δq, δv += δs q̇ + s δq̇, δa += (δv ×m s + v ×m δs) q̇ + δs q̈ + (v ×m s) δq̇ + s δq̈: the adjoints
+      // of a free coordinate's (δq, δq̇, δq̈), or of a prescribed one's motion
+      const double wq = s.dot(W), wqd = s.dot(dv) + crossm(v, s).dot(da), wqdd = s.dot(da);
+      if (k >= 0) out.q(k) += wq, out.qd(k) += wqd, out.qdd(k) += wqdd;
+      if (j >= 0) out.pq(j) += wq, out.pqd(j) += wqd, out.pqdd(j) += wqdd;
+      Vec6 ds = qd * dv;
       dv += qd * crossf(s, da);
       ds += -qd * crossf(v, da) + qdd * da;
-      if (k >= 0) out.qd(k) += crossm(v, s).dot(da), out.qdd(k) += s.dot(da);
       W += crossf(s, ds) + Wu[u];                // δs = W ×m s
     }
     if (sys.parent[p] >= 0) Wb[sys.parent[p]] += W, vb[sys.parent[p]] += dv, ab[sys.parent[p]] += da;

@@ -271,15 +271,13 @@ VecX inverse_dynamics_direction(const System& sys, Data& d, double t, const Eige
   return (up - inverse_dynamics(sys, d, t, q - eps * dq, qd - eps * dqd, qdd - eps * dqdd)) / (2.0 * eps);
 }
 
-std::tuple<VecX, VecX, VecX> inverse_dynamics_vjp(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
-                                                  const Eigen::Ref<const VecX>& qd, const Eigen::Ref<const VecX>& qdd,
-                                                  const VecX& mu) {
+ResidualVjp inverse_dynamics_vjp(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                                 const Eigen::Ref<const VecX>& qd, const Eigen::Ref<const VecX>& qdd, const VecX& mu) {
   if (!recursive(sys))
     throw std::invalid_argument("system: expected a system compiled with algorithm='recursive' (the reverse mode is "
                                 "the recursive engine's), got algorithm='lagrange'");
   full_state(sys, d, t, q, qd, qdd);
-  ResidualVjp r = rnea_vector_jacobian_product(sys, d, mu);
-  return {r.q, r.qd, r.qdd};
+  return rnea_vector_jacobian_product(sys, d, mu);
 }
 
 std::pair<MatX, MatX> acceleration_derivatives(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,

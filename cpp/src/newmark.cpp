@@ -16,6 +16,7 @@
 #include "rigidfem/dynamics.hpp"
 #include "rigidfem/errors.hpp"
 #include "rigidfem/kinematics.hpp"
+#include "rigidfem/newmark.hpp"
 #include "rigidfem/newton_matrix.hpp"
 #include "rigidfem/sensitivities.hpp"
 #include "rigidfem/stepper.hpp"
@@ -24,13 +25,7 @@ namespace rigidfem {
 
 namespace {
 
-struct NewmarkState {
-  VecX q, v, qdd, a, lambda;  // lambda (nl): the loops' multipliers at the same time
-  VecX s;                     // (nz) the Maxwell arms' forces
-  MatX Sq, Sv, Sqdd, Sa, Slambda;  // (nq, P) and (nl, P): their derivatives by each parameter (sensitivities.hpp)
-};
-
-class NewmarkFamily final : public Stepper {
+class NewmarkFamily final : public NewmarkStepper {
  public:
   NewmarkFamily(const System& sys, const IntegratorOptions& o, IntegratorStats& stats)
       : sys_(sys),
@@ -150,6 +145,15 @@ class NewmarkFamily final : public Stepper {
   }
   /// The estimate per unit step is O(h²).
   StepControl control() const override { return {2, 5.0, false, 1.25}; }
+
+  const NewmarkState& current() const override { return s_; }
+  void restore(double t, const NewmarkState& s) override {
+    s_ = s;
+    y_.resize(2 * sys_.nq + sys_.nz);
+    y_ << s.q, s.v, s.s;
+    t_ = t, h_step_ = 1.0, lambda_a_ = s.lambda;
+  }
+  NewmarkCoefficients coefficients() const override { return {am_, af_, beta_, gamma_}; }
 
  private:
   /// Newton iterations for q̈_{n+1} into s1_; false when they do not converge.
@@ -391,6 +395,11 @@ class NewmarkFamily final : public Stepper {
 }  // namespace
 
 std::unique_ptr<Stepper> make_newmark(const System& sys, const IntegratorOptions& o, IntegratorStats& stats) {
+  return std::make_unique<NewmarkFamily>(sys, o, stats);
+}
+
+std::unique_ptr<NewmarkStepper> make_newmark_stepper(const System& sys, const IntegratorOptions& o,
+                                                     IntegratorStats& stats) {
   return std::make_unique<NewmarkFamily>(sys, o, stats);
 }
 

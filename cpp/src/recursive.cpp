@@ -7,16 +7,14 @@
 
 namespace rigidfem {
 
-namespace {
-
-// Spatial inertia at the global origin of mass m with centre c and inertia I_c about it
-// (global axes): [[I_c + m S(c) S(c)ᵀ, m S(c)], [m S(c)ᵀ, m 1]].
 Mat6 spatial_inertia(double m, const Vec3& c, const Mat3& Ic) {
   const Mat3 C = skew(c);
   Mat6 I;
   I << Ic + m * C * C.transpose(), m * C, m * C.transpose(), m * Mat3::Identity();
   return I;
 }
+
+namespace {
 
 void require_tree(const System& sys) {
   if (sys.algorithm != Algorithm::Recursive)

@@ -47,6 +47,7 @@ from .error_control import ErrorEstimate  # noqa: E402
 from .viewer import Viewer, view  # noqa: E402 (the 3D viewer: notebooks and HTML files)
 from . import parameters, sensitivities  # noqa: E402 (named parameters; forward sensitivities)
 from .parameters import Parameter  # noqa: E402
+from .adjoint import Gradient, gradient  # noqa: E402 (adjoint gradients of an objective of a run)
 
 __version__ = "0.1.0"
 
@@ -68,6 +69,7 @@ __all__ = [
     "Body",
     "Data",
     "Equilibrium",
+    "Gradient",
     "ErrorEstimate",
     "Joint",
     "JointSpec",
@@ -90,6 +92,7 @@ __all__ = [
     "display",
     "euler_zyx",
     "export",
+    "gradient",
     "homogeneous",
     "inverse",
     "plots",

@@ -52,15 +52,16 @@ def specs(system, error_on) -> list:
     return [_spec(system, item) for item in items]
 
 
-def _spec(system, item):
+def _spec(system, item, argument: str = "error_on"):
+    """(kind, index, r) of one output; ValueError naming ``argument``."""
     if isinstance(item, Body):
         item = item.origin
     if isinstance(item, Point):
-        same_model(item, system, "error_on", "points and bodies of the model this system was compiled from")
+        same_model(item, system, argument, "points and bodies of the model this system was compiled from")
         return ("point", int(item.body), np.asarray(item.r, dtype=float))
     if isinstance(item, (int, np.integer)) and not isinstance(item, bool):
         if not 0 <= item < system.nq:
-            raise ValueError(f"error_on: expected coordinate indices 0 ... {system.nq - 1} (nq - 1), got {item}")
+            raise ValueError(f"{argument}: expected coordinate indices 0 ... {system.nq - 1} (nq - 1), got {item}")
         return ("coordinate", int(item), np.zeros(3))
     if isinstance(item, str):
         found = [(kind, names.index(item)) for kind, names in
@@ -69,10 +70,10 @@ def _spec(system, item):
         if len(found) == 1:
             return (found[0][0], found[0][1], np.zeros(3))
         if len(found) > 1:
-            raise ValueError(f"error_on: the name {item!r} is a {' and a '.join(k for k, _ in found)}: ambiguous")
-        raise ValueError(f"error_on: expected a coordinate ({_few(system.coordinate_names)}), force element "
+            raise ValueError(f"{argument}: the name {item!r} is a {' and a '.join(k for k, _ in found)}: ambiguous")
+        raise ValueError(f"{argument}: expected a coordinate ({_few(system.coordinate_names)}), force element "
                          f"({_few(system.element_names)}) or loop ({_few(system.loop_names)}) name, got {item!r}")
-    raise ValueError(f"error_on: expected points, bodies, coordinate indices or names of coordinates, force "
+    raise ValueError(f"{argument}: expected points, bodies, coordinate indices or names of coordinates, force "
                      f"elements or loops, got {item!r}")
 
 

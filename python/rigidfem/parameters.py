@@ -307,10 +307,19 @@ class Parameters:
             prefix, short = self.where[name]
             touched.setdefault(prefix, {})[short] = value
         for prefix, new in touched.items():
-            g = self.groups[prefix]
-            current = {short: self.values[p.name] for short, p in g.parameters.items()}
-            out += g.changes({**current, **new})
+            out += self.groups[prefix].changes({**self._current(prefix), **new})
         return out
+
+    def _current(self, prefix: str) -> dict[str, float]:
+        """{short name: value} of a group's parameters; of a profile's, only those that differ from the numbers
+        it was made of (a spline's hundred knots: each difference of one of them stays O(1) here)."""
+        cache = self.__dict__.setdefault("_cache", {})
+        if prefix not in cache:
+            g = self.groups[prefix]
+            leaves = g.current_leaves() if isinstance(g, ProfileGroup) else {}
+            cache[prefix] = {short: self.values[p.name] for short, p in g.parameters.items()
+                             if not isinstance(g, ProfileGroup) or self.values[p.name] != leaves.get(short)}
+        return cache[prefix]
 
     def updated(self, values: dict[str, float]) -> Parameters:
         copy = Parameters.__new__(Parameters)
@@ -335,11 +344,11 @@ class Parameters:
         round-off (∝ 1/h) both stay near 1e-10 of the derivative."""
         prefix, short = self.where[name]
         group = self.groups[prefix]
-        current = {s: self.values[p.name] for s, p in group.parameters.items()}
-        base = remade(group.profile, current)
+        changed = self._current(prefix)
+        base = remade(group.profile, changed)
         p = self.values[name]
         delta = 1e-6 * max(abs(p), 1.0)
-        moved = remade(group.profile, {**current, short: p + delta})
+        moved = remade(group.profile, {**changed, short: p + delta})
         times = np.linspace(t0, t1, 41)
         q = np.array([base(t)[0] for t in times])
         change = np.max(np.abs(np.array([moved(t)[0] for t in times]) - q))
@@ -402,7 +411,7 @@ def remade(profile, values: dict[str, float], path: str = ""):
             arg = remade(arg, values, here + ".")
         elif isinstance(arg, (list, tuple)) and arg and isinstance(arg[0], _core.Profile):
             arg = [remade(part, values, f"{here}[{k}].") for k, part in enumerate(arg)]
-        elif isinstance(arg, (list, tuple)):
+        elif isinstance(arg, (list, tuple)) and any(key.startswith(here + "[") for key in values):
             arg = [values.get(f"{here}[{k}]", v) for k, v in enumerate(arg)]
         elif isinstance(arg, float):
             arg = values.get(here, arg)
@@ -419,14 +428,23 @@ class ProfileGroup(Group):
 
     def __init__(self, prefix, what: str, body: int, index: int, profile, unit: str):
         self.profile, self.what, self.body, self.index = profile, what, body, index
+        self.leaves = profile_leaves(profile)
         params = {path: Parameter(f"{prefix}.{path}", value, unit, f"a number of the profile {profile!r}",
                                   -math.inf, False, linear=False)
-                  for path, value in profile_leaves(profile).items()}
+                  for path, value in self.leaves.items()}
         super().__init__(prefix, params)
 
     def changes(self, values: dict) -> Changes:
+        leaves = self.current_leaves()
+        values = {path: v for path, v in values.items() if v != leaves.get(path)}  # the few that change
         try:
             profile = remade(self.profile, values)
         except (TypeError, ValueError) as e:
             raise ValueError(f"values: expected numbers the profile of {self.prefix} takes, got {values} ({e})") from None
         return Changes(profiles=[(self.what, self.body, self.index, profile)])
+
+    def current_leaves(self) -> dict[str, float]:
+        """The numbers of the profile the builder was given (kept: a group unpickled from before has none)."""
+        if not hasattr(self, "leaves"):
+            self.leaves = profile_leaves(self.profile)
+        return self.leaves

@@ -34,11 +34,11 @@ import numpy as np
 from . import parameters as parameters_
 
 
-def directions(system, names, options, t0: float, t1: float) -> list[str]:
+def directions(system, names, options, t0: float, t1: float, argument: str = "sensitivities") -> list[str]:
     """Adds each named direction's systems at p + h (and p − h for a profile's number) and initial sensitivity
     to the C++ ``options`` for a run over [t0, t1] (s); returns the names. ValueError naming what is not a
     parameter or an initial value of the system."""
-    names = parameters_.names_argument(names, "sensitivities", "parameter names (System.parameters) or initial "
+    names = parameters_.names_argument(names, argument, "parameter names (System.parameters) or initial "
                                                               "values 'q0[<coordinate>]', 'qd0[<coordinate>]'")
     n = system.nq
     for name in names:
@@ -50,14 +50,14 @@ def directions(system, names, options, t0: float, t1: float) -> list[str]:
             options.add_sensitivity(None, None, 0.0, S0)
             continue
         params = system._parameters
-        parameter = params.parameter(name, "sensitivities")  # ValueError naming an unknown one
+        parameter = params.parameter(name, argument)  # ValueError naming an unknown one
         if parameter.linear:
             h = params.step(name)
             options.add_sensitivity(params.shifted(system, name, h), None, h, S0)
             continue
         if isinstance(params.groups[params.where[name][0]], parameters_.ProfileGroup) and \
                 params.groups[params.where[name][0]].what == "loop":
-            raise ValueError(f"sensitivities: expected no actuator's profile (its loop's g(q, t; p) would need "
+            raise ValueError(f"{argument}: expected no actuator's profile (its loop's g(q, t; p) would need "
                              f"∂g/∂p, not implemented yet), got {name!r}")
         h = params.profile_step(name, t0, t1)
         options.add_sensitivity(params.shifted(system, name, h), params.shifted(system, name, -h), h, S0)

@@ -80,6 +80,7 @@ import numpy as np
 
 from . import _checks, _core, _deprecation, _interrupt, display, error_control, export
 from . import sensitivities as sensitivities_
+from . import parameters as parameters_
 from . import options as options_
 from ._progress import ProgressBar
 from .persistence import Versioned
@@ -229,15 +230,24 @@ class Result(Versioned):
         return S[:, :n], S[:, n:]
 
     def position_sensitivity(self, point, name: str, frame: Body | None = None) -> np.ndarray:
-        """∂x/∂p (len(t), 3) of a point's position x (``position``: global, or in ``frame``'s axes) by
+        """dx/dp (len(t), 3) of a point's position x (``position``: global, or in ``frame``'s axes) by
         ``name``: (∂x/∂q) ∂q/∂p, by a central difference of x along ∂q/∂p at each output (about 1e-10
-        relative; m per unit of the parameter)."""
+        relative; m per unit of the parameter), plus, for a profile's number, ∂x/∂p at fixed q: a drive's
+        number moves its prescribed coordinate, and the point with it (a central difference of x on the
+        systems at p ± h)."""
         dq, _ = self.sensitivity(name)
         size = np.max(np.abs(dq), axis=1) / np.maximum(1.0, np.max(np.abs(self.q), axis=1, initial=0.0))
         eps = 6e-6 / np.where(size > 0.0, size, 1.0)  # the largest relative change of q: 6e-6
         up, down = (dataclasses.replace(self, q=self.q + sign * eps[:, None] * dq).position(point, frame)
                     for sign in (1.0, -1.0))
-        return (up - down) / (2.0 * eps[:, None])  # zero where ∂q/∂p is
+        dx = (up - down) / (2.0 * eps[:, None])  # zero where ∂q/∂p is
+        params = self.system._parameters
+        if parameters_.initial_value(self.system, name) is None and not params.parameter(name).linear:
+            h = params.profile_step(name, self.t[0], self.t[-1])
+            up, down = (dataclasses.replace(self, system=params.shifted(self.system, name, sign * h)).position(
+                point, frame) for sign in (1.0, -1.0))
+            dx += (up - down) / (2.0 * h)
+        return dx
 
     def __repr__(self) -> str:
         s = self.stats

@@ -43,11 +43,13 @@ std::pair<MatX, MatX> rnea_derivatives(const System& sys, Data& d);
 /// δs_u = W_before ×m s_u and δI_p = W_p ×* I_p − I_p W_p ×m; the RNEA's passes differentiated along it).
 VecX rnea_directional_derivative(const System& sys, Data& d, const VecX& dq, const VecX& dqd, const VecX& dqdd);
 
-/// (∂r/∂q)ᵀ μ, (∂r/∂q̇)ᵀ μ and A μ (each nq) for one μ (nq): the reverse mode, rnea_directional_derivative's
-/// sweeps transposed (leaves to root), O(n) — what an adjoint needs of the residual. Needs what
-/// rnea_derivatives needs; links of varying length are not covered (std::invalid_argument).
+/// (∂r/∂q)ᵀ μ, (∂r/∂q̇)ᵀ μ and A μ (each nq) for one μ (nq), and the same by the prescribed coordinates'
+/// values, rates and accelerations (each np): the reverse mode, rnea_directional_derivative's sweeps transposed
+/// (leaves to root), O(n) — what an adjoint needs of the residual. Needs what rnea_derivatives needs; links of
+/// varying length are not covered (std::invalid_argument).
 struct ResidualVjp {
   VecX q, qd, qdd;
+  VecX pq, pqd, pqdd;  ///< (np) ∂(μᵀr)/∂ of the prescribed coordinates' q, q̇, q̈
 };
 ResidualVjp rnea_vector_jacobian_product(const System& sys, Data& d, const VecX& mu);
 

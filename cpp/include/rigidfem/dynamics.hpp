@@ -9,6 +9,7 @@
 #include <tuple>
 #include <utility>
 
+#include "rigidfem/derivatives.hpp"
 #include "rigidfem/system.hpp"
 
 namespace rigidfem {
@@ -68,11 +69,11 @@ std::pair<MatX, MatX> inverse_dynamics_derivatives(const System& sys, Data& d, d
 VecX inverse_dynamics_direction(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
                                 const Eigen::Ref<const VecX>& qd, const Eigen::Ref<const VecX>& qdd, const VecX& dq,
                                 const VecX& dqd, const VecX& dqdd);
-/// ((∂r/∂q)ᵀ μ, (∂r/∂q̇)ᵀ μ, A μ) at (t, q, q̇, q̈): the RNEA's reverse mode (recursive systems without links of
-/// varying length: std::invalid_argument otherwise), O(n).
-std::tuple<VecX, VecX, VecX> inverse_dynamics_vjp(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
-                                                  const Eigen::Ref<const VecX>& qd, const Eigen::Ref<const VecX>& qdd,
-                                                  const VecX& mu);
+/// ((∂r/∂q)ᵀ μ, (∂r/∂q̇)ᵀ μ, A μ) and the same by the prescribed coordinates' motion at (t, q, q̇, q̈): the RNEA's
+/// reverse mode (derivatives.hpp; recursive systems without links of varying length: std::invalid_argument
+/// otherwise), O(n).
+ResidualVjp inverse_dynamics_vjp(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
+                                 const Eigen::Ref<const VecX>& qd, const Eigen::Ref<const VecX>& qdd, const VecX& mu);
 /// ∂q̈/∂q and ∂q̈/∂q̇ (nq, nq) at (t, q, q̇): −A⁻¹ (∂r/∂q, ∂r/∂q̇) at the forward-dynamics q̈; with loops, of
 /// the constrained q̈ (λ(q, q̇) and G(q) varying too) by central differences.
 std::pair<MatX, MatX> acceleration_derivatives(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,

@@ -67,6 +67,9 @@ class NewtonMatrix {
   virtual void solve(const VecX& b, VecX& x) = 0;
   /// x = S⁻¹ b with slot 1's matrix.
   virtual void solve(const VecXc& b, VecXc& x) = 0;
+  /// x = P⁻ᵀ b with slot 0's factorisation P: S itself (dense), the preconditioner M + diag(c₁ b + c₂ k + e),
+  /// symmetric (Krylov). The adjoint's preconditioner for Sᵀ (adjoint.cpp).
+  virtual void precondition_transposed(const VecX& b, VecX& x) = 0;
   /// X = S⁻¹ B column by column with slot 0's matrix.
   MatX solve(const MatX& B);
   /// Whether the tangent is matrix-free.

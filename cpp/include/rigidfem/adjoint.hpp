@@ -1,0 +1,132 @@
+/// Adjoint gradients of a scalar objective of a run, J = Σ_n ȳ-weighted outputs (a quadrature of ∫ L(t, y) dt
+/// plus Φ(y(t_end)), formed in Python from the outputs y_n the forward run records), with respect to many
+/// parameters at the cost of a few runs: the discrete adjoint of the Newmark family (generalised-α in the form of
+/// Arnold & Brüls, newmark.cpp) at fixed steps.
+///
+/// A step n → n+1 solves r(q_{n+1}, q̇_{n+1}, q̈_{n+1}, t_{n+1}; p) = 0 for z = q̈_{n+1}, with
+///   a_{n+1} = [(1 − α_f) z + α_f q̈_n − α_m a_n]/(1 − α_m),
+///   q_{n+1} = q_n + h q̇_n + h² [(½ − β) a_n + β a_{n+1}],   q̇_{n+1} = q̇_n + h [(1 − γ) a_n + γ a_{n+1}].
+/// With the adjoints (q̄, q̇̄, ā, q̈̄) of the state = ∂J/∂(q, q̇, a, q̈) by everything after it, the step transposed:
+///   ã = ā_{n+1} + βh² q̄_{n+1} + γh q̇̄_{n+1},      g = q̈̄_{n+1} + (1 − α_f)/(1 − α_m) ã,
+///   Sᵀ μ = g,   S = M + γ'h C + β'h² K (Newton's matrix at the step's end; β' = β(1 − α_f)/(1 − α_m), γ' alike),
+///   q̂ = q̄_{n+1} − Kᵀμ,   q̇̂ = q̇̄_{n+1} − Cᵀμ,   A = ā_{n+1} + βh² q̂ + γh q̇̂,
+///   q̄_n = q̂ + ∂J/∂q_n,  q̇̄_n = h q̂ + q̇̂ + ∂J/∂q̇_n,  ā_n = h²(½ − β) q̂ + h(1 − γ) q̇̂ − α_m/(1 − α_m) A,
+///   q̈̄_n = α_f/(1 − α_m) A,   dJ/dp −= μᵀ ∂r/∂p (at t_{n+1}).
+/// At t0, a_0 = q̈_0 solves r(q_0, q̇_0, q̈_0) = 0: M μ_0 = ā_0 + q̈̄_0, q̄_0 −= Kᵀμ_0, q̇̄_0 −= Cᵀμ_0,
+/// dJ/dp −= μ_0ᵀ ∂r/∂p. Kᵀμ, Cᵀμ, Mμ come from the RNEA's reverse mode (derivatives.hpp: O(n)); Sᵀμ = g is
+/// solved by GMRES on those products, preconditioned by the transposed factorisation of a Newton matrix kept
+/// from an earlier step (dense) or by M + diag(γ'h b + β'h² k) (Krylov), to 1e-10; μᵀ∂r/∂p for every parameter
+/// in one pass (ParameterVjp). Recursive tree systems without Maxwell arms or links of varying length.
+///
+/// Checkpointing: the forward run keeps every state while they fit into `memory` bytes, else every k-th (k = ⌈√N⌉,
+/// about 2√N states in all) and the backward sweep runs each segment again from its checkpoint: memory O(√N)
+/// states, one extra forward run's work.
+#pragma once
+
+#include <memory>
+#include <vector>
+
+#include "rigidfem/derivatives.hpp"
+#include "rigidfem/error_measure.hpp"
+#include "rigidfem/integrators.hpp"
+#include "rigidfem/newmark.hpp"
+#include "rigidfem/newton_matrix.hpp"
+#include "rigidfem/sensitivities.hpp"
+
+namespace rigidfem {
+
+/// The objective's outputs: a point's global position (Point: 3 numbers, m) or a free coordinate (Coordinate: 1).
+/// y (K) at the state of d (set_state and tree_kinematics done).
+int output_size(const std::vector<OutputSpec>& outputs);
+void objective_outputs(const System& sys, const Data& d, const std::vector<OutputSpec>& outputs, Eigen::Ref<VecX> y);
+/// (∂y/∂q)ᵀ ȳ added into qbar (nq) and its part by the prescribed coordinates into pbar (np), at the state of d.
+void objective_outputs_vjp(const System& sys, const Data& d, const std::vector<OutputSpec>& outputs,
+                           const VecX& ybar, VecX& qbar, VecX& pbar);
+
+/// μᵀ ∂r/∂p_j of r = M q̈ − f for every parameter of a run in one O(n) pass: each parameter's system at p ± h
+/// differs from the run's in a few components (bodies' inertias, coordinates' springs and forces, elements'
+/// laws, loads, drives), each component's part of μᵀr is its virtual power under the virtual velocity μ
+/// (a body's V_bᵀ(I a + v ×* I v) with V_b = Σ_{path} s_u μ_u; −μ_k Q_k of a coordinate; −F δl of an element;
+/// −V_bᵀ w of a load), and only those are evaluated again. A drive's numbers enter through the prescribed
+/// coordinate's (q, q̇, q̈): ∂(μᵀr)/∂ of those from the reverse mode, times the profile's own difference.
+class ParameterVjp {
+ public:
+  ParameterVjp(const System& sys, const std::vector<SensitivityParameter>& parameters);
+  /// grad_j += w μᵀ ∂r/∂p_j at (t, q, q̇, q̈), r the reverse mode's products there (its part by the prescribed
+  /// coordinates' motion: a drive's numbers).
+  void add(double t, const VecX& q, const VecX& qd, const VecX& qdd, const VecX& mu, const ResidualVjp& r, double w,
+           Eigen::Ref<VecX> grad);
+  /// grad_j += pbarᵀ ∂q_p(t)/∂p_j: the prescribed coordinates' values moved by a drive's numbers.
+  void add_prescribed(double t, const VecX& pbar, Eigen::Ref<VecX> grad) const;
+  int count() const { return static_cast<int>(parameters_.size()); }
+  /// [∂q₀/∂p_j, ∂q̇₀/∂p_j] (2 nq).
+  const VecX& initial(int j) const { return parameters_[j].S0; }
+
+ private:
+  struct Component {
+    enum Kind { Body, Coordinate, Element, Load, Drive } kind;
+    int index;  // body, coordinate (in coords), element, load
+  };
+  double power(const System& X, const Component& c, const VecX& mu) const;
+  MotionState drive_derivative(int j, int coord, double t) const;
+  const System& sys_;
+  std::vector<SensitivityParameter> parameters_;
+  std::vector<std::vector<Component>> touched_;  // per parameter
+  Data d_;
+  std::vector<Vec6> V_;                           // (nbodies) V_b = Σ s_u μ_u along the path
+};
+
+/// The state at a step's end the backward sweep linearises at.
+struct StepState {
+  double t = 0.0, h = 0.0;  // h: the step that reached it (0 at t0)
+  VecX q, v, qdd;
+};
+
+struct AdjointStats {
+  long steps = 0, recomputed_steps = 0, checkpoints = 0, stored_states = 0, interval = 1;
+  long gmres_iterations = 0, preconditioner_refreshes = 0;
+  double forward_time = 0.0, backward_time = 0.0;  // s
+};
+
+/// One forward run recording the outputs and its checkpoints, then any number of backward sweeps.
+class NewmarkAdjoint {
+ public:
+  /// o: a Newmark-family method at fixed steps dt, o.sensitivities the parameters (their systems at p ± h and S0).
+  NewmarkAdjoint(std::shared_ptr<const System> sys, const IntegratorOptions& o, std::vector<OutputSpec> outputs,
+                 double memory);
+  /// Runs from (t0, q0, q̇0) to t_end: times() and outputs() (N + 1, K), the checkpoints.
+  void forward(double t0, double t_end, const VecX& q0, const VecX& qd0);
+  const std::vector<double>& times() const { return t_; }
+  const RowMatX& outputs() const { return Y_; }
+  /// dJ/dp_j (P) for ȳ_n = ∂J/∂y_n (N + 1, K); q0bar(), qd0bar() the gradient by the initial state.
+  VecX backward(const Eigen::Ref<const RowMatX>& ybar);
+  const VecX& q0bar() const { return q0bar_; }
+  const VecX& qd0bar() const { return qd0bar_; }
+  const AdjointStats& stats() const { return stats_; }
+
+ private:
+  void replay(long first, long last, std::vector<StepState>& states);
+  VecX transposed_solve(const StepState& s, const VecX& g, double c1, double c2);
+  void at(const StepState& s);  // set_state, q̈ and the axes on d_
+  void output_vjp(const StepState& s, const VecX& ybar, VecX& qbar, VecX& grad);
+
+  std::shared_ptr<const System> sys_;
+  IntegratorOptions o_;
+  std::vector<OutputSpec> outputs_;
+  double memory_;
+  IntegratorStats istats_;
+  std::unique_ptr<NewmarkStepper> stepper_;
+  std::unique_ptr<NewtonMatrix> matrix_;
+  std::unique_ptr<ParameterVjp> params_;
+  Data d_;
+  std::vector<double> t_;
+  RowMatX Y_;
+  long interval_ = 1;                          // steps between checkpoints
+  std::vector<NewmarkState> checkpoints_;      // at steps 0, k, 2k, ... (all: k = 1)
+  VecX q0bar_, qd0bar_;
+  AdjointStats stats_;
+  bool preconditioner_ = false;
+  long last_iterations_ = 0;
+};
+
+}  // namespace rigidfem

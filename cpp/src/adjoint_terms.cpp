@@ -1,0 +1,166 @@
+// The adjoint's terms besides the residual's reverse mode: the objective's outputs and their transposed
+// Jacobian, and μᵀ ∂r/∂p of every parameter in one pass (adjoint.hpp).
+#include <stdexcept>
+
+#include "rigidfem/adjoint.hpp"
+#include "rigidfem/derivatives.hpp"
+#include "rigidfem/dynamics.hpp"
+#include "rigidfem/recursive.hpp"
+
+namespace rigidfem {
+
+int output_size(const std::vector<OutputSpec>& outputs) {
+  int K = 0;
+  for (const OutputSpec& o : outputs) K += o.kind == OutputSpec::Kind::Point ? 3 : 1;
+  return K;
+}
+
+void objective_outputs(const System& sys, const Data& d, const std::vector<OutputSpec>& outputs, Eigen::Ref<VecX> y) {
+  int k = 0;
+  for (const OutputSpec& o : outputs) {
+    if (o.kind == OutputSpec::Kind::Point) {
+      y.segment<3>(k) = (d.T[o.index] * o.r.homogeneous()).head<3>();
+      k += 3;
+    } else {
+      y(k++) = d.qa(sys.free_coords[o.index]);
+    }
+  }
+}
+
+void objective_outputs_vjp(const System& sys, const Data& d, const std::vector<OutputSpec>& outputs,
+                           const VecX& ybar, VecX& qbar, VecX& pbar) {
+  int k = 0;
+  for (const OutputSpec& o : outputs) {
+    if (o.kind != OutputSpec::Kind::Point) {
+      qbar(o.index) += ybar(k++);
+      continue;
+    }
+    // x = T_b r moves by δx = Σ_u δq_u (ω_u × x + v_u) over the uses u on b's path: ȳ·δx = Σ δq_u s_uᵀ (x × ȳ, ȳ)
+    const Vec3 x = (d.T[o.index] * o.r.homogeneous()).head<3>(), yb = ybar.segment<3>(k);
+    k += 3;
+    Vec6 w;
+    w << x.cross(yb), yb;
+    for (int p = o.index; p >= 0; p = sys.parent[p])
+      for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) {
+        const double c = d.axes[u].dot(w);
+        if (sys.use_q[u] >= 0)
+          qbar(sys.use_q[u]) += c;
+        else if (sys.use_drive[u] >= 0)
+          pbar(sys.use_drive[u]) += c;
+      }
+  }
+}
+
+ParameterVjp::ParameterVjp(const System& sys, const std::vector<SensitivityParameter>& parameters)
+    : sys_(sys), parameters_(parameters), touched_(parameters.size()), d_(sys), V_(sys.nbodies) {
+  for (std::size_t j = 0; j < parameters_.size(); ++j) {
+    for (const auto& X : {parameters_[j].plus, parameters_[j].minus}) {
+      if (!X) continue;
+      std::vector<Component>& touched = touched_[j];
+      auto add = [&](Component::Kind kind, int index) {
+        for (const Component& c : touched)
+          if (c.kind == kind && c.index == index) return;
+        touched.push_back({kind, index});
+      };
+      for (int b = 0; b < sys.nbodies; ++b)
+        if (X->H[b] != sys.H[b]) add(Component::Body, b);
+      for (int i = 0; i < sys.nc; ++i) {
+        const Coordinate &a = X->coords[i], &c = sys.coords[i];
+        if (c.free_index >= 0 && (a.stiffness != c.stiffness || a.damping != c.damping || a.force != c.force ||
+                                  a.rest != c.rest))
+          add(Component::Coordinate, i);
+        if (a.drive != c.drive) add(Component::Drive, i);
+      }
+      for (std::size_t e = 0; e < sys.elements.size(); ++e)
+        if (X->elements[e].law != sys.elements[e].law) add(Component::Element, static_cast<int>(e));
+      for (std::size_t l = 0; l < sys.loads.size(); ++l) {
+        const Load &a = X->loads[l], &c = sys.loads[l];
+        if (a.force != c.force || a.torque != c.torque || a.scale != c.scale) add(Component::Load, static_cast<int>(l));
+      }
+      for (std::size_t k = 0; k < sys.loops.size(); ++k)
+        if (X->loops[k].drive != sys.loops[k].drive)
+          throw std::invalid_argument("parameters: expected no actuator's length profile (its loop's ∂g/∂p is not "
+                                      "implemented)");
+    }
+  }
+}
+
+double ParameterVjp::power(const System& X, const Component& c, const VecX& mu) const {
+  const Data& d = d_;
+  auto velocity = [&](int b, const Vec3& x) -> Vec3 {  // the point x of body b under the virtual velocity
+    return b < 0 ? Vec3::Zero() : Vec3(V_[b].tail<3>() + V_[b].head<3>().cross(x));
+  };
+  switch (c.kind) {
+    case Component::Body: {  // V_bᵀ (I a + v ×* I v), gravity in a (a_0 = −g)
+      const int b = c.index;
+      const Mat3 R = d.T[b].topLeftCorner<3, 3>();
+      const Mat6 I = spatial_inertia(X.mass[b], R * X.com[b] + d.T[b].topRightCorner<3, 1>(),
+                                     R * X.inertia[b] * R.transpose());
+      return V_[b].dot(I * d.a[b] + crossf(d.v[b], I * d.v[b]));
+    }
+    case Component::Coordinate:  // −μ_k Q_k
+      return -mu(X.coords[c.index].free_index) * passive_force(X, d, c.index);
+    case Component::Element: {  // −F e·(V_b(x_b) − V_a(x_a)) = −F δl
+      const ForceElement& E = X.elements[c.index];
+      const ElementState s = element_state(d, E, true);
+      return -s.F * s.e.dot(velocity(E.body_b, s.xb) - velocity(E.body_a, s.xa));
+    }
+    case Component::Load: {  // −V_bᵀ (x × F + τ, F)
+      const Load& L = X.loads[c.index];
+      const AppliedLoad a = applied_load(d, L);
+      return -(V_[L.body].head<3>().dot(a.x.cross(a.F) + a.tau) + V_[L.body].tail<3>().dot(a.F));
+    }
+    case Component::Drive:
+      return 0.0;  // by the prescribed coordinate's derivatives (add)
+  }
+  return 0.0;
+}
+
+MotionState ParameterVjp::drive_derivative(int j, int coord, double t) const {
+  const SensitivityParameter& p = parameters_[j];
+  const MotionState up = p.plus->coords[coord].drive->at(t);
+  const MotionState down = p.minus ? p.minus->coords[coord].drive->at(t) : sys_.coords[coord].drive->at(t);
+  const double h = p.minus ? 2.0 * p.h : p.h;
+  return {(up.q - down.q) / h, (up.qd - down.qd) / h, (up.qdd - down.qdd) / h};
+}
+
+void ParameterVjp::add(double t, const VecX& q, const VecX& qd, const VecX& qdd, const VecX& mu,
+                       const ResidualVjp& r, double w, Eigen::Ref<VecX> grad) {
+  set_state(sys_, d_, t, q, qd);
+  set_accelerations(sys_, d_, qdd);
+  tree_kinematics(sys_, d_);
+  spatial_kinematics(sys_, d_);
+  rnea_pass(sys_, d_);
+  // V_b = V_parent + Σ_{free uses u of b's joint} s_u μ_u: each body's velocity for q̇ = μ
+  for (int b = 0; b < sys_.nbodies; ++b) {
+    V_[b] = sys_.parent[b] >= 0 ? V_[sys_.parent[b]] : Vec6::Zero();
+    for (int u = sys_.use_start[b]; u < sys_.use_start[b + 1]; ++u)
+      if (sys_.use_q[u] >= 0) V_[b] += d_.axes[u] * mu(sys_.use_q[u]);
+  }
+  for (std::size_t j = 0; j < parameters_.size(); ++j) {
+    const SensitivityParameter& p = parameters_[j];
+    if (!p.plus) continue;
+    double sum = 0.0;
+    for (const Component& c : touched_[j]) {
+      if (c.kind == Component::Drive) {  // the reverse mode's ∂(μᵀr)/∂ of the prescribed coordinate's motion
+        const int k = sys_.coords[c.index].drive_index;
+        const MotionState dp = drive_derivative(static_cast<int>(j), c.index, t);
+        sum += r.pq(k) * dp.q + r.pqd(k) * dp.qd + r.pqdd(k) * dp.qdd;
+      } else if (p.minus) {
+        sum += (power(*p.plus, c, mu) - power(*p.minus, c, mu)) / (2.0 * p.h);
+      } else {
+        sum += (power(*p.plus, c, mu) - power(sys_, c, mu)) / p.h;
+      }
+    }
+    grad(j) += w * sum;
+  }
+}
+
+void ParameterVjp::add_prescribed(double t, const VecX& pbar, Eigen::Ref<VecX> grad) const {
+  for (std::size_t j = 0; j < parameters_.size(); ++j)
+    for (const Component& c : touched_[j])
+      if (c.kind == Component::Drive)
+        grad(j) += pbar(sys_.coords[c.index].drive_index) * drive_derivative(static_cast<int>(j), c.index, t).q;
+}
+
+}  // namespace rigidfem
