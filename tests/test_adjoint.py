@@ -1,0 +1,213 @@
+"""Adjoint gradients (rigidfem.gradient) against independent references: the forward sensitivities of the same
+discrete run (the derivative of the same discrete solution, integrated forwards by another code path), central
+differences of the objective over whole runs converging as h², the reverse mode's derivatives by the prescribed
+coordinates against differences of the residual, and bad input."""
+
+import numpy as np
+import pytest
+
+import rigidfem as rf
+from rigidfem import samples
+
+G = 9.81
+
+
+def strip(elements=6):
+    """A clamped-hinged 3D steel strip on a sprung revolute joint, a tip load and a spring-damper to the ground."""
+    m = rf.Model(gravity=(0.0, -G, 0.0))
+    b = m.add_beam("strip", m.ground, 1.0, rf.Material(E=2e11, rho=7800.0, G=8e10, damping=1e-4),
+                   rf.Section.rectangle(0.02, 0.005), elements, joint=rf.Joint.revolute("z", stiffness=5.0),
+                   tip_mass=0.1, deform=("bend_z", "torsion", "bend_y"))
+    m.add_force(b.tip, (0.0, -1.0, 0.5), name="push")
+    m.add_spring_damper(b.tip, m.ground, stiffness=10.0, damping=0.5, length=0.5, name="spring")
+    return m.compile(), b
+
+
+def boom_and_rope():
+    """A boom slewed by a harmonic drive, a payload hoisted on a rope by a winch's ramp (taut throughout)."""
+    m = rf.Model(gravity=(0.0, 0.0, -G))
+    boom = m.add_body("boom", m.ground, rf.Joint.revolute("z"), 10.0, (1.0, 1.0, 1.0), com=(1.0, 0.0, 0.0))
+    m.prescribe(boom, rf.motion.harmonic(0.3, 1.5))
+    load = m.add_body("load", boom, rf.Joint.free(), 5.0, (0.1, 0.1, 0.1), placement=rf.transform((2.0, 0, 0)))
+    m.add_rope(boom.point((2.0, 0.0, 0.0)), load, EA=1e6, damping=1e3, length=rf.motion.ramp(-0.2, 0.0, 0.5, start=1.0),
+               name="rope")
+    return m.compile(), load.origin, [0.0, 0.0, -1.0 - 5 * G / 1e6, 0.0, 0.0, 0.0]
+
+
+def running(t, y):
+    """L: a point's height squared and a smooth function of its x."""
+    return y["p"][:, 1] ** 2 + 0.1 * np.sin(y["p"][:, 0])
+
+
+def terminal(y):
+    return 3.0 * y["p"][1] + y["p"][0] ** 2
+
+
+def forward_gradient(system, point, names, t_end, method="generalized_alpha", **run):
+    """J and dJ/dp of the same discrete objective from the forward sensitivities of the same run (trapezoid on its
+    steps): dJ/dp = Σ w_n ∂L/∂x · dx_n/dp + ∂Φ/∂x · dx_N/dp."""
+    r = rf.simulate(system, t_end, method, sensitivities=names, **run)
+    x = r.position(point)
+    w = np.zeros(len(r.t))
+    w[:-1] += np.diff(r.t) / 2
+    w[1:] += np.diff(r.t) / 2
+    J = w @ (x[:, 1] ** 2 + 0.1 * np.sin(x[:, 0])) + 3 * x[-1, 1] + x[-1, 0] ** 2
+    out = {}
+    for name in names:
+        dx = r.position_sensitivity(point, name)
+        out[name] = w @ (2 * x[:, 1] * dx[:, 1] + 0.1 * np.cos(x[:, 0]) * dx[:, 0]) + 3 * dx[-1, 1] + 2 * x[-1, 0] * dx[-1, 0]
+    return J, out
+
+
+def assert_gradients_agree(got, expected, rtol):
+    scale = max(abs(v) for v in expected.values())
+    for name, e in expected.items():
+        assert abs(got[name] - e) <= rtol * abs(e) + 1e-12 * scale, (name, got[name], e)
+
+
+def test_the_adjoint_is_the_derivative_of_the_discrete_run():
+    """On a 3D strip, its material, section, damping, springs, force and the initial state: the adjoint's dJ/dp
+    equals the one the forward sensitivities give for the same discrete objective to 1e-8 (both are the exact
+    derivative of the discrete solution), and J itself equals the run's."""
+    s, beam = strip()
+    names = ["strip.E", "strip.rho", "strip.damping", "strip.Iz", "strip.A", "strip.G", "spring.stiffness",
+             "spring.damping", "push.force", "strip.rfe0.rz.stiffness", f"q0[{s.coordinate_names[0]}]",
+             f"qd0[{s.coordinate_names[2]}]"]
+    g = rf.gradient(s, 0.02, names, outputs={"p": beam.tip}, running=running, terminal=terminal, dt=1e-4)
+    J, expected = forward_gradient(s, beam.tip, names, 0.02, dt=1e-4)
+    assert g.value == pytest.approx(J, rel=1e-10)  # the same run to Newton's tolerance
+    assert_gradients_agree(g.gradient, expected, 1e-8)
+    assert g.stats["steps"] == 200 and g.stats["objective_derivative"] == "complex step"
+    # the gradient by the initial state as arrays
+    assert g.q0[0] == pytest.approx(g[f"q0[{s.coordinate_names[0]}]"], rel=1e-14)
+    assert g.qd0[2] == pytest.approx(g[f"qd0[{s.coordinate_names[2]}]"], rel=1e-14)
+
+
+def test_central_differences_of_whole_runs_converge_onto_the_adjoint():
+    """dJ/dE and dJ/dρ against (J(p + h) − J(p − h))/2h of whole runs: the error falls as h² onto the adjoint."""
+    s, beam = strip(elements=4)
+    run = dict(outputs={"p": beam.tip}, running=running, terminal=terminal, dt=2e-4)
+    g = rf.gradient(s, 0.02, ["strip.E", "strip.rho"], **run)
+    for name in ("strip.E", "strip.rho"):
+        p = s.parameters[name].value
+        errors = []
+        for rel in (1e-2, 1e-3):
+            J = [rf.gradient(s.with_parameters({name: p * (1 + sign * rel)}), 0.02, [], **run).value for sign in (1, -1)]
+            errors.append(abs((J[0] - J[1]) / (2 * rel * p) - g[name]) / abs(g[name]))
+        assert errors[1] <= 1e-6 and errors[1] <= errors[0] / 50, (name, errors)
+
+
+def test_checkpoints_give_the_same_gradient():
+    """With room for a few states only, the run keeps checkpoints every ⌈√N⌉ steps and runs each segment again:
+    the same gradient (to Newton's tolerance: the repeated steps start from another iteration matrix), every step
+    computed twice."""
+    s, beam = strip(elements=4)
+    run = dict(outputs={"p": beam.tip}, running=running, terminal=terminal, dt=1e-4)
+    names = ["strip.E", "push.force", "spring.stiffness"]
+    full = rf.gradient(s, 0.02, names, **run)
+    saved = rf.gradient(s, 0.02, names, memory=3e4, **run)
+    assert full.stats["recomputed_steps"] == 0 and full.stats["checkpoint_interval"] == 1
+    assert saved.stats["checkpoint_interval"] == 15 and saved.stats["recomputed_steps"] == 200
+    for name in names:
+        assert saved[name] == pytest.approx(full[name], rel=1e-8)
+    with pytest.raises(ValueError, match="memory: expected at least"):
+        rf.gradient(s, 0.02, names, memory=2e3, **run)
+
+
+def test_drives_winches_and_ropes():
+    """A boom's harmonic drive (its numbers move the prescribed coordinate, and the payload with it), a winch's
+    ramp, the rope's EA and damping, the payload's mass and joint springs: the adjoint against the forward
+    sensitivities, and one drive number against central differences of whole runs."""
+    s, point, q0 = boom_and_rope()
+    names = ["boom.rz.drive.amplitude", "boom.rz.drive.omega", "boom.rz.drive.offset", "rope.length.rate",
+             "rope.length.duration", "rope.EA", "rope.damping", "load.mass", "load.x.stiffness"]
+    run = dict(dt=1e-3, q0=q0, newton_tol=1e-14)
+    g = rf.gradient(s, 1.0, names, outputs={"p": point}, running=running, terminal=terminal, **run)
+    _, expected = forward_gradient(s, point, names, 1.0, **run)
+    assert_gradients_agree(g.gradient, expected, 1e-7)
+    h = 1e-5
+    J = [rf.gradient(s.with_parameters({"boom.rz.drive.omega": 1.5 + sign * h}), 1.0, [], outputs={"p": point},
+                     running=running, terminal=terminal, **run).value for sign in (1, -1)]
+    assert (J[0] - J[1]) / (2 * h) == pytest.approx(g["boom.rz.drive.omega"], rel=1e-6)
+
+
+def test_reverse_mode_by_the_prescribed_motion():
+    """∂(μᵀr)/∂ of a prescribed coordinate's value, rate and acceleration from the reverse mode against central
+    differences of μᵀr: a polynomial drive at t = 0 has q = c₀, q̇ = c₁, q̈ = 2 c₂ (r is quadratic in q̇ and linear
+    in q̈: their differences are exact for any step, so it is large, 0.1, against round-off)."""
+    model = rf.Model(gravity=(0.0, -G, 0.0))
+    hub = model.add_body("hub", model.ground, rf.Joint.revolute("z"), mass=1.0, inertia=(1.0, 1.0, 1.0))
+    model.prescribe(hub, rf.motion.polynomial([0.3, 0.7, 0.4]))
+    beam = model.add_beam("beam", hub, 1.0, rf.Material(E=7e10, rho=2700.0), rf.Section.rectangle(0.02, 0.01), 3,
+                          deform=("bend_z", "bend_y"))
+    model.add_force(beam.tip, (0.0, 1.0, 0.5), follower=True)
+    s = model.compile()
+    rng = np.random.default_rng(5)
+    q, qd, qdd, mu = rng.normal(0, 0.1, (4, s.nq))
+    *_, pq, pqd, pqdd = s._inverse_dynamics_vjp(0.0, q, qd, qdd, mu)
+    for k, (got, factor) in enumerate(((pq[0], 1.0), (pqd[0], 1.0), (pqdd[0], 2.0))):
+        name, c = f"hub.rz.drive.coefficients[{k}]", [0.3, 0.7, 0.4][k]
+        e = 1e-4 if k == 0 else 0.1
+        r = [mu @ s.with_parameters({name: c + sign * e}).inverse_dynamics(0.0, q, qd, qdd) for sign in (1, -1)]
+        assert got * factor == pytest.approx((r[0] - r[1]) / (2 * e), rel=1e-8), name
+
+
+@pytest.mark.parametrize("method, options", [("newmark", {}), ("hht", dict(alpha=-0.2)),
+                                             ("implicit_spring", dict(rho_inf=0.6)),
+                                             ("generalized_alpha", dict(iteration_matrix="krylov"))])
+def test_every_newmark_method(method, options):
+    """newmark, hht, implicit_spring and a Krylov Newton matrix: each adjoint against its own forward sensitivities."""
+    s, beam = strip(elements=4)
+    names = ["strip.E", "strip.damping", "push.force", f"q0[{s.coordinate_names[1]}]"]
+    g = rf.gradient(s, 0.01, names, method=method, outputs={"p": beam.tip}, running=running, terminal=terminal,
+                    dt=1e-4, **options)
+    _, expected = forward_gradient(s, beam.tip, names, 0.01, method=method, dt=1e-4, adaptive=False, **options)
+    assert_gradients_agree(g.gradient, expected, 1e-8)
+
+
+def test_objectives_without_complex_arithmetic():
+    """A running cost through np.abs (no complex step) is differentiated by central differences, said in stats;
+    coordinates as outputs; the default parameters are all of the system's."""
+    s, beam = strip(elements=3)
+    outputs = {"tip": beam.tip, "hinge": s.coordinate_names[0]}
+    g = rf.gradient(s, 0.01, outputs=outputs, running=lambda t, y: np.abs(y["tip"][:, 1] - 1.0) + y["hinge"] ** 2,
+                    dt=1e-4)
+    assert g.stats["objective_derivative"] == "central differences"
+    assert list(g.gradient) == list(s.parameters)
+    smooth = rf.gradient(s, 0.01, outputs=outputs, running=lambda t, y: 1.0 - y["tip"][:, 1] + y["hinge"] ** 2,
+                         dt=1e-4)
+    assert np.all(g.outputs["tip"][:, 1] < 1.0)  # |y − 1| = 1 − y
+    np.testing.assert_allclose(g.array(), smooth.array(), rtol=1e-6, atol=1e-12 * np.abs(smooth.array()).max())
+
+
+def test_bad_input():
+    s, beam = strip(elements=2)
+    ok = dict(outputs={"p": beam.tip}, running=running, dt=1e-3)
+    with pytest.raises(ValueError, match="parameters: expected"):
+        rf.gradient(s, 0.01, ["strip.e"], **ok)
+    with pytest.raises(ValueError, match="method: expected one of"):
+        rf.gradient(s, 0.01, ["strip.E"], method="rk4", **ok)
+    with pytest.raises(ValueError, match="dt: expected a fixed step"):
+        rf.gradient(s, 0.01, ["strip.E"], **{**ok, "dt": None})
+    with pytest.raises(ValueError, match="outputs: expected"):
+        rf.gradient(s, 0.01, ["strip.E"], **{**ok, "outputs": {"p": "spring"}})
+    with pytest.raises(ValueError, match="outputs: expected a dict"):
+        rf.gradient(s, 0.01, ["strip.E"], **{**ok, "outputs": [beam.tip]})
+    with pytest.raises(ValueError, match="running: expected a function L"):
+        rf.gradient(s, 0.01, ["strip.E"], outputs=ok["outputs"], dt=1e-3)
+    for bad in (lambda t, y: np.full(len(t), np.nan), lambda t, y: y["p"], lambda t, y: "big"):
+        with pytest.raises(ValueError, match="running: expected an array of L at the 11 steps"):
+            rf.gradient(s, 0.01, ["strip.E"], **{**ok, "running": bad})
+    with pytest.raises(ValueError, match="terminal: expected a number"):
+        rf.gradient(s, 0.01, ["strip.E"], **{**ok, "terminal": lambda y: [1.0, 2.0]})
+    with pytest.raises(ValueError, match="algorithm='recursive'"):
+        rf.gradient(strip_lagrange(), 0.01, ["strip.E"], outputs={"p": 0}, running=lambda t, y: y["p"], dt=1e-3)
+    loop = samples.four_bar()[0].compile()
+    with pytest.raises(ValueError, match="no loop closures"):
+        rf.gradient(loop, 0.01, [], outputs={"q": 0}, running=lambda t, y: y["q"], dt=1e-3)
+
+
+def strip_lagrange():
+    m = rf.Model(gravity=(0.0, -G, 0.0))
+    m.add_beam("strip", m.ground, 1.0, rf.Material(E=2e11, rho=7800.0), rf.Section.rectangle(0.02, 0.005), 2)
+    return m.compile("lagrange")
