@@ -1,4 +1,4 @@
-"""What a forward sensitivity costs against the run it differentiates (issue 26, item 7)::
+"""What a forward sensitivity and an adjoint gradient cost against the run they differentiate (issue 26, item 7)::
 
     python -m benchmarks sensitivities [--quick] [--output DIR]
 
@@ -10,8 +10,12 @@ rho, damping and the tip force's magnitude). CPU time of the quickest of 3 inter
 ``per_parameter`` = (time with P − time without)/(P × time without): the cost of one parameter's
 sensitivities in units of the run itself.
 
-The adjoint gradient (many parameters for the cost of a few runs) is not implemented yet: its column is
-empty.
+The adjoint gradient (``rigidfem.gradient``): the same strip on a hub driven by a natural spline through 100
+knots (a hub motion to shape, 0.1 sin(100 t) rad), J = ∫ |x_tip|² dt over 0.1 s by generalized_alpha and radau5
+(fixed steps, dt = 1e-4 s: 1000 steps), by all its parameters: the 100 knot values, the beam's 8 constants and the tip force (109). ``adjoint_over_forward`` =
+CPU time of ``rf.gradient`` (forward run, objective, backward sweep, and the 209 systems at p ± h it sets up)
+over that of ``rf.simulate`` of the same run (109 forward sensitivities would cost about 109 times the
+per-parameter cost of the first table, in runs).
 
 ``--quick``: m = 20 and 80, one round.
 """
@@ -30,7 +34,12 @@ from ._common import machine, report
 NAMES = ("strip.E", "strip.rho", "strip.damping", "push.force")
 METHODS = {"generalized_alpha": dict(dt=1e-4), "esdirk43": dict(dt=1e-4, adaptive=False), "rk4": dict()}
 T_END = 0.01
-COLUMNS = ("elements", "nq", "method", "parameters", "cpu_s", "per_parameter", "adjoint_over_forward")
+COLUMNS = ("elements", "nq", "method", "parameters", "cpu_s", "per_parameter")
+ADJOINT_METHODS = ("generalized_alpha", "radau5")
+ADJOINT_COLUMNS = ("elements", "nq", "method", "parameters", "forward_cpu_s", "gradient_cpu_s", "adjoint_over_forward",
+                   "backward_cpu_s", "gmres_per_step")
+KNOTS = 100
+T_ADJOINT = 0.1  # s: 1000 steps, so that setting up the 209 systems at p ± h (O(n) each) is not the most of it
 
 
 def strip(elements: int):
@@ -41,6 +50,29 @@ def strip(elements: int):
                           joint=rf.Joint.revolute("z", stiffness=50.0))
     model.add_force(beam.tip, (0.0, -5.0, 2.0), name="push")
     return model.compile(), beam
+
+
+def driven_strip(elements: int):
+    """The strip on a hub turned by a spline through KNOTS knots over the run (a motion to shape), its tip."""
+    model = rf.Model(gravity=(0.0, -9.81, 0.0))
+    hub = model.add_body("hub", model.ground, rf.Joint.revolute("z"), 1.0, (0.1, 0.1, 0.1))
+    knots = np.linspace(0.0, T_ADJOINT, KNOTS)
+    model.prescribe(hub, rf.motion.spline(knots, 0.1 * np.sin(100.0 * knots)))
+    beam = model.add_beam("strip", hub, 1.0, rf.Material(E=2.1e11, rho=7850.0), rf.Section.rectangle(0.02, 0.005),
+                          elements, deform=("bend_z", "bend_y"))
+    model.add_force(beam.tip, (0.0, -5.0, 2.0), name="push")
+    return model.compile(), beam
+
+
+def _adjoint_cpu(system, tip, names, method):
+    """CPU times (s) of the forward run alone and of the gradient by ``names``, and the gradient's stats."""
+    start = time.process_time()
+    rf.simulate(system, T_ADJOINT, method, dt=1e-4, adaptive=False, t_eval=[T_ADJOINT])
+    forward = time.process_time() - start
+    start = time.process_time()
+    g = rf.gradient(system, T_ADJOINT, names, method=method, outputs={"tip": tip},
+                    running=lambda t, y: np.sum(y["tip"] ** 2, axis=1), dt=1e-4)
+    return forward, time.process_time() - start, g.stats
 
 
 def _cpu(system, method, names, dt_rk4):
@@ -64,6 +96,22 @@ def run(output_dir="bench", quick: bool = False):
                     t = _cpu(systems[m], method, NAMES[:P], dt_rk4[m])
                     key = (m, method, P)
                     best[key] = min(best.get(key, np.inf), t)
+    driven = {m: driven_strip(m) for m in sizes}
+    gradient_names = {m: [n for n in driven[m][0].parameters if ".q[" in n or n.startswith("strip.") and n.count(".") == 1
+                          or n == "push.force"] for m in sizes}
+    adjoint = {}
+    for _ in range(rounds):
+        for m in sizes:
+            for method in ADJOINT_METHODS:
+                forward, grad, stats = _adjoint_cpu(driven[m][0], driven[m][1].tip, gradient_names[m], method)
+                old = adjoint.get((m, method), (np.inf, np.inf, None))
+                adjoint[m, method] = (min(old[0], forward), min(old[1], grad), stats if grad < old[1] else old[2])
+    adjoint_rows = [{"elements": m, "nq": driven[m][0].nq, "method": method, "parameters": len(gradient_names[m]),
+                     "forward_cpu_s": adjoint[m, method][0], "gradient_cpu_s": adjoint[m, method][1],
+                     "adjoint_over_forward": adjoint[m, method][1] / adjoint[m, method][0],
+                     "backward_cpu_s": adjoint[m, method][2]["backward_time"],
+                     "gmres_per_step": adjoint[m, method][2]["gmres_iterations"] / adjoint[m, method][2]["steps"]}
+                    for m in sizes for method in ADJOINT_METHODS]
     rows = []
     for m in sizes:
         for method in METHODS:
@@ -71,7 +119,9 @@ def run(output_dir="bench", quick: bool = False):
             for P in counts:
                 t = best[(m, method, P)]
                 rows.append({"elements": m, "nq": systems[m].nq, "method": method, "parameters": P, "cpu_s": t,
-                             "per_parameter": (t - base) / (P * base) if P else None, "adjoint_over_forward": None})
+                             "per_parameter": (t - base) / (P * base) if P else None})
     print(machine())
     return report({"sensitivities": ("Forward sensitivities: CPU time and cost per parameter against the run",
-                                     Table(rows, COLUMNS))}, output_dir)
+                                     Table(rows, COLUMNS)),
+                   "adjoint": ("Adjoint gradient by 109 parameters against one forward run",
+                               Table(adjoint_rows, ADJOINT_COLUMNS))}, output_dir)

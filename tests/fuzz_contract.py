@@ -1930,7 +1930,9 @@ class Gen:
                 self.emit(f"rf.stages.{name}", [A("system"), da], ["system", "data"], label=f"stages.{name}")
 
     def misc_call(self):
-        kind = self.choice(["coordinate_index", "beam", "profile", "centerline", "parameters"])
+        kind = self.choice(["coordinate_index", "beam", "profile", "centerline", "parameters", "gradient"])
+        if kind == "gradient":
+            return self.gradient_call()
         if kind == "parameters":
             # every parameter scaled by 1.5 keeps its sign (a valid change), or one unknown, NaN or a non-dict
             if self.chance(0.6):
@@ -1968,6 +1970,30 @@ class Gen:
         a = A(fl(s)) if s is not None else A(self.choice(["-0.1", fl(bm["length"] * 1.5), "nan", "'x'", "None"]),
                                              bad=True)
         return self.emit(f"{bm['var']}.point", [a], ["s"], label="Beam.point")
+
+    def gradient_call(self):
+        """rf.gradient over 10 steps: a system it refuses (loops, arms, flows, Lagrange, nq = 0) names ``system`` or
+        ``outputs``; a Newton failure is a SimulationError; one bad argument is a ValueError naming it."""
+        def pick(good, bad, names):
+            return A(self.choice(bad), bad=True, names=names) if self.chance(0.15) else A(self.choice(good))
+        kw = {"outputs": A("{'y': 0}", soft=True, names=("outputs", "system")),
+              "running": pick(["lambda t, y: y['y'] ** 2", "lambda t, y: np.abs(y['y'])"],
+                              ["lambda t, y: 'x'", "lambda t, y: np.nan * t", "3"], ("running",)),
+              "dt": pick(["1e-3"], ["0.0", "nan", "None", "'x'"], ("dt",))}
+        if self.chance(0.3):
+            kw["method"] = pick(["'generalized_alpha'", "'radau5'", "'newmark'", "'implicit_spring'"], ["'rk4'", "3"],
+                                ("method",))
+        if self.chance(0.2):
+            kw["memory"] = pick(["1e6", "1e3"], ["-1.0", "'x'", "nan"], ("memory",))
+            if kw["memory"]["e"] == "1e3":
+                kw["memory"]["soft"], kw["memory"]["names"] = 1, ["memory"]  # too little for a large system
+        if self.chance(0.2):
+            kw["terminal"] = pick(["lambda y: y['y']"], ["lambda y: [1.0, 2.0]", "lambda y: None"], ("terminal",))
+        params = pick(["list(system.parameters)[:3]", "['q0[' + system.coordinate_names[0] + ']'] if system.nq else []",
+                       "[]"], ["['nope']", "'x'", "[3]"], ("parameters",))
+        params["soft"], params["names"] = 1, params.get("names", []) + ["parameters"]  # an actuator's profile: refused
+        return self.emit("rf.gradient", [A("system", soft=True, names=("system", "outputs", "dt")), A("0.01"), params],
+                         ["system", "t_end", "parameters"], kw, label="gradient")
 
     def core_call(self):
         """The exported helpers of rigidfem._core, with good and bad arguments."""

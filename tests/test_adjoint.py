@@ -152,17 +152,42 @@ def test_reverse_mode_by_the_prescribed_motion():
         assert got * factor == pytest.approx((r[0] - r[1]) / (2 * e), rel=1e-8), name
 
 
-@pytest.mark.parametrize("method, options", [("newmark", {}), ("hht", dict(alpha=-0.2)),
-                                             ("implicit_spring", dict(rho_inf=0.6)),
-                                             ("generalized_alpha", dict(iteration_matrix="krylov"))])
-def test_every_newmark_method(method, options):
-    """newmark, hht, implicit_spring and a Krylov Newton matrix: each adjoint against its own forward sensitivities."""
+@pytest.mark.parametrize("method, options, rtol", [("newmark", {}, 1e-8), ("hht", dict(alpha=-0.2), 1e-8),
+                                                   ("implicit_spring", dict(rho_inf=0.6), 1e-8),
+                                                   ("generalized_alpha", dict(iteration_matrix="krylov"), 1e-8),
+                                                   ("radau5", {}, 1e-7), ("radau5", dict(iteration_matrix="krylov"), 1e-7)])
+def test_every_method(method, options, rtol):
+    """newmark, hht, implicit_spring, radau5 and Krylov Newton matrices: each adjoint against its own forward
+    sensitivities (radau5's stage corrections stop at 1e-9 of them, or at the differences' noise)."""
     s, beam = strip(elements=4)
-    names = ["strip.E", "strip.damping", "push.force", f"q0[{s.coordinate_names[1]}]"]
+    names = ["strip.E", "strip.damping", "push.force", f"q0[{s.coordinate_names[1]}]", f"qd0[{s.coordinate_names[3]}]"]
     g = rf.gradient(s, 0.01, names, method=method, outputs={"p": beam.tip}, running=running, terminal=terminal,
                     dt=1e-4, **options)
     _, expected = forward_gradient(s, beam.tip, names, 0.01, method=method, dt=1e-4, adaptive=False, **options)
-    assert_gradients_agree(g.gradient, expected, 1e-8)
+    assert_gradients_agree(g.gradient, expected, rtol)
+
+
+def test_radau5_on_a_drive_and_a_winch_with_checkpoints():
+    """radau5's adjoint on the boom's drive and winch, its states kept or checkpointed, against its forward
+    sensitivities and central differences of whole runs (its stages depend on the drive's numbers at three
+    times per step)."""
+    s, point, q0 = boom_and_rope()
+    names = ["boom.rz.drive.omega", "rope.length.rate", "rope.EA", "load.mass"]
+    run = dict(method="radau5", dt=2e-3, q0=q0, newton_tol=1e-13, outputs={"p": point}, running=running,
+               terminal=terminal)
+    g = rf.gradient(s, 0.6, names, **run)
+    saved = rf.gradient(s, 0.6, names, memory=6e4, **run)
+    assert saved.stats["recomputed_steps"] == 300 and g.stats["recomputed_steps"] == 0
+    _, expected = forward_gradient(s, point, names, 0.6, method="radau5", dt=2e-3, q0=q0, newton_tol=1e-13,
+                                   adaptive=False)
+    assert_gradients_agree(g.gradient, expected, 1e-7)
+    for name in names:
+        assert saved[name] == pytest.approx(g[name], rel=1e-8), name
+    for name in names[:3]:  # the payload's mass moves J by too little for differences of whole runs
+        p = s.parameters[name].value
+        h = 1e-4 * max(abs(p), 1.0)  # the truncation ∝ h² and the round-off ∝ 1/h both below 1e-7 here
+        J = [rf.gradient(s.with_parameters({name: p + sign * h}), 0.6, [], **run).value for sign in (1, -1)]
+        assert (J[0] - J[1]) / (2 * h) == pytest.approx(g[name], rel=1e-6), name
 
 
 def test_objectives_without_complex_arithmetic():

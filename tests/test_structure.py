@@ -79,12 +79,13 @@ LAYERS = [
     {"lagrange", "recursive", "derivatives"},  # the formulations
     {"dynamics"},                              # the only place that chooses one
     {"error_measure", "sensitivities"},        # the outputs an error is measured on; the sensitivity equations
-    {"integrators", "stepper", "newton_matrix", "outputs", "timing", "auto_method"},
+    {"integrators", "stepper", "newton_matrix", "gmres", "outputs", "timing", "auto_method", "newmark", "radau"},
+    {"adjoint"},                               # the methods' transposes over whole runs
 ]
 RANK = {name: k for k, layer in enumerate(LAYERS) for name in layer}
 # Sources named after their family rather than a header.
-RANK.update({"integrate": RANK["stepper"], "runge_kutta": RANK["stepper"], "newmark": RANK["stepper"],
-             "implicit_rk": RANK["stepper"]})
+RANK.update({"integrate": RANK["stepper"], "runge_kutta": RANK["stepper"], "implicit_rk": RANK["stepper"],
+             "adjoint_terms": RANK["adjoint"]})
 
 
 def _cpp_includes(path: Path) -> set:

@@ -149,7 +149,7 @@ void bind_integrators(py::module_& m) {
       py::arg("options"), py::arg("keep_going"));
 
   // The adjoint (adjoint.hpp): one forward run, then backward sweeps; Ctrl-C stops either (the GIL is held).
-  py::class_<NewmarkAdjoint>(m, "_NewmarkAdjoint")
+  py::class_<Adjoint>(m, "_Adjoint")
       .def(py::init([](std::shared_ptr<const System> s, const IntegratorOptions& o,
                        const std::vector<std::tuple<std::string, int, Vec3>>& outputs, double memory) {
              std::vector<OutputSpec> specs;
@@ -157,12 +157,12 @@ void bind_integrators(py::module_& m) {
                if (kind != "point" && kind != "coordinate") bad("outputs", "points and coordinates", kind);
                specs.push_back({kind == "point" ? OutputSpec::Kind::Point : OutputSpec::Kind::Coordinate, index, r});
              }
-             return std::make_unique<NewmarkAdjoint>(s, o, specs, memory);
+             return std::make_unique<Adjoint>(s, o, specs, memory);
            }),
            py::arg("system"), py::arg("options"), py::arg("outputs"), py::arg("memory"))
       .def(
           "forward",
-          [](NewmarkAdjoint& a, double t0, double t_end, const VecX& q0, const VecX& qd0) {
+          [](Adjoint& a, double t0, double t_end, const VecX& q0, const VecX& qd0) {
             InterruptScope interrupt([] {
               if (PyErr_CheckSignals() != 0) throw py::error_already_set();
             });
@@ -172,7 +172,7 @@ void bind_integrators(py::module_& m) {
           py::arg("t0"), py::arg("t_end"), py::arg("q0"), py::arg("qd0"), "(t (N + 1), y (N + 1, K)) of the run.")
       .def(
           "backward",
-          [](NewmarkAdjoint& a, const Eigen::Ref<const RowMatX>& ybar) {
+          [](Adjoint& a, const Eigen::Ref<const RowMatX>& ybar) {
             InterruptScope interrupt([] {
               if (PyErr_CheckSignals() != 0) throw py::error_already_set();
             });

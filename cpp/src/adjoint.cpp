@@ -1,4 +1,4 @@
-// The discrete adjoint of the Newmark family with checkpointing (adjoint.hpp).
+// The discrete adjoints of the Newmark family and of radau5, with checkpointing (adjoint.hpp).
 #include "rigidfem/adjoint.hpp"
 
 #include <chrono>
@@ -10,15 +10,15 @@
 #include "rigidfem/dynamics.hpp"
 #include "rigidfem/errors.hpp"
 #include "rigidfem/gmres.hpp"
+#include "rigidfem/newmark.hpp"
 #include "rigidfem/newton_matrix.hpp"
+#include "rigidfem/radau.hpp"
 
 namespace rigidfem {
 
 namespace {
 
 using Clock = std::chrono::steady_clock;
-
-StepState step_state(double t, double h, const NewmarkState& s) { return {t, h, s.q, s.v, s.qdd}; }
 
 // The run's grid: t_k = t0 + k dt, the last step landing on t_end (as integrate() takes fixed steps).
 std::vector<double> grid(double t0, double t_end, double dt) {
@@ -32,13 +32,233 @@ std::vector<double> grid(double t0, double t_end, double dt) {
   return t;
 }
 
+/// What both methods' transposes share: the reverse mode at a state, and GMRES on a transposed Newton matrix
+/// with a preconditioner kept while it converges in a few iterations.
+class Transposes : public AdjointSteps {
+ public:
+  Transposes(const System& sys, const IntegratorOptions& o, ParameterVjp& params)
+      : sys_(sys), params_(params), d_(sys), matrix_(NewtonMatrix::make(sys, o, istats_)) {}
+
+ protected:
+  /// set_state, q̈ and the axes on d_ at (t, q, q̇, q̈): what the reverse mode starts from.
+  void at(double t, const Eigen::Ref<const VecX>& q, const Eigen::Ref<const VecX>& v, const Eigen::Ref<const VecX>& a) {
+    set_state(sys_, d_, t, q, v);
+    set_accelerations(sys_, d_, a);
+    tree_kinematics(sys_, d_);
+  }
+  /// (Kᵀμ, Cᵀμ, Mμ) at (t, q, q̇, q̈); d_ keeps the state's spatial kinematics and RNEA pass (ParameterVjp::add).
+  ResidualVjp vjp(double t, const Eigen::Ref<const VecX>& q, const Eigen::Ref<const VecX>& v,
+                  const Eigen::Ref<const VecX>& a, const VecX& mu) {
+    at(t, q, v, a);
+    return rnea_vector_jacobian_product(sys_, d_, mu);
+  }
+  /// x with S x = b by GMRES to 1e-11 (S, P as Gmres takes them), the preconditioner refreshed by `refresh` first
+  /// when the last solve took more iterations than refresh_above_.
+  template <class Op, class Prec, class Refresh>
+  VecX gmres(const Op& S, const Prec& P, const VecX& b, Refresh&& refresh, double t) {
+    if (!fresh_ || last_iterations_ > refresh_above_) {
+      refresh();
+      fresh_ = true;
+      ++stats->preconditioner_refreshes;
+    }
+    VecX x;
+    last_iterations_ = gmres_.solve(S, P, b, x, 1e-11, 300);
+    stats->gmres_iterations += last_iterations_;
+    if (!x.allFinite()) throw SimulationError(t, "the adjoint became NaN or inf");
+    return x;
+  }
+
+  const System& sys_;
+  ParameterVjp& params_;
+  Data d_;
+  IntegratorStats istats_;
+  std::unique_ptr<NewtonMatrix> matrix_;
+  Gmres<double> gmres_;
+  // measured on strips of 20-320 elements over 1000 steps: an O(n) armature factor is worth refreshing after 2
+  // iterations, a dense LU after 5 (2.6-4.1 runs for the gradient; 4.6-5.4 after 3 or 4, 3.7-5.2 after 8)
+  const long refresh_above_ = matrix_->krylov() ? 2 : 5;
+  bool fresh_ = false;
+  long last_iterations_ = 0;
+};
+
+/// The Newmark family (adjoint.hpp): the adjoint state (q̄, q̇̄, ā, q̈̄).
+class NewmarkSteps final : public Transposes {
+ public:
+  NewmarkSteps(const System& sys, const IntegratorOptions& o, ParameterVjp& params)
+      : Transposes(sys, o, params), stepper_(make_newmark_stepper(sys, o, istats_)), k_(stepper_->coefficients()) {}
+
+  void start(double t0, const VecX& q0, const VecX& qd0) override {
+    VecX y0(2 * sys_.nq);
+    y0 << q0, qd0;
+    stepper_->start(t0, y0);
+  }
+  void step(double t, double h) override {
+    double err = 0.0;
+    if (!stepper_->attempt(t, h, nullptr, err))
+      step_failure(t, h, "Newton iterations did not converge in newton_max_iterations; reduce dt or raise "
+                         "newton_max_iterations");
+    stepper_->accept();
+  }
+  StepRecord record(double t, double h) const override {
+    const NewmarkState& s = stepper_->current();
+    return {t, h, s.q, s.v, s.qdd, s.a, {}, {}, {}};
+  }
+  void restore(const StepRecord& r) override {
+    NewmarkState s;
+    s.q = r.q, s.v = r.v, s.qdd = r.qdd, s.a = r.a, s.s = VecX(0), s.lambda = VecX(0);
+    stepper_->restore(r.t, s);
+  }
+  int adjoint_size() const override { return 4; }
+
+  void transpose(const StepRecord& s, VecX& bars, VecX& grad) override {
+    const int n = sys_.nq;
+    const double h = s.h, z = (1.0 - k_.af) / (1.0 - k_.am), c1 = k_.gamma * z * h, c2 = k_.beta * z * h * h;
+    auto qb = bars.segment(0, n), vb = bars.segment(n, n), ab = bars.segment(2 * n, n), zb = bars.segment(3 * n, n);
+    const VecX g = zb + z * (ab + (k_.beta * h * h) * qb + (k_.gamma * h) * vb);
+    // Sᵀ μ = g, Sᵀv = M v + c₁ Cᵀ v + c₂ Kᵀ v by the reverse mode at the step's end
+    at(s.t, s.q, s.v, s.qdd);
+    auto S = [&](const VecX& v, VecX& out) {
+      const ResidualVjp r = rnea_vector_jacobian_product(sys_, d_, v);
+      out = r.qdd + c1 * r.qd + c2 * r.q;
+    };
+    auto P = [&](const VecX& v, VecX& out) { matrix_->precondition_transposed(v, out); };
+    const VecX mu = gmres(S, P, g, [&] {
+      matrix_->linearize(s.t, s.q, s.v, s.qdd, VecX());
+      if (!(matrix_->factor(c1, c2, VecX()) > 1e-15))
+        throw SimulationError(s.t, "the adjoint's Newton matrix M + γh C + βh² K is singular");
+    }, s.t);
+    const ResidualVjp r = rnea_vector_jacobian_product(sys_, d_, mu);
+    const VecX qh = qb - r.q, vh = vb - r.qd;
+    const VecX A = ab + (k_.beta * h * h) * qh + (k_.gamma * h) * vh;
+    qb = qh;
+    vb = h * qh + vh;
+    ab = (h * h * (0.5 - k_.beta)) * qh + (h * (1.0 - k_.gamma)) * vh - (k_.am / (1.0 - k_.am)) * A;
+    zb = (k_.af / (1.0 - k_.am)) * A;
+    params_.add(d_, mu, r, -1.0, grad);
+  }
+
+  /// a_0 = q̈_0 solves r(q_0, q̇_0, q̈_0) = 0: M μ_0 = ā_0 + q̈̄_0, q̄_0 −= Kᵀμ_0, q̇̄_0 −= Cᵀμ_0.
+  void transpose_start(const StepRecord& s, VecX& bars, VecX& grad) override {
+    const int n = sys_.nq;
+    set_state(sys_, d_, s.t, s.q, s.v);
+    tree_kinematics(sys_, d_);
+    factor_mass(sys_, d_);
+    VecX mu(n);
+    solve_armature(sys_, d_, VecX(bars.segment(2 * n, n) + bars.segment(3 * n, n)), mu);
+    const ResidualVjp r = vjp(s.t, s.q, s.v, s.qdd, mu);
+    bars.segment(0, n) -= r.q;
+    bars.segment(n, n) -= r.qd;
+    params_.add(d_, mu, r, -1.0, grad);
+  }
+
+ private:
+  std::unique_ptr<NewmarkStepper> stepper_;
+  NewmarkCoefficients k_;
+};
+
+/// radau5 (adjoint.hpp): the adjoint state (q̄, q̇̄).
+class RadauSteps final : public Transposes {
+ public:
+  RadauSteps(const System& sys, const IntegratorOptions& o, ParameterVjp& params)
+      : Transposes(sys, o, params), stepper_(make_implicit_rk(sys, o, istats_)),
+        access_(dynamic_cast<RadauAccess*>(stepper_.get())) {
+    if (!access_) throw std::logic_error("RadauSteps: the stepper is not radau5");
+  }
+
+  void start(double t0, const VecX& q0, const VecX& qd0) override {
+    VecX y0(2 * sys_.nq);
+    y0 << q0, qd0;
+    stepper_->start(t0, y0);
+  }
+  void step(double t, double h) override {
+    double err = 0.0;
+    if (!stepper_->attempt(t, h, nullptr, err))
+      step_failure(t, h, "Newton iterations did not converge in newton_max_iterations; reduce dt or raise "
+                         "newton_max_iterations");
+    stepper_->accept();
+  }
+  StepRecord record(double t, double h) const override {
+    StepRecord r{t, h, {}, {}, {}, {}, {}, {}, {}};
+    access_->current(r.q, r.v, r.qdd);
+    if (h > 0.0) access_->stages(r.Q, r.V, r.A);
+    return r;
+  }
+  void restore(const StepRecord& r) override { access_->restore(r.t, r.q, r.v, r.qdd); }
+  int adjoint_size() const override { return 2; }
+
+  void transpose(const StepRecord& s, VecX& bars, VecX& grad) override {
+    const int n = sys_.nq;
+    const double h = s.h, t0 = s.t - h;
+    const Eigen::Matrix3d& a = tab_.a;
+    const Eigen::Matrix3d a2 = a * a;
+    MatX Qb = MatX::Zero(n, 3), Vb = MatX::Zero(n, 3);
+    Qb.col(2) = bars.head(n), Vb.col(2) = bars.tail(n);
+    const MatX Vt = Vb + h * Qb * a;
+    const MatX G = h * Vt * a;
+    // 𝒮ᵀ μ by the reverse mode at each stage: M_j μ_j + h Σ_i a_ij C_iᵀ μ_i + h² Σ_i (a²)_ij K_iᵀ μ_i
+    MatX Kmu(n, 3), Cmu(n, 3), Mmu(n, 3);
+    auto products = [&](const MatX& mu) {
+      for (int i = 0; i < 3; ++i) {
+        const ResidualVjp r = vjp(t0 + tab_.c(i) * h, s.Q.col(i), s.V.col(i), s.A.col(i), mu.col(i));
+        Kmu.col(i) = r.q, Cmu.col(i) = r.qd, Mmu.col(i) = r.qdd;
+      }
+    };
+    auto S = [&](const VecX& v, VecX& out) {
+      products(Eigen::Map<const MatX>(v.data(), n, 3));
+      const MatX y = Mmu + h * Cmu * a + (h * h) * Kmu * a2;
+      out = Eigen::Map<const VecX>(y.data(), 3 * n);
+    };
+    // the transposed blocks of one tangent: X̃ = X P, (M + h d_k C + h² d_k² K)ᵀ ỹ_k = x̃_k, Y = Re(Ỹ P⁻¹)
+    auto P = [&](const VecX& v, VecX& out) {
+      const Eigen::MatrixXcd Xt = Eigen::Map<const MatX>(v.data(), n, 3).cast<cplx>() * tab_.P;
+      Eigen::MatrixXcd Yt(n, 3);
+      VecX x = Xt.col(0).real(), y;
+      matrix_->precondition_transposed(x, y);
+      Yt.col(0) = y.cast<cplx>();
+      VecXc z = Xt.col(1), w;
+      matrix_->precondition_transposed(z, w);
+      Yt.col(1) = w;
+      Yt.col(2) = w.conjugate();
+      const MatX Y = Yt.real() * tab_.Pinv.real() - Yt.imag() * tab_.Pinv.imag();
+      out = Eigen::Map<const VecX>(Y.data(), 3 * n);
+    };
+    const VecX g = Eigen::Map<const VecX>(G.data(), 3 * n);
+    const VecX m = gmres(S, P, g, [&] {
+      matrix_->linearize(s.t, s.q, s.v, s.qdd, VecX());
+      const double gr = h * tab_.d(0).real();
+      const cplx gc = h * tab_.d(1);
+      if (!(matrix_->factor(gr, gr * gr, VecX()) > 1e-15) || !(matrix_->factor(gc, gc * gc) > 1e-15))
+        throw SimulationError(s.t, "the adjoint's Newton matrix of radau5 is singular");
+    }, s.t);
+    const MatX mu = Eigen::Map<const MatX>(m.data(), n, 3);
+    // q̂ = Q̄ − Kμ, V̂ = V̄ − Cμ; q̄_n = Σ Q̂_i, q̇̄_n = Σ V̂_i + h Σ c_i Q̂_i; dJ/dp −= Σ μ_iᵀ ∂r_i/∂p
+    VecX qb = VecX::Zero(n), vb = VecX::Zero(n);
+    for (int i = 0; i < 3; ++i) {
+      const ResidualVjp r = vjp(t0 + tab_.c(i) * h, s.Q.col(i), s.V.col(i), s.A.col(i), mu.col(i));
+      const VecX Qh = Qb.col(i) - r.q, Vh = Vb.col(i) - r.qd;
+      qb += Qh;
+      vb += Vh + (h * tab_.c(i)) * Qh;
+      params_.add(d_, mu.col(i), r, -1.0, grad);
+    }
+    bars << qb, vb;
+  }
+
+  /// q̈_0 only starts the first step's Newton iterations: nothing depends on it.
+  void transpose_start(const StepRecord&, VecX&, VecX&) override {}
+
+ private:
+  std::unique_ptr<Stepper> stepper_;
+  RadauAccess* access_;
+  const RadauTableau tab_;
+};
+
 }  // namespace
 
-NewmarkAdjoint::NewmarkAdjoint(std::shared_ptr<const System> sys, const IntegratorOptions& o,
-                               std::vector<OutputSpec> outputs, double memory)
+Adjoint::Adjoint(std::shared_ptr<const System> sys, const IntegratorOptions& o, std::vector<OutputSpec> outputs,
+                 double memory)
     : sys_(std::move(sys)), o_(o), outputs_(std::move(outputs)), memory_(memory), d_(*sys_) {
   const System& s = *sys_;
-  if (s.algorithm != Algorithm::Recursive)
+  if (!reverse_mode(s))
     throw std::invalid_argument("system: expected a system compiled with algorithm='recursive' (the adjoint "
                                 "transposes the recursive engine's derivatives), got algorithm='lagrange'");
   if (s.nl > 0) throw std::invalid_argument("system: expected no loop closures (not implemented for the adjoint yet)");
@@ -57,10 +277,20 @@ NewmarkAdjoint::NewmarkAdjoint(std::shared_ptr<const System> sys, const Integrat
   params_ = std::make_unique<ParameterVjp>(s, o.sensitivities);
   o_.sensitivities.clear();  // the stepper runs the state alone
   o_.adaptive = 0;
-  matrix_ = NewtonMatrix::make(s, o_, istats_);
+  if (o.method == Method::Radau5)
+    steps_ = std::make_unique<RadauSteps>(s, o_, *params_);
+  else if (o.method == Method::Newmark || o.method == Method::HHT || o.method == Method::GeneralizedAlpha ||
+           o.method == Method::ImplicitSpring)
+    steps_ = std::make_unique<NewmarkSteps>(s, o_, *params_);
+  else
+    bad("method", "generalized_alpha, newmark, hht, implicit_spring or radau5 (the methods with an adjoint)",
+        method_name(o.method));
+  steps_->stats = &stats_;
 }
 
-void NewmarkAdjoint::forward(double t0, double t_end, const VecX& q0, const VecX& qd0) {
+Adjoint::~Adjoint() = default;
+
+void Adjoint::forward(double t0, double t_end, const VecX& q0, const VecX& qd0) {
   const auto start = Clock::now();
   const System& s = *sys_;
   const int n = s.nq, K = output_size(outputs_);
@@ -68,7 +298,8 @@ void NewmarkAdjoint::forward(double t0, double t_end, const VecX& q0, const VecX
   t_ = grid(t0, t_end, o_.dt);
   const long N = static_cast<long>(t_.size()) - 1;
   // every state if they fit, else checkpoints every k = ⌈√N⌉ steps and one segment of k states
-  const double state_bytes = 8.0 * (4.0 * n + 16.0) + 8.0 * (3.0 * n + 2.0);
+  const double stages = o_.method == Method::Radau5 ? 9.0 : 0.0;
+  const double state_bytes = 8.0 * ((4.0 + stages) * n + 16.0);
   interval_ = 1;
   if ((N + 1) * state_bytes > memory_) {
     interval_ = static_cast<long>(std::ceil(std::sqrt(static_cast<double>(N))));
@@ -77,148 +308,85 @@ void NewmarkAdjoint::forward(double t0, double t_end, const VecX& q0, const VecX
       bad("memory", "at least " + num(need) + " bytes (2√N states of this run's " + std::to_string(N) + " steps)",
           num(memory_));
   }
-  stepper_ = make_newmark_stepper(s, o_, istats_);
-  VecX y0(2 * n);
-  y0 << q0, qd0;
-  stepper_->start(t0, y0);
-  checkpoints_.assign(1, stepper_->current());
+  stats_ = {};
+  steps_->start(t0, q0, qd0);
+  checkpoints_.assign(1, steps_->record(t0, 0.0));
   Y_.resize(N + 1, K);
-  auto record = [&](long k) {
-    set_state(s, d_, t_[k], stepper_->current().q, stepper_->current().v);
+  auto outputs_at = [&](long k, const VecX& q, const VecX& v) {
+    set_state(s, d_, t_[k], q, v);
     tree_kinematics(s, d_);
     objective_outputs(s, d_, outputs_, Y_.row(k).transpose());
   };
-  record(0);
+  outputs_at(0, q0, qd0);
   for (long k = 0; k < N; ++k) {
-    double err = 0.0;
-    if (!stepper_->attempt(t_[k], t_[k + 1] - t_[k], nullptr, err))
-      step_failure(t_[k], t_[k + 1] - t_[k],
-                   "Newton iterations did not converge in newton_max_iterations = " +
-                       std::to_string(o_.newton_max_iterations) + "; reduce dt or raise newton_max_iterations");
-    stepper_->accept();
-    if ((k + 1) % interval_ == 0) checkpoints_.push_back(stepper_->current());
-    record(k + 1);
+    interruption_point();
+    steps_->step(t_[k], t_[k + 1] - t_[k]);
+    StepRecord r = steps_->record(t_[k + 1], t_[k + 1] - t_[k]);
+    outputs_at(k + 1, r.q, r.v);
+    if ((k + 1) % interval_ == 0) checkpoints_.push_back(std::move(r));
   }
-  stats_ = {};
   stats_.steps = N;
   stats_.checkpoints = static_cast<long>(checkpoints_.size());
   stats_.interval = interval_;
   stats_.forward_time = std::chrono::duration<double>(Clock::now() - start).count();
 }
 
-void NewmarkAdjoint::replay(long first, long last, std::vector<StepState>& states) {
+void Adjoint::replay(long first, long last, std::vector<StepRecord>& states) {
   states.clear();
-  const NewmarkState& c = checkpoints_[first / interval_];
-  states.push_back(step_state(t_[first], first ? t_[first] - t_[first - 1] : 0.0, c));
+  states.push_back(checkpoints_[first / interval_]);
   if (last == first) return;
   if (interval_ == 1) {  // every state kept
-    states.push_back(step_state(t_[last], t_[last] - t_[first], checkpoints_[last]));
+    states.push_back(checkpoints_[last]);
     return;
   }
-  stepper_->restore(t_[first], c);
+  steps_->restore(states[0]);
   for (long k = first; k < last; ++k) {
-    double err = 0.0;
-    if (!stepper_->attempt(t_[k], t_[k + 1] - t_[k], nullptr, err))
-      step_failure(t_[k], t_[k + 1] - t_[k], "Newton iterations did not converge when the run was repeated");
-    stepper_->accept();
+    steps_->step(t_[k], t_[k + 1] - t_[k]);
     ++stats_.recomputed_steps;
-    states.push_back(step_state(t_[k + 1], t_[k + 1] - t_[k], stepper_->current()));
+    states.push_back(steps_->record(t_[k + 1], t_[k + 1] - t_[k]));
   }
 }
 
-VecX NewmarkAdjoint::transposed_solve(const StepState& s, const VecX& g, double c1, double c2) {
-  const System& sys = *sys_;
-  // Sᵀ v = M v + c₁ Cᵀ v + c₂ Kᵀ v by the reverse mode at the step's end
-  at(s);  // the reverse mode's passes start from the state and its axes
-  auto S = [&](const VecX& v, VecX& out) {
-    const ResidualVjp r = rnea_vector_jacobian_product(sys, d_, v);
-    out = r.qdd + c1 * r.qd + c2 * r.q;
-  };
-  // a preconditioner from an earlier step while GMRES converges in a few iterations with it
-  if (!preconditioner_ || last_iterations_ > 8) {
-    matrix_->linearize(s.t, s.q, s.v, s.qdd, VecX());
-    if (!(matrix_->factor(c1, c2, VecX()) > 1e-15))
-      throw SimulationError(s.t, "the adjoint's Newton matrix M + γh C + βh² K is singular");
-    preconditioner_ = true;
-    ++stats_.preconditioner_refreshes;
-  }
-  auto P = [&](const VecX& v, VecX& out) { matrix_->precondition_transposed(v, out); };
-  Gmres<double> gmres;
-  VecX mu;
-  last_iterations_ = gmres.solve(S, P, g, mu, 1e-11, 200);
-  stats_.gmres_iterations += last_iterations_;
-  if (!mu.allFinite()) throw SimulationError(s.t, "the adjoint became NaN or inf");
-  return mu;
-}
-
-void NewmarkAdjoint::at(const StepState& s) {
-  set_state(*sys_, d_, s.t, s.q, s.v);
-  set_accelerations(*sys_, d_, s.qdd);
-  tree_kinematics(*sys_, d_);
-}
-
-void NewmarkAdjoint::output_vjp(const StepState& s, const VecX& ybar, VecX& qbar, VecX& grad) {
+void Adjoint::output_vjp(const StepRecord& s, const VecX& ybar, Eigen::Ref<VecX> qbar, VecX& grad) {
   const System& sys = *sys_;
   set_state(sys, d_, s.t, s.q, s.v);
   tree_kinematics(sys, d_);
-  VecX pbar = VecX::Zero(sys.np);
-  objective_outputs_vjp(sys, d_, outputs_, ybar, qbar, pbar);
+  VecX pbar = VecX::Zero(sys.np), qb = qbar;
+  objective_outputs_vjp(sys, d_, outputs_, ybar, qb, pbar);
+  qbar = qb;
   if (sys.np > 0) params_->add_prescribed(s.t, pbar, grad);
 }
 
-VecX NewmarkAdjoint::backward(const Eigen::Ref<const RowMatX>& ybar) {
+VecX Adjoint::backward(const Eigen::Ref<const RowMatX>& ybar) {
   const auto start = Clock::now();
   const System& sys = *sys_;
   const int n = sys.nq;
   const long N = static_cast<long>(t_.size()) - 1;
-  if (N < 1 || checkpoints_.empty()) throw std::logic_error("NewmarkAdjoint::backward before forward");
+  if (N < 1 || checkpoints_.empty()) throw std::logic_error("Adjoint::backward before forward");
   if (ybar.rows() != N + 1 || ybar.cols() != Y_.cols())
     bad("ybar", "an array (" + std::to_string(N + 1) + ", " + std::to_string(Y_.cols()) + ")",
         "(" + std::to_string(ybar.rows()) + ", " + std::to_string(ybar.cols()) + ")");
-  const NewmarkCoefficients k = stepper_->coefficients();
-  const double z = (1.0 - k.af) / (1.0 - k.am);
+  stats_.recomputed_steps = stats_.gmres_iterations = stats_.preconditioner_refreshes = 0;
   const int P = params_->count();
-  VecX grad = VecX::Zero(P), qb = VecX::Zero(n), vb = VecX::Zero(n), ab = VecX::Zero(n), zb = VecX::Zero(n);
-  std::vector<StepState> states;
+  VecX grad = VecX::Zero(P), bars = VecX::Zero(steps_->adjoint_size() * n);
+  std::vector<StepRecord> states;
   for (long last = N; last > 0;) {
     const long first = ((last - 1) / interval_) * interval_;
     replay(first, last, states);
     for (long m = last; m > first; --m) {
       interruption_point();
-      const StepState& s = states[m - first];
-      output_vjp(s, ybar.row(m).transpose(), qb, grad);
-      const double h = s.h;
-      // the step m−1 → m transposed (adjoint.hpp)
-      const VecX at = ab + (k.beta * h * h) * qb + (k.gamma * h) * vb;
-      const VecX g = zb + z * at;
-      const VecX mu = transposed_solve(s, g, k.gamma * z * h, k.beta * z * h * h);
-      const ResidualVjp r = rnea_vector_jacobian_product(sys, d_, mu);
-      const VecX qh = qb - r.q, vh = vb - r.qd;
-      const VecX A = ab + (k.beta * h * h) * qh + (k.gamma * h) * vh;
-      qb = qh;
-      vb = h * qh + vh;
-      ab = (h * h * (0.5 - k.beta)) * qh + (h * (1.0 - k.gamma)) * vh - (k.am / (1.0 - k.am)) * A;
-      zb = (k.af / (1.0 - k.am)) * A;
-      params_->add(s.t, s.q, s.v, s.qdd, mu, r, -1.0, grad);
+      const StepRecord& s = states[m - first];
+      output_vjp(s, ybar.row(m).transpose(), bars.head(n), grad);  // the objective at t_m
+      steps_->transpose(s, bars, grad);                               // the step m−1 → m
     }
     last = first;
   }
-  // t0: the objective there, and a_0 = q̈_0 from r(q_0, q̇_0, q̈_0) = 0
-  replay(0, 0, states);
-  const StepState& s0 = states[0];
-  output_vjp(s0, ybar.row(0).transpose(), qb, grad);
-  set_state(sys, d_, s0.t, s0.q, s0.v);
-  tree_kinematics(sys, d_);
-  factor_mass(sys, d_);
-  VecX mu0(n);
-  solve_armature(sys, d_, VecX(ab + zb), mu0);
-  at(s0);
-  const ResidualVjp r0 = rnea_vector_jacobian_product(sys, d_, mu0);
-  qb -= r0.q;
-  vb -= r0.qd;
-  params_->add(s0.t, s0.q, s0.v, s0.qdd, mu0, r0, -1.0, grad);
-  q0bar_ = qb, qd0bar_ = vb;
-  for (int j = 0; j < P; ++j) grad(j) += params_->initial(j).head(n).dot(qb) + params_->initial(j).tail(n).dot(vb);
+  const StepRecord& s0 = checkpoints_[0];
+  output_vjp(s0, ybar.row(0).transpose(), bars.head(n), grad);
+  steps_->transpose_start(s0, bars, grad);
+  q0bar_ = bars.head(n), qd0bar_ = bars.segment(n, n);
+  for (int j = 0; j < P; ++j)
+    grad(j) += params_->initial(j).head(n).dot(q0bar_) + params_->initial(j).tail(n).dot(qd0bar_);
   stats_.backward_time = std::chrono::duration<double>(Clock::now() - start).count();
   return grad;
 }

@@ -1,5 +1,8 @@
 // The adjoint's terms besides the residual's reverse mode: the objective's outputs and their transposed
 // Jacobian, and μᵀ ∂r/∂p of every parameter in one pass (adjoint.hpp).
+#include <algorithm>
+#include <cmath>
+#include <limits>
 #include <stdexcept>
 
 #include "rigidfem/adjoint.hpp"
@@ -52,7 +55,9 @@ void objective_outputs_vjp(const System& sys, const Data& d, const std::vector<O
 }
 
 ParameterVjp::ParameterVjp(const System& sys, const std::vector<SensitivityParameter>& parameters)
-    : sys_(sys), parameters_(parameters), touched_(parameters.size()), d_(sys), V_(sys.nbodies) {
+    : sys_(sys), parameters_(parameters), touched_(parameters.size()), V_(sys.nbodies),
+      base_{std::vector<double>(sys.nbodies), std::vector<double>(sys.nc), std::vector<double>(sys.elements.size()),
+            std::vector<double>(sys.loads.size()), std::vector<double>()} {
   for (std::size_t j = 0; j < parameters_.size(); ++j) {
     for (const auto& X : {parameters_[j].plus, parameters_[j].minus}) {
       if (!X) continue;
@@ -85,8 +90,7 @@ ParameterVjp::ParameterVjp(const System& sys, const std::vector<SensitivityParam
   }
 }
 
-double ParameterVjp::power(const System& X, const Component& c, const VecX& mu) const {
-  const Data& d = d_;
+double ParameterVjp::power(const System& X, const Data& d, const Component& c, const VecX& mu) const {
   auto velocity = [&](int b, const Vec3& x) -> Vec3 {  // the point x of body b under the virtual velocity
     return b < 0 ? Vec3::Zero() : Vec3(V_[b].tail<3>() + V_[b].head<3>().cross(x));
   };
@@ -116,6 +120,12 @@ double ParameterVjp::power(const System& X, const Component& c, const VecX& mu) 
   return 0.0;
 }
 
+double ParameterVjp::base_power(const Data& d, const Component& c, const VecX& mu) {
+  double& cached = base_[c.kind][c.index];  // a component many parameters change (E: every sde) is evaluated once
+  if (std::isnan(cached)) cached = power(sys_, d, c, mu);
+  return cached;
+}
+
 MotionState ParameterVjp::drive_derivative(int j, int coord, double t) const {
   const SensitivityParameter& p = parameters_[j];
   const MotionState up = p.plus->coords[coord].drive->at(t);
@@ -124,19 +134,15 @@ MotionState ParameterVjp::drive_derivative(int j, int coord, double t) const {
   return {(up.q - down.q) / h, (up.qd - down.qd) / h, (up.qdd - down.qdd) / h};
 }
 
-void ParameterVjp::add(double t, const VecX& q, const VecX& qd, const VecX& qdd, const VecX& mu,
-                       const ResidualVjp& r, double w, Eigen::Ref<VecX> grad) {
-  set_state(sys_, d_, t, q, qd);
-  set_accelerations(sys_, d_, qdd);
-  tree_kinematics(sys_, d_);
-  spatial_kinematics(sys_, d_);
-  rnea_pass(sys_, d_);
+void ParameterVjp::add(const Data& d, const VecX& mu, const ResidualVjp& r, double w, Eigen::Ref<VecX> grad) {
   // V_b = V_parent + Σ_{free uses u of b's joint} s_u μ_u: each body's velocity for q̇ = μ
   for (int b = 0; b < sys_.nbodies; ++b) {
     V_[b] = sys_.parent[b] >= 0 ? V_[sys_.parent[b]] : Vec6::Zero();
     for (int u = sys_.use_start[b]; u < sys_.use_start[b + 1]; ++u)
-      if (sys_.use_q[u] >= 0) V_[b] += d_.axes[u] * mu(sys_.use_q[u]);
+      if (sys_.use_q[u] >= 0) V_[b] += d.axes[u] * mu(sys_.use_q[u]);
   }
+  const double t = d.t;
+  for (auto& cache : base_) std::fill(cache.begin(), cache.end(), std::numeric_limits<double>::quiet_NaN());
   for (std::size_t j = 0; j < parameters_.size(); ++j) {
     const SensitivityParameter& p = parameters_[j];
     if (!p.plus) continue;
@@ -147,9 +153,9 @@ void ParameterVjp::add(double t, const VecX& q, const VecX& qd, const VecX& qdd,
         const MotionState dp = drive_derivative(static_cast<int>(j), c.index, t);
         sum += r.pq(k) * dp.q + r.pqd(k) * dp.qd + r.pqdd(k) * dp.qdd;
       } else if (p.minus) {
-        sum += (power(*p.plus, c, mu) - power(*p.minus, c, mu)) / (2.0 * p.h);
+        sum += (power(*p.plus, d, c, mu) - power(*p.minus, d, c, mu)) / (2.0 * p.h);
       } else {
-        sum += (power(*p.plus, c, mu) - power(sys_, c, mu)) / p.h;
+        sum += (power(*p.plus, d, c, mu) - base_power(d, c, mu)) / p.h;
       }
     }
     grad(j) += w * sum;

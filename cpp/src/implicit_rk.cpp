@@ -38,6 +38,7 @@
 #include "rigidfem/errors.hpp"
 #include "rigidfem/kinematics.hpp"
 #include "rigidfem/newton_matrix.hpp"
+#include "rigidfem/radau.hpp"
 #include "rigidfem/sensitivities.hpp"
 #include "rigidfem/stepper.hpp"
 
@@ -636,34 +637,7 @@ class Esdirk final : public ImplicitRk {
 /// Radau IIA of order 5 (Ehle; Hairer & Wanner IV.5, IV.8): c = ((4 − √6)/10, (4 + √6)/10, 1),
 /// stiffly accurate, L-stable. Its error estimate (Hairer & Wanner IV.8, (8.19)–(8.20)), of order 3,
 /// is filtered through (I − h d₁ J)⁻¹.
-struct RadauTableau {
-  static constexpr int s = 3;
-  Eigen::Matrix3d a;
-  Eigen::Vector3d c, dd;       // dd: the estimate's weights on the stage increments (Y_i − y_n)/h
-  Eigen::Matrix3cd P, Pinv;    // a = P diag(d) P⁻¹
-  Eigen::Vector3cd d;          // d(0) real, d(2) = conj d(1), Im d(1) > 0
-  RadauTableau() {
-    const double r6 = std::sqrt(6.0);
-    c << (4 - r6) / 10, (4 + r6) / 10, 1;
-    a << (88 - 7 * r6) / 360, (296 - 169 * r6) / 1800, (-2 + 3 * r6) / 225,  //
-        (296 + 169 * r6) / 1800, (88 + 7 * r6) / 360, (-2 - 3 * r6) / 225,   //
-        (16 - r6) / 36, (16 + r6) / 36, 1.0 / 9;
-    dd << -(13 + 7 * r6) / 3, (-13 + 7 * r6) / 3, -1.0 / 3;
-    Eigen::EigenSolver<Eigen::Matrix3d> es(a);
-    Eigen::Vector3cd ev = es.eigenvalues();
-    Eigen::Matrix3cd V = es.eigenvectors();
-    int real = 0;
-    for (int k = 1; k < 3; ++k)
-      if (std::abs(ev(k).imag()) < std::abs(ev(real).imag())) real = k;
-    const int up = ev((real + 1) % 3).imag() > 0 ? (real + 1) % 3 : (real + 2) % 3, down = 3 - real - up;
-    const int order[3] = {real, up, down};
-    for (int k = 0; k < 3; ++k) d(k) = ev(order[k]), P.col(k) = V.col(order[k]);
-    d(0) = d(0).real();
-    Pinv = P.inverse();
-  }
-};
-
-class Radau5 final : public ImplicitRk {
+class Radau5 final : public ImplicitRk, public RadauAccess {
   using cplx = std::complex<double>;
   using MatXc = Eigen::MatrixXcd;
 
@@ -673,6 +647,16 @@ class Radau5 final : public ImplicitRk {
         Aprev_(n_, 3), Rt_(n_, 3), Dt_(n_, 3), z_(n_), zs_(n_), x_(n_), xs_(n_), b1_(n_), b2_(n_), qx_(n_), vx_(n_),
         L_(sys.nl, 3), Cres_(sys.nl, 3), W_(3 * sys.nl, 3 * sys.nl),
         w_(3 * sys.nl), E_(n_, 3), Z_(n_, 3) {}
+
+  void stages(MatX& Q, MatX& V, MatX& A) const override { Q = Q_, V = V_, A = A_; }
+  void current(VecX& q, VecX& v, VecX& a) const override { q = q_, v = v_, a = a_; }
+  void restore(double t, const VecX& q, const VecX& v, const VecX& a) override {
+    q_ = q, v_ = v, a_ = a;
+    y_ << q_, v_;
+    ys_.resize(2 * n_ + sys_.nz);
+    ys_ << y_, s_;
+    t_ = t, have_previous_ = false, rejected_ = false;
+  }
 
  private:
   /// The stages by simplified Newton on the transformed system: R = [r_i] (nq, 3), R̃ = R P⁻ᵀ, each

@@ -7,8 +7,8 @@
 and dJ/dp for every parameter p named (``System.parameters``, or initial values ``"q0[<coordinate>]"``,
 ``"qd0[<coordinate>]"``), where y are the outputs asked for: points' global positions (m) and free
 coordinates (m or rad). The integral is the trapezoidal rule on the run's steps, and the gradient is that of
-the discrete objective of the discrete solution: the discrete adjoint of the Newmark family at fixed steps
-(``cpp/include/rigidfem/adjoint.hpp``). Its cost does not grow with the number of parameters: one forward
+the discrete objective of the discrete solution: the discrete adjoint of the Newmark family or of radau5 at fixed
+steps (``cpp/include/rigidfem/adjoint.hpp``). Its cost does not grow with the number of parameters: one forward
 run, one backward sweep (a transposed solve per step by GMRES on the RNEA's reverse mode, preconditioned by a
 kept factorisation), μᵀ∂r/∂p of every parameter in one O(n) pass, and, when the states do not all fit into
 ``memory`` bytes, a second forward run of each segment between checkpoints (⌈√N⌉ steps apart).
@@ -20,7 +20,7 @@ with t (N + 1,) and y a dict {name: (N + 1, 3) or (N + 1,)} returns L at every s
 complex input (abs, comparisons, float()) is differentiated by central differences instead
 (``Gradient.stats["objective_derivative"]`` says which).
 
-Not yet: radau5's adjoint, loop closures, Maxwell arms, links of varying length, the Lagrange engine
+Not yet: loop closures, Maxwell arms, links of varying length, the Lagrange engine
 (algorithm='lagrange'), adaptive steps, an actuator's length profile.
 """
 
@@ -38,7 +38,7 @@ from . import parameters as parameters_
 from . import sensitivities as sensitivities_
 
 #: The methods with an adjoint.
-METHODS = ("generalized_alpha", "newmark", "hht", "implicit_spring")
+METHODS = ("generalized_alpha", "newmark", "hht", "implicit_spring", "radau5")
 
 
 @dataclass
@@ -88,7 +88,7 @@ def gradient(system, t_end: float, parameters=None, *, outputs, running=None, te
     terminal : callable, optional
         Φ(y) -> float, y {name: (3,) or float} at t_end; None: no terminal term.
     method : str
-        "generalized_alpha" (default), "newmark", "hht" or "implicit_spring", at fixed steps ``dt`` (s).
+        "generalized_alpha" (default), "newmark", "hht", "implicit_spring" or "radau5", at fixed steps ``dt`` (s).
     memory : float
         Bytes for the states the backward sweep needs (default 256 MiB): all of them if they fit, else
         checkpoints every ⌈√N⌉ steps and each segment run again.
@@ -124,7 +124,7 @@ def gradient(system, t_end: float, parameters=None, *, outputs, running=None, te
     if parameters is None:
         parameters = list(system.parameters)
     directions = sensitivities_.directions(system, parameters, opt, t0, t_end, "parameters")
-    adjoint = _core._NewmarkAdjoint(system, opt, specs, memory)
+    adjoint = _core._Adjoint(system, opt, specs, memory)
     start = time.perf_counter()
     t, Y = adjoint.forward(t0, t_end, q0, qd0)
     y = _split(Y, specs, names)

@@ -310,10 +310,15 @@ class Parameters:
             out += self.groups[prefix].changes({**self._current(prefix), **new})
         return out
 
+    @property
+    def _cache(self) -> dict:
+        """Per object (its values do not change): each profile group's changed numbers and sampled values."""
+        return self.__dict__.setdefault("_memo", {})
+
     def _current(self, prefix: str) -> dict[str, float]:
         """{short name: value} of a group's parameters; of a profile's, only those that differ from the numbers
         it was made of (a spline's hundred knots: each difference of one of them stays O(1) here)."""
-        cache = self.__dict__.setdefault("_cache", {})
+        cache = self._cache
         if prefix not in cache:
             g = self.groups[prefix]
             leaves = g.current_leaves() if isinstance(g, ProfileGroup) else {}
@@ -345,12 +350,15 @@ class Parameters:
         prefix, short = self.where[name]
         group = self.groups[prefix]
         changed = self._current(prefix)
-        base = remade(group.profile, changed)
+        times = np.linspace(t0, t1, 41)
+        key = (prefix, float(t0), float(t1))
+        if key not in self._cache:  # the profile at its current values, once for all its numbers
+            base = remade(group.profile, changed)
+            self._cache[key] = np.array([base(t)[0] for t in times])
+        q = self._cache[key]
         p = self.values[name]
         delta = 1e-6 * max(abs(p), 1.0)
         moved = remade(group.profile, {**changed, short: p + delta})
-        times = np.linspace(t0, t1, 41)
-        q = np.array([base(t)[0] for t in times])
         change = np.max(np.abs(np.array([moved(t)[0] for t in times]) - q))
         return delta * 1e-6 * max(1.0, float(np.max(np.abs(q)))) / change if change > 0.0 else delta
 
@@ -411,8 +419,15 @@ def remade(profile, values: dict[str, float], path: str = ""):
             arg = remade(arg, values, here + ".")
         elif isinstance(arg, (list, tuple)) and arg and isinstance(arg[0], _core.Profile):
             arg = [remade(part, values, f"{here}[{k}].") for k, part in enumerate(arg)]
-        elif isinstance(arg, (list, tuple)) and any(key.startswith(here + "[") for key in values):
-            arg = [values.get(f"{here}[{k}]", v) for k, v in enumerate(arg)]
+        elif isinstance(arg, (list, tuple)):  # the entries "<here>[k]" named in values
+            start = len(here) + 1
+            hits = [(int(key[start:-1]), v) for key, v in values.items()
+                    if key.startswith(here + "[") and key.endswith("]") and key[start:-1].isdigit()]
+            if hits:
+                arg = list(arg)
+                for k, v in hits:
+                    if k < len(arg):
+                        arg[k] = v
         elif isinstance(arg, float):
             arg = values.get(here, arg)
         new.append(arg)

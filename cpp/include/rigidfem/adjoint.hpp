@@ -1,7 +1,7 @@
 /// Adjoint gradients of a scalar objective of a run, J = Σ_n ȳ-weighted outputs (a quadrature of ∫ L(t, y) dt
 /// plus Φ(y(t_end)), formed in Python from the outputs y_n the forward run records), with respect to many
-/// parameters at the cost of a few runs: the discrete adjoint of the Newmark family (generalised-α in the form of
-/// Arnold & Brüls, newmark.cpp) at fixed steps.
+/// parameters at the cost of a few runs: the discrete adjoints of the Newmark family (generalised-α in the form of
+/// Arnold & Brüls, newmark.cpp) and of radau5 (implicit_rk.cpp) at fixed steps.
 ///
 /// A step n → n+1 solves r(q_{n+1}, q̇_{n+1}, q̈_{n+1}, t_{n+1}; p) = 0 for z = q̈_{n+1}, with
 ///   a_{n+1} = [(1 − α_f) z + α_f q̈_n − α_m a_n]/(1 − α_m),
@@ -18,6 +18,13 @@
 /// from an earlier step (dense) or by M + diag(γ'h b + β'h² k) (Krylov), to 1e-10; μᵀ∂r/∂p for every parameter
 /// in one pass (ParameterVjp). Recursive tree systems without Maxwell arms or links of varying length.
 ///
+/// Radau IIA (3 stages; implicit_rk.cpp): V = q̇_n 1ᵀ + h A aᵀ, Q = q_n 1ᵀ + h V aᵀ, r_i(Q_i, V_i, A_i) = 0, and
+/// (q, q̇)_{n+1} = (Q_3, V_3). With Q̄ = [0, 0, q̄_{n+1}], V̄ = [0, 0, q̇̄_{n+1}]:
+///   V̄' = V̄ + h Q̄ a,   𝒮ᵀ μ = h V̄' a,   (𝒮ᵀμ)_j = M_j μ_j + h Σ_i a_ij C_iᵀ μ_i + h² Σ_i (a²)_ij K_iᵀ μ_i
+/// (each stage's own tangent), Q̂ = Q̄ − [K_iᵀμ_i], V̂ = V̄ − [C_iᵀμ_i], q̄_n = Σ_i Q̂_i, q̇̄_n = Σ_i V̂_i + h Σ_i c_i Q̂_i,
+/// dJ/dp −= Σ_i μ_iᵀ ∂r_i/∂p. 𝒮ᵀμ = g by GMRES on those products, preconditioned by the transposed real and
+/// complex blocks of one tangent: X̃ = X P, (M + h d_k C + h² d_k² K)ᵀ ỹ_k = x̃_k, Y = Re(Ỹ P⁻¹).
+///
 /// Checkpointing: the forward run keeps every state while they fit into `memory` bytes, else every k-th (k = ⌈√N⌉,
 /// about 2√N states in all) and the backward sweep runs each segment again from its checkpoint: memory O(√N)
 /// states, one extra forward run's work.
@@ -29,8 +36,6 @@
 #include "rigidfem/derivatives.hpp"
 #include "rigidfem/error_measure.hpp"
 #include "rigidfem/integrators.hpp"
-#include "rigidfem/newmark.hpp"
-#include "rigidfem/newton_matrix.hpp"
 #include "rigidfem/sensitivities.hpp"
 
 namespace rigidfem {
@@ -52,10 +57,10 @@ void objective_outputs_vjp(const System& sys, const Data& d, const std::vector<O
 class ParameterVjp {
  public:
   ParameterVjp(const System& sys, const std::vector<SensitivityParameter>& parameters);
-  /// grad_j += w μᵀ ∂r/∂p_j at (t, q, q̇, q̈), r the reverse mode's products there (its part by the prescribed
+  /// grad_j += w μᵀ ∂r/∂p_j at the state of d, r the reverse mode's products there (d: after
+  /// rnea_vector_jacobian_product, whose spatial kinematics and RNEA pass it reads; r's part by the prescribed
   /// coordinates' motion: a drive's numbers).
-  void add(double t, const VecX& q, const VecX& qd, const VecX& qdd, const VecX& mu, const ResidualVjp& r, double w,
-           Eigen::Ref<VecX> grad);
+  void add(const Data& d, const VecX& mu, const ResidualVjp& r, double w, Eigen::Ref<VecX> grad);
   /// grad_j += pbarᵀ ∂q_p(t)/∂p_j: the prescribed coordinates' values moved by a drive's numbers.
   void add_prescribed(double t, const VecX& pbar, Eigen::Ref<VecX> grad) const;
   int count() const { return static_cast<int>(parameters_.size()); }
@@ -67,33 +72,57 @@ class ParameterVjp {
     enum Kind { Body, Coordinate, Element, Load, Drive } kind;
     int index;  // body, coordinate (in coords), element, load
   };
-  double power(const System& X, const Component& c, const VecX& mu) const;
+  double power(const System& X, const Data& d, const Component& c, const VecX& mu) const;
+  double base_power(const Data& d, const Component& c, const VecX& mu);
   MotionState drive_derivative(int j, int coord, double t) const;
   const System& sys_;
   std::vector<SensitivityParameter> parameters_;
   std::vector<std::vector<Component>> touched_;  // per parameter
-  Data d_;
   std::vector<Vec6> V_;                           // (nbodies) V_b = Σ s_u μ_u along the path
+  std::vector<double> base_[5];                   // per kind of component: its power on the run's system, or NaN
 };
 
-/// The state at a step's end the backward sweep linearises at.
-struct StepState {
-  double t = 0.0, h = 0.0;  // h: the step that reached it (0 at t0)
-  VecX q, v, qdd;
+/// What the backward sweep needs of a step, and what a replay starts again from: the state at the step's end
+/// (q, q̇, q̈; a: the Newmark family's pseudo-acceleration) and the step's stages (radau5: Q, V, A (nq, 3)).
+struct StepRecord {
+  double t = 0.0, h = 0.0;  // h: the step that reached t (0 at t0)
+  VecX q, v, qdd, a;
+  MatX Q, V, A;
 };
 
 struct AdjointStats {
-  long steps = 0, recomputed_steps = 0, checkpoints = 0, stored_states = 0, interval = 1;
+  long steps = 0, recomputed_steps = 0, checkpoints = 0, interval = 1;
   long gmres_iterations = 0, preconditioner_refreshes = 0;
   double forward_time = 0.0, backward_time = 0.0;  // s
 };
 
-/// One forward run recording the outputs and its checkpoints, then any number of backward sweeps.
-class NewmarkAdjoint {
+/// One method's steps and their transposes (adjoint.cpp: the Newmark family, radau5). The adjoint state is
+/// k nq long, q̄ and q̇̄ first (the Newmark family's also ā and q̈̄).
+class AdjointSteps {
  public:
-  /// o: a Newmark-family method at fixed steps dt, o.sensitivities the parameters (their systems at p ± h and S0).
-  NewmarkAdjoint(std::shared_ptr<const System> sys, const IntegratorOptions& o, std::vector<OutputSpec> outputs,
-                 double memory);
+  virtual ~AdjointSteps() = default;
+  virtual void start(double t0, const VecX& q0, const VecX& qd0) = 0;
+  /// The step t → t + h from the current state (SimulationError if Newton fails).
+  virtual void step(double t, double h) = 0;
+  /// The current state after start or a step of h to t, with that step's stages.
+  virtual StepRecord record(double t, double h) const = 0;
+  virtual void restore(const StepRecord& r) = 0;
+  virtual int adjoint_size() const = 0;
+  /// The adjoint state at a step's end (its record `end`) into the one at its start; grad += its parameters' part.
+  virtual void transpose(const StepRecord& end, VecX& bars, VecX& grad) = 0;
+  /// At t0: what the start (q̈_0 from the dynamics) adds; bars keeps (q̄_0, q̇̄_0) in front.
+  virtual void transpose_start(const StepRecord& start, VecX& bars, VecX& grad) = 0;
+  AdjointStats* stats = nullptr;
+};
+
+/// One forward run recording the outputs and its checkpoints, then any number of backward sweeps.
+class Adjoint {
+ public:
+  /// o: generalized_alpha, newmark, hht, implicit_spring or radau5 at fixed steps dt, o.sensitivities the
+  /// parameters (their systems at p ± h and S0); memory: bytes for the states kept.
+  Adjoint(std::shared_ptr<const System> sys, const IntegratorOptions& o, std::vector<OutputSpec> outputs,
+          double memory);
+  ~Adjoint();
   /// Runs from (t0, q0, q̇0) to t_end: times() and outputs() (N + 1, K), the checkpoints.
   void forward(double t0, double t_end, const VecX& q0, const VecX& qd0);
   const std::vector<double>& times() const { return t_; }
@@ -105,28 +134,22 @@ class NewmarkAdjoint {
   const AdjointStats& stats() const { return stats_; }
 
  private:
-  void replay(long first, long last, std::vector<StepState>& states);
-  VecX transposed_solve(const StepState& s, const VecX& g, double c1, double c2);
-  void at(const StepState& s);  // set_state, q̈ and the axes on d_
-  void output_vjp(const StepState& s, const VecX& ybar, VecX& qbar, VecX& grad);
+  void replay(long first, long last, std::vector<StepRecord>& states);
+  void output_vjp(const StepRecord& s, const VecX& ybar, Eigen::Ref<VecX> qbar, VecX& grad);
 
   std::shared_ptr<const System> sys_;
   IntegratorOptions o_;
   std::vector<OutputSpec> outputs_;
   double memory_;
-  IntegratorStats istats_;
-  std::unique_ptr<NewmarkStepper> stepper_;
-  std::unique_ptr<NewtonMatrix> matrix_;
   std::unique_ptr<ParameterVjp> params_;
+  std::unique_ptr<AdjointSteps> steps_;
   Data d_;
   std::vector<double> t_;
   RowMatX Y_;
-  long interval_ = 1;                          // steps between checkpoints
-  std::vector<NewmarkState> checkpoints_;      // at steps 0, k, 2k, ... (all: k = 1)
+  long interval_ = 1;                      // steps between checkpoints
+  std::vector<StepRecord> checkpoints_;    // at steps 0, k, 2k, ... (all: k = 1)
   VecX q0bar_, qd0bar_;
   AdjointStats stats_;
-  bool preconditioner_ = false;
-  long last_iterations_ = 0;
 };
 
 }  // namespace rigidfem

@@ -25,6 +25,9 @@ inline bool analytic_derivatives(const System& sys) { return sys.algorithm == Al
 /// Whether M + diag δ has the O(n) articulated-body factorisation (recursive systems): the matrix-free
 /// Newton matrix's preconditioner (newton_matrix.hpp).
 inline bool articulated(const System& sys) { return sys.algorithm == Algorithm::Recursive; }
+/// Whether the residual has the RNEA's reverse mode, (Kᵀμ, Cᵀμ, Mμ) in O(n) (recursive systems): the adjoint's
+/// (adjoint.hpp).
+inline bool reverse_mode(const System& sys) { return sys.algorithm == Algorithm::Recursive; }
 
 // Stages, after set_state and a kinematics pass.
 /// => f (nq): loads, velocity terms and passive forces (f − A q̈ if d.qdda holds free accelerations).

@@ -70,6 +70,8 @@ class NewtonMatrix {
   /// x = P⁻ᵀ b with slot 0's factorisation P: S itself (dense), the preconditioner M + diag(c₁ b + c₂ k + e),
   /// symmetric (Krylov). The adjoint's preconditioner for Sᵀ (adjoint.cpp).
   virtual void precondition_transposed(const VecX& b, VecX& x) = 0;
+  /// ... with slot 1's (complex) factorisation.
+  virtual void precondition_transposed(const VecXc& b, VecXc& x) = 0;
   /// X = S⁻¹ B column by column with slot 0's matrix.
   MatX solve(const MatX& B);
   /// Whether the tangent is matrix-free.
