@@ -167,6 +167,26 @@ def test_every_method(method, options, rtol):
     assert_gradients_agree(g.gradient, expected, rtol)
 
 
+def test_radau5_krylov_on_a_long_chain():
+    """radau5 with the matrix-free Newton matrix on a 40-element strip on a turning hub: its transposed stages
+    preconditioned by the articulated-body factor at the complex shift converge in a few GMRES iterations a step
+    and give the dense tangent's gradient. (That factor's rounding once grew up the chain: 300 iterations a step
+    and a gradient of 1e45.)"""
+    model = rf.Model(gravity=(0.0, -G, 0.0))
+    hub = model.add_body("hub", model.ground, rf.Joint.revolute("z"), 1.0, (0.1, 0.1, 0.1))
+    model.prescribe(hub, rf.motion.harmonic(0.1, 100.0))
+    beam = model.add_beam("strip", hub, 1.0, rf.Material(E=2.1e11, rho=7850.0), rf.Section.rectangle(0.02, 0.005), 40,
+                          deform=("bend_z", "bend_y"))
+    model.add_force(beam.tip, (0.0, -5.0, 2.0), name="push")
+    s = model.compile()
+    run = dict(method="radau5", outputs={"p": beam.tip}, running=running, terminal=terminal, dt=1e-4)
+    names = ["strip.E", "push.force", "hub.rz.drive.omega"]
+    krylov = rf.gradient(s, 0.005, names, iteration_matrix="krylov", **run)
+    dense = rf.gradient(s, 0.005, names, iteration_matrix="tangent", **run)
+    assert krylov.stats["gmres_iterations"] <= 6 * krylov.stats["steps"]
+    np.testing.assert_allclose(krylov.array(), dense.array(), rtol=1e-6)
+
+
 def test_radau5_on_a_drive_and_a_winch_with_checkpoints():
     """radau5's adjoint on the boom's drive and winch, its states kept or checkpointed, against its forward
     sensitivities and central differences of whole runs (its stages depend on the drive's numbers at three
