@@ -241,8 +241,10 @@ def test_bad_input():
     with pytest.raises(ValueError, match="running: expected a function L"):
         rf.gradient(s, 0.01, ["strip.E"], outputs=ok["outputs"], dt=1e-3)
     for bad in (lambda t, y: np.full(len(t), np.nan), lambda t, y: y["p"], lambda t, y: "big"):
-        with pytest.raises(ValueError, match="running: expected an array of L at the 11 steps"):
+        with pytest.raises(ValueError, match="running: expected an array of L at every step"):
             rf.gradient(s, 0.01, ["strip.E"], **{**ok, "running": bad})
+    with pytest.raises(ValueError, match="running: expected an array of L at the 11 steps"):  # NaN later only
+        rf.gradient(s, 0.01, ["strip.E"], **{**ok, "running": lambda t, y: np.where(t > 0.005, np.nan, t)})
     with pytest.raises(ValueError, match="terminal: expected a number"):
         rf.gradient(s, 0.01, ["strip.E"], **{**ok, "terminal": lambda y: [1.0, 2.0]})
     with pytest.raises(ValueError, match="algorithm='recursive'"):

@@ -123,6 +123,7 @@ def gradient(system, t_end: float, parameters=None, *, outputs, running=None, te
     _core._check_options(system, t0, t_end, q0, qd0, np.empty(0), opt)
     if parameters is None:
         parameters = list(system.parameters)
+    _probe(system, specs, names, running, terminal, t0, q0)  # a bad objective is named before any run
     directions = sensitivities_.directions(system, parameters, opt, t0, t_end, "parameters")
     adjoint = _core._Adjoint(system, opt, specs, memory)
     start = time.perf_counter()
@@ -149,6 +150,22 @@ def _outputs(system, outputs) -> tuple[list, list]:
             raise ValueError(f"outputs: expected points, bodies or free coordinates, got the {kind} {item!r}")
         specs.append((kind, index, r))
     return specs, list(outputs)
+
+
+def _probe(system, specs, names, running, terminal, t0, q0) -> None:
+    """The objective's functions at the initial state: ValueError naming the one that does not return finite
+    real numbers of the expected shape."""
+    row = []
+    for kind, index, r in specs:
+        if kind == "point":
+            row.extend(_core._point_positions(system, index, r, -1, np.array([t0]), q0[None, :])[0])
+        else:
+            row.append(q0[index])
+    Y = np.array([row], dtype=float)
+    if running is not None:
+        _values(running(np.array([t0]), _split(Y, specs, names)), (1,), "running", "an array of L at every step")
+    if terminal is not None:
+        _values(terminal({k: v[0] for k, v in _split(Y, specs, names).items()}), (), "terminal", "a number")
 
 
 def _split(Y, specs, names) -> dict:
