@@ -132,3 +132,21 @@ def test_profile_numbers_are_parameters():
                                       crane(**{keyword: value}).forward_dynamics(1.5, q, qd))
     with pytest.raises(ValueError, match=r"values: expected boom.rz.drive.parts\[0\].omega to be a finite value in"):
         s.with_parameters({"boom.rz.drive.parts[0].omega": float("inf")})
+
+
+def test_a_sum_with_a_python_part_keeps_that_part():
+    """A drive that sums a Python function and a ramp: the ramp's numbers are parameters, the function (no
+    recipe, no numbers) is kept as it is when one of them changes (found by fuzzing: it was remade and failed)."""
+    def build(rate):
+        m = rf.Model(gravity=(0.0, -G, 0.0))
+        b = m.add_body("b", m.ground, rf.Joint.prismatic("y"), mass=1.0, inertia=(0.1, 0.1, 0.1))
+        m.prescribe(b, 2.0 * rf.motion.function(lambda t: (np.sin(t), np.cos(t), -np.sin(t))) - rf.motion.ramp(rate, 0.0, 0.3))
+        a = m.add_body("a", b, rf.Joint.revolute("z"), mass=1.0, inertia=(0.1, 0.1, 0.1), com=(0.5, 0.0, 0.0))
+        return m.compile(), a
+    s, a = build(1.0)
+    name = next(n for n in s.parameters if n.endswith(".rate"))
+    q, qd = np.array([0.3]), np.array([0.1])
+    np.testing.assert_array_equal(s.with_parameters({name: 1.5}).forward_dynamics(0.2, q, qd),
+                                  build(1.5)[0].forward_dynamics(0.2, q, qd))
+    r = rf.simulate(s, 0.2, "rk4", dt=1e-3, q0=[0.3], sensitivities=[name])
+    assert np.isfinite(r.sensitivity(name)[0]).all() and np.abs(r.sensitivity(name)[0]).max() > 0.0

@@ -410,8 +410,12 @@ def profile_leaves(profile, path: str = "") -> dict[str, float]:
 
 
 def remade(profile, values: dict[str, float], path: str = ""):
-    """The profile made again with the numbers at the paths in ``values`` changed (its maker's checks apply)."""
-    maker, names, args = _recipe(profile)
+    """The profile made again with the numbers at the paths in ``values`` changed (its maker's checks apply); one
+    without a recipe (a Python function's, a part of a sum) has no numbers and stays as it is."""
+    recipe = _recipe(profile)
+    if recipe is None:
+        return profile
+    maker, names, args = recipe
     new = []
     for name, arg in zip(names, args):
         here = f"{path}{name}"
