@@ -320,3 +320,17 @@ def test_adaptive_runs_take_the_same_steps_with_sensitivities(method):
                      adaptive=adaptive).position(beam.tip) for sign in (1, -1)]
     dx = r.position_sensitivity(beam.tip, "strip.E")
     assert np.max(np.abs(dx - (x[0] - x[1]) / (2 * h))) <= 1e-2 * np.max(np.abs(dx))
+
+
+def test_sensitivities_are_saved_with_the_result(tmp_path):
+    """Result.to_npz keeps the sensitivities; load_npz gives them back, position_sensitivity with the system."""
+    s = pendulum()
+    r = rf.simulate(s, 0.1, "rk4", dt=1e-3, q0=[0.3], sensitivities=["rod.mass", "q0[rod.rz]"])
+    back = rf.load_npz(r.to_npz(tmp_path / "r.npz"), s)
+    assert list(back.sensitivities) == ["rod.mass", "q0[rod.rz]"]
+    for name in back.sensitivities:
+        np.testing.assert_array_equal(back.sensitivity(name)[0], r.sensitivity(name)[0])
+    np.testing.assert_array_equal(back.position_sensitivity(rf.Point(0, (0.4, 0.0, 0.0)), "rod.mass"),
+                                  r.position_sensitivity(rf.Point(0, (0.4, 0.0, 0.0)), "rod.mass"))
+    assert rf.load_npz(rf.simulate(s, 0.1, "rk4", dt=1e-3).to_npz(tmp_path / "p.npz")).sensitivities == {}
+

@@ -79,8 +79,12 @@ def to_csv(result, path, points=None):
 
 def to_npz(result, path):
     """NumPy archive with t (s), q, qd (m, rad; per s), arm_forces (N or N·m), the method's own loop
-    multipliers (if any), coordinate_names, method and stats (JSON)."""
+    multipliers (if any), the forward sensitivities (if any: their names and a (P, len t, 2 nq) array),
+    coordinate_names, method and stats (JSON)."""
     own = {} if result.multipliers is None else {"multipliers": result.multipliers}
+    if result.sensitivities:
+        own["sensitivity_names"] = np.array(list(result.sensitivities), dtype=str)
+        own["sensitivities"] = np.stack(list(result.sensitivities.values()))
     np.savez(path, t=result.t, q=result.q, qd=result.qd, arm_forces=result.arm_forces, coordinate_names=np.array(result.system.coordinate_names,
              dtype=str), method=np.array(result.method), stats=np.array(json.dumps(result.stats)),
              interrupted=np.array(result.interrupted), **own)
@@ -98,7 +102,9 @@ def read_npz(path, system=None) -> dict:
         return {"t": f["t"], "q": f["q"], "qd": f["qd"], "stats": json.loads(str(f["stats"])),
                 "method": str(f["method"]), "interrupted": bool(f["interrupted"]),
                 "arm_forces": f["arm_forces"] if "arm_forces" in f.files else None,
-                "multipliers": f["multipliers"] if "multipliers" in f.files else None}
+                "multipliers": f["multipliers"] if "multipliers" in f.files else None,
+                "sensitivities": dict(zip((str(n) for n in f["sensitivity_names"]), f["sensitivities"]))
+                if "sensitivities" in f.files else {}}
 
 
 def modes_table(modes) -> list[dict]:

@@ -276,8 +276,8 @@ class Result(Versioned):
         return export.to_csv(self, path, points)
 
     def to_npz(self, path):
-        """Save t, q, qd, coordinate_names, method, stats and interrupted in a NumPy archive;
-        ``rigidfem.load_npz(path, system)`` reads it back. Returns ``path``."""
+        """Save t, q, qd, the forward sensitivities (if any), coordinate_names, method, stats and interrupted in a
+        NumPy archive; ``rigidfem.load_npz(path, system)`` reads it back. Returns ``path``."""
         return export.to_npz(self, path)
 
 
