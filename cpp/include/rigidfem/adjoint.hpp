@@ -15,7 +15,7 @@
 /// At t0, a_0 = q̈_0 solves r(q_0, q̇_0, q̈_0) = 0: M μ_0 = ā_0 + q̈̄_0, q̄_0 −= Kᵀμ_0, q̇̄_0 −= Cᵀμ_0,
 /// dJ/dp −= μ_0ᵀ ∂r/∂p. Kᵀμ, Cᵀμ, Mμ come from the RNEA's reverse mode (derivatives.hpp: O(n)); Sᵀμ = g is
 /// solved by GMRES on those products, preconditioned by the transposed factorisation of a Newton matrix kept
-/// from an earlier step (dense) or by M + diag(γ'h b + β'h² k) (Krylov), to 1e-10; μᵀ∂r/∂p for every parameter
+/// from an earlier step (dense) or by M + diag(γ'h b + β'h² k) (Krylov), to 1e-11; μᵀ∂r/∂p for every parameter
 /// in one pass (ParameterVjp). Recursive tree systems without Maxwell arms or links of varying length.
 ///
 /// Radau IIA (3 stages; implicit_rk.cpp): V = q̇_n 1ᵀ + h A aᵀ, Q = q_n 1ᵀ + h V aᵀ, r_i(Q_i, V_i, A_i) = 0, and
