@@ -1,7 +1,7 @@
 """Adjoint gradients (rigidfem.gradient) against independent references: the forward sensitivities of the same
 discrete run (the derivative of the same discrete solution, integrated forwards by another code path), central
 differences of the objective over whole runs converging as h², the reverse mode's derivatives by the prescribed
-coordinates against differences of the residual, and bad input."""
+coordinates against differences of the residual, closed loops, and bad input."""
 
 import numpy as np
 import pytest
@@ -167,6 +167,44 @@ def test_every_method(method, options, rtol):
     assert_gradients_agree(g.gradient, expected, rtol)
 
 
+def test_closed_loops():
+    """A four-bar (a redundant revolute loop) with a sprung, damped crank: the crank's spring and damper, the
+    bodies' masses and an initial rate moved along the loop, against the forward sensitivities (1e-7); a
+    four-bar whose rocker pivot rides on a driven slider: the drive's numbers move the loop's g, G and γ, against
+    central differences of whole runs."""
+    model, h = samples.four_bar(crank_spring=dict(stiffness=5.0, rest=0.3, damping=0.1))
+    s = model.compile()
+    q0, qd0 = s.assemble([0.4, -1.9, 4.6], [1.0, 0.0, 0.0])
+    names = ["crank.rz.stiffness", "crank.rz.damping", "coupler.mass", "rocker.mass", "qd0[crank.rz]"]
+    point = h["coupler"].point((0.4, 0.0, 0.0))
+    run = dict(outputs={"p": point}, running=running, terminal=terminal, dt=1e-3, q0=q0, qd0=qd0)
+    g = rf.gradient(s, 0.5, names, **run)
+    _, expected = forward_gradient(s, point, names, 0.5, dt=1e-3, q0=q0, qd0=qd0)
+    assert_gradients_agree(g.gradient, expected, 1e-7)
+
+    def rod(length):
+        return dict(mass=1.0, inertia=(1e-4, length**2 / 12, length**2 / 12), com=(length / 2, 0, 0))
+    m = rf.Model(gravity=(0.0, -G, 0.0))
+    crank = m.add_body("crank", m.ground, rf.Joint.revolute("z", stiffness=5.0, damping=0.1), **rod(0.3))
+    coupler = m.add_body("coupler", crank, rf.Joint.revolute("z"), **rod(0.8), placement=rf.transform((0.3, 0, 0)))
+    slider = m.add_body("slider", m.ground, rf.Joint.prismatic("x"), 0.5, (0.01, 0.01, 0.01),
+                        placement=rf.transform((0.7, 0, 0)))
+    m.prescribe(slider, rf.motion.rest_to_rest(0.0, 0.08, 0.1, 0.3))  # at rest at t0 whatever its end
+    rocker = m.add_body("rocker", slider, rf.Joint.revolute("z"), **rod(0.6))
+    m.add_loop_joint("revolute", coupler.point((0.8, 0, 0)), rocker.point((0.6, 0, 0)), name="C")
+    s = m.compile()
+    q0, qd0 = s.assemble([0.4, -1.9, 4.6], [0.0, 0.0, 0.0], t=0.0)
+    run = dict(outputs={"p": coupler.point((0.4, 0.0, 0.0))}, running=running, terminal=terminal, dt=1e-3, q0=q0,
+               qd0=qd0, newton_tol=1e-14)
+    g = rf.gradient(s, 0.5, ["slider.x.drive.end", "rocker.mass"], **run)
+    for name, h in (("slider.x.drive.end", 1e-5), ("rocker.mass", 1e-4)):
+        p = s.parameters[name].value
+        J = [rf.gradient(s.with_parameters({name: p + sign * h}), 0.5, [], **run).value for sign in (1, -1)]
+        assert (J[0] - J[1]) / (2 * h) == pytest.approx(g[name], rel=1e-6), name
+    with pytest.raises(ValueError, match="sensitivities: expected no drive's number on a system with loop closures"):
+        rf.simulate(s, 0.1, "generalized_alpha", dt=1e-3, q0=q0, qd0=qd0, sensitivities=["slider.x.drive.end"])
+
+
 def test_radau5_krylov_on_a_long_chain():
     """radau5 with the matrix-free Newton matrix on a 40-element strip on a turning hub: its transposed stages
     preconditioned by the articulated-body factor at the complex shift converge in a few GMRES iterations a step
@@ -250,7 +288,10 @@ def test_bad_input():
     with pytest.raises(ValueError, match="algorithm='recursive'"):
         rf.gradient(strip_lagrange(), 0.01, ["strip.E"], outputs={"p": 0}, running=lambda t, y: y["p"], dt=1e-3)
     loop = samples.four_bar()[0].compile()
-    with pytest.raises(ValueError, match="no loop closures"):
+    q0 = loop.assemble([0.4, -1.9, 4.6])[0]
+    with pytest.raises(ValueError, match="no loop closures with method 'radau5'"):
+        rf.gradient(loop, 0.01, [], method="radau5", q0=q0, outputs={"q": 0}, running=lambda t, y: y["q"], dt=1e-3)
+    with pytest.raises(ValueError, match="q0: expected initial coordinates that close every loop"):
         rf.gradient(loop, 0.01, [], outputs={"q": 0}, running=lambda t, y: y["q"], dt=1e-3)
 
 

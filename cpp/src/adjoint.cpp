@@ -6,6 +6,7 @@
 #include <stdexcept>
 #include <string>
 
+#include "rigidfem/constraints.hpp"
 #include "rigidfem/derivatives.hpp"
 #include "rigidfem/dynamics.hpp"
 #include "rigidfem/errors.hpp"
@@ -101,11 +102,11 @@ class NewmarkSteps final : public Transposes {
   }
   StepRecord record(double t, double h) const override {
     const NewmarkState& s = stepper_->current();
-    return {t, h, s.q, s.v, s.qdd, s.a, {}, {}, {}};
+    return {t, h, s.q, s.v, s.qdd, s.a, s.lambda, {}, {}, {}};
   }
   void restore(const StepRecord& r) override {
     NewmarkState s;
-    s.q = r.q, s.v = r.v, s.qdd = r.qdd, s.a = r.a, s.s = VecX(0), s.lambda = VecX(0);
+    s.q = r.q, s.v = r.v, s.qdd = r.qdd, s.a = r.a, s.s = VecX(0), s.lambda = r.lambda;
     stepper_->restore(r.t, s);
   }
   int adjoint_size() const override { return 4; }
@@ -117,43 +118,101 @@ class NewmarkSteps final : public Transposes {
     const VecX g = zb + z * (ab + (k_.beta * h * h) * qb + (k_.gamma * h) * vb);
     // Sᵀ μ = g, Sᵀv = M v + c₁ Cᵀ v + c₂ Kᵀ v by the reverse mode at the step's end
     at(s.t, s.q, s.v, s.qdd);
+    const bool loops = sys_.nl > 0;
+    // A₁₁ᵀv = M v + c₁ Cᵀ v + c₂ (Kᵀ v − H v), H = ∂(Gᵀλ)/∂q (symmetric) with loops
     auto S = [&](const VecX& v, VecX& out) {
       const ResidualVjp r = rnea_vector_jacobian_product(sys_, d_, v);
       out = r.qdd + c1 * r.qd + c2 * r.q;
+      if (loops) out -= c2 * hessian(s, v);
     };
     auto P = [&](const VecX& v, VecX& out) { matrix_->precondition_transposed(v, out); };
-    const VecX mu = gmres(S, P, g, [&] {
+    auto refresh = [&] {
       matrix_->linearize(s.t, s.q, s.v, s.qdd, VecX());
       if (!(matrix_->factor(c1, c2, VecX()) > 1e-15))
         throw SimulationError(s.t, "the adjoint's Newton matrix M + γh C + βh² K is singular");
-    }, s.t);
+    };
+    VecX mu = gmres(S, P, g, refresh, s.t);
+    VecX nu, loop_q;
+    if (loops) {  // the saddle system by its Schur complement: μ = x − Y ν, Y = A₁₁⁻ᵀ (c₂ Gᵀ), (G Y) ν = G x
+      loop_equations(sys_, e_, s.t, s.q, s.v);
+      const MatX G = free_jacobian(sys_, e_);
+      MatX Y(sys_.nq, sys_.nl);
+      for (int k = 0; k < sys_.nl; ++k) Y.col(k) = gmres(S, P, VecX(c2 * G.row(k).transpose()), refresh, s.t);
+      nu = least_norm(G * Y, G * mu);
+      mu -= Y * nu;
+      loop_q = G.transpose() * nu - hessian(s, mu);
+    }
+    at(s.t, s.q, s.v, s.qdd);
     const ResidualVjp r = rnea_vector_jacobian_product(sys_, d_, mu);
-    const VecX qh = qb - r.q, vh = vb - r.qd;
+    const VecX qh = loops ? VecX(qb - r.q - loop_q) : VecX(qb - r.q), vh = vb - r.qd;
     const VecX A = ab + (k_.beta * h * h) * qh + (k_.gamma * h) * vh;
     qb = qh;
     vb = h * qh + vh;
     ab = (h * h * (0.5 - k_.beta)) * qh + (h * (1.0 - k_.gamma)) * vh - (k_.am / (1.0 - k_.am)) * A;
     zb = (k_.af / (1.0 - k_.am)) * A;
     params_.add(d_, mu, r, -1.0, grad);
+    if (loops) params_.add_loops(s.t, s.q, s.v, s.qdd, s.lambda, mu, nu, false, grad);
   }
 
-  /// a_0 = q̈_0 solves r(q_0, q̇_0, q̈_0) = 0: M μ_0 = ā_0 + q̈̄_0, q̄_0 −= Kᵀμ_0, q̇̄_0 −= Cᵀμ_0.
+  /// a_0 = q̈_0 solves r(q_0, q̇_0, q̈_0) = 0: M μ_0 = ā_0 + q̈̄_0, q̄_0 −= Kᵀμ_0, q̇̄_0 −= Cᵀμ_0. With loops the
+  /// constrained forward dynamics (r − Gᵀλ = 0, G q̈ = γ) transposed: M μ_0 + Gᵀν_0 = ā_0 + q̈̄_0, G μ_0 = 0, and
+  /// q̄_0 −= −H μ_0 + ∂(G q̈ − γ)/∂qᵀ ν_0, q̇̄_0 −= ∂(G q̈ − γ)/∂q̇ᵀ ν_0 (central differences, coordinate by coordinate).
   void transpose_start(const StepRecord& s, VecX& bars, VecX& grad) override {
     const int n = sys_.nq;
     set_state(sys_, d_, s.t, s.q, s.v);
     tree_kinematics(sys_, d_);
     factor_mass(sys_, d_);
-    VecX mu(n);
-    solve_armature(sys_, d_, VecX(bars.segment(2 * n, n) + bars.segment(3 * n, n)), mu);
+    VecX mu(n), nu;
+    const VecX g = bars.segment(2 * n, n) + bars.segment(3 * n, n);
+    solve_armature(sys_, d_, g, mu);
+    if (sys_.nl > 0) {
+      loop_equations(sys_, e_, s.t, s.q, s.v);
+      const MatX G = free_jacobian(sys_, e_), Y = solve_armature(sys_, d_, MatX(G.transpose()));
+      nu = least_norm(G * Y, G * mu);
+      mu -= Y * nu;
+    }
     const ResidualVjp r = vjp(s.t, s.q, s.v, s.qdd, mu);
     bars.segment(0, n) -= r.q;
     bars.segment(n, n) -= r.qd;
     params_.add(d_, mu, r, -1.0, grad);
+    if (sys_.nl == 0) return;
+    bars.segment(0, n) += hessian(s, mu);
+    // ν_0ᵀ (G q̈_0 − γ)(q, q̇) differentiated by each coordinate of q and q̇
+    auto c = [&](const VecX& q, const VecX& v) {
+      loop_equations(sys_, e_, s.t, q, v);
+      return nu.dot(free_jacobian(sys_, e_) * s.qdd - e_.gamma);
+    };
+    VecX q = s.q, v = s.v;
+    for (int k = 0; k < n; ++k) {
+      interruption_point();
+      for (VecX* x : {&q, &v}) {
+        const double x0 = (*x)(k), h = 6e-6 * std::max(1.0, std::abs(x0));
+        (*x)(k) = x0 + h;
+        const double up = c(q, v);
+        (*x)(k) = x0 - h;
+        const double down = c(q, v);
+        (*x)(k) = x0;
+        bars((x == &q ? 0 : n) + k) -= (up - down) / (2.0 * h);
+      }
+    }
+    params_.add_loops(s.t, s.q, s.v, s.qdd, s.lambda, mu, nu, true, grad);
   }
 
  private:
+  /// H v = ∂(G(q)ᵀλ)/∂q v at the step's end (λ its multipliers), by a central difference along v.
+  VecX hessian(const StepRecord& s, const VecX& v) {
+    const double size = max_abs(v) / std::max(1.0, max_abs(s.q));
+    if (size == 0.0) return VecX::Zero(sys_.nq);
+    const double eps = 6e-6 / size;
+    loop_equations(sys_, e_, s.t, s.q + eps * v, s.v);
+    const VecX up = free_jacobian(sys_, e_).transpose() * s.lambda;
+    loop_equations(sys_, e_, s.t, s.q - eps * v, s.v);
+    return (up - free_jacobian(sys_, e_).transpose() * s.lambda) / (2.0 * eps);
+  }
+
   std::unique_ptr<NewmarkStepper> stepper_;
   NewmarkCoefficients k_;
+  Data e_{sys_};  // the loops' equations
 };
 
 /// radau5 (adjoint.hpp): the adjoint state (q̄, q̇̄).
@@ -178,7 +237,7 @@ class RadauSteps final : public Transposes {
     stepper_->accept();
   }
   StepRecord record(double t, double h) const override {
-    StepRecord r{t, h, {}, {}, {}, {}, {}, {}, {}};
+    StepRecord r{t, h, {}, {}, {}, {}, {}, {}, {}, {}};
     access_->current(r.q, r.v, r.qdd);
     if (h > 0.0) access_->stages(r.Q, r.V, r.A);
     return r;
@@ -261,7 +320,9 @@ Adjoint::Adjoint(std::shared_ptr<const System> sys, const IntegratorOptions& o, 
   if (!reverse_mode(s))
     throw std::invalid_argument("system: expected a system compiled with algorithm='recursive' (the adjoint "
                                 "transposes the recursive engine's derivatives), got algorithm='lagrange'");
-  if (s.nl > 0) throw std::invalid_argument("system: expected no loop closures (not implemented for the adjoint yet)");
+  if (s.nl > 0 && o.method == Method::Radau5)
+    throw std::invalid_argument("system: expected no loop closures with method 'radau5' (its adjoint does not hold "
+                                "them yet; the Newmark family's does), got " + std::to_string(s.nl) + " rows");
   if (s.nz > 0) throw std::invalid_argument("system: expected no Maxwell arms (not implemented for the adjoint yet)");
   if (!s.flows.empty())
     throw std::invalid_argument("system: expected no link of varying length (not implemented for the adjoint yet)");
@@ -309,6 +370,17 @@ void Adjoint::forward(double t0, double t_end, const VecX& q0, const VecX& qd0) 
           num(memory_));
   }
   stats_ = {};
+  // the initial values' directions [∂q₀/∂p, ∂q̇₀/∂p], with loops moved along them as assemble() would
+  initial_.resize(2 * n, params_->count());
+  for (int j = 0; j < params_->count(); ++j) {
+    initial_.col(j) = params_->initial(j);
+    if (s.nl > 0 && initial_.col(j).any()) {
+      SensitivityEquations sens(s, {SensitivityParameter{nullptr, nullptr, 0.0, initial_.col(j)}});
+      VecX S0 = initial_.col(j);
+      sens.project(t0, q0, qd0, S0);
+      initial_.col(j) = S0;
+    }
+  }
   steps_->start(t0, q0, qd0);
   checkpoints_.assign(1, steps_->record(t0, 0.0));
   Y_.resize(N + 1, K);
@@ -385,8 +457,7 @@ VecX Adjoint::backward(const Eigen::Ref<const RowMatX>& ybar) {
   output_vjp(s0, ybar.row(0).transpose(), bars.head(n), grad);
   steps_->transpose_start(s0, bars, grad);
   q0bar_ = bars.head(n), qd0bar_ = bars.segment(n, n);
-  for (int j = 0; j < P; ++j)
-    grad(j) += params_->initial(j).head(n).dot(q0bar_) + params_->initial(j).tail(n).dot(qd0bar_);
+  for (int j = 0; j < P; ++j) grad(j) += initial_.col(j).head(n).dot(q0bar_) + initial_.col(j).tail(n).dot(qd0bar_);
   stats_.backward_time = std::chrono::duration<double>(Clock::now() - start).count();
   return grad;
 }

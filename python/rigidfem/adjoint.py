@@ -20,7 +20,7 @@ with t (N + 1,) and y a dict {name: (N + 1, 3) or (N + 1,)} returns L at every s
 complex input (abs, comparisons, float()) is differentiated by central differences instead
 (``Gradient.stats["objective_derivative"]`` says which).
 
-Not yet: loop closures, Maxwell arms, links of varying length, the Lagrange engine
+Closed loops with the Newmark family (not radau5 yet). Not yet: Maxwell arms, links of varying length, the Lagrange engine
 (algorithm='lagrange'), adaptive steps, an actuator's length profile.
 """
 
@@ -98,7 +98,9 @@ def gradient(system, t_end: float, parameters=None, *, outputs, running=None, te
     Returns
     -------
     Gradient
-        ``value`` J, ``gradient`` {name: dJ/dp}, ``q0``/``qd0`` dJ/dq₀, dJ/dq̇₀, ``stats``.
+        ``value`` J, ``gradient`` {name: dJ/dp}, ``q0``/``qd0`` dJ/dq₀, dJ/dq̇₀, ``stats``. With loop closures
+        ``q0``/``qd0`` are the partial derivatives by each coordinate; an initial value named in ``parameters``
+        moves along the loops (as ``System.assemble`` would close them).
     """
     from . import simulation  # the options' conversion (simulation imports the analyses, not this module)
 
@@ -121,10 +123,11 @@ def gradient(system, t_end: float, parameters=None, *, outputs, running=None, te
     opt = simulation._options(method, dt, None, [1e-6], [1e-9], math.inf, 1_000_000, False, beta, gamma, alpha,
                               rho_inf, newton_tol, newton_max_iterations, iteration_matrix)
     _core._check_options(system, t0, t_end, q0, qd0, np.empty(0), opt)
+    simulation._check_closed(system, t0, q0, qd0)
     if parameters is None:
         parameters = list(system.parameters)
     _probe(system, specs, names, running, terminal, t0, q0)  # a bad objective is named before any run
-    directions = sensitivities_.directions(system, parameters, opt, t0, t_end, "parameters")
+    directions = sensitivities_.directions(system, parameters, opt, t0, t_end, "parameters", drives_in_loops=True)
     adjoint = _core._Adjoint(system, opt, specs, memory)
     start = time.perf_counter()
     t, Y = adjoint.forward(t0, t_end, q0, qd0)

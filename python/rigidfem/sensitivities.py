@@ -23,8 +23,8 @@ state (the derivative of its projection); an initial value moves along the loops
 closes them.
 
 ``Result.sensitivity(name)`` returns (∂q/∂p, ∂q̇/∂p), each (len t, nq); ``Result.position_sensitivity(point,
-name)`` the derivative (len t, 3) of a point's position. Not yet: Maxwell arms, an actuator's length
-profile.
+name)`` the derivative (len t, 3) of a point's position. Not yet: Maxwell arms, an actuator's length profile, a
+drive's numbers on a system with loop closures (each refused; ``rigidfem.gradient`` takes the last).
 """
 
 from __future__ import annotations
@@ -34,7 +34,8 @@ import numpy as np
 from . import parameters as parameters_
 
 
-def directions(system, names, options, t0: float, t1: float, argument: str = "sensitivities") -> list[str]:
+def directions(system, names, options, t0: float, t1: float, argument: str = "sensitivities",
+               drives_in_loops: bool = False) -> list[str]:
     """Adds each named direction's systems at p + h (and p − h for a profile's number) and initial sensitivity
     to the C++ ``options`` for a run over [t0, t1] (s); returns the names. ValueError naming what is not a
     parameter or an initial value of the system."""
@@ -55,10 +56,14 @@ def directions(system, names, options, t0: float, t1: float, argument: str = "se
             h = params.step(name)
             options.add_sensitivity(params.shifted(system, name, h), None, h, S0)
             continue
-        if isinstance(params.groups[params.where[name][0]], parameters_.ProfileGroup) and \
-                params.groups[params.where[name][0]].what == "loop":
+        group = params.groups[params.where[name][0]]
+        if isinstance(group, parameters_.ProfileGroup) and group.what == "loop":
             raise ValueError(f"{argument}: expected no actuator's profile (its loop's g(q, t; p) would need "
                              f"∂g/∂p, not implemented yet), got {name!r}")
+        if isinstance(group, parameters_.ProfileGroup) and group.what == "drive" and system.nl and not drives_in_loops:
+            raise ValueError(f"{argument}: expected no drive's number on a system with loop closures (the loops' "
+                             f"g(q, t) move with the drive: their ∂g/∂p is not in the forward sensitivities yet; "
+                             f"rigidfem.gradient's adjoint has it), got {name!r}")
         h = params.profile_step(name, t0, t1)
         options.add_sensitivity(params.shifted(system, name, h), params.shifted(system, name, -h), h, S0)
     return names

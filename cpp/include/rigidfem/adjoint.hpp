@@ -18,6 +18,12 @@
 /// from an earlier step (dense) or by M + diag(γ'h b + β'h² k) (Krylov), to 1e-11; μᵀ∂r/∂p for every parameter
 /// in one pass (ParameterVjp). Recursive tree systems without Maxwell arms or links of varying length.
 ///
+/// Closed loops (the Newmark family, index 3: r − Gᵀλ = 0 and g(q_{n+1}) = 0 for (z, λ)): the transposed saddle
+/// system A₁₁ᵀμ + β'h² Gᵀν = g, G μ = 0 with A₁₁ = S − β'h² ∂(Gᵀλ)/∂q (the Hessian of λᵀg: symmetric, by central
+/// differences along the direction), by its Schur complement (nl + 1 transposed solves; least-norm ν for
+/// redundant rows), then q̂ = q̄ − (Kᵀμ − ∂(Gᵀλ)/∂q μ) − Gᵀν. At t0 the constrained forward dynamics transposed:
+/// Mμ₀ + Gᵀν₀ = ā₀ + q̈̄₀, Gμ₀ = 0, and ∂(G q̈ − γ)/∂(q, q̇)ᵀν₀ by central differences (O(n²), once).
+///
 /// Radau IIA (3 stages; implicit_rk.cpp): V = q̇_n 1ᵀ + h A aᵀ, Q = q_n 1ᵀ + h V aᵀ, r_i(Q_i, V_i, A_i) = 0, and
 /// (q, q̇)_{n+1} = (Q_3, V_3). With Q̄ = [0, 0, q̄_{n+1}], V̄ = [0, 0, q̇̄_{n+1}]:
 ///   V̄' = V̄ + h Q̄ a,   𝒮ᵀ μ = h V̄' a,   (𝒮ᵀμ)_j = M_j μ_j + h Σ_i a_ij C_iᵀ μ_i + h² Σ_i (a²)_ij K_iᵀ μ_i
@@ -63,6 +69,11 @@ class ParameterVjp {
   void add(const Data& d, const VecX& mu, const ResidualVjp& r, double w, Eigen::Ref<VecX> grad);
   /// grad_j += pbarᵀ ∂q_p(t)/∂p_j: the prescribed coordinates' values moved by a drive's numbers.
   void add_prescribed(double t, const VecX& pbar, Eigen::Ref<VecX> grad) const;
+  /// Closed loops: grad_j −= [μᵀ ∂(−Gᵀλ)/∂p_j + νᵀ ∂c/∂p_j] for the parameters that move a drive (the loops' terms
+  /// see the prescribed coordinates), c = g(q, t) (`acceleration` false) or G q̈ − γ (true), by central differences
+  /// of the systems at p ± h at (t, q, q̇, q̈, λ).
+  void add_loops(double t, const VecX& q, const VecX& qd, const VecX& qdd, const VecX& lambda, const VecX& mu,
+                 const VecX& nu, bool acceleration, Eigen::Ref<VecX> grad);
   int count() const { return static_cast<int>(parameters_.size()); }
   /// [∂q₀/∂p_j, ∂q̇₀/∂p_j] (2 nq).
   const VecX& initial(int j) const { return parameters_[j].S0; }
@@ -80,6 +91,7 @@ class ParameterVjp {
   std::vector<std::vector<Component>> touched_;  // per parameter
   std::vector<Vec6> V_;                           // (nbodies) V_b = Σ s_u μ_u along the path
   std::vector<double> base_[5];                   // per kind of component: its power on the run's system, or NaN
+  std::unique_ptr<Data> e_;                       // the loops' terms on the systems at p ± h (same sizes)
 };
 
 /// What the backward sweep needs of a step, and what a replay starts again from: the state at the step's end
@@ -87,6 +99,7 @@ class ParameterVjp {
 struct StepRecord {
   double t = 0.0, h = 0.0;  // h: the step that reached t (0 at t0)
   VecX q, v, qdd, a;
+  VecX lambda;              // (nl) the loops' multipliers (the Newmark family)
   MatX Q, V, A;
 };
 
@@ -148,6 +161,7 @@ class Adjoint {
   RowMatX Y_;
   long interval_ = 1;                      // steps between checkpoints
   std::vector<StepRecord> checkpoints_;    // at steps 0, k, 2k, ... (all: k = 1)
+  MatX initial_;                           // (2 nq, P) the initial values' directions (along the loops)
   VecX q0bar_, qd0bar_;
   AdjointStats stats_;
 };
