@@ -1992,7 +1992,8 @@ class Gen:
         params = pick(["list(system.parameters)[:3]", "['q0[' + system.coordinate_names[0] + ']'] if system.nq else []",
                        "[]"], ["['nope']", "'x'", "[3]"], ("parameters",))
         params["soft"], params["names"] = 1, params.get("names", []) + ["parameters"]  # an actuator's profile: refused
-        return self.emit("rf.gradient", [A("system", soft=True, names=("system", "outputs", "dt")), A("0.01"), params],
+        # a system with loops starts from q0 = 0, which need not close them: refused naming q0
+        return self.emit("rf.gradient", [A("system", soft=True, names=("system", "outputs", "dt", "q0")), A("0.01"), params],
                          ["system", "t_end", "parameters"], kw, label="gradient")
 
     def core_call(self):

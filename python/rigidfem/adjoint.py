@@ -123,11 +123,11 @@ def gradient(system, t_end: float, parameters=None, *, outputs, running=None, te
     opt = simulation._options(method, dt, None, [1e-6], [1e-9], math.inf, 1_000_000, False, beta, gamma, alpha,
                               rho_inf, newton_tol, newton_max_iterations, iteration_matrix)
     _core._check_options(system, t0, t_end, q0, qd0, np.empty(0), opt)
-    simulation._check_closed(system, t0, q0, qd0)
     if parameters is None:
         parameters = list(system.parameters)
     _probe(system, specs, names, running, terminal, t0, q0)  # a bad objective is named before any run
     directions = sensitivities_.directions(system, parameters, opt, t0, t_end, "parameters", drives_in_loops=True)
+    simulation._check_closed(system, t0, q0, qd0)  # the arguments first, then whether the state closes the loops
     adjoint = _core._Adjoint(system, opt, specs, memory)
     start = time.perf_counter()
     t, Y = adjoint.forward(t0, t_end, q0, qd0)
