@@ -1931,7 +1931,7 @@ class Gen:
 
     def misc_call(self):
         kind = self.choice(["coordinate_index", "beam", "profile", "centerline", "parameters", "gradient"])
-        if kind == "gradient":
+        if kind == "gradient" and self.chance(0.4):  # a run and its adjoint: the dearest call here, drawn less
             return self.gradient_call()
         if kind == "parameters":
             # every parameter scaled by 1.5 keeps its sign (a valid change), or one unknown, NaN or a non-dict
