@@ -149,6 +149,9 @@ void bind_integrators(py::module_& m) {
       py::arg("options"), py::arg("keep_going"));
 
   // The adjoint (adjoint.hpp): one forward run, then backward sweeps; Ctrl-C stops either (the GIL is held).
+  static const auto check_signals = [] {
+    if (PyErr_CheckSignals() != 0) throw py::error_already_set();
+  };
   py::class_<Adjoint>(m, "_Adjoint")
       .def(py::init([](std::shared_ptr<const System> s, const IntegratorOptions& o,
                        const std::vector<std::tuple<std::string, int, Vec3>>& outputs, double memory) {
@@ -163,9 +166,7 @@ void bind_integrators(py::module_& m) {
       .def(
           "forward",
           [](Adjoint& a, double t0, double t_end, const VecX& q0, const VecX& qd0) {
-            InterruptScope interrupt([] {
-              if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-            });
+            InterruptScope interrupt(check_signals);
             a.forward(t0, t_end, q0, qd0);
             return py::make_tuple(VecX(Eigen::Map<const VecX>(a.times().data(), a.times().size())), a.outputs());
           },
@@ -173,9 +174,7 @@ void bind_integrators(py::module_& m) {
       .def(
           "backward",
           [](Adjoint& a, const Eigen::Ref<const RowMatX>& ybar) {
-            InterruptScope interrupt([] {
-              if (PyErr_CheckSignals() != 0) throw py::error_already_set();
-            });
+            InterruptScope interrupt(check_signals);
             VecX grad = a.backward(ybar);
             const AdjointStats& st = a.stats();
             py::dict stats;

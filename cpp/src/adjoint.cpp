@@ -40,7 +40,22 @@ class Transposes : public AdjointSteps {
   Transposes(const System& sys, const IntegratorOptions& o, ParameterVjp& params)
       : sys_(sys), params_(params), d_(sys), matrix_(NewtonMatrix::make(sys, o, istats_)) {}
 
+  void start(double t0, const VecX& q0, const VecX& qd0) override {
+    VecX y0(2 * sys_.nq);
+    y0 << q0, qd0;
+    stepper().start(t0, y0);
+  }
+  void step(double t, double h) override {
+    double err = 0.0;
+    if (!stepper().attempt(t, h, nullptr, err))
+      step_failure(t, h, "Newton iterations did not converge in newton_max_iterations; reduce dt or raise "
+                         "newton_max_iterations");
+    stepper().accept();
+  }
+
  protected:
+  /// The method's own stepper, which the forward run and the replays step with.
+  virtual Stepper& stepper() = 0;
   /// set_state, q̈ and the axes on d_ at (t, q, q̇, q̈): what the reverse mode starts from.
   void at(double t, const Eigen::Ref<const VecX>& q, const Eigen::Ref<const VecX>& v, const Eigen::Ref<const VecX>& a) {
     set_state(sys_, d_, t, q, v);
@@ -88,18 +103,6 @@ class NewmarkSteps final : public Transposes {
   NewmarkSteps(const System& sys, const IntegratorOptions& o, ParameterVjp& params)
       : Transposes(sys, o, params), stepper_(make_newmark_stepper(sys, o, istats_)), k_(stepper_->coefficients()) {}
 
-  void start(double t0, const VecX& q0, const VecX& qd0) override {
-    VecX y0(2 * sys_.nq);
-    y0 << q0, qd0;
-    stepper_->start(t0, y0);
-  }
-  void step(double t, double h) override {
-    double err = 0.0;
-    if (!stepper_->attempt(t, h, nullptr, err))
-      step_failure(t, h, "Newton iterations did not converge in newton_max_iterations; reduce dt or raise "
-                         "newton_max_iterations");
-    stepper_->accept();
-  }
   StepRecord record(double t, double h) const override {
     const NewmarkState& s = stepper_->current();
     return {t, h, s.q, s.v, s.qdd, s.a, s.lambda, {}, {}, {}};
@@ -142,8 +145,7 @@ class NewmarkSteps final : public Transposes {
       mu -= Y * nu;
       loop_q = G.transpose() * nu - hessian(s, mu);
     }
-    at(s.t, s.q, s.v, s.qdd);
-    const ResidualVjp r = rnea_vector_jacobian_product(sys_, d_, mu);
+    const ResidualVjp r = rnea_vector_jacobian_product(sys_, d_, mu);  // d_ still at the step's end (GMRES's products)
     const VecX qh = loops ? VecX(qb - r.q - loop_q) : VecX(qb - r.q), vh = vb - r.qd;
     const VecX A = ab + (k_.beta * h * h) * qh + (k_.gamma * h) * vh;
     qb = qh;
@@ -199,6 +201,8 @@ class NewmarkSteps final : public Transposes {
   }
 
  private:
+  Stepper& stepper() override { return *stepper_; }
+
   /// H v = ∂(G(q)ᵀλ)/∂q v at the step's end (λ its multipliers), by a central difference along v.
   VecX hessian(const StepRecord& s, const VecX& v) {
     const double size = max_abs(v) / std::max(1.0, max_abs(s.q));
@@ -224,18 +228,6 @@ class RadauSteps final : public Transposes {
     if (!access_) throw std::logic_error("RadauSteps: the stepper is not radau5");
   }
 
-  void start(double t0, const VecX& q0, const VecX& qd0) override {
-    VecX y0(2 * sys_.nq);
-    y0 << q0, qd0;
-    stepper_->start(t0, y0);
-  }
-  void step(double t, double h) override {
-    double err = 0.0;
-    if (!stepper_->attempt(t, h, nullptr, err))
-      step_failure(t, h, "Newton iterations did not converge in newton_max_iterations; reduce dt or raise "
-                         "newton_max_iterations");
-    stepper_->accept();
-  }
   StepRecord record(double t, double h) const override {
     StepRecord r{t, h, {}, {}, {}, {}, {}, {}, {}, {}};
     access_->current(r.q, r.v, r.qdd);
@@ -306,6 +298,7 @@ class RadauSteps final : public Transposes {
   void transpose_start(const StepRecord&, VecX&, VecX&) override {}
 
  private:
+  Stepper& stepper() override { return *stepper_; }
   std::unique_ptr<Stepper> stepper_;
   RadauAccess* access_;
   const RadauTableau tab_;
@@ -423,9 +416,8 @@ void Adjoint::output_vjp(const StepRecord& s, const VecX& ybar, Eigen::Ref<VecX>
   const System& sys = *sys_;
   set_state(sys, d_, s.t, s.q, s.v);
   tree_kinematics(sys, d_);
-  VecX pbar = VecX::Zero(sys.np), qb = qbar;
-  objective_outputs_vjp(sys, d_, outputs_, ybar, qb, pbar);
-  qbar = qb;
+  VecX pbar = VecX::Zero(sys.np);
+  objective_outputs_vjp(sys, d_, outputs_, ybar, qbar, pbar);
   if (sys.np > 0) params_->add_prescribed(s.t, pbar, grad);
 }
 

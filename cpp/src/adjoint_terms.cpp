@@ -33,7 +33,7 @@ void objective_outputs(const System& sys, const Data& d, const std::vector<Outpu
 }
 
 void objective_outputs_vjp(const System& sys, const Data& d, const std::vector<OutputSpec>& outputs,
-                           const VecX& ybar, VecX& qbar, VecX& pbar) {
+                           const VecX& ybar, Eigen::Ref<VecX> qbar, VecX& pbar) {
   int k = 0;
   for (const OutputSpec& o : outputs) {
     if (o.kind != OutputSpec::Kind::Point) {

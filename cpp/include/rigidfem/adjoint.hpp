@@ -52,7 +52,7 @@ int output_size(const std::vector<OutputSpec>& outputs);
 void objective_outputs(const System& sys, const Data& d, const std::vector<OutputSpec>& outputs, Eigen::Ref<VecX> y);
 /// (∂y/∂q)ᵀ ȳ added into qbar (nq) and its part by the prescribed coordinates into pbar (np), at the state of d.
 void objective_outputs_vjp(const System& sys, const Data& d, const std::vector<OutputSpec>& outputs,
-                           const VecX& ybar, VecX& qbar, VecX& pbar);
+                           const VecX& ybar, Eigen::Ref<VecX> qbar, VecX& pbar);
 
 /// μᵀ ∂r/∂p_j of r = M q̈ − f for every parameter of a run in one O(n) pass: each parameter's system at p ± h
 /// differs from the run's in a few components (bodies' inertias, coordinates' springs and forces, elements'
