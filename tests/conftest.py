@@ -98,3 +98,45 @@ def step_of(method: str, dt: float) -> dict:
     """The keyword for a step dt: dt for a fixed-step method, first_step for an adaptive one (a dt would set
     its first step with a UserWarning)."""
     return {"first_step": dt} if method in ("auto", "dopri5", "rkf45", "esdirk43", "radau5") else {"dt": dt}
+
+
+# ----------------------------------------------------------------- loops that a parameter moves
+
+
+def luffed_boom():
+    """A boom (revolute, sprung and damped) luffed by a cylinder "cylinder" from (0.5, 0) on the ground to the
+    boom's point at 1 m, of length l(t) = c₀ + c₁ t (c = 0.9 m, 0.3 m/s): θ = arccos(1.25 − l²) by the law of
+    cosines, whatever the boom's mass or spring. Returns (system, boom, q0, q̇0)."""
+    import rigidfem as rf
+    m = rf.Model(gravity=(0.0, -9.81, 0.0))
+    boom = m.add_body("boom", m.ground, rf.Joint.revolute("z", stiffness=3.0, damping=0.5), 5.0,
+                      (1e-4, 5.0 * 4 / 12, 5.0 * 4 / 12), com=(1.0, 0.0, 0.0))
+    m.add_actuator(m.ground.point((0.5, 0, 0)), boom.point((1.0, 0, 0)), rf.motion.polynomial([0.9, 0.3]),
+                   name="cylinder")
+    s = m.compile()
+    q0, qd0 = s.assemble([np.arccos(1.25 - 0.81)], [0.0])
+    return s, boom, q0, qd0
+
+
+def boom_angle_derivative(t, c0=0.9, c1=0.3):
+    """∂θ/∂c₀ of the luffed boom's θ = arccos(1.25 − l²), l = c₀ + c₁ t (∂θ/∂c₁ = t ∂θ/∂c₀)."""
+    l = c0 + c1 * t
+    return 2 * l / np.sqrt(1 - (1.25 - l * l) ** 2)
+
+
+def slider_four_bar(profile):
+    """A four-bar (crank sprung and damped, coupler, rocker: rods of 1 kg) whose rocker pivot rides on a slider
+    "slider" driven along x by `profile`: the drive moves the loop C's g(q, t). Returns (system, coupler)."""
+    import rigidfem as rf
+
+    def rod(length):
+        return dict(mass=1.0, inertia=(1e-4, length**2 / 12, length**2 / 12), com=(length / 2, 0, 0))
+    m = rf.Model(gravity=(0.0, -9.81, 0.0))
+    crank = m.add_body("crank", m.ground, rf.Joint.revolute("z", stiffness=5.0, damping=0.1), **rod(0.3))
+    coupler = m.add_body("coupler", crank, rf.Joint.revolute("z"), **rod(0.8), placement=rf.transform((0.3, 0, 0)))
+    slider = m.add_body("slider", m.ground, rf.Joint.prismatic("x"), 0.5, (0.01, 0.01, 0.01),
+                        placement=rf.transform((0.7, 0, 0)))
+    m.prescribe(slider, profile)
+    rocker = m.add_body("rocker", slider, rf.Joint.revolute("z"), **rod(0.6))
+    m.add_loop_joint("revolute", coupler.point((0.8, 0, 0)), rocker.point((0.6, 0, 0)), name="C")
+    return m.compile(), coupler

@@ -1991,7 +1991,7 @@ class Gen:
             kw["terminal"] = pick(["lambda y: y['y']"], ["lambda y: [1.0, 2.0]", "lambda y: None"], ("terminal",))
         params = pick(["list(system.parameters)[:3]", "['q0[' + system.coordinate_names[0] + ']'] if system.nq else []",
                        "[]"], ["['nope']", "'x'", "[3]"], ("parameters",))
-        params["soft"], params["names"] = 1, params.get("names", []) + ["parameters"]  # an actuator's profile: refused
+        params["soft"], params["names"] = 1, params.get("names", []) + ["parameters"]  # may be refused naming them
         # a system with loops starts from q0 = 0, which need not close them: refused naming q0
         return self.emit("rf.gradient", [A("system", soft=True, names=("system", "outputs", "dt", "q0")), A("0.01"), params],
                          ["system", "t_end", "parameters"], kw, label="gradient")

@@ -8,6 +8,7 @@ import pytest
 
 import rigidfem as rf
 from rigidfem import samples
+from conftest import boom_angle_derivative, luffed_boom, slider_four_bar
 
 G = 9.81
 
@@ -182,17 +183,7 @@ def test_closed_loops():
     _, expected = forward_gradient(s, point, names, 0.5, dt=1e-3, q0=q0, qd0=qd0)
     assert_gradients_agree(g.gradient, expected, 1e-7)
 
-    def rod(length):
-        return dict(mass=1.0, inertia=(1e-4, length**2 / 12, length**2 / 12), com=(length / 2, 0, 0))
-    m = rf.Model(gravity=(0.0, -G, 0.0))
-    crank = m.add_body("crank", m.ground, rf.Joint.revolute("z", stiffness=5.0, damping=0.1), **rod(0.3))
-    coupler = m.add_body("coupler", crank, rf.Joint.revolute("z"), **rod(0.8), placement=rf.transform((0.3, 0, 0)))
-    slider = m.add_body("slider", m.ground, rf.Joint.prismatic("x"), 0.5, (0.01, 0.01, 0.01),
-                        placement=rf.transform((0.7, 0, 0)))
-    m.prescribe(slider, rf.motion.rest_to_rest(0.0, 0.08, 0.1, 0.3))  # at rest at t0 whatever its end
-    rocker = m.add_body("rocker", slider, rf.Joint.revolute("z"), **rod(0.6))
-    m.add_loop_joint("revolute", coupler.point((0.8, 0, 0)), rocker.point((0.6, 0, 0)), name="C")
-    s = m.compile()
+    s, coupler = slider_four_bar(rf.motion.rest_to_rest(0.0, 0.08, 0.1, 0.3))  # at rest at t0 whatever its end
     q0, qd0 = s.assemble([0.4, -1.9, 4.6], [0.0, 0.0, 0.0], t=0.0)
     run = dict(outputs={"p": coupler.point((0.4, 0.0, 0.0))}, running=running, terminal=terminal, dt=1e-3, q0=q0,
                qd0=qd0, newton_tol=1e-14)
@@ -201,8 +192,33 @@ def test_closed_loops():
         p = s.parameters[name].value
         J = [rf.gradient(s.with_parameters({name: p + sign * h}), 0.5, [], **run).value for sign in (1, -1)]
         assert (J[0] - J[1]) / (2 * h) == pytest.approx(g[name], rel=1e-6), name
-    with pytest.raises(ValueError, match="sensitivities: expected no drive's number on a system with loop closures"):
-        rf.simulate(s, 0.1, "generalized_alpha", dt=1e-3, q0=q0, qd0=qd0, sensitivities=["slider.x.drive.end"])
+    _, expected = forward_gradient(s, coupler.point((0.4, 0.0, 0.0)), ["slider.x.drive.end", "rocker.mass"], 0.5,
+                                   dt=1e-3, q0=q0, qd0=qd0, newton_tol=1e-14)
+    assert_gradients_agree(g.gradient, expected, 1e-7)
+
+
+def test_an_actuator_and_a_drive_moving_the_loops_at_the_start():
+    """A boom luffed by a cylinder l = c₀ + c₁ t: Φ = x_tip(1 s) = 2 cos θ(1) with θ = arccos(1.25 − l²), so
+    dΦ/dc₀ = dΦ/dc₁ = −2 sin θ ∂θ/∂l at t = 1 exactly, and the boom's mass moves no point (0). The four-bar on a
+    harmonic slider: the drive's offset moves the loop at t0 already, so the initial state moves with it (as
+    assemble closes it): the adjoint against the forward sensitivities of the same run."""
+    s, boom, q0, qd0 = luffed_boom()
+    names = ["cylinder.length.coefficients[0]", "cylinder.length.coefficients[1]", "boom.mass"]
+    g = rf.gradient(s, 1.0, names, outputs={"p": boom.point((2.0, 0.0, 0.0))}, terminal=lambda y: y["p"][0],
+                    dt=1e-3, q0=q0, qd0=qd0, newton_tol=1e-13)
+    theta = np.arccos(1.25 - 1.2**2)
+    assert g[names[0]] == pytest.approx(-2 * np.sin(theta) * boom_angle_derivative(1.0), rel=1e-9)
+    assert g[names[1]] == pytest.approx(g[names[0]], rel=1e-9)
+    assert abs(g["boom.mass"]) <= 1e-12
+
+    s, coupler = slider_four_bar(rf.motion.harmonic(0.05, 8.0))
+    q0, qd0 = s.assemble([0.4, -1.9, 4.6], [0.0, 0.0, 0.0], t=0.0)
+    names = ["slider.x.drive.offset", "slider.x.drive.amplitude", "crank.mass"]
+    point = coupler.point((0.4, 0.0, 0.0))
+    g = rf.gradient(s, 0.4, names, outputs={"p": point}, running=running, terminal=terminal, dt=1e-3, q0=q0, qd0=qd0,
+                    newton_tol=1e-14)
+    _, expected = forward_gradient(s, point, names, 0.4, dt=1e-3, q0=q0, qd0=qd0, newton_tol=1e-14)
+    assert_gradients_agree(g.gradient, expected, 1e-7)
 
 
 def test_radau5_krylov_on_a_long_chain():

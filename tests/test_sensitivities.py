@@ -8,6 +8,7 @@ import pytest
 
 import rigidfem as rf
 from rigidfem import samples
+from conftest import boom_angle_derivative, luffed_boom, slider_four_bar
 
 G = 9.81
 
@@ -182,6 +183,47 @@ def test_initial_values_on_a_closed_loop_move_along_it():
     S = r.sensitivity("q0[crank.rz]")[0]
     assert 0.0 < S[0, 0] < 1.0  # the crank gives way to the rest of the loop
     np.testing.assert_allclose(S, (runs[0] - runs[1]) / (2 * h), rtol=0, atol=1e-6 * np.max(np.abs(S)))
+
+
+@pytest.mark.parametrize("method, run", [("rk4", dict(dt=1e-3)), ("generalized_alpha", dict(dt=1e-3)),
+                                         ("esdirk43", dict(dt=1e-2, adaptive=False)),
+                                         ("radau5", dict(dt=1e-2, adaptive=False))])
+def test_an_actuator_moves_its_loop(method, run):
+    """The cylinder's numbers move the loop's g(q, t; c) (∂g/∂p, ∂ġ/∂p, ∂γ/∂p): the boom angle's sensitivities
+    against the law of cosines' derivative; the boom's mass and spring change only the cylinder's force, so the
+    loop holds their sensitivities at zero (the implicit methods' corrections converge to 0, where no relative
+    test passes: they once ran out of iterations)."""
+    s, _, q0, qd0 = luffed_boom()
+    names = ["cylinder.length.coefficients[0]", "cylinder.length.coefficients[1]", "boom.mass", "boom.rz.stiffness"]
+    r = rf.simulate(s, 1.0, method, q0=q0, qd0=qd0, sensitivities=names, **run)
+    d = boom_angle_derivative(r.t)
+    np.testing.assert_allclose(r.sensitivity(names[0])[0][:, 0], d, rtol=1e-9)
+    np.testing.assert_allclose(r.sensitivity(names[1])[0][:, 0], r.t * d, rtol=0, atol=1e-9 * np.max(r.t * d))
+    for name in names[2:]:
+        assert np.max(np.abs(r.sensitivity(name)[0])) <= 1e-12, name
+
+
+def test_a_drive_inside_a_loop():
+    """A four-bar whose rocker pivot rides on a slider driven by x(t) = 0.05 sin(8t + φ) + x₀: the drive's numbers
+    move the loop's g, ġ, γ; its offset moves them already at t0, so the initial state moves along the loop as
+    System.assemble closes it. Against central differences of whole runs from the states assemble gives."""
+    s, _ = slider_four_bar(rf.motion.harmonic(0.05, 8.0))
+    guess = np.array([0.4, -1.9, 4.6])
+    names = ["slider.x.drive.amplitude", "slider.x.drive.offset"]
+    t = np.linspace(0.0, 0.4, 5)
+    for method, run in (("rk4", dict(dt=1e-3)), ("generalized_alpha", dict(dt=1e-3, newton_tol=1e-14))):
+        q0, qd0 = s.assemble(guess, np.zeros(3), t=0.0)
+        r = rf.simulate(s, 0.4, method, q0=q0, qd0=qd0, t_eval=t, sensitivities=names, **run)
+        for name in names:
+            p, h = s.parameters[name].value, 1e-5
+            runs = []
+            for sign in (1, -1):
+                moved = s.with_parameters({name: p + sign * h})
+                a, b = moved.assemble(q0, qd0, t=0.0)
+                runs.append(rf.simulate(moved, 0.4, method, q0=a, qd0=b, t_eval=t, **run).q)
+            S = r.sensitivity(name)[0]
+            np.testing.assert_allclose(S, (runs[0] - runs[1]) / (2 * h), rtol=0, atol=1e-7 * np.max(np.abs(S)))
+        assert abs(r.sensitivity("slider.x.drive.offset")[0][0]).max() > 0.1  # q0 moved with the loop
 
 
 def test_bad_input():

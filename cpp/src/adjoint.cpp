@@ -363,14 +363,16 @@ void Adjoint::forward(double t0, double t_end, const VecX& q0, const VecX& qd0) 
           num(memory_));
   }
   stats_ = {};
-  // the initial values' directions [∂q₀/∂p, ∂q̇₀/∂p], with loops moved along them as assemble() would
+  // the initial values' directions [∂q₀/∂p, ∂q̇₀/∂p]; with loops, the initial state moves along them as
+  // assemble() would, also by a drive's or an actuator's numbers (∂g/∂p, ∂ġ/∂p at t0)
   initial_.resize(2 * n, params_->count());
+  std::unique_ptr<SensitivityEquations> sens;
   for (int j = 0; j < params_->count(); ++j) {
     initial_.col(j) = params_->initial(j);
-    if (s.nl > 0 && initial_.col(j).any()) {
-      SensitivityEquations sens(s, {SensitivityParameter{nullptr, nullptr, 0.0, initial_.col(j)}});
+    if (s.nl > 0 && (initial_.col(j).any() || params_->parameters()[j].minus)) {
+      if (!sens) sens = std::make_unique<SensitivityEquations>(s, params_->parameters());
       VecX S0 = initial_.col(j);
-      sens.project(t0, q0, qd0, S0);
+      sens->project(j, t0, q0, qd0, S0);
       initial_.col(j) = S0;
     }
   }

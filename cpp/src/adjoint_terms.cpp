@@ -85,9 +85,7 @@ ParameterVjp::ParameterVjp(const System& sys, const std::vector<SensitivityParam
         if (a.force != c.force || a.torque != c.torque || a.scale != c.scale) add(Component::Load, static_cast<int>(l));
       }
       for (std::size_t k = 0; k < sys.loops.size(); ++k)
-        if (X->loops[k].drive != sys.loops[k].drive)
-          throw std::invalid_argument("parameters: expected no actuator's length profile (its loop's ∂g/∂p is not "
-                                      "implemented)");
+        if (X->loops[k].drive != sys.loops[k].drive) add(Component::Actuator, static_cast<int>(k));
     }
   }
 }
@@ -116,8 +114,9 @@ double ParameterVjp::power(const System& X, const Data& d, const Component& c, c
       const AppliedLoad a = applied_load(d, L);
       return -(V_[L.body].head<3>().dot(a.x.cross(a.F) + a.tau) + V_[L.body].tail<3>().dot(a.F));
     }
-    case Component::Drive:
-      return 0.0;  // by the prescribed coordinate's derivatives (add)
+    case Component::Drive:     // by the prescribed coordinate's derivatives (add)
+    case Component::Actuator:  // not in r: in the loops' g, G, γ (add_loops)
+      return 0.0;
   }
   return 0.0;
 }
@@ -150,6 +149,7 @@ void ParameterVjp::add(const Data& d, const VecX& mu, const ResidualVjp& r, doub
     if (!p.plus) continue;
     double sum = 0.0;
     for (const Component& c : touched_[j]) {
+      if (c.kind == Component::Actuator) continue;
       if (c.kind == Component::Drive) {  // the reverse mode's ∂(μᵀr)/∂ of the prescribed coordinate's motion
         const int k = sys_.coords[c.index].drive_index;
         const MotionState dp = drive_derivative(static_cast<int>(j), c.index, t);
@@ -176,9 +176,10 @@ void ParameterVjp::add_loops(double t, const VecX& q, const VecX& qd, const VecX
   };
   for (std::size_t j = 0; j < parameters_.size(); ++j) {
     const SensitivityParameter& p = parameters_[j];
-    const bool drive = std::any_of(touched_[j].begin(), touched_[j].end(),
-                                   [](const Component& c) { return c.kind == Component::Drive; });
-    if (!drive) continue;  // the constants are not in g, G or γ
+    const bool moves_loops = std::any_of(touched_[j].begin(), touched_[j].end(), [](const Component& c) {
+      return c.kind == Component::Drive || c.kind == Component::Actuator;
+    });
+    if (!moves_loops) continue;  // the constants are not in g, G or γ
     const double up = terms(*p.plus), down = p.minus ? terms(*p.minus) : terms(sys_);
     grad(j) -= (up - down) / (p.minus ? 2.0 * p.h : p.h);
   }

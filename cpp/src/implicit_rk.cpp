@@ -135,7 +135,7 @@ class ImplicitRk : public Stepper {
       VecX S(2 * n_);
       for (int j = 0; j < sens_->count(); ++j) {
         S << Sq_.col(j), Sv_.col(j);
-        sens_->project(t, q_, v_, S);
+        sens_->project(j, t, q_, v_, S);
         Sq_.col(j) = S.head(n_), Sv_.col(j) = S.tail(n_);
       }
       forward_dynamics(sys_, d_, t, q_, v_);
@@ -251,7 +251,7 @@ class ImplicitRk : public Stepper {
   void sensitivity_stage(int j, double ti, double gh, const VecX& Q, const VecX& V, const VecX& A, const VecX& lambda,
                          const VecX& dqhat, const VecX& dvhat, Eigen::Ref<VecX> dA, VecX& dV, VecX& dQ, VecX& dl,
                          Correct&& correct, Refresh&& refresh) {
-    double previous = 0.0;
+    double previous = 0.0, free = 0.0;  // free: the largest correction before the loops' part
     bool refreshed = false;
     dl = VecX::Zero(sys_.nl);
     for (int it = 0;; ++it) {
@@ -262,12 +262,17 @@ class ImplicitRk : public Stepper {
         step_failure(t_, h_, "the sensitivities' corrections did not converge with the Newton matrix");
       const VecX R = sens_->residual_derivative(j, ti, Q, V, A, lambda, dQ, dV, dA, dl);
       VecX dx(n_), dlambda;
-      correct(R, dQ, dV, dA, dx, dlambda);
+      free = std::max(free, correct(R, dQ, dV, dA, dx, dlambda));
       if (sys_.nl > 0) dl += dlambda;
       dA += dx;
       if (!dA.allFinite()) step_failure(t_, h_, "the sensitivities became NaN or inf");
+      // converged: the change below 1e-9 of δQ and δV, or below 1e-12 of what the loops took out of it (a
+      // sensitivity they hold at zero, as a mechanism's the drives move alone by its masses, converges to 0,
+      // where no relative test passes)
       const double change = max_abs(dx);
-      if (gh * gh * change <= 1e-9 * max_abs(dQ) && gh * change <= 1e-9 * max_abs(dV)) break;
+      if ((gh * gh * change <= 1e-9 * max_abs(dQ) && gh * change <= 1e-9 * max_abs(dV)) ||
+          (sys_.nl > 0 && change <= 1e-12 * free))
+        break;
       if (it > 0 && change > 0.5 * previous) {
         if (change <= 1e-6 * max_abs(VecX(dA))) break;
         if (!refreshed) refreshed = true, refresh();
@@ -477,7 +482,9 @@ class Esdirk final : public ImplicitRk {
         const double ti = t + T::c[i] * h;
         const VecX Vi = V_.col(i), Ai = A_.col(i), li = sys_.nl ? VecX(Lam_.col(i)) : VecX();
         dA.col(i) = dA.col(i - 1);
-        auto correct = [&](const VecX& R, const VecX& dq, const VecX& dv, const VecX& a, VecX& dx, VecX& dlambda) {
+        // −S⁻¹R and the loops' Schur step into dx; returns |S⁻¹R| before the loops' step
+        auto correct = [&](const VecX& R, const VecX& dq, const VecX& dv, const VecX& a, VecX& dx,
+                           VecX& dlambda) -> double {
           if (tangent_here) {
             matrix_->solve(R, dx);
           } else {
@@ -489,13 +496,15 @@ class Esdirk final : public ImplicitRk {
             solve_armature(sys_, d_, R, dx);
           }
           dx = -dx;
-          if (sys_.nl == 0) return;
+          const double free = max_abs(dx);
+          if (sys_.nl == 0) return free;
           loop_equations(sys_, d_, ti, Q, Vi);
           const MatX G = free_jacobian(sys_, d_);
           const MatX Y = tangent_here ? matrix_->solve(MatX(G.transpose())) : solve_armature(sys_, d_, G.transpose());
-          const VecX c = sens_->acceleration_constraint_derivative(ti, Q, Vi, Ai, dq, dv);
+          const VecX c = sens_->acceleration_constraint_derivative(j, ti, Q, Vi, Ai, dq, dv);
           dlambda = least_norm(G * Y, c - G * (a + dx));
           dx += Y * dlambda;
+          return free;
         };
         auto refresh = [&] {
           matrix_->linearize(ti, Q, Vi, Ai, s_);
@@ -715,7 +724,7 @@ class Radau5 final : public ImplicitRk, public RadauAccess {
     for (int j = 0; j < P; ++j) {
       dA.colwise() = VecX(Sa_.col(j));
       dL.setZero();
-      double previous = 0.0;
+      double previous = 0.0, free = 0.0;  // free: the largest correction before the loops' part
       for (int it = 0;; ++it) {
         interruption_point();
         dV.noalias() = h * dA * tab_.a.transpose();
@@ -729,11 +738,12 @@ class Radau5 final : public ImplicitRk, public RadauAccess {
           R.col(i) = sens_->residual_derivative(j, ti, Q.col(i), V.col(i), A.col(i), nl ? VecX(L.col(i)) : VecX(),
                                                 dQ.col(i), dV.col(i), dA.col(i), nl ? VecX(dL.col(i)) : VecX());
           if (nl > 0)
-            Cres_.col(i) = sens_->acceleration_constraint_derivative(ti, Q.col(i), V.col(i), A.col(i), dQ.col(i),
+            Cres_.col(i) = sens_->acceleration_constraint_derivative(j, ti, Q.col(i), V.col(i), A.col(i), dQ.col(i),
                                                                      dV.col(i)) - G_[i] * dA.col(i);
         }
         solve_stages(R, D_);
         D_ = -D_;
+        free = std::max(free, D_.cwiseAbs().maxCoeff());
         if (nl > 0) {
           L_ = dL;
           close_loops_correction();
@@ -744,8 +754,9 @@ class Radau5 final : public ImplicitRk, public RadauAccess {
         // the increments (ΔV, ΔQ) = (h ΔA aᵀ, h ΔV aᵀ) against the stages' δV, δQ
         const double change = D_.cwiseAbs().maxCoeff();
         const MatX incV = h * D_ * tab_.a.transpose(), incQ = h * incV * tab_.a.transpose();
-        if (incQ.cwiseAbs().maxCoeff() <= 1e-9 * dQ.cwiseAbs().maxCoeff() &&
-            incV.cwiseAbs().maxCoeff() <= 1e-9 * dV.cwiseAbs().maxCoeff())
+        if ((incQ.cwiseAbs().maxCoeff() <= 1e-9 * dQ.cwiseAbs().maxCoeff() &&
+             incV.cwiseAbs().maxCoeff() <= 1e-9 * dV.cwiseAbs().maxCoeff()) ||
+            (nl > 0 && change <= 1e-12 * free))  // a sensitivity the loops hold at zero (sensitivity_stage)
           break;
         if (it > 0 && change > 0.5 * previous && change <= 1e-6 * dA.cwiseAbs().maxCoeff()) break;
         previous = change;

@@ -125,7 +125,7 @@ class Recorder {
     traj_.sensitivities.push_back(y.tail(y.size() - m));
     if (d_) project_onto_loops(sys_, *d_, t, traj_.q.back(), traj_.qd.back(), 1e-12, 10);
     for (int j = 0; sens_ && j < sens_->count(); ++j)
-      sens_->project(t, traj_.q.back(), traj_.qd.back(), traj_.sensitivities.back().segment(2 * nq_ * j, 2 * nq_));
+      sens_->project(j, t, traj_.q.back(), traj_.qd.back(), traj_.sensitivities.back().segment(2 * nq_ * j, 2 * nq_));
   }
   void start(double t0, const VecX& y0, const Stepper& stepper) {
     if (t_eval_.size() == 0) {
@@ -255,7 +255,7 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
     SensitivityEquations sens(sys, o.sensitivities);
     y0.tail(2 * n * sens.count()) = sens.initial();
     for (int j = 0; sys.nl > 0 && j < sens.count(); ++j)  // initial values move along the loops (as assemble() would)
-      sens.project(t0, q0, qd0, y0.segment(2 * n + sys.nz + 2 * n * j, 2 * n));
+      sens.project(j, t0, q0, qd0, y0.segment(2 * n + sys.nz + 2 * n * j, 2 * n));
   }
   // method="auto": its policy (auto_method.hpp) picks the first method and, after each step, whether to change
   std::unique_ptr<AutoChoice> choice;

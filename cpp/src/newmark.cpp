@@ -312,7 +312,8 @@ class NewmarkFamily final : public NewmarkStepper {
 
   /// The staggered direct method: the step's equations differentiated by each parameter are linear in
   /// δq̈_{n+1} (and δλ_{n+1}) with the Newton matrix S = M + γ'h C + β'h² K as their matrix,
-  ///   R(δq̈) = ∂r/∂q δq_{n+1} + ∂r/∂q̇ δq̇_{n+1} + M δq̈ − ∂(Gᵀλ)/∂q δq_{n+1} − Gᵀ δλ + ∂r/∂p = 0,  G δq_{n+1} = 0,
+  ///   R(δq̈) = ∂r/∂q δq_{n+1} + ∂r/∂q̇ δq̇_{n+1} + M δq̈ − ∂(Gᵀλ)/∂q δq_{n+1} − Gᵀ δλ + ∂r/∂p = 0,
+  ///   G δq_{n+1} + ∂g/∂p = 0,
   /// with δq_{n+1}, δq̇_{n+1} from the method's update. Solved by corrections with the step's own iteration matrix
   /// (exact tangent: one correction to the differences' accuracy; spring matrix: a few) until they are below
   /// 1e-10 of δq̈.
@@ -325,8 +326,11 @@ class NewmarkFamily final : public NewmarkStepper {
     const int max_it = std::max(20, max_it_);
     for (int j = 0; j < P; ++j) {
       VecX dqdd = s_.Sqdd.col(j), dl = s_.Slambda.col(j), dq, dv, da;
+      // G δq_{n+1} + ∂g/∂p = 0: a drive's number moves the loops' g(q, t; p) at fixed q
+      const VecX dg_dp = sys_.nl ? sens_->loop_parameter_derivative(j, t + h, s1.q, s1.v, s1.qdd).g : VecX();
       double previous = 0.0;
       bool spring = spring_now_, refreshed = false;
+      double free = 0.0;  // the largest correction before the loops' part
       for (int it = 0;; ++it) {
         interruption_point();
         da = ((1.0 - af_) * dqdd + af_ * s_.Sqdd.col(j) - am_ * s_.Sa.col(j)) / (1.0 - am_);
@@ -339,22 +343,27 @@ class NewmarkFamily final : public NewmarkStepper {
         const bool spring_matrix = spring_now_;
         spring_now_ = spring;  // the loops' correction solves with the matrix used here
         VecX dx = spring ? spring_correction(h, R, bp, gp) : tangent_correction(t + h, h, R, bp, gp, false);
+        free = std::max(free, max_abs(dx));
         if (sys_.nl > 0) {
           const MatX G = free_jacobian(sys_, d_);
           VecX dlambda;
-          close_loops_correction(h * h * bp, G * dq, dx, dlambda);
+          close_loops_correction(h * h * bp, G * dq + dg_dp, dx, dlambda);
           dl += dlambda;
         }
         spring_now_ = spring_matrix;
         dqdd += dx;
         if (!dqdd.allFinite()) step_failure(t, h, "the sensitivities became NaN or inf");
-        // Converged when the correction moves δq_{n+1} and δq̇_{n+1} by less than 1e-9 of them. A correction that
+        // Converged when the correction moves δq_{n+1} and δq̇_{n+1} by less than 1e-9 of them, or is below 1e-12
+        // of what the loops took out of the corrections: a sensitivity they hold at zero (a mechanism the drives
+        // move alone, by its masses) converges to 0, against which no relative test passes. A correction that
         // no longer halves has either reached the central differences' noise (below 1e-6 of δq̈: measured 1e-8 to
         // 1e-7 on beams and ropes, whose axial stiffness dwarfs the transverse one) or meets a matrix too far
         // from this step's tangent (an older one, or the spring matrix): then the exact tangent is formed here,
         // once, and the corrections go on with it.
         const double change = max_abs(dx);
-        if (bp * h * h * change <= 1e-9 * max_abs(dq) && gp * h * change <= 1e-9 * max_abs(dv)) break;
+        if ((bp * h * h * change <= 1e-9 * max_abs(dq) && gp * h * change <= 1e-9 * max_abs(dv)) ||
+            (sys_.nl > 0 && change <= 1e-12 * free))
+          break;
         if (it > 0 && change > 0.5 * previous) {
           if (change <= 1e-6 * max_abs(dqdd)) break;
           if (!refreshed) refreshed = true, spring = false, valid_ = false;

@@ -43,7 +43,7 @@ class FirstOrder {
     VecX q = y.head(n), qd = y.segment(n, n);
     project_onto_loops(sys_, d_, t, q, qd, 1e-12, 10);
     y.head(n) = q, y.segment(n, n) = qd;
-    for (int j = 0; sens_ && j < sens_->count(); ++j) sens_->project(t, q, qd, y.segment(state_size() + 2 * n * j, 2 * n));
+    for (int j = 0; sens_ && j < sens_->count(); ++j) sens_->project(j, t, q, qd, y.segment(state_size() + 2 * n * j, 2 * n));
   }
   int controlled() const { return 2 * sys_.nq; }  ///< the error is controlled on y's first 2 nq: [q, q̇]
   int state_size() const { return 2 * sys_.nq + sys_.nz; }  ///< [q, q̇, s]; the sensitivities follow

@@ -2,6 +2,7 @@
 #include "rigidfem/sensitivities.hpp"
 
 #include <algorithm>
+#include <cmath>
 
 #include "rigidfem/constraints.hpp"
 #include "rigidfem/dynamics.hpp"
@@ -17,7 +18,8 @@ double max_abs(const VecX& v) { return v.size() ? v.cwiseAbs().maxCoeff() : 0.0;
 // to max(1, |x|) (0: the direction is zero).
 double direction_step(const VecX& q, const VecX& qd, const VecX& dq, const VecX& dqd) {
   const double size = std::max(max_abs(dq) / std::max(1.0, max_abs(q)), max_abs(dqd) / std::max(1.0, max_abs(qd)));
-  return size > 0.0 ? 6e-6 / size : 0.0;
+  const double eps = 6e-6 / size;
+  return size > 0.0 && std::isfinite(eps) ? eps : 0.0;  // a subnormal direction: none (its ε would overflow)
 }
 
 // R = M q̈ − f − Gᵀλ (nq) at (t, q, q̇, q̈, λ) on the workspace d of sys; with loops g, G, γ left in d.
@@ -70,7 +72,7 @@ void SensitivityEquations::rates(Data& fd, double t, const VecX& q, const VecX& 
     VecX b = residual_derivative(j, t, q, qd, qdd, lambda, dq, dqd, zero, VecX::Zero(nl));
     VecX x(n);
     solve_armature(sys_, fd, -b, x);
-    if (nl > 0) x += Y * least_norm(GY, acceleration_constraint_derivative(t, q, qd, qdd, dq, dqd) - G * x);
+    if (nl > 0) x += Y * least_norm(GY, acceleration_constraint_derivative(j, t, q, qd, qdd, dq, dqd) - G * x);
     Sd.segment(2 * n * j, n) = dqd;
     Sd.segment(2 * n * j + n, n) = x;
   }
@@ -111,26 +113,43 @@ VecX SensitivityEquations::residual_derivative(int j, double t, const VecX& q, c
   return R;
 }
 
-VecX SensitivityEquations::acceleration_constraint_derivative(double t, const VecX& q, const VecX& qd,
+VecX SensitivityEquations::acceleration_constraint_derivative(int j, double t, const VecX& q, const VecX& qd,
                                                                const VecX& qdd, const VecX& dq, const VecX& dqd) {
   VecX c = VecX::Zero(sys_.nl);
   if (const double eps = direction_step(q, qd, dq, dqd); eps > 0.0) {
     const VecX up = acceleration_constraint(sys_, e_, t, q + eps * dq, qd + eps * dqd, qdd);
     c = (up - acceleration_constraint(sys_, e_, t, q - eps * dq, qd - eps * dqd, qdd)) / (2.0 * eps);
   }
+  if (parameters_[j].minus) c += loop_parameter_derivative(j, t, q, qd, qdd).c;
   return c;
 }
 
-void SensitivityEquations::project(double t, const VecX& q, const VecX& qd, Eigen::Ref<VecX> S) {
+SensitivityEquations::LoopRates SensitivityEquations::loop_parameter_derivative(int j, double t, const VecX& q,
+                                                                                const VecX& qd, const VecX& qdd) {
+  const SensitivityParameter& p = parameters_[j];
+  const int nl = sys_.nl;
+  if (!p.minus) return {VecX::Zero(nl), VecX::Zero(nl), VecX::Zero(nl)};
+  // (x(p + h) − x(p − h))/(2h) of x = g, ġ, γ − G q̈ at the same state
+  Data& up = *plus_[j];
+  Data& down = *minus_[j];
+  loop_equations(*p.plus, up, t, q, qd);
+  loop_equations(*p.minus, down, t, q, qd);
+  const double w = 1.0 / (2.0 * p.h);
+  return {w * (up.g - down.g), w * (up.gd - down.gd),
+          w * ((up.gamma - free_jacobian(*p.plus, up) * qdd) - (down.gamma - free_jacobian(*p.minus, down) * qdd))};
+}
+
+void SensitivityEquations::project(int j, double t, const VecX& q, const VecX& qd, Eigen::Ref<VecX> S) {
   if (sys_.nl == 0) return;
   const int n = sys_.nq;
   VecX dq = S.head(n), dqd = S.tail(n);
+  const LoopRates direct = loop_parameter_derivative(j, t, q, qd, VecX::Zero(n));
   loop_equations(sys_, d_, t, q, qd);
   const MatX G = free_jacobian(sys_, d_);
   factor_mass(sys_, d_);
   const MatX Y = solve_armature(sys_, d_, G.transpose());
   const MatX GY = G * Y;
-  dq -= Y * least_norm(GY, G * dq);
+  dq -= Y * least_norm(GY, G * dq + direct.g);
   // ∂ġ/∂q δq along the projected δq, by a central difference of ġ(q ± ε δq, q̇)
   VecX dgd_dq = VecX::Zero(sys_.nl);
   const VecX zero = VecX::Zero(n);
@@ -140,7 +159,7 @@ void SensitivityEquations::project(double t, const VecX& q, const VecX& qd, Eige
     loop_equations(sys_, e_, t, q - eps * dq, qd);
     dgd_dq = (up - e_.gd) / (2.0 * eps);
   }
-  dqd -= Y * least_norm(GY, G * dqd + dgd_dq);
+  dqd -= Y * least_norm(GY, G * dqd + dgd_dq + direct.gd);
   S.head(n) = dq;
   S.tail(n) = dqd;
 }

@@ -20,8 +20,8 @@ with t (N + 1,) and y a dict {name: (N + 1, 3) or (N + 1,)} returns L at every s
 complex input (abs, comparisons, float()) is differentiated by central differences instead
 (``Gradient.stats["objective_derivative"]`` says which).
 
-Closed loops with the Newmark family (not radau5 yet). Not yet: Maxwell arms, links of varying length, the Lagrange engine
-(algorithm='lagrange'), adaptive steps, an actuator's length profile.
+Closed loops with the Newmark family (not radau5 yet), a drive's or an actuator's numbers moving them included. Not
+yet: Maxwell arms, links of varying length, the Lagrange engine (algorithm='lagrange'), adaptive steps.
 """
 
 from __future__ import annotations
@@ -126,7 +126,7 @@ def gradient(system, t_end: float, parameters=None, *, outputs, running=None, te
     if parameters is None:
         parameters = list(system.parameters)
     _probe(system, specs, names, running, terminal, t0, q0)  # a bad objective is named before any run
-    directions = sensitivities_.directions(system, parameters, opt, t0, t_end, "parameters", drives_in_loops=True)
+    directions = sensitivities_.directions(system, parameters, opt, t0, t_end, "parameters")
     simulation._check_closed(system, t0, q0, qd0)  # the arguments first, then whether the state closes the loops
     adjoint = _core._Adjoint(system, opt, specs, memory)
     start = time.perf_counter()

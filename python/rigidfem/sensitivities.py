@@ -20,11 +20,11 @@ the forward dynamics' own factorisation (O(n)). Step sizes are the state's, and 
 sensitivities' error is not controlled. A Python force law or drive is differentiated through these central
 differences alike. Closed loops: the sensitivities are projected onto the tangent of the constraints with the
 state (the derivative of its projection); an initial value moves along the loops as ``System.assemble``
-closes them.
+closes them. A drive's or an actuator's numbers move the loops' g(q, t; p) too: their ∂g/∂p, ∂ġ/∂p, ∂γ/∂p
+(central differences of the systems at p ± h) enter the differentiated constraints and the projection.
 
 ``Result.sensitivity(name)`` returns (∂q/∂p, ∂q̇/∂p), each (len t, nq); ``Result.position_sensitivity(point,
-name)`` the derivative (len t, 3) of a point's position. Not yet: Maxwell arms, an actuator's length profile, a
-drive's numbers on a system with loop closures (each refused; ``rigidfem.gradient`` takes the last).
+name)`` the derivative (len t, 3) of a point's position. Not yet: Maxwell arms (refused).
 """
 
 from __future__ import annotations
@@ -34,8 +34,7 @@ import numpy as np
 from . import parameters as parameters_
 
 
-def directions(system, names, options, t0: float, t1: float, argument: str = "sensitivities",
-               drives_in_loops: bool = False) -> list[str]:
+def directions(system, names, options, t0: float, t1: float, argument: str = "sensitivities") -> list[str]:
     """Adds each named direction's systems at p + h (and p − h for a profile's number) and initial sensitivity
     to the C++ ``options`` for a run over [t0, t1] (s); returns the names. ValueError naming what is not a
     parameter or an initial value of the system."""
@@ -57,13 +56,6 @@ def directions(system, names, options, t0: float, t1: float, argument: str = "se
             options.add_sensitivity(params.shifted(system, name, h), None, h, S0)
             continue
         group = params.groups[params.where[name][0]]
-        if isinstance(group, parameters_.ProfileGroup) and group.what == "loop":
-            raise ValueError(f"{argument}: expected no actuator's profile (its loop's g(q, t; p) would need "
-                             f"∂g/∂p, not implemented yet), got {name!r}")
-        if isinstance(group, parameters_.ProfileGroup) and group.what == "drive" and system.nl and not drives_in_loops:
-            raise ValueError(f"{argument}: expected no drive's number on a system with loop closures (the loops' "
-                             f"g(q, t) move with the drive: their ∂g/∂p is not in the forward sensitivities yet; "
-                             f"rigidfem.gradient's adjoint has it), got {name!r}")
         h = params.profile_step(name, t0, t1)
         options.add_sensitivity(params.shifted(system, name, h), params.shifted(system, name, -h), h, S0)
     return names

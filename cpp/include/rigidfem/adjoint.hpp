@@ -77,11 +77,12 @@ class ParameterVjp {
   int count() const { return static_cast<int>(parameters_.size()); }
   /// [∂q₀/∂p_j, ∂q̇₀/∂p_j] (2 nq).
   const VecX& initial(int j) const { return parameters_[j].S0; }
+  const std::vector<SensitivityParameter>& parameters() const { return parameters_; }
 
  private:
   struct Component {
-    enum Kind { Body, Coordinate, Element, Load, Drive } kind;
-    int index;  // body, coordinate (in coords), element, load
+    enum Kind { Body, Coordinate, Element, Load, Drive, Actuator } kind;
+    int index;  // body, coordinate (in coords), element, load, loop (an actuator's: only in g, G, γ)
   };
   double power(const System& X, const Data& d, const Component& c, const VecX& mu) const;
   double base_power(const Data& d, const Component& c, const VecX& mu);
@@ -90,7 +91,7 @@ class ParameterVjp {
   std::vector<SensitivityParameter> parameters_;
   std::vector<std::vector<Component>> touched_;  // per parameter
   std::vector<Vec6> V_;                           // (nbodies) V_b = Σ s_u μ_u along the path
-  std::vector<double> base_[5];                   // per kind of component: its power on the run's system, or NaN
+  std::vector<double> base_[5];                   // per kind of component in r: its power on the run's system, or NaN
   std::unique_ptr<Data> e_;                       // the loops' terms on the systems at p ± h (same sizes)
 };
 

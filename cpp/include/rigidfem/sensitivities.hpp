@@ -3,7 +3,8 @@
 ///
 /// Differentiating A(q; p) q̈ = f(q, q̇, t; p) gives the sensitivity equations
 ///   A S̈_q + (∂r/∂q) S_q + (∂r/∂q̇) S_q̇ + ∂r/∂p = 0,      r = A q̈ − f,
-/// with closed loops M S̈ + … = Gᵀ δλ and G S̈ = δγ. A parameter p_j comes as the system at p_j + h_j
+/// with closed loops M S̈ + … = Gᵀ δλ and G S̈ = δγ (δγ with ∂γ/∂p: a drive's or an actuator's numbers move the
+/// loops' g(q, t; p), loop_parameter_derivative). A parameter p_j comes as the system at p_j + h_j
 /// (parameters.hpp: only constants the residual is linear in differ, so ∂r/∂p = (r(p + h) − r(p))/h exactly,
 /// to round-off, whatever h: h = |p| keeps the round-off at that of r; a profile's coefficient, which the
 /// residual is not linear in, by a central difference of the systems at p ± h), an initial value as S_j(t0). The
@@ -49,15 +50,23 @@ class SensitivityEquations {
   VecX residual_derivative(int j, double t, const VecX& q, const VecX& qd, const VecX& qdd, const VecX& lambda,
                            const VecX& dq, const VecX& dqd, const VecX& dqdd, const VecX& dlambda);
 
-  /// Loops: D(γ − G q̈)[δq, δq̇] (nl) at (t, q, q̇) and fixed free accelerations q̈, by a central difference:
-  /// the right-hand side of G δq̈ in the index-1 equations' derivative.
-  VecX acceleration_constraint_derivative(double t, const VecX& q, const VecX& qd, const VecX& qdd, const VecX& dq,
-                                          const VecX& dqd);
+  /// Loops: D(γ − G q̈)[δq, δq̇] + ∂(γ − G q̈)/∂p_j (nl) at (t, q, q̇) and fixed free accelerations q̈, by
+  /// central differences: the right-hand side of G δq̈ in the index-1 equations' derivative.
+  VecX acceleration_constraint_derivative(int j, double t, const VecX& q, const VecX& qd, const VecX& qdd,
+                                          const VecX& dq, const VecX& dqd);
 
-  /// Systems with loops: S = [S_q, S_q̇] onto the tangent of the constraint manifold at (t, q, q̇), which
-  /// is the derivative of the projection onto it (project_onto_loops) there:
-  ///   S_q ← S_q − Y (G Y)⁺ G S_q,   S_q̇ ← S_q̇ − Y (G Y)⁺ (G S_q̇ + ∂ġ/∂q S_q),   Y = M⁻¹ Gᵀ.
-  void project(double t, const VecX& q, const VecX& qd, Eigen::Ref<VecX> S);
+  /// Loops: the direct derivatives ∂g/∂p_j, ∂ġ/∂p_j and ∂(γ − G q̈)/∂p_j (nl each) at fixed (t, q, q̇, q̈). Only a
+  /// drive's number moves the loops (g(q, t; p) through its prescribed coordinates); by the central difference
+  /// of its systems at p ± h, zero for every other parameter.
+  struct LoopRates {
+    VecX g, gd, c;
+  };
+  LoopRates loop_parameter_derivative(int j, double t, const VecX& q, const VecX& qd, const VecX& qdd);
+
+  /// Systems with loops: S = [S_q, S_q̇] of parameter j onto the tangent of the constraint manifold at
+  /// (t, q, q̇), which is the derivative of the projection onto it (project_onto_loops) there:
+  ///   S_q ← S_q − Y (G Y)⁺ (G S_q + ∂g/∂p),   S_q̇ ← S_q̇ − Y (G Y)⁺ (G S_q̇ + ∂ġ/∂q S_q + ∂ġ/∂p),   Y = M⁻¹ Gᵀ.
+  void project(int j, double t, const VecX& q, const VecX& qd, Eigen::Ref<VecX> S);
 
  private:
   const System& sys_;
