@@ -221,6 +221,28 @@ def test_an_actuator_and_a_drive_moving_the_loops_at_the_start():
     assert_gradients_agree(g.gradient, expected, 1e-7)
 
 
+def test_a_link_of_varying_length():
+    """A tape sliding out of its guide on a turning hub (flows.hpp; the reverse mode of its Coriolis, relative
+    acceleration and turning loads): the hub's drive, the material, the section, a push, and the numbers of the
+    free length L(t), against the forward sensitivities of the same runs."""
+    model = rf.Model(gravity=(0.0, 0.0, -G))
+    hub = model.add_body("hub", model.ground, rf.Joint.revolute("z"), 1.0, (1.0, 1.0, 1.0))
+    model.prescribe(hub, rf.motion.harmonic(0.6, 2.0, 0.3))
+    tape = model.add_beam("tape", hub, rf.motion.polynomial([0.5, 0.8, -0.3]), rf.Material(E=2.1e9, rho=7850.0),
+                          rf.Section.rectangle(0.02, 0.004), 4, deform=("bend_y", "bend_z"),
+                          joint=rf.Joint.revolute("y", stiffness=30.0), placement=rf.transform((0.1, 0.0, 0.0)))
+    model.add_force(tape.tip, (0.0, 0.3, 0.0), name="push")
+    s = model.compile()
+    names = ["hub.rz.drive.amplitude", "tape.E", "tape.rho", "tape.A", "tape.Iy", "tape.rfe0.ry.stiffness",
+             "push.force"] + [f"tape.length.coefficients[{k}]" for k in range(3)]
+    for method, dt in (("generalized_alpha", 1e-3), ("radau5", 2e-3)):
+        run = dict(dt=dt, newton_tol=1e-13)
+        g = rf.gradient(s, 0.3, names, method=method, outputs={"p": tape.tip}, running=running, terminal=terminal,
+                        **run)
+        _, expected = forward_gradient(s, tape.tip, names, 0.3, method, adaptive=False, **run)
+        assert_gradients_agree(g.gradient, expected, 1e-7)
+
+
 def test_radau5_krylov_on_a_long_chain():
     """radau5 with the matrix-free Newton matrix on a 40-element strip on a turning hub: its transposed stages
     preconditioned by the articulated-body factor at the complex shift converge in a few GMRES iterations a step

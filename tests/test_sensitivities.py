@@ -158,14 +158,18 @@ def test_rope_across_slack_phases():
 
 
 def test_varying_length_link():
-    """A tape sliding out of its guide on a turning hub (flows.hpp): E and ρ of the flowing beam."""
+    """A tape sliding out of its guide on a turning hub (flows.hpp): E and ρ of the flowing beam, and the numbers
+    of its free length L(t) = c₀ + c₁ t + c₂ t² (they move the flow's terms and its sdes' growth together)."""
     model = rf.Model(gravity=(0.0, 0.0, -G))
     hub = model.add_body("hub", model.ground, rf.Joint.revolute("z"), 1.0, (1.0, 1.0, 1.0))
     model.prescribe(hub, rf.motion.harmonic(0.6, 2.0, 0.3))
     model.add_beam("tape", hub, rf.motion.polynomial([0.5, 0.8, -0.3]), rf.Material(E=2.1e9, rho=7850.0),
                    rf.Section.rectangle(0.02, 0.004), 4, deform=("bend_y", "bend_z"),
                    joint=rf.Joint.revolute("y", stiffness=30.0), placement=rf.transform((0.1, 0.0, 0.0)))
-    _converges(model.compile(), ["tape.E", "tape.rho"], "rk4", np.linspace(0, 0.3, 4), dt=1e-4)
+    s = model.compile()
+    _converges(s, ["tape.E", "tape.rho"], "rk4", np.linspace(0, 0.3, 4), dt=1e-4)
+    _converges(s, ["tape.length.coefficients[0]", "tape.length.coefficients[2]"], "rk4", np.linspace(0, 0.2, 3),
+               steps=(1e-4, 1e-5, 1e-6), dt=2e-4)
 
 
 def test_initial_values_on_a_closed_loop_move_along_it():

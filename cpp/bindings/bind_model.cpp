@@ -358,6 +358,7 @@ void bind_model(py::module_& m) {
       .def_property_readonly("_nelements", [](const Model& model) { return model.force_elements().size(); })
       .def_property_readonly("_nloads", [](const Model& model) { return model.loads().size(); })
       .def_property_readonly("_nloops", [](const Model& model) { return model.loops().size(); })
+      .def_property_readonly("_nflows", [](const Model& model) { return model.flows().size(); })
       .def_property_readonly("body_names", [](const Model& model) {
         std::vector<std::string> names;
         for (const auto& b : model.bodies()) names.push_back(b.name);

@@ -317,8 +317,6 @@ Adjoint::Adjoint(std::shared_ptr<const System> sys, const IntegratorOptions& o, 
     throw std::invalid_argument("system: expected no loop closures with method 'radau5' (its adjoint does not hold "
                                 "them yet; the Newmark family's does), got " + std::to_string(s.nl) + " rows");
   if (s.nz > 0) throw std::invalid_argument("system: expected no Maxwell arms (not implemented for the adjoint yet)");
-  if (!s.flows.empty())
-    throw std::invalid_argument("system: expected no link of varying length (not implemented for the adjoint yet)");
   if (!(o.dt > 0.0)) bad("dt", "a fixed step > 0 (s)", num(o.dt));
   if (!(memory > 0.0)) bad("memory", "a number of bytes > 0", num(memory));
   for (const OutputSpec& out : outputs_) {

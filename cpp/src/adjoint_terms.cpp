@@ -135,7 +135,31 @@ MotionState ParameterVjp::drive_derivative(int j, int coord, double t) const {
   return {(up.q - down.q) / h, (up.qd - down.qd) / h, (up.qdd - down.qdd) / h};
 }
 
+double ParameterVjp::residual_power(const System& X, const Data& d, const VecX& mu) {
+  if (!e_) e_ = std::make_unique<Data>(sys_);
+  VecX q(sys_.nq), qd(sys_.nq), qdd(sys_.nq);
+  for (int k = 0; k < sys_.nq; ++k) {
+    const int i = sys_.free_coords[k];
+    q(k) = d.qa(i), qd(k) = d.qda(i), qdd(k) = d.qdda(i);
+  }
+  set_state(X, *e_, d.t, q, qd);
+  set_accelerations(X, *e_, qdd);
+  dynamics_kinematics(X, *e_);
+  return mu.dot(inverse_dynamics(X, *e_));
+}
+
 void ParameterVjp::add(const Data& d, const VecX& mu, const ResidualVjp& r, double w, Eigen::Ref<VecX> grad) {
+  if (!sys_.flows.empty()) {  // μᵀ(r(p + h) − r(p ∓ h)) whole
+    double base = std::numeric_limits<double>::quiet_NaN();
+    for (std::size_t j = 0; j < parameters_.size(); ++j) {
+      const SensitivityParameter& p = parameters_[j];
+      if (!p.plus) continue;
+      const double up = residual_power(*p.plus, d, mu);
+      if (!p.minus && std::isnan(base)) base = residual_power(sys_, d, mu);
+      grad(j) += w * (p.minus ? (up - residual_power(*p.minus, d, mu)) / (2.0 * p.h) : (up - base) / p.h);
+    }
+    return;
+  }
   // V_b = V_parent + Σ_{free uses u of b's joint} s_u μ_u: each body's velocity for q̇ = μ
   for (int b = 0; b < sys_.nbodies; ++b) {
     V_[b] = sys_.parent[b] >= 0 ? V_[sys_.parent[b]] : Vec6::Zero();

@@ -226,8 +226,6 @@ VecX rnea_directional_derivative(const System& sys, Data& d, const VecX& dq, con
 }
 
 ResidualVjp rnea_vector_jacobian_product(const System& sys, Data& d, const VecX& mu) {
-  if (!sys.flows.empty())
-    throw std::invalid_argument("system: expected no link of varying length (its terms' transpose is not implemented)");
   spatial_kinematics(sys, d);
   rnea_pass(sys, d);
   const LoadTerms terms(sys, d);
@@ -284,6 +282,17 @@ ResidualVjp rnea_vector_jacobian_product(const System& sys, Data& d, const VecX&
     const Vec3 dd_bar = st.e * dl_bar + (de_bar - st.e * st.e.dot(de_bar)) / st.l;
     point_adjoint(E.body_b, st.xb, dd_bar, ddd_bar);
     point_adjoint(E.body_a, st.xa, -dd_bar, -ddd_bar);
+  }
+  for (const FlowTerm& f : terms.flows) {
+    // flow_tangent transposed: with F̄ = x × h_ω − h_v the adjoints of δF_C (x = x_C) and δF_turn (x = origin),
+    //   ē = −m (2α F̄_C × ω + β F̄_C) − ρA α² F̄_turn,  ē_prev = ρA α² F̄_turn,  δω̄ = −2mα e × F̄_C,
+    // and δe = W_ω × e: W̄_ω += e × ē (likewise for the previous rfe's axis)
+    const Vec6& h = H[f.body];
+    const Vec3 Fc = f.xc.cross(h.head<3>()) - h.tail<3>(), Ft = f.origin.cross(h.head<3>()) - h.tail<3>();
+    const Vec3 e_bar = -f.m * (2.0 * f.alpha * Fc.cross(f.omega) + f.beta * Fc) - f.rhoA * f.alpha * f.alpha * Ft;
+    vb[f.body].head<3>() -= 2.0 * f.m * f.alpha * f.e.cross(Fc);
+    Wb[f.body].head<3>() += f.e.cross(e_bar);
+    if (f.prev >= 0) Wb[f.prev].head<3>() += f.e_prev.cross(f.rhoA * f.alpha * f.alpha * Ft);
   }
   for (const BodyLoad& L : terms.loads) {
     const AppliedLoad& l = L.load;

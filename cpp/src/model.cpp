@@ -43,6 +43,14 @@ class Growth final : public Profile {
   double kappa_, length0_;
 };
 
+}  // namespace
+
+ProfilePtr growth_profile(ProfilePtr length, double kappa, double length0) {
+  return std::make_shared<Growth>(std::move(length), kappa, length0);
+}
+
+namespace {
+
 template <class M>
 void require_finite(const M& x, const std::string& argument) {
   if (!x.allFinite()) bad(argument, "finite values", "NaN or inf");
@@ -341,7 +349,7 @@ void Model::add_flow(Flow flow) {
     if (other.first == flow.first) bad("beam", "a beam not given a varying length yet", "'" + bodies_[flow.first].name + "'");
   flow.length0 = L0;
   for (int k = 1; k <= flow.elements; ++k)
-    coords_[flow.first + k][0].drive = std::make_shared<Growth>(flow.length, flow.spacing(k), L0);
+    coords_[flow.first + k][0].drive = growth_profile(flow.length, flow.spacing(k), L0);
   flows_.push_back(std::move(flow));
 }
 

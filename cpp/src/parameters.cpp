@@ -75,8 +75,15 @@ std::shared_ptr<System> with_constants(const System& sys, const ConstantChanges&
       if (p.index < 0 || p.index >= static_cast<int>(s.loops.size()) || !s.loops[p.index].drive)
         bad("loop", "an actuator (a distance loop with a length profile)", std::to_string(p.index));
       s.loops[p.index].drive = p.profile;
+    } else if (p.what == "flow") {  // a link's free length L(t): the flow's, and its sdes' growth κ_k (L − L₀)
+      if (p.index < 0 || p.index >= static_cast<int>(s.flows.size()))
+        bad("flow", "a link of varying length", std::to_string(p.index));
+      Flow& f = s.flows[p.index];
+      f.length = p.profile;
+      for (int k = 1; k <= f.elements; ++k)
+        s.coords[coordinate_at(s, f.first + k, 0)].drive = growth_profile(f.length, f.spacing(k), f.length0);
     } else {
-      bad("what", "'drive', 'element', 'load' or 'loop'", "'" + p.what + "'");
+      bad("what", "'drive', 'element', 'load', 'loop' or 'flow'", "'" + p.what + "'");
     }
   }
   return copy;

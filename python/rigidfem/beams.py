@@ -481,6 +481,8 @@ def add_beam(
         _add_arms(model, bodies[1:], template.coordinates, sde.stiffness[:, columns], prony, mat_E)
         if flow is not None:
             model._add_flow(flow, root.index, m)
+            parameters.register(model, parameters.ProfileGroup(f"{name}.length", "flow", -1, model._nflows - 1, flow,
+                                                               "the link's free length (m, s, m/s)"))
     except BaseException:
         model._truncate(first)  # nothing half-added
         model._parameter_groups = groups

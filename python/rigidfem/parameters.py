@@ -441,7 +441,7 @@ def remade(profile, values: dict[str, float], path: str = ""):
 class ProfileGroup(Group):
     """The numbers of a profile a builder was given — a prescribed coordinate's drive ("<body>.<axis>.drive"),
     a winch's unstretched length ("<rope>.length"), a cylinder's force ("<element>.profile"), a load's scale
-    ("<load>.scale") or an actuator's length ("<actuator>.length") — each a parameter "<prefix>.<path>":
+    ("<load>.scale"), an actuator's length ("<actuator>.length") or a link's free length ("<beam>.length") — each a parameter "<prefix>.<path>":
     ``coefficients[2]`` of a polynomial, ``amplitude`` of a harmonic, ``q[3]`` of a spline, ``parts[1].omega`` of
     a sum. The residual is not linear in them: their sensitivities difference the systems at p ± h."""
 

@@ -16,7 +16,7 @@
 /// dJ/dp −= μ_0ᵀ ∂r/∂p. Kᵀμ, Cᵀμ, Mμ come from the RNEA's reverse mode (derivatives.hpp: O(n)); Sᵀμ = g is
 /// solved by GMRES on those products, preconditioned by the transposed factorisation of a Newton matrix kept
 /// from an earlier step (dense) or by M + diag(γ'h b + β'h² k) (Krylov), to 1e-11; μᵀ∂r/∂p for every parameter
-/// in one pass (ParameterVjp). Recursive tree systems without Maxwell arms or links of varying length.
+/// in one pass (ParameterVjp). Recursive systems without Maxwell arms.
 ///
 /// Closed loops (the Newmark family, index 3: r − Gᵀλ = 0 and g(q_{n+1}) = 0 for (z, λ)): the transposed saddle
 /// system A₁₁ᵀμ + β'h² Gᵀν = g, G μ = 0 with A₁₁ = S − β'h² ∂(Gᵀλ)/∂q (the Hessian of λᵀg: symmetric, by central
@@ -60,6 +60,8 @@ void objective_outputs_vjp(const System& sys, const Data& d, const std::vector<O
 /// (a body's V_bᵀ(I a + v ×* I v) with V_b = Σ_{path} s_u μ_u; −μ_k Q_k of a coordinate; −F δl of an element;
 /// −V_bᵀ w of a load), and only those are evaluated again. A drive's numbers enter through the prescribed
 /// coordinate's (q, q̇, q̈): ∂(μᵀr)/∂ of those from the reverse mode, times the profile's own difference.
+/// A system with links of varying length differences μᵀr whole (O(n) per parameter): their bodies' inertias,
+/// sdes' springs and flow loads scale with L(t) throughout, and a material's or the length's numbers reach all.
 class ParameterVjp {
  public:
   ParameterVjp(const System& sys, const std::vector<SensitivityParameter>& parameters);
@@ -85,6 +87,7 @@ class ParameterVjp {
     int index;  // body, coordinate (in coords), element, load, loop (an actuator's: only in g, G, γ)
   };
   double power(const System& X, const Data& d, const Component& c, const VecX& mu) const;
+  double residual_power(const System& X, const Data& d, const VecX& mu);  // μᵀ r of X at the state of d
   double base_power(const Data& d, const Component& c, const VecX& mu);
   MotionState drive_derivative(int j, int coord, double t) const;
   const System& sys_;

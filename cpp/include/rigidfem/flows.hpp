@@ -40,4 +40,8 @@ struct Flow {
   double spacing(int k) const { return k == 1 ? 0.5 / elements : 1.0 / elements; }
 };
 
+/// The growth x_k(t) = κ (L(t) − L₀) of the distance between two rfe frames (the prescribed "x" coordinate
+/// first in rfe k's sde joint), with its rates κ L̇ and κ L̈.
+ProfilePtr growth_profile(ProfilePtr length, double kappa, double length0);
+
 }  // namespace rigidfem
