@@ -57,7 +57,8 @@ void objective_outputs_vjp(const System& sys, const Data& d, const std::vector<O
 }
 
 ParameterVjp::ParameterVjp(const System& sys, const std::vector<SensitivityParameter>& parameters)
-    : sys_(sys), parameters_(parameters), touched_(parameters.size()), V_(sys.nbodies),
+    : sys_(sys), parameters_(parameters), touched_(parameters.size()), whole_(parameters.size(), false),
+      V_(sys.nbodies),
       base_{std::vector<double>(sys.nbodies), std::vector<double>(sys.nc), std::vector<double>(sys.elements.size()),
             std::vector<double>(sys.loads.size()), std::vector<double>()} {
   for (std::size_t j = 0; j < parameters_.size(); ++j) {
@@ -86,6 +87,14 @@ ParameterVjp::ParameterVjp(const System& sys, const std::vector<SensitivityParam
       }
       for (std::size_t k = 0; k < sys.loops.size(); ++k)
         if (X->loops[k].drive != sys.loops[k].drive) add(Component::Actuator, static_cast<int>(k));
+      // a link of varying length's rfes' inertias and flow loads scale with L(t) (d's, not X's constants), and
+      // its length reaches every term: such a parameter differences μᵀr whole
+      for (std::size_t f = 0; f < sys.flows.size(); ++f) {
+        const Flow& F = sys.flows[f];
+        if (X->flows[f].length != F.length) whole_[j] = true;
+        for (const Component& c : touched)
+          if (c.kind == Component::Body && c.index >= F.first && c.index <= F.first + F.elements) whole_[j] = true;
+      }
     }
   }
 }
@@ -149,17 +158,6 @@ double ParameterVjp::residual_power(const System& X, const Data& d, const VecX& 
 }
 
 void ParameterVjp::add(const Data& d, const VecX& mu, const ResidualVjp& r, double w, Eigen::Ref<VecX> grad) {
-  if (!sys_.flows.empty()) {  // μᵀ(r(p + h) − r(p ∓ h)) whole
-    double base = std::numeric_limits<double>::quiet_NaN();
-    for (std::size_t j = 0; j < parameters_.size(); ++j) {
-      const SensitivityParameter& p = parameters_[j];
-      if (!p.plus) continue;
-      const double up = residual_power(*p.plus, d, mu);
-      if (!p.minus && std::isnan(base)) base = residual_power(sys_, d, mu);
-      grad(j) += w * (p.minus ? (up - residual_power(*p.minus, d, mu)) / (2.0 * p.h) : (up - base) / p.h);
-    }
-    return;
-  }
   // V_b = V_parent + Σ_{free uses u of b's joint} s_u μ_u: each body's velocity for q̇ = μ
   for (int b = 0; b < sys_.nbodies; ++b) {
     V_[b] = sys_.parent[b] >= 0 ? V_[sys_.parent[b]] : Vec6::Zero();
@@ -168,9 +166,16 @@ void ParameterVjp::add(const Data& d, const VecX& mu, const ResidualVjp& r, doub
   }
   const double t = d.t;
   for (auto& cache : base_) std::fill(cache.begin(), cache.end(), std::numeric_limits<double>::quiet_NaN());
+  double base = std::numeric_limits<double>::quiet_NaN();  // μᵀr of the run's system, for whole differences
   for (std::size_t j = 0; j < parameters_.size(); ++j) {
     const SensitivityParameter& p = parameters_[j];
     if (!p.plus) continue;
+    if (whole_[j]) {  // μᵀ(r(p + h) − r(p ∓ h))
+      const double up = residual_power(*p.plus, d, mu);
+      if (!p.minus && std::isnan(base)) base = residual_power(sys_, d, mu);
+      grad(j) += w * (p.minus ? (up - residual_power(*p.minus, d, mu)) / (2.0 * p.h) : (up - base) / p.h);
+      continue;
+    }
     double sum = 0.0;
     for (const Component& c : touched_[j]) {
       if (c.kind == Component::Actuator) continue;

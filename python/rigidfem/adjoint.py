@@ -21,8 +21,8 @@ complex input (abs, comparisons, float()) is differentiated by central differenc
 (``Gradient.stats["objective_derivative"]`` says which).
 
 Closed loops with the Newmark family (not radau5 yet), a drive's or an actuator's numbers moving them included. Not
-yet: Maxwell arms, the Lagrange engine (algorithm='lagrange'), adaptive steps. Links of varying length: μᵀ∂r/∂p
-by differences of μᵀr whole (O(n) per parameter and step).
+yet: Maxwell arms, the Lagrange engine (algorithm='lagrange'), adaptive steps. Links of varying length: a parameter of
+their rfes' inertias or of L(t) by differences of μᵀr whole (O(n) per such parameter and step).
 """
 
 from __future__ import annotations

@@ -60,8 +60,8 @@ void objective_outputs_vjp(const System& sys, const Data& d, const std::vector<O
 /// (a body's V_bᵀ(I a + v ×* I v) with V_b = Σ_{path} s_u μ_u; −μ_k Q_k of a coordinate; −F δl of an element;
 /// −V_bᵀ w of a load), and only those are evaluated again. A drive's numbers enter through the prescribed
 /// coordinate's (q, q̇, q̈): ∂(μᵀr)/∂ of those from the reverse mode, times the profile's own difference.
-/// A system with links of varying length differences μᵀr whole (O(n) per parameter): their bodies' inertias,
-/// sdes' springs and flow loads scale with L(t) throughout, and a material's or the length's numbers reach all.
+/// A parameter that sets a link of varying length's rfes' inertias (its material's density, its section) or its
+/// length L(t) differences μᵀr whole (O(n) per parameter): their inertias and flow loads scale with L(t).
 class ParameterVjp {
  public:
   ParameterVjp(const System& sys, const std::vector<SensitivityParameter>& parameters);
@@ -93,6 +93,7 @@ class ParameterVjp {
   const System& sys_;
   std::vector<SensitivityParameter> parameters_;
   std::vector<std::vector<Component>> touched_;  // per parameter
+  std::vector<bool> whole_;                       // per parameter: μᵀr differenced whole (links of varying length)
   std::vector<Vec6> V_;                           // (nbodies) V_b = Σ s_u μ_u along the path
   std::vector<double> base_[5];                   // per kind of component in r: its power on the run's system, or NaN
   std::unique_ptr<Data> e_;                       // the loops' terms on the systems at p ± h (same sizes)
