@@ -1972,7 +1972,7 @@ class Gen:
         return self.emit(f"{bm['var']}.point", [a], ["s"], label="Beam.point")
 
     def gradient_call(self):
-        """rf.gradient over 10 steps: a system it refuses (radau5 with loops, arms, Lagrange, nq = 0) names ``system`` or
+        """rf.gradient over 10 steps: a system it refuses (arms, Lagrange, nq = 0) names ``system`` or
         ``outputs``; a Newton failure is a SimulationError; one bad argument is a ValueError naming it."""
         def pick(good, bad, names):
             return A(self.choice(bad), bad=True, names=names) if self.chance(0.15) else A(self.choice(good))

@@ -38,7 +38,7 @@ std::vector<double> grid(double t0, double t_end, double dt) {
 class Transposes : public AdjointSteps {
  public:
   Transposes(const System& sys, const IntegratorOptions& o, ParameterVjp& params)
-      : sys_(sys), params_(params), d_(sys), matrix_(NewtonMatrix::make(sys, o, istats_)) {}
+      : sys_(sys), params_(params), d_(sys), e_(sys), matrix_(NewtonMatrix::make(sys, o, istats_)) {}
 
   void start(double t0, const VecX& q0, const VecX& qd0) override {
     VecX y0(2 * sys_.nq);
@@ -51,11 +51,22 @@ class Transposes : public AdjointSteps {
       step_failure(t, h, "Newton iterations did not converge in newton_max_iterations; reduce dt or raise "
                          "newton_max_iterations");
     stepper().accept();
+    if (sys_.nl > 0) stepper().project(t + h);  // radau5 (as integrate() runs it; the Newmark family: nothing)
   }
 
  protected:
   /// The method's own stepper, which the forward run and the replays step with.
   virtual Stepper& stepper() = 0;
+  /// Loops: H v = ∂(G(q)ᵀλ)/∂q v at (t, q, q̇) for the multipliers λ, by a central difference along v.
+  VecX hessian(double t, const VecX& q, const VecX& qd, const VecX& lambda, const VecX& v) {
+    const double size = max_abs(v) / std::max(1.0, max_abs(q));
+    if (size == 0.0) return VecX::Zero(sys_.nq);
+    const double eps = 6e-6 / size;
+    loop_equations(sys_, e_, t, q + eps * v, qd);
+    const VecX up = free_jacobian(sys_, e_).transpose() * lambda;
+    loop_equations(sys_, e_, t, q - eps * v, qd);
+    return (up - free_jacobian(sys_, e_).transpose() * lambda) / (2.0 * eps);
+  }
   /// set_state, q̈ and the axes on d_ at (t, q, q̇, q̈): what the reverse mode starts from.
   void at(double t, const Eigen::Ref<const VecX>& q, const Eigen::Ref<const VecX>& v, const Eigen::Ref<const VecX>& a) {
     set_state(sys_, d_, t, q, v);
@@ -86,7 +97,7 @@ class Transposes : public AdjointSteps {
 
   const System& sys_;
   ParameterVjp& params_;
-  Data d_;
+  Data d_, e_;  // the state's, and the loops' equations'
   IntegratorStats istats_;
   std::unique_ptr<NewtonMatrix> matrix_;
   Gmres<double> gmres_;
@@ -105,7 +116,7 @@ class NewmarkSteps final : public Transposes {
 
   StepRecord record(double t, double h) const override {
     const NewmarkState& s = stepper_->current();
-    return {t, h, s.q, s.v, s.qdd, s.a, s.lambda, {}, {}, {}};
+    return {t, h, s.q, s.v, s.qdd, s.a, s.lambda, {}, {}, {}, {}};
   }
   void restore(const StepRecord& r) override {
     NewmarkState s;
@@ -126,7 +137,7 @@ class NewmarkSteps final : public Transposes {
     auto S = [&](const VecX& v, VecX& out) {
       const ResidualVjp r = rnea_vector_jacobian_product(sys_, d_, v);
       out = r.qdd + c1 * r.qd + c2 * r.q;
-      if (loops) out -= c2 * hessian(s, v);
+      if (loops) out -= c2 * hessian(s.t, s.q, s.v, s.lambda, v);
     };
     auto P = [&](const VecX& v, VecX& out) { matrix_->precondition_transposed(v, out); };
     auto refresh = [&] {
@@ -143,7 +154,7 @@ class NewmarkSteps final : public Transposes {
       for (int k = 0; k < sys_.nl; ++k) Y.col(k) = gmres(S, P, VecX(c2 * G.row(k).transpose()), refresh, s.t);
       nu = least_norm(G * Y, G * mu);
       mu -= Y * nu;
-      loop_q = G.transpose() * nu - hessian(s, mu);
+      loop_q = G.transpose() * nu - hessian(s.t, s.q, s.v, s.lambda, mu);
     }
     const ResidualVjp r = rnea_vector_jacobian_product(sys_, d_, mu);  // d_ still at the step's end (GMRES's products)
     const VecX qh = loops ? VecX(qb - r.q - loop_q) : VecX(qb - r.q), vh = vb - r.qd;
@@ -178,7 +189,7 @@ class NewmarkSteps final : public Transposes {
     bars.segment(n, n) -= r.qd;
     params_.add(d_, mu, r, -1.0, grad);
     if (sys_.nl == 0) return;
-    bars.segment(0, n) += hessian(s, mu);
+    bars.segment(0, n) += hessian(s.t, s.q, s.v, s.lambda, mu);
     // ν_0ᵀ (G q̈_0 − γ)(q, q̇) differentiated by each coordinate of q and q̇
     auto c = [&](const VecX& q, const VecX& v) {
       loop_equations(sys_, e_, s.t, q, v);
@@ -203,20 +214,8 @@ class NewmarkSteps final : public Transposes {
  private:
   Stepper& stepper() override { return *stepper_; }
 
-  /// H v = ∂(G(q)ᵀλ)/∂q v at the step's end (λ its multipliers), by a central difference along v.
-  VecX hessian(const StepRecord& s, const VecX& v) {
-    const double size = max_abs(v) / std::max(1.0, max_abs(s.q));
-    if (size == 0.0) return VecX::Zero(sys_.nq);
-    const double eps = 6e-6 / size;
-    loop_equations(sys_, e_, s.t, s.q + eps * v, s.v);
-    const VecX up = free_jacobian(sys_, e_).transpose() * s.lambda;
-    loop_equations(sys_, e_, s.t, s.q - eps * v, s.v);
-    return (up - free_jacobian(sys_, e_).transpose() * s.lambda) / (2.0 * eps);
-  }
-
   std::unique_ptr<NewmarkStepper> stepper_;
   NewmarkCoefficients k_;
-  Data e_{sys_};  // the loops' equations
 };
 
 /// radau5 (adjoint.hpp): the adjoint state (q̄, q̇̄).
@@ -229,29 +228,38 @@ class RadauSteps final : public Transposes {
   }
 
   StepRecord record(double t, double h) const override {
-    StepRecord r{t, h, {}, {}, {}, {}, {}, {}, {}, {}};
+    StepRecord r{t, h, {}, {}, {}, {}, {}, {}, {}, {}, {}};
     access_->current(r.q, r.v, r.qdd);
     if (h > 0.0) access_->stages(r.Q, r.V, r.A);
+    if (h > 0.0 && sys_.nl > 0) access_->stage_multipliers(r.L);
     return r;
   }
   void restore(const StepRecord& r) override { access_->restore(r.t, r.q, r.v, r.qdd); }
   int adjoint_size() const override { return 2; }
 
   void transpose(const StepRecord& s, VecX& bars, VecX& grad) override {
-    const int n = sys_.nq;
+    const int n = sys_.nq, nl = sys_.nl;
+    const bool loops = nl > 0;
     const double h = s.h, t0 = s.t - h;
     const Eigen::Matrix3d& a = tab_.a;
     const Eigen::Matrix3d a2 = a * a;
+    if (loops) transpose_projection(s, bars, grad);
     MatX Qb = MatX::Zero(n, 3), Vb = MatX::Zero(n, 3);
     Qb.col(2) = bars.head(n), Vb.col(2) = bars.tail(n);
+    // loops: each stage's G_i, and (∂c_i/∂V_i, ∂c_i/∂Q_i) of its constraint c_i = G_i A_i − γ_i (loop_rates)
+    MatX Gs[3], DV[3], DQ[3];
+    if (loops)
+      for (int i = 0; i < 3; ++i) loop_rates(t0 + tab_.c(i) * h, s.Q.col(i), s.V.col(i), s.A.col(i), Gs[i], DV[i], DQ[i]);
     const MatX Vt = Vb + h * Qb * a;
     const MatX G = h * Vt * a;
     // 𝒮ᵀ μ by the reverse mode at each stage: M_j μ_j + h Σ_i a_ij C_iᵀ μ_i + h² Σ_i (a²)_ij K_iᵀ μ_i
     MatX Kmu(n, 3), Cmu(n, 3), Mmu(n, 3);
     auto products = [&](const MatX& mu) {
       for (int i = 0; i < 3; ++i) {
-        const ResidualVjp r = vjp(t0 + tab_.c(i) * h, s.Q.col(i), s.V.col(i), s.A.col(i), mu.col(i));
+        const double ti = t0 + tab_.c(i) * h;
+        const ResidualVjp r = vjp(ti, s.Q.col(i), s.V.col(i), s.A.col(i), mu.col(i));
         Kmu.col(i) = r.q, Cmu.col(i) = r.qd, Mmu.col(i) = r.qdd;
+        if (loops) Kmu.col(i) -= hessian(ti, s.Q.col(i), s.V.col(i), s.L.col(i), mu.col(i));  // K_i − H_i
       }
     };
     auto S = [&](const VecX& v, VecX& out) {
@@ -274,22 +282,53 @@ class RadauSteps final : public Transposes {
       out = Eigen::Map<const VecX>(Y.data(), 3 * n);
     };
     const VecX g = Eigen::Map<const VecX>(G.data(), 3 * n);
-    const VecX m = gmres(S, P, g, [&] {
+    auto refresh = [&] {
       matrix_->linearize(s.t, s.q, s.v, s.qdd, VecX());
       const double gr = h * tab_.d(0).real();
       const cplx gc = h * tab_.d(1);
       if (!(matrix_->factor(gr, gr * gr, VecX()) > 1e-15) || !(matrix_->factor(gc, gc * gc) > 1e-15))
         throw SimulationError(s.t, "the adjoint's Newton matrix of radau5 is singular");
-    }, s.t);
+    };
+    VecX m = gmres(S, P, g, refresh, s.t);
+    MatX nu;  // (nl, 3) the stages' constraint adjoints
+    if (loops) {
+      // 𝒮ᵀμ + Zν = g, G_i μ_i = 0 (each stage), Z = (∂c/∂A)ᵀ: (Zν)_j = G_jᵀν_j + h Σ_i a_ij DV_iᵀν_i +
+      // h² Σ_i (a²)_ij DQ_iᵀν_i. By the Schur complement: μ = x − Wν, W = 𝒮⁻ᵀZ (3 nl solves), (𝒢W)ν = 𝒢x.
+      MatX W(3 * n, 3 * nl), GW(3 * nl, 3 * nl);
+      for (int i = 0; i < 3; ++i)
+        for (int k = 0; k < nl; ++k) {
+          MatX z = MatX::Zero(n, 3);
+          z.col(i) = Gs[i].row(k).transpose();
+          for (int j = 0; j < 3; ++j)
+            z.col(j) += (h * a(i, j)) * DV[i].row(k).transpose() + (h * h * a2(i, j)) * DQ[i].row(k).transpose();
+          W.col(i * nl + k) = gmres(S, P, Eigen::Map<const VecX>(z.data(), 3 * n), refresh, s.t);
+        }
+      auto stage_constraints = [&](const VecX& x) {  // 𝒢x: (G_i x_i) stacked
+        VecX c(3 * nl);
+        for (int i = 0; i < 3; ++i) c.segment(i * nl, nl) = Gs[i] * x.segment(i * n, n);
+        return c;
+      };
+      for (int col = 0; col < 3 * nl; ++col) GW.col(col) = stage_constraints(W.col(col));
+      const VecX v = least_norm(GW, stage_constraints(m));
+      m -= W * v;
+      nu = Eigen::Map<const MatX>(v.data(), nl, 3);
+    }
     const MatX mu = Eigen::Map<const MatX>(m.data(), n, 3);
-    // q̂ = Q̄ − Kμ, V̂ = V̄ − Cμ; q̄_n = Σ Q̂_i, q̇̄_n = Σ V̂_i + h Σ c_i Q̂_i; dJ/dp −= Σ μ_iᵀ ∂r_i/∂p
+    // q̂ = Q̄ − Kμ, V̂ = V̄ − Cμ (loops: − (K − H)μ − DQᵀν, − DVᵀν); q̄_n = Σ Q̂_i, q̇̄_n = Σ V̂_i + h Σ c_i Q̂_i;
+    // dJ/dp −= Σ μ_iᵀ ∂r_i/∂p (loops: + μ_iᵀ ∂(−G_iᵀΛ_i)/∂p + ν_iᵀ ∂c_i/∂p)
     VecX qb = VecX::Zero(n), vb = VecX::Zero(n);
     for (int i = 0; i < 3; ++i) {
-      const ResidualVjp r = vjp(t0 + tab_.c(i) * h, s.Q.col(i), s.V.col(i), s.A.col(i), mu.col(i));
-      const VecX Qh = Qb.col(i) - r.q, Vh = Vb.col(i) - r.qd;
+      const double ti = t0 + tab_.c(i) * h;
+      const ResidualVjp r = vjp(ti, s.Q.col(i), s.V.col(i), s.A.col(i), mu.col(i));
+      VecX Qh = Qb.col(i) - r.q, Vh = Vb.col(i) - r.qd;
+      params_.add(d_, mu.col(i), r, -1.0, grad);
+      if (loops) {
+        Qh += hessian(ti, s.Q.col(i), s.V.col(i), s.L.col(i), mu.col(i)) - DQ[i].transpose() * nu.col(i);
+        Vh -= DV[i].transpose() * nu.col(i);
+        params_.add_loops(ti, s.Q.col(i), s.V.col(i), s.A.col(i), s.L.col(i), mu.col(i), nu.col(i), true, grad);
+      }
       qb += Qh;
       vb += Vh + (h * tab_.c(i)) * Qh;
-      params_.add(d_, mu.col(i), r, -1.0, grad);
     }
     bars << qb, vb;
   }
@@ -299,6 +338,52 @@ class RadauSteps final : public Transposes {
 
  private:
   Stepper& stepper() override { return *stepper_; }
+
+  /// Loops: the step's end (Q_3, V_3) is projected onto them (project_onto_loops), whose derivative at the
+  /// projected (q, q̇) is (SensitivityEquations::project)
+  ///   δq' = Π δq − B g_p,   δq̇' = Π δq̇ − B (D δq' + ġ_p),   Π = 1 − B G,  B = Y (G Y)⁺,  Y = M⁻¹Gᵀ,  D = ∂ġ/∂q.
+  /// Transposed: w = Bᵀq̇̄', x = q̄' − Dᵀw, q̄ = Πᵀx, q̇̄ = Πᵀq̇̄' and dJ/dp −= (Bᵀx)ᵀ g_p + wᵀ ġ_p (a drive's numbers);
+  /// Bᵀy = (G Y)⁺ Yᵀ y (G Y symmetric), Dᵀw by a central difference of Gᵀw along the motion (loop_rates).
+  void transpose_projection(const StepRecord& s, VecX& bars, VecX& grad) {
+    const int n = sys_.nq;
+    loop_equations(sys_, e_, s.t, s.q, s.v);
+    const MatX G = free_jacobian(sys_, e_);
+    factor_mass(sys_, e_);
+    const MatX Y = solve_armature(sys_, e_, MatX(G.transpose())), GY = G * Y;
+    const VecX qbar = bars.head(n), vbar = bars.tail(n);
+    const VecX w = least_norm(GY, Y.transpose() * vbar);
+    const double eps = motion_step(s.q, s.v, VecX::Zero(n), 6e-6);
+    loop_equations(sys_, e_, s.t + eps, s.q + eps * s.v, s.v);
+    VecX Dw = free_jacobian(sys_, e_).transpose() * w;
+    loop_equations(sys_, e_, s.t - eps, s.q - eps * s.v, s.v);
+    Dw = (Dw - free_jacobian(sys_, e_).transpose() * w) / (2.0 * eps);
+    const VecX x = qbar - Dw, bx = least_norm(GY, Y.transpose() * x);
+    bars.head(n) = x - G.transpose() * bx;
+    bars.tail(n) = vbar - G.transpose() * w;
+    params_.add_projection(s.t, s.q, s.v, bx, w, grad);
+  }
+
+  /// G (nl, nq) at a stage (t, q, q̇, q̈), and the derivatives of c = G q̈ − γ = g̈ by q̇ and q: ∂c/∂q̇ = 2 dG/dt
+  /// and ∂c/∂q = d²G/dt² (row by row, the gradients of νᵀg̈), along the motion q(τ) = q + τ q̇ + τ²/2 q̈ at t + τ
+  /// (the prescribed coordinates along their profiles): central differences, first and second.
+  void loop_rates(double t, const VecX& q, const VecX& v, const VecX& acc, MatX& G, MatX& DV, MatX& DQ) {
+    auto jacobian = [&](double tau) {
+      loop_equations(sys_, e_, t + tau, q + tau * v + (0.5 * tau * tau) * acc, v + tau * acc);
+      return MatX(free_jacobian(sys_, e_));
+    };
+    G = jacobian(0.0);
+    const double e1 = motion_step(q, v, acc, 6e-6), e2 = motion_step(q, v, acc, 1e-4);
+    DV = (jacobian(e1) - jacobian(-e1)) / e1;  // 2 (G(+) − G(−))/(2ε)
+    DQ = (jacobian(e2) - 2.0 * G + jacobian(-e2)) / (e2 * e2);
+  }
+
+  /// τ (s) that moves q along the motion by about `size` relative to max(1, |q|), and t by at most `size`.
+  static double motion_step(const VecX& q, const VecX& v, const VecX& acc, double size) {
+    const double scale = std::max(1.0, max_abs(q));
+    const double rate = std::max({max_abs(v) / scale, std::sqrt(max_abs(acc) / scale), 1.0});
+    return size / rate;
+  }
+
   std::unique_ptr<Stepper> stepper_;
   RadauAccess* access_;
   const RadauTableau tab_;
@@ -313,9 +398,6 @@ Adjoint::Adjoint(std::shared_ptr<const System> sys, const IntegratorOptions& o, 
   if (!reverse_mode(s))
     throw std::invalid_argument("system: expected a system compiled with algorithm='recursive' (the adjoint "
                                 "transposes the recursive engine's derivatives), got algorithm='lagrange'");
-  if (s.nl > 0 && o.method == Method::Radau5)
-    throw std::invalid_argument("system: expected no loop closures with method 'radau5' (its adjoint does not hold "
-                                "them yet; the Newmark family's does), got " + std::to_string(s.nl) + " rows");
   if (s.nz > 0) throw std::invalid_argument("system: expected no Maxwell arms (not implemented for the adjoint yet)");
   if (!(o.dt > 0.0)) bad("dt", "a fixed step > 0 (s)", num(o.dt));
   if (!(memory > 0.0)) bad("memory", "a number of bytes > 0", num(memory));
@@ -351,7 +433,7 @@ void Adjoint::forward(double t0, double t_end, const VecX& q0, const VecX& qd0) 
   const long N = static_cast<long>(t_.size()) - 1;
   // every state if they fit, else checkpoints every k = ⌈√N⌉ steps and one segment of k states
   const double stages = o_.method == Method::Radau5 ? 9.0 : 0.0;
-  const double state_bytes = 8.0 * ((4.0 + stages) * n + 16.0);
+  const double state_bytes = 8.0 * ((4.0 + stages) * n + 4.0 * s.nl + 16.0);  // radau5 with loops: Λ too
   interval_ = 1;
   if ((N + 1) * state_bytes > memory_) {
     interval_ = static_cast<long>(std::ceil(std::sqrt(static_cast<double>(N))));

@@ -193,25 +193,29 @@ void ParameterVjp::add(const Data& d, const VecX& mu, const ResidualVjp& r, doub
   }
 }
 
+bool ParameterVjp::moves_loops(int j) const {
+  return std::any_of(touched_[j].begin(), touched_[j].end(), [](const Component& c) {
+    return c.kind == Component::Drive || c.kind == Component::Actuator;
+  });
+}
+
 void ParameterVjp::add_loops(double t, const VecX& q, const VecX& qd, const VecX& qdd, const VecX& lambda,
                              const VecX& mu, const VecX& nu, bool acceleration, Eigen::Ref<VecX> grad) {
-  if (!e_) e_ = std::make_unique<Data>(sys_);
   // μᵀ(−Gᵀλ) + νᵀ c on a system at p ± h
-  auto terms = [&](const System& X) {
+  add_loop_difference([&](const System& X) {
     loop_equations(X, *e_, t, q, qd);
     const MatX G = free_jacobian(X, *e_);
     const VecX c = acceleration ? VecX(G * qdd - e_->gamma) : VecX(e_->g);
     return -mu.dot(G.transpose() * lambda) + nu.dot(c);
-  };
-  for (std::size_t j = 0; j < parameters_.size(); ++j) {
-    const SensitivityParameter& p = parameters_[j];
-    const bool moves_loops = std::any_of(touched_[j].begin(), touched_[j].end(), [](const Component& c) {
-      return c.kind == Component::Drive || c.kind == Component::Actuator;
-    });
-    if (!moves_loops) continue;  // the constants are not in g, G or γ
-    const double up = terms(*p.plus), down = p.minus ? terms(*p.minus) : terms(sys_);
-    grad(j) -= (up - down) / (p.minus ? 2.0 * p.h : p.h);
-  }
+  }, grad);
+}
+
+void ParameterVjp::add_projection(double t, const VecX& q, const VecX& qd, const VecX& a, const VecX& b,
+                                  Eigen::Ref<VecX> grad) {
+  add_loop_difference([&](const System& X) {  // aᵀg + bᵀġ on a system at p ± h
+    loop_equations(X, *e_, t, q, qd);
+    return a.dot(e_->g) + b.dot(e_->gd);
+  }, grad);
 }
 
 void ParameterVjp::add_prescribed(double t, const VecX& pbar, Eigen::Ref<VecX> grad) const {

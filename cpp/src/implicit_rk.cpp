@@ -658,6 +658,7 @@ class Radau5 final : public ImplicitRk, public RadauAccess {
         w_(3 * sys.nl), E_(n_, 3), Z_(n_, 3) {}
 
   void stages(MatX& Q, MatX& V, MatX& A) const override { Q = Q_, V = V_, A = A_; }
+  void stage_multipliers(MatX& L) const override { L = L_; }
   void current(VecX& q, VecX& v, VecX& a) const override { q = q_, v = v_, a = a_; }
   void restore(double t, const VecX& q, const VecX& v, const VecX& a) override {
     q_ = q, v_ = v, a_ = a;

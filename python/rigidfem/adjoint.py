@@ -20,7 +20,7 @@ with t (N + 1,) and y a dict {name: (N + 1, 3) or (N + 1,)} returns L at every s
 complex input (abs, comparisons, float()) is differentiated by central differences instead
 (``Gradient.stats["objective_derivative"]`` says which).
 
-Closed loops with the Newmark family (not radau5 yet), a drive's or an actuator's numbers moving them included. Not
+Closed loops with the Newmark family and radau5, a drive's or an actuator's numbers moving them included. Not
 yet: Maxwell arms, the Lagrange engine (algorithm='lagrange'), adaptive steps. Links of varying length: a parameter of
 their rfes' inertias or of L(t) by differences of μᵀr whole (O(n) per such parameter and step).
 """

@@ -24,6 +24,10 @@
 /// redundant rows), then q̂ = q̄ − (Kᵀμ − ∂(Gᵀλ)/∂q μ) − Gᵀν. At t0 the constrained forward dynamics transposed:
 /// Mμ₀ + Gᵀν₀ = ā₀ + q̈̄₀, Gμ₀ = 0, and ∂(G q̈ − γ)/∂(q, q̇)ᵀν₀ by central differences (O(n²), once).
 ///
+/// radau5 with loops: the projection of each step's end transposed (RadauSteps::transpose_projection), then the
+/// stages' saddle system 𝒮ᵀμ + Zν = g, G_i μ_i = 0 (Z = (∂c/∂A)ᵀ of c_i = G_i A_i − γ_i, whose derivatives by V_i
+/// and Q_i are 2 dG/dt and d²G/dt² along the stage's motion) by its Schur complement (3 nl + 1 transposed solves).
+///
 /// Radau IIA (3 stages; implicit_rk.cpp): V = q̇_n 1ᵀ + h A aᵀ, Q = q_n 1ᵀ + h V aᵀ, r_i(Q_i, V_i, A_i) = 0, and
 /// (q, q̇)_{n+1} = (Q_3, V_3). With Q̄ = [0, 0, q̄_{n+1}], V̄ = [0, 0, q̇̄_{n+1}]:
 ///   V̄' = V̄ + h Q̄ a,   𝒮ᵀ μ = h V̄' a,   (𝒮ᵀμ)_j = M_j μ_j + h Σ_i a_ij C_iᵀ μ_i + h² Σ_i (a²)_ij K_iᵀ μ_i
@@ -76,6 +80,9 @@ class ParameterVjp {
   /// of the systems at p ± h at (t, q, q̇, q̈, λ).
   void add_loops(double t, const VecX& q, const VecX& qd, const VecX& qdd, const VecX& lambda, const VecX& mu,
                  const VecX& nu, bool acceleration, Eigen::Ref<VecX> grad);
+  /// Loops, radau5's projection: grad_j −= aᵀ ∂g/∂p_j + bᵀ ∂ġ/∂p_j at (t, q, q̇) for the parameters that move the
+  /// loops (a drive's or an actuator's numbers), by central differences of the systems at p ± h.
+  void add_projection(double t, const VecX& q, const VecX& qd, const VecX& a, const VecX& b, Eigen::Ref<VecX> grad);
   int count() const { return static_cast<int>(parameters_.size()); }
   /// [∂q₀/∂p_j, ∂q̇₀/∂p_j] (2 nq).
   const VecX& initial(int j) const { return parameters_[j].S0; }
@@ -88,6 +95,19 @@ class ParameterVjp {
   };
   double power(const System& X, const Data& d, const Component& c, const VecX& mu) const;
   double residual_power(const System& X, const Data& d, const VecX& mu);  // μᵀ r of X at the state of d
+  bool moves_loops(int j) const;  // a drive's or an actuator's numbers: in the loops' g, G, γ
+  /// grad_j −= ∂f/∂p_j of a scalar f(X) of the loops' terms (on e_), by the difference of the systems at p ± h, for
+  /// the parameters that move the loops.
+  template <class F>
+  void add_loop_difference(F&& f, Eigen::Ref<VecX> grad) {
+    if (!e_) e_ = std::make_unique<Data>(sys_);
+    for (std::size_t j = 0; j < parameters_.size(); ++j) {
+      if (!moves_loops(static_cast<int>(j))) continue;
+      const SensitivityParameter& p = parameters_[j];
+      const double up = f(*p.plus), down = p.minus ? f(*p.minus) : f(sys_);
+      grad(j) -= (up - down) / (p.minus ? 2.0 * p.h : p.h);
+    }
+  }
   double base_power(const Data& d, const Component& c, const VecX& mu);
   MotionState drive_derivative(int j, int coord, double t) const;
   const System& sys_;
@@ -105,7 +125,8 @@ struct StepRecord {
   double t = 0.0, h = 0.0;  // h: the step that reached t (0 at t0)
   VecX q, v, qdd, a;
   VecX lambda;              // (nl) the loops' multipliers (the Newmark family)
-  MatX Q, V, A;
+  MatX Q, V, A;             // radau5: the step's stages (nq, 3)
+  MatX L;                   // radau5 with loops: the stages' multipliers (nl, 3)
 };
 
 struct AdjointStats {

@@ -42,6 +42,8 @@ class RadauAccess {
   virtual ~RadauAccess() = default;
   /// The converged stages Q, V, A (nq, 3) of the last attempted step, at t + c_i h.
   virtual void stages(MatX& Q, MatX& V, MatX& A) const = 0;
+  /// The converged stages' multipliers Λ (nl, 3) of the last attempted step (closed loops).
+  virtual void stage_multipliers(MatX& L) const = 0;
   /// q, q̇, q̈ after the last accepted step.
   virtual void current(VecX& q, VecX& v, VecX& a) const = 0;
   /// Makes (q, q̇, q̈) at t the current state (a checkpoint's; no Maxwell arms), without the last step's stages
