@@ -1,4 +1,4 @@
-"""``python -m benchmarks {scaling,peers,scale,loops,implicit_step,sweep,kane_peers,orders,tolerance,accuracy,viewer,sensitivities} [--quick] [--output DIR]``, from the root of a checkout."""
+"""``python -m benchmarks {scaling,peers,scale,loops,implicit_step,sweep,kane_peers,loop_peers,orders,tolerance,accuracy,viewer,sensitivities} [--quick] [--output DIR]``, from the root of a checkout."""
 
 from __future__ import annotations
 
@@ -15,6 +15,7 @@ COMMANDS = {
     "implicit_step": "where a generalised-alpha step's time goes on Kane's beam (m = 10 ... 1000): floor and parts",
     "sweep": "rf.sweep on 1 and 2 threads, 2 processes and a 2-worker Dask LocalCluster (needs dask[distributed])",
     "kane_peers": "Kane's spin-up beam (m = 20, 40): CPU time to a tip error against Exudyn and MuJoCo (needs: pip install exudyn mujoco)",
+    "loop_peers": "closed loops (a slider-crank with a flexible rod, a Bricard linkage): CPU time to a point error and the closure kept, against Exudyn and MuJoCo (needs: pip install exudyn mujoco)",
     "orders": "speed against error on Kane's beam: esdirk43, radau5, generalised-α and dopri5",
     "tolerance": "Kane's beam (m = 20): tip error delivered against rtol asked, every adaptive method; fixed-step failures",
     "accuracy": "the default asked for a tip error against the best of every method: strips, tapes, the bench's scenes",
