@@ -2,8 +2,12 @@
 
 from __future__ import annotations
 
+import ctypes
 import os
 import platform
+import shutil
+import subprocess
+import tempfile
 from pathlib import Path
 
 from rigidfem._core._bench import forward_dynamics_seconds
@@ -32,3 +36,20 @@ def report(tables: dict, output_dir) -> dict:
         print(f"\n{title} ({path}):\n")
         print(table.to_markdown(), flush=True)
     return {name: table for name, (_, table) in tables.items()}
+
+
+def compile_mujoco_callback(mujoco, source: str, prefix: str):
+    """A MuJoCo callback's C ``source`` compiled against MuJoCo's headers (cc -O2 -shared) and loaded by
+    ctypes, or None without a C compiler or the headers (the caller then falls back to Python)."""
+    compiler = shutil.which(os.environ.get("CC", "cc")) or shutil.which("gcc")
+    include = Path(mujoco.__file__).parent / "include"
+    if compiler is None or not (include / "mujoco" / "mujoco.h").exists():
+        return None
+    folder = Path(tempfile.mkdtemp(prefix=prefix))
+    (folder / "drive.c").write_text(source)
+    try:
+        subprocess.run([compiler, "-O2", "-shared", "-fPIC", f"-I{include}", str(folder / "drive.c"), "-o",
+                        str(folder / "drive.so"), "-lm"], check=True, capture_output=True)
+        return ctypes.CDLL(str(folder / "drive.so"))
+    except (OSError, subprocess.CalledProcessError):
+        return None

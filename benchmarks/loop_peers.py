@@ -81,10 +81,6 @@ from __future__ import annotations
 import ctypes
 import itertools
 import math
-import os
-import shutil
-import subprocess
-import tempfile
 import time
 import warnings
 from dataclasses import dataclass, field
@@ -96,7 +92,7 @@ import rigidfem as rf
 from rigidfem import SimulationError, simulate
 from rigidfem.study import Table
 
-from ._common import machine, report
+from ._common import compile_mujoco_callback, machine, report
 from .peers import Chain, _require, describe, to_mjcf
 
 INSTALL_HINT = 'pip install ".[benchmarks]" (or: pip install exudyn mujoco)'
@@ -597,19 +593,8 @@ void lp_drive(const mjModel* m, mjData* d) {
 
 
 def _compile_drive(mujoco):
-    """``_DRIVE_C`` compiled against MuJoCo's headers (cc -O2 -shared), or None."""
-    compiler = shutil.which(os.environ.get("CC", "cc")) or shutil.which("gcc")
-    include = Path(mujoco.__file__).parent / "include"
-    if compiler is None or not (include / "mujoco" / "mujoco.h").exists():
-        return None
-    folder = Path(tempfile.mkdtemp(prefix="loop_peers_"))
-    (folder / "drive.c").write_text(_DRIVE_C)
-    try:
-        subprocess.run([compiler, "-O2", "-shared", "-fPIC", f"-I{include}", str(folder / "drive.c"), "-o",
-                        str(folder / "drive.so"), "-lm"], check=True, capture_output=True)
-        return ctypes.CDLL(str(folder / "drive.so"))
-    except (OSError, subprocess.CalledProcessError):
-        return None
+    """``_DRIVE_C`` compiled against MuJoCo's headers, or None."""
+    return compile_mujoco_callback(mujoco, _DRIVE_C, "loop_peers_")
 
 
 @dataclass(frozen=True)
