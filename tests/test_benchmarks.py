@@ -116,6 +116,37 @@ def test_loop_peers_models_agree():
                 assert scene.drive_error(Q) < 1e-7
 
 
+def test_strip_peers_models_agree():
+    """The whippy strip of strip_peers (m = 4, 0.5 s) in its five models: the section read from the
+    System is the strip's; Exudyn's KinematicTree and MuJoCo's chain (RK4 at interval/64) give
+    rigidfem's tip within 1e-9 m (measured 1.6e-11 m), by the benchmark's forward kinematics,
+    itself rigidfem's; Exudyn's ANCF cable, another discretisation, is within 1e-2 m (4.4e-3 m);
+    MuJoCo's flex rod runs and bends (its clamp's first-order error puts it far off at m = 4)."""
+    pytest.importorskip("exudyn")
+    pytest.importorskip("mujoco")
+    from benchmarks import strip_peers as sp
+    from rigidfem import simulate
+
+    s = sp.whippy_strip(4)
+    sec = s.section
+    assert np.allclose([sec.length, sec.E, sec.width, sec.thickness, sec.rhoA], [1.0, 2.1e11, 0.02, 0.002, 7850 * 4e-5],
+                       rtol=1e-9)
+    runners = {code: cls(s) for code, cls in sp.RUNNERS.items()}
+    t_end = 0.5
+    q = runners["rigidfem"].run("radau5", "rtol", 1e-11, t_end=t_end)
+    r = simulate(s.system, t_end, method="radau5", rtol=1e-11, atol=1e-13, t_eval=s.t_eval[:101])
+    assert np.array_equal(q, r.q)
+    tip = sp.tip_position(s, q)
+    assert np.allclose(r.position(s.scene.tip), tip, rtol=0, atol=1e-12)
+    assert tip[:, 1].min() < -0.2  # the strip does swing down
+    for code, method, tol in [("Exudyn", "RK44", 1e-9), ("MuJoCo", "RK4", 1e-9), ("Exudyn ANCF", "GeneralizedAlpha", 1e-2)]:
+        error = sp.max_error(runners[code].tip(runners[code].run(method, "dt", s.interval / 64, t_end=t_end)), tip)
+        assert error < tol, f"{code} {method}: tip differs from rigidfem's by {error:.3g} m"
+    flex = runners["MuJoCo flex"]
+    bent = flex.tip(flex.run("RK4", "dt", s.interval / 64, t_end=t_end))
+    assert bent.shape == tip.shape and np.all(np.isfinite(bent)) and bent[:, 1].min() < -0.2
+
+
 def test_orders_study_table():
     """The high-order study's structure on a 4-element beam: every method reaches 1e-4 m, and the
     summary keeps the least time per method and target."""
