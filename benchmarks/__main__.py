@@ -1,4 +1,4 @@
-"""``python -m benchmarks {scaling,peers,scale,loops,implicit_step,sweep,kane_peers,loop_peers,strip_peers,orders,tolerance,accuracy,viewer,sensitivities} [--quick] [--output DIR]``, from the root of a checkout."""
+"""``python -m benchmarks {scaling,peers,scale,loops,implicit_step,sweep,kane_peers,loop_peers,sweep_peers,strip_peers,orders,tolerance,accuracy,viewer,sensitivities} [--quick] [--output DIR]``, from the root of a checkout."""
 
 from __future__ import annotations
 
@@ -16,6 +16,7 @@ COMMANDS = {
     "sweep": "rf.sweep on 1 and 2 threads, 2 processes and a 2-worker Dask LocalCluster (needs dask[distributed])",
     "kane_peers": "Kane's spin-up beam (m = 20, 40): CPU time to a tip error against Exudyn and MuJoCo (needs: pip install exudyn mujoco)",
     "loop_peers": "closed loops (a slider-crank with a flexible rod, a Bricard linkage): CPU time to a point error and the closure kept, against Exudyn and MuJoCo (needs: pip install exudyn mujoco)",
+    "sweep_peers": "64 runs of Kane's beam on 2 cores: rf.sweep (threads, processes, Dask) against Exudyn's ParameterVariation and MuJoCo's rollout, wall time at 1e-4 m (needs: pip install exudyn mujoco dask[distributed])",
     "strip_peers": "a whippy strip released from rest (m = 16, 32, 64): CPU time to a tip error against Exudyn (KinematicTree, ANCF cable) and MuJoCo (chain, flex rod) (needs: pip install exudyn mujoco)",
     "orders": "speed against error on Kane's beam: esdirk43, radau5, generalised-α and dopri5",
     "tolerance": "Kane's beam (m = 20): tip error delivered against rtol asked, every adaptive method; fixed-step failures",

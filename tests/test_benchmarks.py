@@ -116,6 +116,29 @@ def test_loop_peers_models_agree():
                 assert scene.drive_error(Q) < 1e-7
 
 
+def test_sweep_peers_structure():
+    """sweep_peers on a tiny case (m = 4, 3 spin rates, a tip error of 1e-3 m, one round, no Dask):
+    each code's setting chosen where it reaches the error at the lowest and highest Ω, MuJoCo's
+    per-rollout control array driving the hub exactly as kane_peers' callback, every executor of a
+    code giving the same results and each peer's tips agreeing with rigidfem's per Ω (asserted
+    inside), a timing row per executor (its numbers are the benchmark's, not asserted)."""
+    pytest.importorskip("exudyn")
+    pytest.importorskip("mujoco")
+    from benchmarks import sweep_peers as sp
+
+    tables = sp.measure(4, (4.0, 7.5, 11.0), rounds=1, dask=False, target=1e-3, log=lambda *_: None)
+    chosen = [r for r in tables["settings"].rows if r["chosen"] == "yes"]
+    assert sorted({r["code"] for r in chosen}) == ["Exudyn", "MuJoCo", "rigidfem"]
+    assert len(chosen) == 6 and all(r["tip_rms_error_m"] <= 1e-3 for r in chosen)
+    assert tables["settings"].rows[-1]["max_m"] < 1e-9  # rollout's control array = the callback
+    rows = tables["timing"].rows
+    assert len(rows) == 9 and all(r["runs"] == 3 and r["wall_time_s"] > 0 for r in rows)
+    assert min(r["time_over_rigidfem_best"] for r in rows) == 1.0 and rows[0]["speed_up_over_serial"] == 1.0
+    assert [r["omega"] for r in tables["agreement"].rows] == [4.0, 7.5, 11.0]
+    assert all(r["MuJoCo_vs_rigidfem_rms_m"] < 2e-3 and r["Exudyn_vs_rigidfem_rms_m"] < 2e-3
+               for r in tables["agreement"].rows)
+
+
 def test_strip_peers_models_agree():
     """The whippy strip of strip_peers (m = 4, 0.5 s) in its five models: the section read from the
     System is the strip's; Exudyn's KinematicTree and MuJoCo's chain (RK4 at interval/64) give
