@@ -238,8 +238,8 @@ class ExudynKane:
     def _build(self, scene: Kane, hub_inertia: float):
         exu = self.exu
         from exudyn.advancedUtilities import CreateSymbolicUserFunction
-        from exudyn.itemInterface import (LoadCoordinate, MarkerNodeCoordinate, NodeGenericODE2, NodePointGround,
-                                          ObjectConnectorCoordinate, ObjectKinematicTree, SensorNode)
+        from exudyn.itemInterface import (LoadCoordinate, MarkerNodeCoordinate, NodeGenericODE2, ObjectKinematicTree,
+                                          SensorNode)
 
         chain = scene.chain
         hub, welded = chain.links[0], chain.links[1]
@@ -283,20 +283,7 @@ class ExudynKane:
             self.keep.append(f)
             mbs.AddLoad(LoadCoordinate(markerNumber=marker, load=0.0, loadUserFunction=f))
         else:
-            def angle(mbs, t, itemNumber, lOffset):
-                return esym.IfThenElse(t < Ts, Om / Ts * (0.5 * t * t + (esym.cos(w * t) - 1.0) / w**2),
-                                       Om * (t - 0.5 * Ts))
-
-            def rate(mbs, t, itemNumber, lOffset):
-                return esym.IfThenElse(t < Ts, Om / Ts * (t - esym.sin(w * t) / w), esym.Real(Om))
-
-            f = CreateSymbolicUserFunction(mbs, angle, "offsetUserFunction", itemTypeName="ObjectConnectorCoordinate")
-            f_t = CreateSymbolicUserFunction(mbs, rate, "offsetUserFunction_t",
-                                             itemTypeName="ObjectConnectorCoordinate")
-            self.keep += [f, f_t]
-            ground = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=mbs.AddNode(NodePointGround()), coordinate=0))
-            mbs.AddObject(ObjectConnectorCoordinate(markerNumbers=[ground, marker], offsetUserFunction=f,
-                                                    offsetUserFunction_t=f_t))
+            self.keep += exudyn_spin_up(exu, mbs, marker, Om, Ts)
         sensor = mbs.AddSensor(SensorNode(nodeNumber=node, storeInternal=True,
                                           outputVariableType=exu.OutputVariableType.Coordinates))
         mbs.Assemble()
@@ -334,6 +321,31 @@ class ExudynKane:
 
     def reference(self) -> np.ndarray:
         return self.run("RK44", "dt", _divide(REFERENCE_STEP * 2.785 / self.scene.omega_max))
+
+
+def exudyn_spin_up(exu, mbs, marker: int, omega: float, duration: float) -> list:
+    """Holds the coordinate of ``marker`` (a MarkerNodeCoordinate of ``mbs``) on the spin-up θ(t) of
+    ``rigidfem.motion.spin_up(omega, duration)`` by an ``ObjectConnectorCoordinate`` to the ground with θ(t) and
+    θ̇(t) as symbolic user functions (C++ expression trees: no Python while solving). Returns the user functions,
+    which must outlive the system."""
+    from exudyn.advancedUtilities import CreateSymbolicUserFunction
+    from exudyn.itemInterface import MarkerNodeCoordinate, NodePointGround, ObjectConnectorCoordinate
+
+    esym = exu.symbolic
+    Om, Ts, w = omega, duration, 2.0 * math.pi / duration
+
+    def angle(mbs, t, itemNumber, lOffset):
+        return esym.IfThenElse(t < Ts, Om / Ts * (0.5 * t * t + (esym.cos(w * t) - 1.0) / w**2), Om * (t - 0.5 * Ts))
+
+    def rate(mbs, t, itemNumber, lOffset):
+        return esym.IfThenElse(t < Ts, Om / Ts * (t - esym.sin(w * t) / w), esym.Real(Om))
+
+    f = CreateSymbolicUserFunction(mbs, angle, "offsetUserFunction", itemTypeName="ObjectConnectorCoordinate")
+    f_t = CreateSymbolicUserFunction(mbs, rate, "offsetUserFunction_t", itemTypeName="ObjectConnectorCoordinate")
+    ground = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=mbs.AddNode(NodePointGround()), coordinate=0))
+    mbs.AddObject(ObjectConnectorCoordinate(markerNumbers=[ground, marker], offsetUserFunction=f,
+                                            offsetUserFunction_t=f_t))
+    return [f, f_t]
 
 
 class MujocoKane:

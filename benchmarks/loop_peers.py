@@ -93,6 +93,7 @@ from rigidfem import SimulationError, simulate
 from rigidfem.study import Table
 
 from ._common import compile_mujoco_callback, machine, report
+from .kane_peers import exudyn_spin_up
 from .peers import Chain, _require, describe, to_mjcf
 
 INSTALL_HINT = 'pip install ".[benchmarks]" (or: pip install exudyn mujoco)'
@@ -320,10 +321,9 @@ class ExudynLoops:
 
     def _build(self, scene: Scene):
         exu = self.exu
-        from exudyn.advancedUtilities import CreateSymbolicUserFunction
         from exudyn.itemInterface import (MarkerBodyRigid, MarkerKinematicTreeRigid, MarkerNodeCoordinate,
-                                          NodeGenericODE2, NodePointGround, ObjectConnectorCoordinate, ObjectGround,
-                                          ObjectJointGeneric, ObjectKinematicTree, SensorNode)
+                                          NodeGenericODE2, ObjectGround, ObjectJointGeneric, ObjectKinematicTree,
+                                          SensorNode)
 
         chain = scene.chain
         kinds = {"rx": exu.JointType.RevoluteX, "ry": exu.JointType.RevoluteY, "rz": exu.JointType.RevoluteZ,
@@ -369,25 +369,9 @@ class ExudynLoops:
                                              constrainedAxes=list(loop.held)))
         if scene.drive is not None:
             coordinate, _ = scene.drive
-            esym = exu.symbolic
-            Om, Ts, w = OMEGA, T_SPIN, 2.0 * math.pi / T_SPIN
-
-            def angle(mbs, t, itemNumber, lOffset):
-                return esym.IfThenElse(t < Ts, Om / Ts * (0.5 * t * t + (esym.cos(w * t) - 1.0) / w**2),
-                                       Om * (t - 0.5 * Ts))
-
-            def rate(mbs, t, itemNumber, lOffset):
-                return esym.IfThenElse(t < Ts, Om / Ts * (t - esym.sin(w * t) / w), esym.Real(Om))
-
-            f = CreateSymbolicUserFunction(mbs, angle, "offsetUserFunction", itemTypeName="ObjectConnectorCoordinate")
-            f_t = CreateSymbolicUserFunction(mbs, rate, "offsetUserFunction_t",
-                                             itemTypeName="ObjectConnectorCoordinate")
-            self.keep += [f, f_t]
-            fixed = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=mbs.AddNode(NodePointGround()), coordinate=0))
             driven = mbs.AddMarker(MarkerNodeCoordinate(nodeNumber=node,
                                                         coordinate=chain.coordinate_names.index(coordinate)))
-            mbs.AddObject(ObjectConnectorCoordinate(markerNumbers=[fixed, driven], offsetUserFunction=f,
-                                                    offsetUserFunction_t=f_t))
+            self.keep += exudyn_spin_up(exu, mbs, driven, OMEGA, T_SPIN)
         sensor = mbs.AddSensor(SensorNode(nodeNumber=node, storeInternal=True,
                                           outputVariableType=exu.OutputVariableType.Coordinates))
         mbs.Assemble()

@@ -62,6 +62,7 @@ from rigidfem.study import Table
 
 from ._common import machine, report
 from .accuracy import strip
+from .kane_peers import _rotation
 from .peers import Chain, _require, describe, to_mjcf
 
 INSTALL_HINT = 'pip install ".[benchmarks]" (or: pip install exudyn mujoco)'
@@ -167,15 +168,6 @@ def whippy_strip(elements: int) -> Strip:
     M = system.mass_matrix(0.0, np.zeros(system.nq))
     omega_max = float(np.sqrt(np.max(np.linalg.eigvals(np.linalg.solve(M, np.diag(system.stiffness))).real)))
     return Strip(elements, scene, describe(system), section(system, scene.tip), omega_max, scene.t_eval)
-
-
-def _rotation(axis: str, angle):
-    """(N, 4, 4) rotations about x, y or z by the angles (N,)."""
-    c, s = np.cos(angle), np.sin(angle)
-    R = np.tile(np.eye(4), (len(angle), 1, 1))
-    i, j = {"rx": (1, 2), "ry": (2, 0), "rz": (0, 1)}[axis]
-    R[:, i, i], R[:, i, j], R[:, j, i], R[:, j, j] = c, -s, s, c
-    return R
 
 
 def tip_position(s: Strip, q) -> np.ndarray:
