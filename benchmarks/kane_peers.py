@@ -40,7 +40,6 @@ Needs the peer codes: ``pip install exudyn mujoco``. SI units: m, rad, kg, s, N�
 from __future__ import annotations
 
 import ctypes
-import itertools
 import math
 import time
 import warnings
@@ -48,14 +47,15 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-import rigidfem
 from rigidfem import SimulationError, samples, simulate
 from rigidfem.study import Table
 
-from ._common import compile_mujoco_callback, machine, report
-from .peers import Chain, Link, _require, to_mjcf
+from . import _peers_common as common
+from ._common import compile_mujoco_callback, report
+from ._peers_common import INSTALL_HINT  # noqa: F401 - kept: this module's name for it
+from ._peers_common import cheapest, exudyn_settings, first_run, least_cpu_times, summary_table
+from .peers import Chain, Link, to_mjcf
 
-INSTALL_HINT = 'pip install ".[benchmarks]" (or: pip install exudyn mujoco)'
 OMEGA, SPIN_UP, T_END, OUTPUTS = 6.0, 15.0, 20.0, 201
 INTERVAL = T_END / (OUTPUTS - 1)  #: 0.1 s between outputs; every fixed step divides it
 HUB_INERTIA = 1e10                #: kg·m², the peers' flywheel hub
@@ -64,11 +64,7 @@ THRESHOLDS = (1e-4, 1e-6)         #: m, tip RMS errors
 REFERENCE_STEP = 0.5              #: the peers' references: RK4 at this fraction of its stability limit
 
 
-def _peer(module: str, package: str):
-    try:
-        return _require(module, package)
-    except ImportError as e:
-        raise ImportError(f"benchmarks.kane_peers needs '{package}': {INSTALL_HINT}") from e
+_peer = common.peer_guard("kane_peers")
 
 
 def spin_up_acceleration(t: float) -> float:
@@ -294,18 +290,7 @@ class ExudynKane:
         if setting != "dt":
             raise ValueError(f"setting: expected dt for Exudyn, got {setting}")
         _, mbs, sensor = self.systems["constraint" if method in self.IMPLICIT else "flywheel"]
-        ss = exu.SimulationSettings()
-        ti = ss.timeIntegration
-        ti.endTime = T_END
-        ti.numberOfSteps = int(round(T_END / value))
-        ti.automaticStepSize = False
-        ti.verboseMode = 0
-        ti.explicit.computeEndOfStepAccelerations = False  # not needed: saves a forward evaluation per step
-        ss.solution.file.write = False
-        ss.solution.sensors.writePeriod = INTERVAL
-        ss.show.computationTime = False
-        ss.show.statistics = False
-        ss.show.globalTimers = False
+        ss = exudyn_settings(exu, T_END, value, INTERVAL)
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
             try:
@@ -531,15 +516,8 @@ def sweep(scene: Kane, runners: dict, references: dict, todo: dict, budget: floa
             for value in values:
                 row = {"m": scene.elements, "code": code, "method": method, "setting": setting, "value": value,
                        "note": ""}
-                start = time.process_time()
-                try:
-                    q = runner.run(method, setting, value)
-                    row["first_cpu_s"] = time.process_time() - start
-                    row["tip_rms_m"] = rms_error(tip_in_hub(scene, q), ref)
-                except (SimulationError, RuntimeError) as e:
-                    row.update(first_cpu_s=time.process_time() - start, tip_rms_m=np.inf, note=str(e)[:80])
-                if not np.isfinite(row["tip_rms_m"]) or row["tip_rms_m"] > 1.0:
-                    row["note"] = row["note"] or "unstable or diverged"
+                first_run(row, lambda: runner.run(method, setting, value),
+                          lambda q: {"tip_rms_m": rms_error(tip_in_hub(scene, q), ref)}, "tip_rms_m")
                 rows.append(row)
                 if row["tip_rms_m"] <= min(THRESHOLDS) or row["first_cpu_s"] > budget:
                     break
@@ -556,36 +534,12 @@ def timed(rows: list, runners: dict, rounds: int, long: float = 3.0) -> None:
         r["cpu_s"] = r["first_cpu_s"]
         if r["tip_rms_m"] <= max(THRESHOLDS):
             todo.setdefault(r["code"], []).append(r)
-    order = [r for group in itertools.zip_longest(*todo.values()) for r in group if r is not None]
-    for _ in range(rounds):
-        for r in order:
-            if r["first_cpu_s"] > long:
-                continue  # a long run is timed once (its first run): its noise is small against it
-            start = time.process_time()
-            runners[r["code"]].run(r["method"], r["setting"], r["value"])
-            r["cpu_s"] = min(r["cpu_s"], time.process_time() - start)
-
-
-def cheapest(rows: list, code: str, threshold: float):
-    ok = [r for r in rows if r["code"] == code and r["tip_rms_m"] <= threshold]
-    return min(ok, key=lambda r: r["cpu_s"]) if ok else None
+    least_cpu_times(todo, lambda r: runners[r["code"]].run(r["method"], r["setting"], r["value"]), rounds, long)
 
 
 def summary(rows: list, m: int) -> Table:
     """Per threshold: the cheapest run of each code (CPU s and setting) and the ratios."""
-    out = []
-    for tol in THRESHOLDS:
-        row = {"m": m, "tip_rms_error_m": tol}
-        best = {code: cheapest(rows, code, tol) for code in ("rigidfem", "Exudyn", "MuJoCo")}
-        for code, r in best.items():
-            row[f"{code}_cpu_s"] = r["cpu_s"] if r else "-"
-            row[f"{code}_setting"] = f"{r['method']} {r['setting']}={r['value']:.3g}" if r else "-"
-        for peer in ("Exudyn", "MuJoCo"):
-            row[f"{peer}/rigidfem"] = best[peer]["cpu_s"] / best["rigidfem"]["cpu_s"] \
-                if best[peer] and best["rigidfem"] else "-"
-        out.append(row)
-    return Table(out, ("m", "tip_rms_error_m", "rigidfem_cpu_s", "rigidfem_setting", "Exudyn_cpu_s",
-                       "Exudyn_setting", "MuJoCo_cpu_s", "MuJoCo_setting", "Exudyn/rigidfem", "MuJoCo/rigidfem"))
+    return summary_table(rows, {"m": m}, "tip_rms_error_m", "tip_rms_m", THRESHOLDS)
 
 
 def growth(rows: list, sizes) -> Table:
@@ -595,8 +549,8 @@ def growth(rows: list, sizes) -> Table:
     for tol in THRESHOLDS:
         row = {"tip_rms_error_m": tol}
         for code in ("rigidfem", "Exudyn", "MuJoCo"):
-            ra = cheapest([r for r in rows if r["m"] == a], code, tol)
-            rb = cheapest([r for r in rows if r["m"] == b], code, tol)
+            ra = cheapest([r for r in rows if r["m"] == a], code, "tip_rms_m", tol)
+            rb = cheapest([r for r in rows if r["m"] == b], code, "tip_rms_m", tol)
             row[f"{code}_m{b}/m{a}"] = rb["cpu_s"] / ra["cpu_s"] if ra and rb else "-"
         out.append(row)
     return Table(out, ("tip_rms_error_m", *(f"{c}_m{b}/m{a}" for c in ("rigidfem", "Exudyn", "MuJoCo"))))
@@ -606,9 +560,7 @@ SWEEP_COLUMNS = ("m", "code", "method", "setting", "value", "tip_rms_m", "cpu_s"
 
 
 def versions() -> dict:
-    exu, mujoco = _peer("exudyn", "exudyn"), _peer("mujoco", "mujoco")
-    return {"rigidfem": rigidfem.__version__, "exudyn": exu.__version__, "mujoco": mujoco.__version__,
-            "numpy": np.__version__}
+    return common.versions(_peer)
 
 
 def run(output_dir="bench", quick: bool = False) -> dict:
@@ -617,9 +569,7 @@ def run(output_dir="bench", quick: bool = False) -> dict:
     solvers, time the runs reaching 1e-4 m in 3 interleaved rounds, and print the cheapest
     setting per code and threshold, the ratios and the growth from the smaller m to the larger.
     Writes kane_peers_{verification,sweep,summary,growth}.csv into ``output_dir``."""
-    info = versions()
-    print(f"rigidfem {info['rigidfem']}, Exudyn {info['exudyn']}, MuJoCo {info['mujoco']}, numpy {info['numpy']}; "
-          f"{machine()}", flush=True)
+    print(common.versions_line(versions()), flush=True)
     sizes = (4, 6) if quick else (20, 40)
     checks, rows, summaries = [], [], []
     for m in sizes:
