@@ -79,7 +79,6 @@ Needs the peer codes: ``pip install exudyn mujoco``. SI units: m, rad, kg, s, N,
 from __future__ import annotations
 
 import ctypes
-import itertools
 import math
 import time
 import warnings
@@ -92,11 +91,13 @@ import rigidfem as rf
 from rigidfem import SimulationError, simulate
 from rigidfem.study import Table
 
-from ._common import compile_mujoco_callback, machine, report
+from . import _peers_common as common
+from ._common import compile_mujoco_callback, report
+from ._peers_common import CODES, INSTALL_HINT  # noqa: F401 - INSTALL_HINT kept: this module's name for it
+from ._peers_common import exudyn_settings, first_run, least_cpu_times, summary_columns, summary_table
 from .kane_peers import exudyn_spin_up
-from .peers import Chain, _require, describe, to_mjcf
+from .peers import Chain, describe, to_mjcf
 
-INSTALL_HINT = 'pip install ".[benchmarks]" (or: pip install exudyn mujoco)'
 THRESHOLDS = (1e-4, 1e-6)   #: largest point error over the outputs, relative to the point's motion amplitude
 AGREEMENT = 1e-7            #: relative: largest difference allowed between converged solutions
 CRANK_ARMATURE = 1e8        #: kg·m², MuJoCo's crank: a flywheel ...
@@ -116,11 +117,7 @@ BRICARD_LINK, BRICARD_MASS, BRICARD_SIDE = 1.0, 1.0, 0.1   #: m, kg, m (square s
 BRICARD_END, BRICARD_OUTPUTS = 10.0, 201
 
 
-def _peer(module: str, package: str):
-    try:
-        return _require(module, package)
-    except ImportError as e:
-        raise ImportError(f"benchmarks.loop_peers needs '{package}': {INSTALL_HINT}") from e
+_peer = common.peer_guard("loop_peers")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -381,17 +378,8 @@ class ExudynLoops:
         """Exudyn's settings for a run at the step h; ``newton``: Newton's (relative, absolute)
         tolerances instead of Exudyn's (1e-8, 1e-10)."""
         exu, s = self.exu, self.scene
-        ss = exu.SimulationSettings()
+        ss = exudyn_settings(exu, s.t_end, h, s.interval, end_accelerations=None)
         ti = ss.timeIntegration
-        ti.endTime = s.t_end
-        ti.numberOfSteps = int(round(s.t_end / h))
-        ti.automaticStepSize = False
-        ti.verboseMode = 0
-        ss.solution.file.write = False
-        ss.solution.sensors.writePeriod = s.interval
-        ss.show.computationTime = False
-        ss.show.statistics = False
-        ss.show.globalTimers = False
         if not s.planar:  # the Bricard's redundant row: Eigen's full-pivoting LU
             ss.linearSolver.solverType = exu.LinearSolverType.EigenDense
             ss.linearSolver.ignoreSingularJacobian = True
@@ -696,16 +684,8 @@ def sweep(scene: Scene, runners: dict, references: dict, todo: dict, budget: flo
             for value in values:
                 row = {"scene": scene.name, "code": code, "method": label, "setting": setting, "value": value,
                        "closure_max_g": np.nan, "note": "", "run": (method, options)}
-                start = time.process_time()
-                try:
-                    Q = runner.run(method, setting, value, **options)
-                    row["first_cpu_s"] = time.process_time() - start
-                    row["rel_error"] = error(scene, Q, ref)
-                    row["closure_max_g"] = scene.closure(Q)
-                except (SimulationError, RuntimeError) as e:
-                    row.update(first_cpu_s=time.process_time() - start, rel_error=np.inf, note=str(e)[:80])
-                if not np.isfinite(row["rel_error"]) or row["rel_error"] > 1.0:
-                    row["note"] = row["note"] or "unstable or diverged"
+                first_run(row, lambda: runner.run(method, setting, value, **options),
+                          lambda Q: {"rel_error": error(scene, Q, ref), "closure_max_g": scene.closure(Q)}, "rel_error")
                 rows.append(row)
                 if row["rel_error"] <= min(THRESHOLDS) or row["first_cpu_s"] > budget:
                     break
@@ -737,50 +717,23 @@ def timed(rows: list, runners: dict, rounds: int, long: float = 3.0, contenders:
                 least = min(r["first_cpu_s"] for r in within)
                 chosen += [r for r in within if r["first_cpu_s"] <= contenders * least and r["first_cpu_s"] <= long]
         todo[code] = list({id(r): r for r in chosen}.values())
-    order = [r for group in itertools.zip_longest(*todo.values()) for r in group if r is not None]
-    for _ in range(rounds):
-        for r in order:
-            method, options = r["run"]
-            start = time.process_time()
-            runners[r["code"]].run(method, r["setting"], r["value"], **options)
-            r["cpu_s"] = min(r["cpu_s"], time.process_time() - start)
-
-
-CODES = ("rigidfem", "Exudyn", "MuJoCo")
-
-
-def cheapest(rows: list, code: str, threshold: float):
-    ok = [r for r in rows if r["code"] == code and r["rel_error"] <= threshold]
-    return min(ok, key=lambda r: r["cpu_s"]) if ok else None
+    least_cpu_times(todo, lambda r: runners[r["code"]].run(r["run"][0], r["setting"], r["value"], **r["run"][1]),
+                    rounds)
 
 
 def summary(rows: list, scene: str) -> Table:
     """Per threshold: the cheapest run of each code (CPU s, setting, closure) and the ratios."""
-    out = []
-    for tol in THRESHOLDS:
-        row = {"scene": scene, "rel_error": tol}
-        best = {code: cheapest(rows, code, tol) for code in CODES}
-        for code, r in best.items():
-            row[f"{code}_cpu_s"] = r["cpu_s"] if r else "-"
-            row[f"{code}_setting"] = f"{r['method']} {r['setting']}={r['value']:.3g}" if r else "-"
-            row[f"{code}_closure"] = r["closure_max_g"] if r else "-"
-        for peer in CODES[1:]:
-            row[f"{peer}/rigidfem"] = best[peer]["cpu_s"] / best["rigidfem"]["cpu_s"] \
-                if best[peer] and best["rigidfem"] else "-"
-        out.append(row)
-    return Table(out, SUMMARY_COLUMNS)
+    return summary_table(rows, {"scene": scene}, "rel_error", "rel_error", THRESHOLDS,
+                         extra={"closure": lambda r: r["closure_max_g"]})
 
 
-SUMMARY_COLUMNS = ("scene", "rel_error", *(f"{c}_{k}" for c in CODES for k in ("cpu_s", "setting", "closure")),
-                   "Exudyn/rigidfem", "MuJoCo/rigidfem")
+SUMMARY_COLUMNS = summary_columns(("scene",), "rel_error", CODES, ("closure",))
 SWEEP_COLUMNS = ("scene", "code", "method", "setting", "value", "rel_error", "closure_max_g", "cpu_s", "first_cpu_s",
                  "note")
 
 
 def versions() -> dict:
-    exu, mujoco = _peer("exudyn", "exudyn"), _peer("mujoco", "mujoco")
-    return {"rigidfem": rf.__version__, "exudyn": exu.__version__, "mujoco": mujoco.__version__,
-            "numpy": np.__version__}
+    return common.versions(_peer)
 
 
 def runners_for(scene: Scene) -> dict:
@@ -802,9 +755,7 @@ def run(output_dir="bench", quick: bool = False) -> dict:
     every code's solvers, time the runs within 1e-4 in 3 interleaved rounds (``quick``: 1) and
     print the cheapest setting per code and threshold with the closure it keeps. Writes
     loop_peers_{verification,sweep,summary}.csv into ``output_dir``."""
-    info = versions()
-    print(f"rigidfem {info['rigidfem']}, Exudyn {info['exudyn']}, MuJoCo {info['mujoco']}, numpy {info['numpy']}; "
-          f"{machine()}", flush=True)
+    print(common.versions_line(versions()), flush=True)
     scenes = [lambda: slider_crank(4)] + ([] if quick else [lambda: slider_crank(16)]) + [
               lambda: bricard(outputs=41 if quick else BRICARD_OUTPUTS, t_end=2.0 if quick else BRICARD_END)]
     checks, rows, summaries = [], [], []
