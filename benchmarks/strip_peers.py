@@ -47,7 +47,6 @@ Needs the peer codes: ``pip install exudyn mujoco``. SI units: m, rad, kg, s, N.
 
 from __future__ import annotations
 
-import itertools
 import math
 import time
 import warnings
@@ -56,16 +55,17 @@ from pathlib import Path
 
 import numpy as np
 
-import rigidfem
 from rigidfem import SimulationError, simulate
 from rigidfem.study import Table
 
-from ._common import machine, report
+from . import _peers_common as common
+from ._common import report
+from ._peers_common import INSTALL_HINT  # noqa: F401 - kept: this module's name for it
+from ._peers_common import exudyn_settings, first_run, least_cpu_times, setting_text, summary_columns, summary_table
 from .accuracy import strip
 from .kane_peers import _rotation
-from .peers import Chain, _require, describe, to_mjcf
+from .peers import Chain, describe, to_mjcf
 
-INSTALL_HINT = 'pip install ".[benchmarks]" (or: pip install exudyn mujoco)'
 AGREEMENT = 1e-6          #: m, largest tip difference allowed between the identical models' converged solutions
 THRESHOLDS = (1e-4, 1e-6)  #: m, largest tip errors
 CODES = ("rigidfem", "Exudyn", "Exudyn ANCF", "MuJoCo", "MuJoCo flex")
@@ -81,11 +81,7 @@ LONG = 2.0          #: s, a run whose first took longer is timed once (its first
 EDGE_SOLREF = 1e-3  #: s, the time constant of MuJoCo's edge equality constraints on the flex rod (MujocoFlex)
 
 
-def _peer(module: str, package: str):
-    try:
-        return _require(module, package)
-    except ImportError as e:
-        raise ImportError(f"benchmarks.strip_peers needs '{package}': {INSTALL_HINT}") from e
+_peer = common.peer_guard("strip_peers")
 
 
 # ---------------------------------------------------------------------------------------------
@@ -216,7 +212,20 @@ def _explicit(s: Strip, limit: float, quick: bool, factors=STABLE) -> list:
 # angles or tip positions) at the output times, ``tip`` turns it into the tip (N, 3)
 # ---------------------------------------------------------------------------------------------
 
-class RigidfemStrip:
+class _OnTheChain:
+    """What the three models of rigidfem's chain share (rigidfem's, Exudyn's KinematicTree and
+    MuJoCo's chain, all with the chain's coordinates): the tip by the chain's forward kinematics
+    (``tip_position``) and the chain's highest natural frequency."""
+
+    def tip(self, raw) -> np.ndarray:
+        return tip_position(self.s, raw)
+
+    @property
+    def omega_max(self) -> float:
+        return self.s.omega_max
+
+
+class RigidfemStrip(_OnTheChain):
     code = "rigidfem"
 
     def __init__(self, s: Strip):
@@ -234,13 +243,6 @@ class RigidfemStrip:
             r = simulate(self.s.system, t_end, method=method, t_eval=self.s.t_eval[self.s.t_eval <= t_end + 1e-12],
                          max_steps=10**8, stiffness_warning=False, **kw)
         return np.asarray(r.q)
-
-    def tip(self, raw) -> np.ndarray:
-        return tip_position(self.s, raw)
-
-    @property
-    def omega_max(self) -> float:
-        return self.s.omega_max
 
     def references(self) -> list:
         """radau5 at rtol = 1e-11 (its error on the bodies' displacements), checked at 1e-10."""
@@ -270,22 +272,12 @@ class _Exudyn:
         self.s = s
 
     def _settings(self, method: str, h: float, t_end: float):
-        ss = self.exu.SimulationSettings()
+        ss = exudyn_settings(self.exu, t_end, h, self.s.interval)
         ti = ss.timeIntegration
-        ti.endTime = t_end
-        ti.numberOfSteps = int(round(t_end / h))
-        ti.automaticStepSize = False
-        ti.verboseMode = 0
-        ti.explicit.computeEndOfStepAccelerations = False  # not needed: saves a forward evaluation per step
         for key, value in self.newton.items():
             setattr(ti.newton, key, value)
         if self.newton:
             ti.adaptiveStep = False  # a Newton failure fails the run instead of halving the step for minutes
-        ss.solution.file.write = False
-        ss.solution.sensors.writePeriod = self.s.interval
-        ss.show.computationTime = False
-        ss.show.statistics = False
-        ss.show.globalTimers = False
         return ss
 
     def _solve(self, method: str, setting: str, h: float, t_end: float | None):
@@ -311,7 +303,7 @@ class _Exudyn:
         return data
 
 
-class ExudynChain(_Exudyn):
+class ExudynChain(_OnTheChain, _Exudyn):
     """The chain as one ``ObjectKinematicTree``: rfe 0 is clamped to the ground (no joint), so
     the tree's links are rfes 1..m, on RevoluteZ joints at rigidfem's placements (rfe 1's moved
     by rfe 0's), with their masses, centres of mass and inertias; the joint springs and dampers
@@ -370,13 +362,6 @@ class ExudynChain(_Exudyn):
 
     def run(self, method: str, setting: str, value: float, t_end: float | None = None) -> np.ndarray:
         return self._solve(method, setting, value, t_end)[:, 1:]
-
-    def tip(self, raw) -> np.ndarray:
-        return tip_position(self.s, raw)
-
-    @property
-    def omega_max(self) -> float:
-        return self.s.omega_max
 
     def references(self) -> list:
         """RK44 at ``_fine`` steps, checked at twice the step; where that is beyond the budget
@@ -522,7 +507,7 @@ class _Mujoco:
         return out
 
 
-class MujocoChain(_Mujoco):
+class MujocoChain(_OnTheChain, _Mujoco):
     """The chain in MJCF by ``peers.to_mjcf`` (rfe 0 a body without joint, rfes 1..m on hinges
     with stiffness, damping and springref), contacts and constraints disabled. Integrators:
     Euler (semi-implicit; the springs explicit), implicitfast (implicit in the velocity forces:
@@ -543,13 +528,6 @@ class MujocoChain(_Mujoco):
     def run(self, method: str, setting: str, value: float, t_end: float | None = None) -> np.ndarray:
         address = self.address
         return self._step(method, value, t_end, lambda data: data.qpos[address])
-
-    def tip(self, raw) -> np.ndarray:
-        return tip_position(self.s, raw)
-
-    @property
-    def omega_max(self) -> float:
-        return self.s.omega_max
 
     def references(self) -> list:
         """RK4 at ``_fine`` steps checked at twice the step, or (over the budget) at twice that
@@ -823,17 +801,10 @@ def sweep(s: Strip, runners: dict, references: dict, quick: bool = False, budget
                                    note=why or f"skipped: {guess:.0f} s predicted")
                         rows.append(row)
                         break
-                start = time.process_time()
-                try:
-                    raw = runner.run(method, setting, value)
-                    row["first_cpu_s"] = time.process_time() - start
-                    row["tip_error_max_m"] = max_error(runner.tip(raw), ref)
-                except (SimulationError, RuntimeError) as e:
-                    row.update(first_cpu_s=time.process_time() - start, tip_error_max_m=np.inf,
-                               note=" ".join(str(e).split())[:80])
-                if not np.isfinite(row["tip_error_max_m"]) or row["tip_error_max_m"] > 1.0:
-                    row["note"] = row["note"] or "unstable or diverged"
-                else:
+                first_run(row, lambda: runner.run(method, setting, value),
+                          lambda raw: {"tip_error_max_m": max_error(runner.tip(raw), ref)}, "tip_error_max_m",
+                          note=lambda e: " ".join(str(e).split())[:80])
+                if np.isfinite(row["tip_error_max_m"]) and row["tip_error_max_m"] <= 1.0:
                     history.append((value, row["first_cpu_s"], row["tip_error_max_m"]))
                 rows.append(row)
                 if row["tip_error_max_m"] <= min(targets) or row["first_cpu_s"] > budget:
@@ -867,24 +838,19 @@ def timed(rows: list, runners: dict, references: dict, rounds: int, long: float 
     for r in candidates(rows, references):
         if r["first_cpu_s"] <= long:
             todo.setdefault(r["code"], []).append(r)
-    order = [r for group in itertools.zip_longest(*todo.values()) for r in group if r is not None]
-    for _ in range(rounds):
-        for r in order:
-            start = time.process_time()
-            runners[r["code"]].run(r["method"], r["setting"], r["value"])
-            r["cpu_s"] = min(r["cpu_s"], time.process_time() - start)
+    least_cpu_times(todo, lambda r: runners[r["code"]].run(r["method"], r["setting"], r["value"]), rounds)
+
+
+def _judged(references: dict):
+    """``admit(run, threshold)``: whether the run's code has a reference that can judge the threshold."""
+    return lambda r, threshold: references[r["code"]].measures(threshold)
 
 
 def cheapest(rows: list, codes, threshold: float, references: dict):
     """The cheapest run (least ``cpu_s``) of ``codes`` reaching ``threshold``, among the codes
     whose reference can judge it; None if none."""
-    ok = [r for r in rows if r["code"] in codes and references[r["code"]].measures(threshold)
-          and r["tip_error_max_m"] <= threshold]
-    return min(ok, key=lambda r: r["cpu_s"]) if ok else None
-
-
-def _setting(r) -> str:
-    return f"{r['method']} {r['setting']}={r['value']:.3g}"
+    judged = _judged(references)
+    return common.cheapest(rows, codes, "tip_error_max_m", threshold, lambda r: judged(r, threshold))
 
 
 def _why(rows: list, code: str, threshold: float, references: dict) -> str:
@@ -903,28 +869,14 @@ def _why(rows: list, code: str, threshold: float, references: dict) -> str:
 def summary(rows: list, m: int, references: dict) -> Table:
     """Per threshold: the cheapest run of rigidfem, of Exudyn (KinematicTree or ANCF) and of
     MuJoCo (chain or flex), with the peers' time over rigidfem's."""
-    out = []
-    for tol in THRESHOLDS:
-        row = {"m": m, "tip_error_max_m": tol}
-        best = {"rigidfem": cheapest(rows, ("rigidfem",), tol, references)}
-        for peer, codes in PEERS.items():
-            best[peer] = cheapest(rows, codes, tol, references)
-        for name, r in best.items():
-            row[f"{name}_cpu_s"] = r["cpu_s"] if r else "-"
-            if r:
-                row[f"{name}_setting"] = (f"{r['code']}: " if name != "rigidfem" else "") + _setting(r)
-            else:
-                codes = PEERS.get(name, (name,))
-                row[f"{name}_setting"] = "; ".join(f"{c}: {_why(rows, c, tol, references)}" for c in codes)
-        for peer in PEERS:
-            row[f"{peer}/rigidfem"] = best[peer]["cpu_s"] / best["rigidfem"]["cpu_s"] \
-                if best[peer] and best["rigidfem"] else "-"
-        out.append(row)
-    return Table(out, SUMMARY_COLUMNS)
+    return summary_table(
+        rows, {"m": m}, "tip_error_max_m", "tip_error_max_m", THRESHOLDS, GROUPS, admit=_judged(references),
+        setting=lambda group, r: (f"{r['code']}: " if group != "rigidfem" else "") + setting_text(r),
+        missing=lambda group, codes, tol: "; ".join(f"{c}: {_why(rows, c, tol, references)}" for c in codes))
 
 
-SUMMARY_COLUMNS = ("m", "tip_error_max_m", "rigidfem_cpu_s", "rigidfem_setting", "Exudyn_cpu_s", "Exudyn_setting",
-                   "MuJoCo_cpu_s", "MuJoCo_setting", "Exudyn/rigidfem", "MuJoCo/rigidfem")
+GROUPS = {"rigidfem": ("rigidfem",), **PEERS}  #: the summary's columns: rigidfem, then each peer's best model
+SUMMARY_COLUMNS = summary_columns(("m",), "tip_error_max_m", GROUPS)
 
 
 def per_model(rows: list, m: int, references: dict) -> Table:
@@ -934,7 +886,7 @@ def per_model(rows: list, m: int, references: dict) -> Table:
         for code in CODES:
             r = cheapest(rows, (code,), tol, references)
             out.append({"m": m, "tip_error_max_m": tol, "code": code, "cpu_s": r["cpu_s"] if r else "-",
-                        "setting": _setting(r) if r else _why(rows, code, tol, references),
+                        "setting": setting_text(r) if r else _why(rows, code, tol, references),
                         "error_m": r["tip_error_max_m"] if r else "-"})
     return Table(out, MODELS_COLUMNS)
 
@@ -946,9 +898,7 @@ SWEEP_COLUMNS = ("m", "code", "method", "setting", "value", "tip_error_max_m", "
 
 
 def versions() -> dict:
-    exu, mujoco = _peer("exudyn", "exudyn"), _peer("mujoco", "mujoco")
-    return {"rigidfem": rigidfem.__version__, "exudyn": exu.__version__, "mujoco": mujoco.__version__,
-            "numpy": np.__version__}
+    return common.versions(_peer)
 
 
 def run(output_dir="bench", quick: bool = False) -> dict:
@@ -958,9 +908,7 @@ def run(output_dir="bench", quick: bool = False) -> dict:
     cheapest runs reaching 1e-4 m and 1e-6 m in 3 interleaved rounds, and print the cheapest
     setting per code and threshold with the ratios. Writes
     strip_peers_{verification,sweep,models,summary}.csv into ``output_dir``."""
-    info = versions()
-    print(f"rigidfem {info['rigidfem']}, Exudyn {info['exudyn']}, MuJoCo {info['mujoco']}, numpy {info['numpy']}; "
-          f"{machine()}", flush=True)
+    print(common.versions_line(versions()), flush=True)
     sizes = (4, 8) if quick else (16, 32, 64)
     ref_budget, run_budget = (5.0, 3.0) if quick else (REF_BUDGET, RUN_BUDGET)
     checks, rows, models, summaries = [], [], [], []
