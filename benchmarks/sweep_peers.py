@@ -61,8 +61,10 @@ import rigidfem as rf
 from rigidfem import SimulationError, samples
 from rigidfem.study import Table
 
+from . import _peers_common as common
 from . import kane_peers as kp
-from ._common import machine, report
+from ._common import report
+from ._peers_common import exudyn_settings
 
 ELEMENTS = 20
 RUNS = 64
@@ -198,18 +200,7 @@ def exudyn_run(tree: dict, omega: float, method: str, dt: float) -> np.ndarray:
     sensor = mbs.AddSensor(SensorNode(nodeNumber=node, storeInternal=True,
                                       outputVariableType=exu.OutputVariableType.Coordinates))
     mbs.Assemble()
-    ss = exu.SimulationSettings()
-    ti = ss.timeIntegration
-    ti.endTime = kp.T_END
-    ti.numberOfSteps = int(round(kp.T_END / dt))
-    ti.automaticStepSize = False
-    ti.verboseMode = 0
-    ti.explicit.computeEndOfStepAccelerations = False
-    ss.solution.file.write = False
-    ss.solution.sensors.writePeriod = kp.INTERVAL
-    ss.show.computationTime = False
-    ss.show.statistics = False
-    ss.show.globalTimers = False
+    ss = exudyn_settings(exu, kp.T_END, dt, kp.INTERVAL)
     with warnings.catch_warnings():
         warnings.simplefilter("ignore")
         ok = mbs.SolveDynamic(ss, solverType=getattr(exu.DynamicSolverType, method))
@@ -569,9 +560,7 @@ def versions() -> dict:
 def run(output_dir="bench", quick: bool = False) -> dict:
     """``python -m benchmarks sweep_peers``: m = 20, 64 spin rates, 3 interleaved rounds (``quick``:
     m = 4, 6 spin rates, one round). Writes sweep_peers_{settings,timing,agreement}.csv."""
-    info = versions()
-    print(f"rigidfem {info['rigidfem']}, Exudyn {info['exudyn']}, MuJoCo {info['mujoco']}, numpy {info['numpy']}, "
-          f"distributed {info['distributed']}; {machine()}", flush=True)
+    print(common.versions_line(versions()), flush=True)
     if quick:
         tables = measure(4, tuple(np.linspace(4.0, 11.0, 6)), rounds=1)
     else:
