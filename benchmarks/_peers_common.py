@@ -1,8 +1,8 @@
 """What the peer benchmark drivers (``kane_peers``, ``loop_peers``, ``strip_peers``, ``sweep_peers``,
 and those built on them) share: importing a peer code, the versions line, a sweep's first
 timed run of a setting, the interleaved timing of the settings worth timing, the cheapest
-setting per code and threshold, the summary table of the cheapest settings, and Exudyn's
-fixed-step simulation settings.
+setting per code and threshold, the summary table of the cheapest settings, Exudyn's
+fixed-step simulation settings and solve, and MuJoCo's stepping between outputs.
 
 The rows these functions read and write are dicts, one per run of a code at a setting, with at
 least ``code``, ``method``, ``setting`` (the name of the swept setting, e.g. ``"dt"`` or
@@ -15,6 +15,7 @@ from __future__ import annotations
 
 import itertools
 import time
+import warnings
 from typing import Callable, Iterable, Mapping
 
 import numpy as np
@@ -92,6 +93,73 @@ def exudyn_settings(exu, t_end: float, h: float, interval: float, end_accelerati
     ss.show.statistics = False
     ss.show.globalTimers = False
     return ss
+
+
+def exudyn_solve(exu, mbs, ss, sensor, method: str, dt: float, t_eval, *, text: Callable = str,
+                 quiet: bool = False, bound: float | None = None) -> np.ndarray:
+    """``mbs.SolveDynamic(ss)`` by Exudyn's solver ``method`` (a ``DynamicSolverType`` name) at
+    the step ``dt``, Python warnings ignored (``quiet``: Exudyn's console printing off for the
+    run too), and the stored data of ``sensor`` (a ``SensorNode`` with ``storeInternal``):
+    (len(t_eval), 1 + coordinates), time first. Raises ``SimulationError`` "Exudyn <method>
+    dt=<dt>: <text(e)>" when the solver throws, "...: failed or unstable" when it fails or the
+    data are not one finite row per output (or, with ``bound``, a coordinate exceeds it), and
+    ``RuntimeError`` when the sensor's times are off ``t_eval``."""
+    console = exu.config.printToConsole
+    if quiet:
+        exu.config.printToConsole = False  # its "DYNAMIC SOLVER FAILED" banners: the tables say it
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")
+        try:
+            ok = mbs.SolveDynamic(ss, solverType=getattr(exu.DynamicSolverType, method))
+        except Exception as e:  # noqa: BLE001 - Exudyn's solver errors
+            raise SimulationError(f"Exudyn {method} dt={dt:g}: {text(e)}") from e
+        finally:
+            if quiet:
+                exu.config.printToConsole = console
+    data = np.asarray(mbs.GetSensorStoredData(sensor))
+    if ok is False or len(data) != len(t_eval) or not np.all(np.isfinite(data)) \
+            or (bound is not None and np.max(np.abs(data[:, 1:])) > bound):
+        raise SimulationError(f"Exudyn {method} dt={dt:g}: failed or unstable")
+    if np.max(np.abs(data[:, 0] - t_eval)) > 1e-6:
+        raise RuntimeError(f"Exudyn {method}: sensor times off the output grid")
+    return data
+
+
+def mujoco_fixed_step(mujoco, model, data, method: str, dt: float, interval: float) -> int:
+    """Sets ``model`` to MuJoCo's integrator ``method`` (``mjtIntegrator``'s name without
+    ``mjINT_``, any case: "Euler", "implicitfast", "RK4", ...) at the fixed step ``dt``, which
+    must divide the output ``interval`` (ValueError otherwise), and resets ``data``
+    (``mj_resetData``); returns the number of steps per output interval."""
+    n = int(round(interval / dt))
+    if abs(n * dt - interval) > 1e-9 * interval:
+        raise ValueError(f"dt: expected a step dividing {interval} s, got {dt}")
+    model.opt.timestep = dt
+    model.opt.integrator = getattr(mujoco.mjtIntegrator, f"mjINT_{method.upper()}")
+    mujoco.mj_resetData(model, data)
+    return n
+
+
+def mujoco_outputs(mujoco, model, data, steps: int, outputs: int, read: Callable, label: str, *,
+                   bound: float | None = None) -> np.ndarray:
+    """From ``data``'s state as it is: ``read(data)`` (a 1-D array) now and after each
+    ``mj_step(model, data, nstep=steps)``, ``outputs`` rows in all (no Python per step; MuJoCo's
+    user warnings silenced for the run). Raises ``SimulationError`` "MuJoCo <label>: unstable"
+    when MuJoCo flagged a bad qacc or a row is not finite (or, with ``bound``, a value exceeds it)."""
+    first = read(data)
+    out = np.empty((outputs, len(first)))
+    out[0] = first
+    printer = mujoco.get_mju_user_warning()
+    mujoco.set_mju_user_warning(lambda message: None)
+    try:
+        for k in range(1, outputs):
+            mujoco.mj_step(model, data, nstep=steps)
+            out[k] = read(data)
+    finally:
+        mujoco.set_mju_user_warning(printer)
+    if data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number or not np.all(np.isfinite(out)) \
+            or (bound is not None and np.max(np.abs(out)) > bound):
+        raise SimulationError(f"MuJoCo {label}: unstable")
+    return out
 
 
 # ---------------------------------------------------------------------------------------------

@@ -42,18 +42,18 @@ from __future__ import annotations
 import ctypes
 import math
 import time
-import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
 
-from rigidfem import SimulationError, samples, simulate
+from rigidfem import samples, simulate
 from rigidfem.study import Table
 
 from . import _peers_common as common
 from ._common import compile_mujoco_callback, report
 from ._peers_common import INSTALL_HINT  # noqa: F401 - kept: this module's name for it
-from ._peers_common import cheapest, exudyn_settings, first_run, least_cpu_times, summary_table
+from ._peers_common import (cheapest, exudyn_settings, exudyn_solve, first_run, least_cpu_times, mujoco_fixed_step,
+                            mujoco_outputs, summary_table)
 from .peers import Chain, Link, to_mjcf
 
 OMEGA, SPIN_UP, T_END, OUTPUTS = 6.0, 15.0, 20.0, 201
@@ -291,17 +291,7 @@ class ExudynKane:
             raise ValueError(f"setting: expected dt for Exudyn, got {setting}")
         _, mbs, sensor = self.systems["constraint" if method in self.IMPLICIT else "flywheel"]
         ss = exudyn_settings(exu, T_END, value, INTERVAL)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            try:
-                ok = mbs.SolveDynamic(ss, solverType=getattr(exu.DynamicSolverType, method))
-            except Exception as e:  # noqa: BLE001 - Exudyn's solver errors
-                raise SimulationError(f"Exudyn {method} dt={value:g}: {e}") from e
-        data = np.asarray(mbs.GetSensorStoredData(sensor))
-        if ok is False or len(data) != OUTPUTS or not np.all(np.isfinite(data)):
-            raise SimulationError(f"Exudyn {method} dt={value:g}: failed or unstable")
-        if np.max(np.abs(data[:, 0] - self.scene.t_eval)) > 1e-6:
-            raise RuntimeError(f"Exudyn {method}: sensor times off the output grid")
+        data = exudyn_solve(exu, mbs, ss, sensor, method, value, self.scene.t_eval)
         return data[:, 2:]  # time, hub angle, then the beam's q
 
     def reference(self) -> np.ndarray:
@@ -386,26 +376,10 @@ class MujocoKane:
 
     def run(self, method: str, setting: str, value: float) -> np.ndarray:
         mujoco, model, data = self.mujoco, self.model, self.data
-        n = int(round(INTERVAL / value))
-        if abs(n * value - INTERVAL) > 1e-9 * INTERVAL:
-            raise ValueError(f"dt: expected a step dividing {INTERVAL} s, got {value}")
-        model.opt.timestep = value
-        model.opt.integrator = getattr(mujoco.mjtIntegrator, f"mjINT_{method.upper()}")
+        n = mujoco_fixed_step(mujoco, model, data, method, value, INTERVAL)
         self.install()
-        mujoco.mj_resetData(model, data)
-        out = np.empty((OUTPUTS, len(self.address)))
-        out[0] = data.qpos[self.address]
-        printer = mujoco.get_mju_user_warning()
-        mujoco.set_mju_user_warning(lambda message: None)
-        try:
-            for k in range(1, OUTPUTS):
-                mujoco.mj_step(model, data, nstep=n)
-                out[k] = data.qpos[self.address]
-        finally:
-            mujoco.set_mju_user_warning(printer)
-        if data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number or not np.all(np.isfinite(out)):
-            raise SimulationError(f"MuJoCo {method} dt={value:g}: unstable")
-        return out
+        address = self.address
+        return mujoco_outputs(mujoco, model, data, n, OUTPUTS, lambda d: d.qpos[address], f"{method} dt={value:g}")
 
     def reference(self) -> np.ndarray:
         return self.run("RK4", "dt", _divide(REFERENCE_STEP * 2.785 / self.scene.omega_max))

@@ -81,20 +81,20 @@ from __future__ import annotations
 import ctypes
 import math
 import time
-import warnings
 from dataclasses import dataclass, field
 from pathlib import Path
 
 import numpy as np
 
 import rigidfem as rf
-from rigidfem import SimulationError, simulate
+from rigidfem import simulate
 from rigidfem.study import Table
 
 from . import _peers_common as common
 from ._common import compile_mujoco_callback, report
 from ._peers_common import CODES, INSTALL_HINT  # noqa: F401 - INSTALL_HINT kept: this module's name for it
-from ._peers_common import exudyn_settings, first_run, least_cpu_times, summary_columns, summary_table
+from ._peers_common import (exudyn_settings, exudyn_solve, first_run, least_cpu_times, mujoco_fixed_step,
+                            mujoco_outputs, summary_columns, summary_table)
 from .kane_peers import exudyn_spin_up
 from .peers import Chain, describe, to_mjcf
 
@@ -391,23 +391,9 @@ class ExudynLoops:
         """``newton``: Newton's (relative, absolute) tolerances, Exudyn's (1e-8, 1e-10) by default."""
         if setting != "dt":
             raise ValueError(f"setting: expected dt for Exudyn, got {setting}")
-        s = self.scene
         ss = self.settings(method, value, newton)
-        console = self.exu.config.printToConsole
-        self.exu.config.printToConsole = False  # its "DYNAMIC SOLVER FAILED" banners: the tables say it
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            try:
-                ok = self.mbs.SolveDynamic(ss, solverType=getattr(self.exu.DynamicSolverType, method))
-            except Exception as e:  # noqa: BLE001 - Exudyn's solver errors
-                raise SimulationError(f"Exudyn {method} dt={value:g}: {str(e)[:60]}") from e
-            finally:
-                self.exu.config.printToConsole = console
-        data = np.asarray(self.mbs.GetSensorStoredData(self.sensor))
-        if ok is False or len(data) != len(s.t_eval) or not np.all(np.isfinite(data)):
-            raise SimulationError(f"Exudyn {method} dt={value:g}: failed or unstable")
-        if np.max(np.abs(data[:, 0] - s.t_eval)) > 1e-6:
-            raise RuntimeError(f"Exudyn {method}: sensor times off the output grid")
+        data = exudyn_solve(self.exu, self.mbs, ss, self.sensor, method, value, self.scene.t_eval,
+                            text=lambda e: str(e)[:60], quiet=True)
         return data[:, 1:]
 
     def reference_step(self) -> float:
@@ -512,27 +498,14 @@ class MujocoLoops:
     def run(self, method: str, setting: str, value: float) -> np.ndarray:
         """(MuJoCo's constraint solver keeps its defaults: Newton, tolerance 1e-8.)"""
         mujoco, model, data, s = self.mujoco, self.model, self.data, self.scene
-        n = int(round(s.interval / value))
-        if setting != "dt" or abs(n * value - s.interval) > 1e-9 * s.interval:
+        if setting != "dt":
             raise ValueError(f"dt: expected a step dividing {s.interval} s, got {setting}={value}")
-        model.opt.timestep = value
-        model.opt.integrator = getattr(mujoco.mjtIntegrator, f"mjINT_{method.upper()}")
+        n = mujoco_fixed_step(mujoco, model, data, method, value, s.interval)
         self.install()
-        mujoco.mj_resetData(model, data)
-        data.qpos[self.address] = s.q0
-        out = np.empty((len(s.t_eval), len(self.address)))
-        out[0] = data.qpos[self.address]
-        printer = mujoco.get_mju_user_warning()
-        mujoco.set_mju_user_warning(lambda message: None)
-        try:
-            for k in range(1, len(s.t_eval)):
-                mujoco.mj_step(model, data, nstep=n)
-                out[k] = data.qpos[self.address]
-        finally:
-            mujoco.set_mju_user_warning(printer)
-        if data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number or not np.all(np.isfinite(out)):
-            raise SimulationError(f"MuJoCo {method} dt={value:g}: unstable")
-        return out
+        address = self.address
+        data.qpos[address] = s.q0
+        return mujoco_outputs(mujoco, model, data, n, len(s.t_eval), lambda d: d.qpos[address],
+                              f"{method} dt={value:g}")
 
     def reference_step(self) -> float:
         return self.scene.interval / REFERENCE_STEPS[self.scene.planar][1]

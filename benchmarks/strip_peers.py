@@ -61,7 +61,8 @@ from rigidfem.study import Table
 from . import _peers_common as common
 from ._common import report
 from ._peers_common import INSTALL_HINT  # noqa: F401 - kept: this module's name for it
-from ._peers_common import exudyn_settings, first_run, least_cpu_times, setting_text, summary_columns, summary_table
+from ._peers_common import (exudyn_settings, exudyn_solve, first_run, least_cpu_times, mujoco_fixed_step,
+                            mujoco_outputs, setting_text, summary_columns, summary_table)
 from .accuracy import strip
 from .kane_peers import _rotation
 from .peers import Chain, describe, to_mjcf
@@ -288,19 +289,9 @@ class _Exudyn:
             raise ValueError(f"dt: expected a step dividing {self.s.interval} s, got {h}")
         t_end = self.s.t_end if t_end is None else t_end
         ss = self._settings(method, h, t_end)
-        with warnings.catch_warnings():
-            warnings.simplefilter("ignore")
-            try:
-                ok = self.mbs.SolveDynamic(ss, solverType=getattr(self.exu.DynamicSolverType, method))
-            except Exception as e:  # noqa: BLE001 - Exudyn's solver errors
-                raise SimulationError(f"Exudyn {method} dt={h:g}: {str(e).strip()[:60]}") from e
-        data = np.asarray(self.mbs.GetSensorStoredData(self.sensor))
         outputs = int(round(t_end / self.s.interval)) + 1
-        if ok is False or len(data) != outputs or not np.all(np.isfinite(data)) or np.max(np.abs(data[:, 1:])) > 1e3:
-            raise SimulationError(f"Exudyn {method} dt={h:g}: failed or unstable")
-        if np.max(np.abs(data[:, 0] - self.s.t_eval[:outputs])) > 1e-6:
-            raise RuntimeError(f"Exudyn {method}: sensor times off the output grid")
-        return data
+        return exudyn_solve(self.exu, self.mbs, ss, self.sensor, method, h, self.s.t_eval[:outputs],
+                            text=lambda e: str(e).strip()[:60], bound=1e3)
 
 
 class ExudynChain(_OnTheChain, _Exudyn):
@@ -479,32 +470,20 @@ class _Mujoco:
 
     INTEGRATORS = ()
 
+    def references(self) -> list:
+        """RK4 at ``_fine`` steps checked at twice the step, or (over the budget) at twice that
+        checked at four times."""
+        h = _fine(self.s, self.omega_max)
+        return [("RK4", "dt", h, _steps(self.s, 2.0 * h)), ("RK4", "dt", _steps(self.s, 2.0 * h),
+                                                            _steps(self.s, 4.0 * h))]
+
     def _step(self, method: str, value: float, t_end: float | None, read):
         mujoco, model, data = self.mujoco, self.model, self.data
-        n = int(round(self.s.interval / value))
-        if abs(n * value - self.s.interval) > 1e-9 * self.s.interval:
-            raise ValueError(f"dt: expected a step dividing {self.s.interval} s, got {value}")
+        n = mujoco_fixed_step(mujoco, model, data, method, value, self.s.interval)
         t_end = self.s.t_end if t_end is None else t_end
         outputs = int(round(t_end / self.s.interval)) + 1
-        model.opt.timestep = value
-        model.opt.integrator = getattr(mujoco.mjtIntegrator, f"mjINT_{method.upper()}")
-        mujoco.mj_resetData(model, data)
         mujoco.mj_forward(model, data)
-        first = read(data)
-        out = np.empty((outputs, len(first)))
-        out[0] = first
-        printer = mujoco.get_mju_user_warning()
-        mujoco.set_mju_user_warning(lambda message: None)
-        try:
-            for k in range(1, outputs):
-                mujoco.mj_step(model, data, nstep=n)
-                out[k] = read(data)
-        finally:
-            mujoco.set_mju_user_warning(printer)
-        if data.warning[mujoco.mjtWarning.mjWARN_BADQACC].number or not np.all(np.isfinite(out)) \
-                or np.max(np.abs(out)) > 1e3:
-            raise SimulationError(f"MuJoCo {method} dt={value:g}: unstable")
-        return out
+        return mujoco_outputs(mujoco, model, data, n, outputs, read, f"{method} dt={value:g}", bound=1e3)
 
 
 class MujocoChain(_OnTheChain, _Mujoco):
@@ -528,13 +507,6 @@ class MujocoChain(_OnTheChain, _Mujoco):
     def run(self, method: str, setting: str, value: float, t_end: float | None = None) -> np.ndarray:
         address = self.address
         return self._step(method, value, t_end, lambda data: data.qpos[address])
-
-    def references(self) -> list:
-        """RK4 at ``_fine`` steps checked at twice the step, or (over the budget) at twice that
-        checked at four times."""
-        h = _fine(self.s, self.omega_max)
-        return [("RK4", "dt", h, _steps(self.s, 2.0 * h)), ("RK4", "dt", _steps(self.s, 2.0 * h),
-                                                            _steps(self.s, 4.0 * h))]
 
     def methods(self, quick: bool) -> list:
         """Steps from the stability limit (ω_max h ≤ 2 for Euler and implicitfast, whose springs
@@ -658,13 +630,6 @@ class MujocoFlex(_Mujoco):
             mujoco.mj_fullM(model, data, M)
             self._omega_max = float(np.sqrt(np.max(np.abs(np.linalg.eigvals(np.linalg.solve(M, K))))))
         return self._omega_max
-
-    def references(self) -> list:
-        """RK4 at ``_fine`` steps checked at twice the step, or (over the budget) at twice that
-        checked at four times."""
-        h = _fine(self.s, self.omega_max)
-        return [("RK4", "dt", h, _steps(self.s, 2.0 * h)), ("RK4", "dt", _steps(self.s, 2.0 * h),
-                                                            _steps(self.s, 4.0 * h))]
 
     def methods(self, quick: bool) -> list:
         w = self.omega_max
