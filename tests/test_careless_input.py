@@ -212,6 +212,15 @@ def test_scipy_methods_check_the_options_too(kw, name, method):
         rf.simulate(s, 0.1, method=method, **kw)
 
 
+@pytest.mark.parametrize("method", ["generalized_alpha", "dopri5"])
+def test_a_bad_t_eval_is_named_before_tolerances_wrong_only_together(method):
+    """rtol = atol = 0 is wrong only together (and unused at fixed steps): a bad t_eval beside them is
+    the argument named (fuzz seed 282087024, case 20)."""
+    _, _, s = two_dof()
+    with pytest.raises(ValueError, match=named("t_eval")):
+        rf.simulate(s, 0.1, method=method, **step_of(method, 0.01), rtol=0.0, atol=0.0, t_eval=[0.5])
+
+
 def test_scipy_first_step_is_used():
     _, _, s = two_dof()
     r = rf.simulate(s, 0.1, method="scipy:RK45", first_step=1e-4, q0=[0.1, 0.2])

@@ -398,6 +398,11 @@ void check_options(const System& sys, double t0, double t_end, const VecX& q0, c
   if (!is_adaptive(o) && !(o.dt > 0.0 && std::isfinite(o.dt)))
     throw std::invalid_argument(std::string("dt: expected a positive step in s for the fixed-step method '") + m.name +
                                 "', got " + num(o.dt));
+  for (Eigen::Index k = 0; k < t_eval.size(); ++k)
+    if (!(t_eval(k) >= t0 && t_eval(k) <= t_end) || (k > 0 && !(t_eval(k) > t_eval(k - 1))))
+      throw std::invalid_argument("t_eval: expected increasing times within [t0, t_end] = [" + num(t0) + ", " +
+                                  num(t_end) + "] s, got " + num(t_eval(k), 10) + " at index " + std::to_string(k) +
+                                  (k > 0 ? " after " + num(t_eval(k - 1), 10) : std::string()));
   // one option at a time first, then the tolerances (whose rtol = atol = 0 is wrong only together)
   if (!(o.max_step > 0.0))
     throw std::invalid_argument("max_step: expected a positive step in s (inf for no limit), got " + num(o.max_step));
@@ -436,11 +441,6 @@ void check_options(const System& sys, double t0, double t_end, const VecX& q0, c
     throw std::invalid_argument(std::string("stiff_method: expected an implicit method with an error estimate, got '") +
                                 method_name(stiff) + "'");
   check_sensitivities(sys, o);
-  for (Eigen::Index k = 0; k < t_eval.size(); ++k)
-    if (!(t_eval(k) >= t0 && t_eval(k) <= t_end) || (k > 0 && !(t_eval(k) > t_eval(k - 1))))
-      throw std::invalid_argument("t_eval: expected increasing times within [t0, t_end] = [" + num(t0) + ", " +
-                                  num(t_end) + "] s, got " + num(t_eval(k), 10) + " at index " + std::to_string(k) +
-                                  (k > 0 ? " after " + num(t_eval(k - 1), 10) : std::string()));
 }
 
 Trajectory integrate(const System& sys, double t0, double t_end, const VecX& q0, const VecX& qd0,
