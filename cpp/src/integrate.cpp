@@ -260,7 +260,8 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
   // method="auto": its policy (auto_method.hpp) picks the first method and, after each step, whether to change
   std::unique_ptr<AutoChoice> choice;
   if (o.method == Method::Auto) choice = std::make_unique<AutoChoice>(sys, o, asked, t0, y0, stats);
-  const IntegratorOptions first = choice ? choice->first(stats) : o;
+  IntegratorOptions first = choice ? choice->first(stats) : o;
+  first.span = span;
   std::unique_ptr<Stepper> stepper = method_info(first.method).make(sys, first, stats);
   StepSizeControl control(stepper->control());
   stepper->start(t0, y0);

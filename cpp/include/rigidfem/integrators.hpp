@@ -62,6 +62,9 @@ struct IntegratorOptions {
   double alpha = -0.05;             ///< HHT-α, in [−1/3, 0]
   double rho_inf = 0.8;             ///< generalised-α: spectral radius at infinite frequency, in [0, 1]
   double newton_tol = 1e-10;        ///< Newton: increments below newton_tol (1 + |q|), relative for adaptive runs
+  /// The run's length t_end − t0 (s), set by integrate(): the Newmark family holds what Newton leaves in q̇
+  /// to a fraction of its local error over it (0: to newton_tol alone).
+  double span = 0.0;
   int newton_max_iterations = 10;
   IterationMatrix iteration_matrix = IterationMatrix::Auto;
   /// auto: the implicit method it hands over to; Auto: auto_stiff_method's choice (radau5, or esdirk43 with
