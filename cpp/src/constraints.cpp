@@ -1,5 +1,6 @@
 #include "rigidfem/constraints.hpp"
 
+#include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 #include <array>
 #include <cmath>
@@ -177,6 +178,17 @@ VecX least_norm(const MatX& A, const VecX& b) {
   VecX c = svd.matrixU().transpose() * b;
   for (Eigen::Index i = 0; i < s.size(); ++i) c(i) = s(i) > floor ? c(i) / s(i) : 0.0;
   return svd.matrixV() * c;
+}
+
+VecX least_norm_symmetric(const MatX& A, const VecX& b) {
+  // x = V Λ⁺ Vᵀ b, A = V Λ Vᵀ (the lower triangle read), λ_i⁺ = 1/λ_i for λ_i > 1e-10 λ_max, else 0
+  // (a negative λ_i is round-off of a zero one).
+  Eigen::SelfAdjointEigenSolver<MatX> eigen(A);
+  const VecX& s = eigen.eigenvalues();  // ascending
+  const double floor = s.size() > 0 ? 1e-10 * s(s.size() - 1) : 0.0;
+  VecX c = eigen.eigenvectors().transpose() * b;
+  for (Eigen::Index i = 0; i < s.size(); ++i) c(i) = s(i) > floor ? c(i) / s(i) : 0.0;
+  return eigen.eigenvectors() * c;
 }
 
 MatX free_jacobian(const System& sys, const Data& d) { return d.G(Eigen::all, sys.free_coords); }

@@ -155,7 +155,7 @@ std::string worst_loop(const System& sys, const Data& d) {
 void close_loops(const System& sys, Data& d) {
   const MatX G = free_jacobian(sys, d);
   const MatX Y = solve_armature(sys, d, G.transpose());  // M⁻¹ Gᵀ with the tree's factorisation
-  d.lambda = least_norm(G * Y, d.gamma - G * d.qdd);
+  d.lambda = least_norm_symmetric(G * Y, d.gamma - G * d.qdd);
   d.qdd += Y * d.lambda;
   set_accelerations(sys, d, d.qdd);
   if (!d.qdd.allFinite()) throw SimulationError(d.t, "accelerations of the closed loops are NaN or inf");
@@ -196,7 +196,7 @@ double project_onto_loops(const System& sys, Data& d, double t, VecX& q, VecX& q
     // that least_norm counts as dependent) or after max_iterations; linear convergence there is fine.
     if ((it > 0 && residual > 0.9 * previous) || it == max_iterations) break;
     weighted();
-    const VecX dq = Y * least_norm(G * Y, d.g);  // Δq = M⁻¹Gᵀ (G M⁻¹ Gᵀ)⁺ g
+    const VecX dq = Y * least_norm_symmetric(G * Y, d.g);  // Δq = M⁻¹Gᵀ (G M⁻¹ Gᵀ)⁺ g
     q -= dq;
     previous = residual;
   }
@@ -209,7 +209,7 @@ double project_onto_loops(const System& sys, Data& d, double t, VecX& q, VecX& q
   // the loops allow, so it never raises the kinetic energy and takes none from the admissible motion
   // (the Euclidean Gᵀ(GGᵀ)⁺ġ does, where G loses rank).
   weighted();
-  qd -= Y * least_norm(G * Y, d.gd);
+  qd -= Y * least_norm_symmetric(G * Y, d.gd);
   return residual;
 }
 

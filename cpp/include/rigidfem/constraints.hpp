@@ -32,6 +32,10 @@ MatX free_jacobian(const System& sys, const Data& d);
 /// position (a four-bar flat) the row G loses carries no multiplier.
 VecX least_norm(const MatX& A, const VecX& b);
 
+/// The same for a symmetric positive semi-definite A (G M⁻¹ Gᵀ, M symmetric): by its eigenvalues,
+/// which are its singular values (the same rank decision), at a third of the SVD's cost.
+VecX least_norm_symmetric(const MatX& A, const VecX& b);
+
 /// The wrench each loop joint applies to its body B, in frame A's axes: (force N, torque N·m about
 /// B's frame origin) per loop, from the multipliers λ (nl); for a Distance loop the force along the
 /// line (positive pushing B away from A) in the first component, the rest zero. (nloops, 6).
