@@ -1,4 +1,4 @@
-"""``python -m benchmarks {scaling,peers,scale,loops,implicit_step,sweep,kane_peers,loop_peers,sweep_peers,strip_peers,crane_peers,orders,tolerance,accuracy,viewer,sensitivities} [--quick] [--output DIR]``, from the root of a checkout."""
+"""``python -m benchmarks {scaling,peers,scale,loops,implicit_step,sweep,kane_peers,loop_peers,sweep_peers,strip_peers,crane_peers,size_peers,orders,tolerance,accuracy,viewer,sensitivities} [--quick] [--output DIR]``, from the root of a checkout."""
 
 from __future__ import annotations
 
@@ -19,6 +19,7 @@ COMMANDS = {
     "sweep_peers": "64 runs of Kane's beam on 2 cores: rf.sweep (threads, processes, Dask) against Exudyn's ParameterVariation and MuJoCo's rollout, wall time at 1e-4 m (needs: pip install exudyn mujoco dask[distributed])",
     "strip_peers": "a whippy strip released from rest (m = 16, 32, 64): CPU time to a tip error against Exudyn (KinematicTree, ANCF cable) and MuJoCo (chain, flex rod) (needs: pip install exudyn mujoco)",
     "crane_peers": "an offshore crane with a hoisting rope on a moving base: CPU time to a payload error against Exudyn (KinematicTree, rope by a symbolic spring law, base by coordinate constraints) and MuJoCo (tendon rope, servoed base) (needs: pip install exudyn mujoco)",
+    "size_peers": "size: one second of a whippy strip of 10^3 and 10^4 rfes, CPU time to a tip error against Exudyn (the chain in redundant coordinates, sparse solver) and MuJoCo (the chain by MjSpec) (needs: pip install exudyn mujoco)",
     "orders": "speed against error on Kane's beam: esdirk43, radau5, generalised-α and dopri5",
     "tolerance": "Kane's beam (m = 20): tip error delivered against rtol asked, every adaptive method; fixed-step failures",
     "accuracy": "the default asked for a tip error against the best of every method: strips, tapes, the bench's scenes",

@@ -196,6 +196,36 @@ def test_crane_peers_models_agree():
         assert cp.base_error(scene, runners[code]) < (1e-8 if code == "MuJoCo" else 1e-12)
 
 
+def test_size_peers_models_agree():
+    """size_peers' three identical chains on a small strip (m = 8, 0.1 s): Exudyn's chain in redundant
+    coordinates (sparse solver) gives rigidfem's tip within 1e-8 m at interval/64 (3.9 µs) (measured 5e-10 m,
+    generalised-α's and TrapezoidalIndex2's own errors), MuJoCo's chain built by MjSpec within 1e-11 m
+    by RK4 (2e-13 m) and equals the MJCF chain of strip_peers (the same accelerations); verify passes;
+    the sweep's rows reach the thresholds in order."""
+    pytest.importorskip("exudyn")
+    pytest.importorskip("mujoco")
+    from benchmarks import size_peers as zp
+    from benchmarks.strip_peers import MujocoChain
+
+    s = zp.size_strip(8, t_end=0.1)
+    assert len(s.t_eval) == 401 and s.omega_max > 1e3
+    runners = zp.runners_for(s)
+    assert set(runners) == {"rigidfem", "Exudyn", "MuJoCo"}
+    tip = runners["rigidfem"].tip(runners["rigidfem"].run("radau5", "rtol", 1e-11))
+    assert tip[:, 1].min() < -0.05  # it falls
+    for code, method, tol in [("Exudyn", "GeneralizedAlpha", 1e-8), ("Exudyn", "TrapezoidalIndex2", 1e-8),
+                              ("MuJoCo", "RK4", 1e-11)]:
+        error = zp.max_error(runners[code].tip(runners[code].run(method, "dt", s.interval / 64)), tip)
+        assert error < tol, f"{code} {method}: tip differs from rigidfem's by {error:.3g} m"
+    q, qd = np.linspace(-0.01, 0.01, 8), np.linspace(1.0, -1.0, 8)
+    xml = MujocoChain(s)
+    xml.data.qpos[xml.address], xml.data.qvel[xml.address] = q, qd
+    xml.mujoco.mj_forward(xml.model, xml.data)
+    assert runners["MuJoCo"].residual(q, qd, xml.data.qacc[xml.address]) < 1e-12
+    checks = zp.verify(s, runners).rows
+    assert [r["code"] for r in checks] == ["Exudyn", "MuJoCo"] and all(r["difference"] < r["allowed"] for r in checks)
+
+
 def test_orders_study_table():
     """The high-order study's structure on a 4-element beam: every method reaches 1e-4 m, and the
     summary keeps the least time per method and target."""
