@@ -251,6 +251,7 @@ class MujocoSpecChain(MujocoChain):
         model.opt.integrator = getattr(mujoco.mjtIntegrator, f"mjINT_{method.upper()}")
         model.opt.timestep = value
         mujoco.mj_resetData(model, data)
+        mujoco.set_mjcb_control(None)  # global: another driver's must not drive this chain
         start = time.process_time()
         mujoco.mj_step(model, data, nstep=5)
         return (time.process_time() - start) / 5 * self.s.t_end / value

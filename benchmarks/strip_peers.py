@@ -479,6 +479,7 @@ class _Mujoco:
 
     def _step(self, method: str, value: float, t_end: float | None, read):
         mujoco, model, data = self.mujoco, self.model, self.data
+        mujoco.set_mjcb_control(None)  # MuJoCo's callback is global: another driver's must not drive this chain
         n = mujoco_fixed_step(mujoco, model, data, method, value, self.s.interval)
         t_end = self.s.t_end if t_end is None else t_end
         outputs = int(round(t_end / self.s.interval)) + 1
