@@ -5,6 +5,9 @@ power balance τ θ̇ = dE/dt of a driven loop, Newton–Euler for a body held b
 same pendulum built as a tree, and the order of the index-3 generalised-α.
 """
 
+import sys
+from pathlib import Path
+
 import numpy as np
 import pytest
 
@@ -138,6 +141,18 @@ def test_generalized_alpha_keeps_order_two_down_to_small_steps():
         errors.append(np.abs(r.q - ref.q).max())
     ratios = np.array(errors[:-1]) / np.array(errors[1:])
     assert np.all(ratios > 10.0), (errors, ratios)  # measured 16.0, 14.8
+
+
+def test_a_tight_newton_tol_converges_on_a_redundant_loop():
+    """The Bricard linkage (5 coordinates, 5 loop rows, one redundant: benchmarks/loop_peers.py) at
+    newton_tol = 1e-13: the stopping test's floor stays above round-off (500 ε (1 + |q|)); at
+    1e-3 newton_tol it was below, and Newton gave up in the first step at h = 0.39 ms."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the checkout's benchmarks/
+    from benchmarks.loop_peers import bricard
+
+    scene = bricard()
+    r = rf.simulate(scene.system, 0.05, method="generalized_alpha", dt=3.9e-4, newton_tol=1e-13, q0=scene.q0)
+    assert r.t[-1] == pytest.approx(0.05) and r.stats["newton_iterations"] <= 8 * r.stats["steps"]
 
 
 def test_redundant_loop_gives_the_tree_motion_and_newton_euler_reactions():

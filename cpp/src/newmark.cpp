@@ -215,17 +215,20 @@ class NewmarkFamily final : public NewmarkStepper {
   /// newton_tol (1 + |q̇|), and, over a run of known span T, below κ = 0.03 of the step's own local error
   /// estimate e_q = h² |β − 1/6| |a_{n+1} − a_n| (as adaptive radau5 and esdirk43 hold Newton to a
   /// fraction of their error weights): dq ≤ κ e_q, dv ≤ κ e_q / T (an error dv in q̇ moves q by up to
-  /// dv T by the end), each down to 1e-3 of the first bounds. Held to newton_tol (1 + |q̇|) alone, the
-  /// error left in q̇ added up over steps as 1/h: Bricard linkage over 1 s, 6.4e-8 at h = 62.5 µs and
-  /// 2.0e-7 at 15.6 µs, where the method's own error is 3e-9. Where the iterations stall (θ ≥ 1/2:
-  /// round-off) within the first bounds, they are converged as far as the arithmetic goes.
+  /// dv T by the end), each down to 1e-3 of the first bounds, and not below 500 ε (1 + |q|). Held to
+  /// newton_tol (1 + |q̇|) alone, the error left in q̇ added up over steps as 1/h: Bricard linkage over
+  /// 1 s, 6.4e-8 at h = 62.5 µs and 2.0e-7 at 15.6 µs, where the method's own error is 3e-9. Where the
+  /// iterations stall (θ ≥ 1/2: round-off) within the first bounds, they are converged as far as the
+  /// arithmetic goes.
   bool converged(double dq, double dv, double theta, double h, const NewmarkState& s, const NewmarkState& s1) const {
     constexpr double kappa = 0.03;
     const double q_scale = tol_ * (1.0 + max_abs(s1.q)), v_scale = tol_ * (1.0 + max_abs(s1.v));
     if (!(dq <= q_scale && dv <= v_scale)) return false;
     if (theta >= 0.5 || span_ <= 0.0) return true;
+    // the floor: 1e-3 of the first bounds, not below 500 ε (1 + |q|), which round-off reaches
     const double local = kappa * h * h * std::abs(beta_ - 1.0 / 6.0) * max_abs(s1.a - s.a);
-    return dq <= std::max(local, 1e-3 * q_scale) && dv <= std::max(local / span_, 1e-3 * v_scale);
+    const double floor = std::max(1e-3, 500.0 * std::numeric_limits<double>::epsilon() / tol_);
+    return dq <= std::max(local, floor * q_scale) && dv <= std::max(local / span_, floor * v_scale);
   }
 
   void update(double h, const NewmarkState& s, NewmarkState& s1) const {
