@@ -149,20 +149,48 @@ def _resolve_executor(executor, workers):
 
 
 def _case_in_thread(stop, function, case, seed, record_errors):
-    """run_case in a worker thread, whose runs stop with the sweep (``_interrupt.sweep_stop``)."""
+    """run_case in a worker thread, whose runs stop with the sweep (``_interrupt.sweep_stop``): a
+    batch of one case."""
     with _interrupt.sweep_stop(stop):
-        return run_case(function, case, seed, record_errors)
+        return [run_case(function, case, seed, record_errors)]
 
 
-def _submit_all(executor, function, cases, seeds, record_errors, stop) -> list:
-    """Futures of every case, in the order of the cases."""
+def run_cases(function, cases: list, seeds: list, record_errors: bool) -> list:
+    """A batch of cases in one worker task: run_case's (value, error, wall time) for each."""
+    return [run_case(function, case, seed, record_errors) for case, seed in zip(cases, seeds)]
+
+
+#: Tasks per worker a process pool or a Dask cluster gets (each a batch of cases): a task costs
+#: ~3 ms of Dask's scheduling and pickling (a 5 ms run of Kane's beam took 8 ms a case on a
+#: 2-worker LocalCluster sent one case a task), and a few batches per worker still even out
+#: cases of unequal length.
+BATCHES_PER_WORKER = 4
+
+
+def _worker_count(executor) -> int:
+    """How many cases the executor runs at once: a Dask cluster's threads, a pool's workers."""
     if _is_dask_client(executor):
-        return [executor.submit(run_case, function, case, seed, record_errors, pure=False)
-                for case, seed in zip(cases, seeds)]
+        return max(1, sum(executor.nthreads().values()))
+    return max(1, getattr(executor, "_max_workers", None) or os.cpu_count() or 1)
+
+
+def _batches(executor, n: int) -> list[range]:
+    """The cases' indices in batches, one task each: one case a task on threads (a task costs
+    nothing there, and Ctrl-C stops each case's run), else BATCHES_PER_WORKER tasks per worker."""
     if isinstance(executor, concurrent.futures.ThreadPoolExecutor):
-        return [executor.submit(_case_in_thread, stop, function, case, seed, record_errors)
-                for case, seed in zip(cases, seeds)]
-    return [executor.submit(run_case, function, case, seed, record_errors) for case, seed in zip(cases, seeds)]
+        return [range(k, k + 1) for k in range(n)]
+    size = max(1, -(-n // (BATCHES_PER_WORKER * _worker_count(executor))))  # ceil
+    return [range(k, min(k + size, n)) for k in range(0, n, size)]
+
+
+def _submit_all(executor, function, cases, seeds, record_errors, stop, batches) -> list:
+    """A future per batch of cases, in the order of the cases: each returns its cases' outcomes."""
+    if isinstance(executor, concurrent.futures.ThreadPoolExecutor):
+        return [executor.submit(_case_in_thread, stop, function, cases[b[0]], seeds[b[0]], record_errors)
+                for b in batches]
+    options = {"pure": False} if _is_dask_client(executor) else {}
+    return [executor.submit(run_cases, function, [cases[k] for k in b], [seeds[k] for k in b], record_errors,
+                            **options) for b in batches]
 
 
 def _as_completed(executor, futures):
@@ -186,9 +214,13 @@ def _outcomes(function, cases, seeds, executor, record_errors, bar, stop) -> lis
                 if bar is not None:
                     bar.update(len(out))
         return out + [(None, INTERRUPTED, float("nan"))] * (len(cases) - len(out))
-    futures = _submit_all(executor, function, cases, seeds, record_errors, stop)
+    batches = _batches(executor, len(cases))
+    futures = _submit_all(executor, function, cases, seeds, record_errors, stop, batches)
+    size = {f: len(b) for f, b in zip(futures, batches)}  # Dask's futures hash by their key
     try:
-        for done, _ in enumerate(_as_completed(executor, futures), start=1):
+        done = 0
+        for future in _as_completed(executor, futures):
+            done += size[future]
             if bar is not None:
                 bar.update(done)
     except KeyboardInterrupt:
@@ -196,8 +228,13 @@ def _outcomes(function, cases, seeds, executor, record_errors, bar, stop) -> lis
         for f in futures:
             f.cancel()
         concurrent.futures.wait([f for f in futures if not _is_dask_client(executor)], timeout=GRACE)
-    return [f.result() if f.done() and not f.cancelled() and f.exception() is None
-            else (None, INTERRUPTED if stop.is_set() else _failure(f), float("nan")) for f in futures]
+    outcomes = []
+    for f, b in zip(futures, batches):
+        if f.done() and not f.cancelled() and f.exception() is None:
+            outcomes += f.result()
+        else:
+            outcomes += [(None, INTERRUPTED if stop.is_set() else _failure(f), float("nan"))] * len(b)
+    return outcomes
 
 
 def _failure(future) -> str:
@@ -263,7 +300,9 @@ def sweep(function: Callable, cases: Sequence[Mapping] | None = None, *, grid: M
         ``"processes"`` (a process pool; the function and its arguments must pickle),
         ``"serial"``, any ``concurrent.futures.Executor`` (e.g. ``mpi4py.futures.MPIPoolExecutor``),
         or a Dask ``Client`` (``pip install "rigidfem[dask]"``; Dask pickles with cloudpickle, so
-        functions defined in a notebook travel too).
+        functions defined in a notebook travel too). Processes, executors and Dask get the cases
+        in batches, ``BATCHES_PER_WORKER`` (4) tasks per worker, so that short runs do not pay a
+        task's cost each (~3 ms on Dask); threads one case a task.
     workers : int, optional
         Threads or processes of a pool made here (default: the number of cores).
     seed : int, optional
