@@ -6,7 +6,7 @@ The study: Kane's spin-up beam (3D modified RFEM, 40 elements, 120 coordinates; 
 h = 5e-4 s over 20 s, about 1.3 s per run on one core) at 8 spin rates Ω_s, each case building
 its model and running it. Executors: serial (one thread), a pool of 2 threads, 2 processes and a
 Dask LocalCluster of 2 worker processes (one thread each; its start-up is timed apart). Speed-up
-= serial time / time; efficiency = speed-up / 2 workers. The overhead per task is the wall time
+= serial time / time; efficiency = speed-up / 2 workers. The overhead per case is the wall time
 per case of a sweep of 200 tiny cases (a one-coordinate pendulum over 10 ms, about 50 µs of
 work), less that work. Executors are timed in interleaved rounds, the least time kept.
 """
@@ -66,7 +66,7 @@ def _timed_sweep(function, cases, executor, workers) -> tuple[float, object]:
 
 def scaling(spins=SPINS, elements: int = 40, rounds: int = 2, tiny: int = 200) -> Table:
     """Wall time of the sweep per executor, speed-up and efficiency against serial, and the
-    overhead per task on tiny cases (s)."""
+    overhead per case on tiny cases (s)."""
     from distributed import Client, LocalCluster
 
     cases = [{"omega": w, "elements": elements} for w in spins]
@@ -91,9 +91,9 @@ def scaling(spins=SPINS, elements: int = 40, rounds: int = 2, tiny: int = 200) -
     serial = best["serial (1 thread)"]
     rows = [{"executor": name, "cases": len(cases), "wall_time_s": best[name], "speed_up": serial / best[name],
              "efficiency": serial / best[name] / (1 if name.startswith("serial") else WORKERS),
-             "overhead_per_task_s": tiny_best[name] / len(tiny_cases) - work,
+             "overhead_per_case_s": tiny_best[name] / len(tiny_cases) - work,
              "startup_s": startup if name.startswith("Dask") else 0.0} for name in executors]
-    return Table(rows, ("executor", "cases", "wall_time_s", "speed_up", "efficiency", "overhead_per_task_s",
+    return Table(rows, ("executor", "cases", "wall_time_s", "speed_up", "efficiency", "overhead_per_case_s",
                         "startup_s"))
 
 
