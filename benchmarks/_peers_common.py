@@ -162,6 +162,43 @@ def mujoco_outputs(mujoco, model, data, steps: int, outputs: int, read: Callable
     return out
 
 
+class OutputTimes:
+    """For a scene (a dataclass) with its output times ``t_eval``, uniformly spaced from 0: the run's
+    end and the output interval (s)."""
+
+    @property
+    def t_end(self) -> float:
+        return float(self.t_eval[-1])
+
+    @property
+    def interval(self) -> float:
+        return float(self.t_eval[1] - self.t_eval[0])
+
+
+# ---------------------------------------------------------------------------------------------
+# The models checked equal
+# ---------------------------------------------------------------------------------------------
+
+def peer_self_checks(runners: Mapping, tight_newton) -> dict:
+    """code -> (how its converged solution was run, its run at twice that step) for the peers whose
+    runners have ``reference_step()`` and ``reference(h)``: Exudyn's generalised-α with Newton's
+    tolerances ``tight_newton``, MuJoCo's RK4."""
+    checks = {}
+    for code, method in (("Exudyn", "GeneralizedAlpha"), ("MuJoCo", "RK4")):
+        h = runners[code].reference_step()
+        how = f"{method} dt={h:.3g}" + (f" newton={tight_newton}" if code == "Exudyn" else "")
+        checks[code] = (f"{how} (self-check: dt={2 * h:.3g})", runners[code].reference(2 * h))
+    return checks
+
+
+def check_agreement(scene: str, code: str, difference: float, tolerance: float, what: str = "point") -> None:
+    """AssertionError when a code's converged ``what`` differs from rigidfem's by more than
+    ``tolerance`` of its amplitude: the models are not equal."""
+    if difference > tolerance:
+        raise AssertionError(f"{scene}: {code}'s converged {what} differs from rigidfem's by {difference:.3g} of its "
+                             f"amplitude (allowed {tolerance:g}): the models are not equal")
+
+
 # ---------------------------------------------------------------------------------------------
 # Sweeps and timing
 # ---------------------------------------------------------------------------------------------

@@ -78,8 +78,8 @@ from rigidfem import SimulationError, simulate
 from rigidfem.study import Table
 
 from ._common import compile_mujoco_callback, report
-from ._peers_common import (CODES, exudyn_settings, first_run, least_cpu_times, peer_guard, summary_table, versions,
-                            versions_line)
+from ._peers_common import (CODES, OutputTimes, check_agreement, exudyn_settings, first_run, least_cpu_times,
+                            peer_guard, peer_self_checks, summary_table, versions, versions_line)
 from .peers import Link, describe, to_mjcf
 
 _peer = peer_guard("crane_peers")
@@ -145,7 +145,7 @@ def _model(driven: bool, elements: int):
 
 
 @dataclass
-class Crane:
+class Crane(OutputTimes):
     """The compiled scene: ``system`` as simulated (the base prescribed) and ``free`` (the base's
     joint free; its chain ``chain``), the rope's ends (``tip``, ``payload``: Point, Body), the initial
     state q0 (``system``'s) and the outputs. ``positions(Q)`` of a code's result Q (N, 3: the
@@ -160,14 +160,6 @@ class Crane:
     q0: np.ndarray
     t_eval: np.ndarray
     amplitude: float = np.nan
-
-    @property
-    def t_end(self) -> float:
-        return float(self.t_eval[-1])
-
-    @property
-    def interval(self) -> float:
-        return float(self.t_eval[1] - self.t_eval[0])
 
     @property
     def payload_index(self) -> list:
@@ -582,20 +574,15 @@ def verify(scene: Crane, runners: dict, references: dict, tolerance: float = AGR
     against twice the step), and how closely each peer's base follows its profiles; raises
     ``AssertionError`` when a peer differs from rigidfem by more than ``tolerance``."""
     checks = {"rigidfem": ("radau5 rtol=1e-11 (self-check: rtol=1e-9)", runners["rigidfem"].reference(1e-9), "-")}
-    for code, method in (("Exudyn", "GeneralizedAlpha"), ("MuJoCo", "RK4")):
-        h = runners[code].reference_step()
-        how = f"{method} dt={h:.3g}" + (f" newton={TIGHT_NEWTON}" if code == "Exudyn" else "")
-        checks[code] = (f"{how} (self-check: dt={2 * h:.3g})", runners[code].reference(2 * h),
-                        base_error(scene, runners[code]))
+    for code, (how, check) in peer_self_checks(runners, TIGHT_NEWTON).items():
+        checks[code] = (how, check, base_error(scene, runners[code]))
     rows = []
     for code, (how, check, base) in checks.items():
         d = error(scene, references[code], references["rigidfem"])
         rows.append({"scene": scene.name, "code": code, "reference": how,
                      "self_check_rel": error(scene, check, references[code]), "vs_rigidfem_rel": d,
                      "vs_rigidfem_m": d * scene.amplitude, "base_error": base, "amplitude_m": scene.amplitude})
-        if d > tolerance:
-            raise AssertionError(f"{scene.name}: {code}'s converged payload differs from rigidfem's by {d:.3g} of its "
-                                 f"amplitude (allowed {tolerance:g}): the models are not equal")
+        check_agreement(scene.name, code, d, tolerance, "payload")
     return Table(rows, VERIFY_COLUMNS)
 
 

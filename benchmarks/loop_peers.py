@@ -139,7 +139,7 @@ class Loop:
 
 
 @dataclass
-class Scene:
+class Scene(common.OutputTimes):
     """A scene: rigidfem's System as simulated (``system``, the crank prescribed) and the same
     model with every joint free (``free``: the peers' coordinates, for positions and closure);
     the chain read from ``free``; its loops, observed point, initial state (``free`` coordinates),
@@ -157,14 +157,6 @@ class Scene:
     planar: bool = False
     omega_max: float = 0.0              #: highest natural frequency at q0 (rad/s), of the free tree
     amplitude: float = field(default=np.nan)
-
-    @property
-    def t_end(self) -> float:
-        return float(self.t_eval[-1])
-
-    @property
-    def interval(self) -> float:
-        return float(self.t_eval[1] - self.t_eval[0])
 
     def system_state(self):
         """(q0, q̇0) of ``system`` (the drive's coordinate removed)."""
@@ -565,11 +557,8 @@ def verify(scene: Scene, runners: dict, references: dict, tolerance: float = AGR
     ``AssertionError`` when a peer differs from rigidfem by more than ``tolerance``."""
     points = {code: scene.positions(Q) for code, Q in references.items()}
     checks = {"rigidfem": ("dopri5 rtol=1e-12 (self-check: rtol=1e-10)",
-                           runners["rigidfem"].run("dopri5", "rtol", 1e-10))}
-    for code, method in (("Exudyn", "GeneralizedAlpha"), ("MuJoCo", "RK4")):
-        h = runners[code].reference_step()
-        how = f"{method} dt={h:.3g}" + (f" newton={TIGHT_NEWTON}" if code == "Exudyn" else "")
-        checks[code] = (f"{how} (self-check: dt={2 * h:.3g})", runners[code].reference(2 * h))
+                           runners["rigidfem"].run("dopri5", "rtol", 1e-10)),
+              **common.peer_self_checks(runners, TIGHT_NEWTON)}
     rows = []
     for code, (how, check) in checks.items():
         d = np.max(np.linalg.norm(points[code] - points["rigidfem"], axis=1)) / scene.amplitude
@@ -578,9 +567,7 @@ def verify(scene: Scene, runners: dict, references: dict, tolerance: float = AGR
                      "closure_max_g": scene.closure(references[code]),
                      "drive_error_rad": scene.drive_error(references[code]),
                      "amplitude_m": scene.amplitude})
-        if d > tolerance:
-            raise AssertionError(f"{scene.name}: {code}'s converged point differs from rigidfem's by {d:.3g} of its "
-                                 f"amplitude (allowed {tolerance:g}): the models are not equal")
+        common.check_agreement(scene.name, code, d, tolerance)
     return Table(rows, VERIFY_COLUMNS)
 
 
