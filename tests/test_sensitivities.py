@@ -380,3 +380,27 @@ def test_sensitivities_are_saved_with_the_result(tmp_path):
                                   r.position_sensitivity(rf.Point(0, (0.4, 0.0, 0.0)), "rod.mass"))
     assert rf.load_npz(rf.simulate(s, 0.1, "rk4", dt=1e-3).to_npz(tmp_path / "p.npz")).sensitivities == {}
 
+
+
+def _driven_pendulum(fraction, law="trapezoidal"):
+    m = rf.Model(gravity=(0.0, -9.81, 0.0))
+    arm = m.add_body("arm", m.ground, rf.Joint.revolute("z"), mass=1.0, inertia=(0.1, 0.1, 0.1), com=(0.5, 0.0, 0.0))
+    m.add_body("bob", arm, rf.Joint.revolute("z"), mass=1.0, inertia=(0.1, 0.1, 0.1), com=(0.5, 0.0, 0.0),
+               placement=rf.transform((1.0, 0.0, 0.0)))
+    m.prescribe(arm, rf.motion.rest_to_rest(0.0, 1.0, t0=0.0, duration=1.0, law=law, fraction=fraction))
+    return m.compile()
+
+
+def test_a_profile_number_at_the_edge_of_its_values():
+    """A trapezoidal drive's fraction at 0.5, the largest it takes: its difference moves inward
+    ([p − 2h, p]) instead of refusing the run (fuzz seed 2033567127, case 37: a 1 ms run, on which
+    the step grew to 1.8 past the edge). The sensitivity at the edge continues the one just inside it,
+    and with the quintic law, which has no fraction, it is zero."""
+    name = "arm.rz.drive.fraction"
+    edge = rf.simulate(_driven_pendulum(0.5), 1.0, "rk4", dt=1e-4, sensitivities=[name]).sensitivity(name)[0][-1]
+    inside = rf.simulate(_driven_pendulum(0.4999), 1.0, "rk4", dt=1e-4, sensitivities=[name]).sensitivity(name)[0][-1]
+    assert np.isfinite(edge).all() and np.abs(edge - inside).max() < 0.2 * np.abs(inside).max()  # measured 0.09
+    short = rf.simulate(_driven_pendulum(0.5), 1e-3, "rkf45", sensitivities=[name]).sensitivity(name)[0]
+    assert np.isfinite(short).all()
+    quintic = rf.simulate(_driven_pendulum(0.5, "quintic"), 1.0, "rk4", dt=1e-3, sensitivities=[name])
+    assert np.abs(quintic.sensitivity(name)[0]).max() == 0.0

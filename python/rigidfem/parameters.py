@@ -343,10 +343,24 @@ class Parameters:
         p = self.values[name]
         return abs(p) if p != 0.0 else 1.0
 
+    def profile_pair(self, base, name: str, t0: float, t1: float) -> tuple:
+        """(system at p + h, system at p − h, h) of a profile's number for the central difference over
+        [t0, t1] (s), h from ``profile_step``. Where p sits at the edge of the values its profile takes
+        (a ramp's fraction at 0.5), the side beyond is refused: the pair moves inward by h, [p, p − 2h]
+        or [p + 2h, p] (the difference is then first order, its error O(h), ~1e-8 of the derivative)."""
+        h = self.profile_step(name, t0, t1)
+        for low, high in ((-1.0, 1.0), (-2.0, 0.0), (0.0, 2.0)):
+            try:
+                return self.shifted(base, name, high * h), self.shifted(base, name, low * h), h
+            except ValueError:
+                continue
+        raise ValueError(f"sensitivities: expected a parameter whose profile takes values beside "
+                         f"{name} = {self.values[name]:g} (p ± {h:.3g}), got none on either side")
+
     def profile_step(self, name: str, t0: float, t1: float) -> float:
         """h for a profile's number: a trial step δ = 1e-6 max(|p|, 1) moves q(t) over 41 times in [t0, t1] by
         at most Δ; h = δ · 1e-6 max(1, |q|) / Δ, so that the central difference's truncation (∝ h²) and
-        round-off (∝ 1/h) both stay near 1e-10 of the derivative."""
+        round-off (∝ 1/h) both stay near 1e-10 of the derivative; at most 1e3 δ."""
         prefix, short = self.where[name]
         group = self.groups[prefix]
         changed = self._current(prefix)
@@ -358,9 +372,15 @@ class Parameters:
         q = self._cache[key]
         p = self.values[name]
         delta = 1e-6 * max(abs(p), 1.0)
-        moved = remade(group.profile, {**changed, short: p + delta})
+        try:
+            moved = remade(group.profile, {**changed, short: p + delta})
+        except ValueError:  # p at the upper edge of the values its profile takes: the trial step below it
+            moved = remade(group.profile, {**changed, short: p - delta})
         change = np.max(np.abs(np.array([moved(t)[0] for t in times]) - q))
-        return delta * 1e-6 * max(1.0, float(np.max(np.abs(q)))) / change if change > 0.0 else delta
+        # at most δ · 1e3: a number the profile hardly depends on over [t0, t1] (a ramp's fraction over 1 ms)
+        # would otherwise get a step far beyond its values
+        return min(delta * 1e-6 * max(1.0, float(np.max(np.abs(q)))) / change, 1e3 * delta) if change > 0.0 \
+            else delta
 
 
 # ----------------------------------------------------------------- profiles

@@ -55,9 +55,8 @@ def directions(system, names, options, t0: float, t1: float, argument: str = "se
             h = params.step(name)
             options.add_sensitivity(params.shifted(system, name, h), None, h, S0)
             continue
-        group = params.groups[params.where[name][0]]
-        h = params.profile_step(name, t0, t1)
-        options.add_sensitivity(params.shifted(system, name, h), params.shifted(system, name, -h), h, S0)
+        plus, minus, h = params.profile_pair(system, name, t0, t1)
+        options.add_sensitivity(plus, minus, h, S0)
     return names
 
 

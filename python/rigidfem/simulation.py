@@ -243,9 +243,8 @@ class Result(Versioned):
         dx = (up - down) / (2.0 * eps[:, None])  # zero where ∂q/∂p is
         params = self.system._parameters
         if parameters_.initial_value(self.system, name) is None and not params.parameter(name).linear:
-            h = params.profile_step(name, self.t[0], self.t[-1])
-            up, down = (dataclasses.replace(self, system=params.shifted(self.system, name, sign * h)).position(
-                point, frame) for sign in (1.0, -1.0))
+            plus, minus, h = params.profile_pair(self.system, name, self.t[0], self.t[-1])
+            up, down = (dataclasses.replace(self, system=shifted).position(point, frame) for shifted in (plus, minus))
             dx += (up - down) / (2.0 * h)
         return dx
 
