@@ -229,7 +229,7 @@ class NewmarkFamily final : public NewmarkStepper {
     if (!(dq <= q_scale && dv <= v_scale)) return false;
     if (theta >= 0.5 || span_ <= 0.0) return true;
     // the floor: 1e-3 of the first bounds, not below 500 ε (1 + |q|), which round-off reaches
-    const double local = kappa * h * h * std::abs(beta_ - 1.0 / 6.0) * max_abs(s1.a - s.a);
+    const double local = kappa * h * h * std::abs(beta_ - 1.0 / 6.0) * (s1.a - s.a).lpNorm<Eigen::Infinity>();
     const double floor = std::max(1e-3, 500.0 * std::numeric_limits<double>::epsilon() / tol_);
     return dq <= std::max(local, floor * q_scale) && dv <= std::max(local / std::sqrt(h * span_), floor * v_scale);
   }

@@ -92,8 +92,9 @@ OPTIONS = (
            "Generalised-α's spectral radius at infinite frequency ρ∞ ∈ [0, 1]."),
     Option("newton_tol", 1e-10, "1", _IMPLICIT,
            "Newton stops when the increments of q and q̇ fall below newton_tol (1 + |q|); the Newmark family "
-           "also holds them to 0.03 of the step's local error estimate (the velocity's over the run's length), "
-           "down to 1e-3 newton_tol (1 + |q|), so that small steps keep the method's order; adaptive esdirk43 "
+           "also holds them to 0.03 of the step's local error estimate e_q (q̇'s to 0.03 e_q/√(h T), T the run's "
+           "length), down to 1e-3 newton_tol (1 + |q|) and at least 500 ε (1 + |q|), so that small steps keep "
+           "the method's order; adaptive esdirk43 "
            "and radau5 runs stop it at 0.03 of the error weights instead."),
     Option("newton_max_iterations", 10, "", _IMPLICIT, "Newton iterations per step (or stage) at most."),
     Option("iteration_matrix", "auto", "", _IMPLICIT,

@@ -347,7 +347,7 @@ class Parameters:
         """(system at p + h, system at p − h, h) of a profile's number for the central difference over
         [t0, t1] (s), h from ``profile_step``. Where p sits at the edge of the values its profile takes
         (a ramp's fraction at 0.5), the side beyond is refused: the pair moves inward by h, [p, p − 2h]
-        or [p + 2h, p] (the difference is then first order, its error O(h), ~1e-8 of the derivative)."""
+        or [p + 2h, p] (the difference is then first order: the derivative at p ∓ h, its error O(h))."""
         h = self.profile_step(name, t0, t1)
         for low, high in ((-1.0, 1.0), (-2.0, 0.0), (0.0, 2.0)):
             try:

@@ -33,7 +33,7 @@ MatX free_jacobian(const System& sys, const Data& d);
 VecX least_norm(const MatX& A, const VecX& b);
 
 /// The same for a symmetric positive semi-definite A (G M⁻¹ Gᵀ, M symmetric): by its eigenvalues,
-/// which are its singular values (the same rank decision), at a third of the SVD's cost.
+/// which are its singular values (the same rank decision), without the Jacobi SVD's sweeps.
 VecX least_norm_symmetric(const MatX& A, const VecX& b);
 
 /// The wrench each loop joint applies to its body B, in frame A's axes: (force N, torque N·m about
