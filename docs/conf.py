@@ -53,13 +53,14 @@ def _copy_notebooks() -> None:
 
 
 def _write_options_table() -> None:
-    """docs/_generated/options.md: simulate's options, from the one table (rigidfem.options)."""
+    """docs/_generated/options.md and methods.md: simulate's options and methods, from the C++ tables
+    (rigidfem.options reads them)."""
     out = HERE / "_generated"
     out.mkdir(exist_ok=True)
-    text = options.table() + "\n"
-    path = out / "options.md"
-    if not path.exists() or path.read_text() != text:
-        path.write_text(text)
+    for name, text in (("options.md", options.table()), ("methods.md", options.method_table())):
+        path = out / name
+        if not path.exists() or path.read_text() != text + "\n":
+            path.write_text(text + "\n")
 
 
 def _write_api_page() -> None:

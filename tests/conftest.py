@@ -97,7 +97,9 @@ def central_jacobians(s, t, q, qd, h=1e-6):
 def step_of(method: str, dt: float) -> dict:
     """The keyword for a step dt: dt for a fixed-step method, first_step for an adaptive one (a dt would set
     its first step with a UserWarning)."""
-    return {"first_step": dt} if method in ("auto", "dopri5", "rkf45", "esdirk43", "radau5") else {"dt": dt}
+    import rigidfem as rf
+
+    return {"first_step": dt} if rf.methods()[method].adaptive else {"dt": dt}
 
 
 # ----------------------------------------------------------------- loops that a parameter moves

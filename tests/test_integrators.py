@@ -23,6 +23,7 @@ from conftest import DOUBLE_PENDULUM_Y0 as Y0  # the pendulum2 fixture's initial
     ("rk4", [0.02, 0.01, 0.005], 4, {}),
     ("dopri5", [0.04, 0.02, 0.01], 5, {"adaptive": False}),
     ("rkf45", [0.01, 0.005, 0.0025], 4, {"adaptive": False}),
+    ("bs23", [0.01, 0.005, 0.0025], 3, {"adaptive": False}),
     ("newmark", [0.01, 0.005, 0.0025], 2, {}),
     ("hht", [0.01, 0.005, 0.0025], 2, {}),
     ("generalized_alpha", [0.01, 0.005, 0.0025], 2, {}),
@@ -38,14 +39,14 @@ def test_observed_order_of_accuracy(pendulum2, method, dts, order, kw):
     assert np.all(observed > order - 0.3), observed
 
 
-@pytest.mark.parametrize("method", ["dopri5", "rkf45", "rk4", "generalized_alpha"])
+@pytest.mark.parametrize("method", ["dopri5", "rkf45", "bs23", "rk4", "generalized_alpha"])
 def test_output_at_t_eval_is_dense_output_not_nearest_steps(pendulum2, method):
     system, ref = pendulum2
     t = np.linspace(0, 1.0, 37)  # not on the step grid
-    kw = {"rtol": 1e-10, "atol": 1e-12} if method in ("dopri5", "rkf45") else {"dt": 1e-3}
+    kw = {"rtol": 1e-10, "atol": 1e-12} if method in ("dopri5", "rkf45", "bs23") else {"dt": 1e-3}
     r = rf.simulate(system, 1.0, method=method, q0=Y0[:2], t_eval=t, **kw)
     np.testing.assert_array_equal(r.t, t)
-    bound = {"dopri5": 1e-8, "rkf45": 1e-8, "rk4": 1e-9, "generalized_alpha": 2e-5}[method]
+    bound = {"dopri5": 1e-8, "rkf45": 1e-8, "bs23": 1e-8, "rk4": 1e-9, "generalized_alpha": 2e-5}[method]
     assert np.max(np.abs(r.q - ref.sol(t)[:2].T)) < bound
     assert np.max(np.abs(r.qd - ref.sol(t)[2:].T)) < 20 * bound
     # A quantity derived at the outputs: q̈ is the forward dynamics at the interpolated state.
@@ -61,6 +62,11 @@ def test_adaptive_methods_meet_their_tolerance_and_count_work(pendulum2):
         s = r.stats
         assert s["rhs_evaluations"] >= 6 * (s["steps"] + s["rejected_steps"])
         assert s["wall_time"] > 0
+    # bs23 (3 evaluations a step, FSAL) the same way
+    for rtol in (1e-4, 1e-7):
+        r = rf.simulate(system, 1.0, method="bs23", q0=Y0[:2], rtol=rtol, atol=rtol * 1e-2)
+        assert np.max(np.abs(np.r_[r.q[-1], r.qd[-1]] - ref.y[:, -1])) < 100 * rtol
+        assert r.stats["rhs_evaluations"] >= 3 * (r.stats["steps"] + r.stats["rejected_steps"])
     # Tolerances per component of y = [q, q̇]: one tight component drives the step size.
     same = rf.simulate(system, 1.0, q0=Y0[:2], rtol=np.full(4, 1e-6), atol=1e-8)
     loose = rf.simulate(system, 1.0, q0=Y0[:2], rtol=1e-3, atol=1e-8)

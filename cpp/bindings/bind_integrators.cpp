@@ -1,5 +1,7 @@
 // The C++ integrators: options, the run (GIL released), and batch outputs for results.
 #include <limits>
+#include <type_traits>
+#include <variant>
 
 #include "bindings.hpp"
 #include "rigidfem/adjoint.hpp"
@@ -12,6 +14,48 @@
 namespace rigidfem::bindings {
 
 namespace {
+// An option's value as a Python object.
+py::object option_value(const OptionValue& v) {
+  return std::visit(
+      [](const auto& x) -> py::object {
+        using T = std::decay_t<decltype(x)>;
+        if constexpr (std::is_same_v<T, std::monostate>)
+          return py::none();
+        else
+          return py::cast(x);
+      },
+      v);
+}
+
+// A Python value as the option `info` takes it: None where allowed, else a real number, an integer, True or
+// False, a name, or one or more real numbers (the bindings' conversion rules; ValueError naming the option).
+OptionValue option_value(const OptionInfo& info, const py::object& x) {
+  const std::string name = info.name, expected = info.expected;
+  if (x.is_none()) {
+    if (info.none_allowed) return std::monostate();
+    bad(name, expected, "None");
+  }
+  switch (info.type) {
+    case OptionType::Real: return real_arg(x, name, expected);
+    case OptionType::Integer: return static_cast<long>(int_arg(x, name, expected, -(1LL << 62), 1LL << 62));
+    case OptionType::Flag:
+      if (!PyBool_Check(x.ptr()) && !(py::hasattr(x, "dtype") && std::string(py::str(x.attr("dtype"))) == "bool"))
+        bad(name, expected, arg_repr(x));
+      return x.cast<bool>();
+    case OptionType::Name:
+      if (!PyUnicode_Check(x.ptr())) bad(name, expected, arg_repr(x));
+      return x.cast<std::string>();
+    case OptionType::Reals: {
+      const py::array_t<double> a = real_array_arg(x, name, expected);
+      if (a.ndim() == 0) return *a.data();
+      if (a.ndim() != 1) bad(name, expected, "an array of " + std::to_string(a.ndim()) + " dimensions");
+      return std::vector<double>(a.data(), a.data() + a.size());
+    }
+    case OptionType::Outputs: break;
+  }
+  bad(name, "an option set by its own converter", arg_repr(x));
+}
+
 // The states of a trajectory as the rows of a (len t, n) array.
 RowMatX stack(const std::vector<VecX>& rows, int n) {
   RowMatX M(rows.size(), n);
@@ -77,7 +121,19 @@ void bind_integrators(py::module_& m) {
           "(None, None: an initial value), and [dq0/dp, dqd0/dp] (2 nq).")
       .def_property(
           "stiff_method", [](const IntegratorOptions& o) { return method_name(o.stiff_method); },
-          [](IntegratorOptions& o, const std::string& name) { o.stiff_method = parse_method(name); });
+          [](IntegratorOptions& o, const std::string& name) { o.stiff_method = parse_method(name); })
+      .def(
+          "set",
+          [](IntegratorOptions& o, const std::string& name, const py::object& value) {
+            const OptionInfo& info = option_info(name);
+            if (!info.set) bad(name, "an option set by its own converter", "'" + name + "'");
+            info.set(o, option_value(info, value));
+          },
+          py::arg("name"), py::arg("value"),
+          "Sets the option `name` from a Python value of its type (integrator_options: ValueError naming it otherwise).")
+      .def(
+          "get", [](const IntegratorOptions& o, const std::string& name) { return option_value(option_info(name).get(o)); },
+          py::arg("name"), "The option `name` as Python shows it.");
 
   m.def(
       "_auto_stiff_method",
@@ -87,6 +143,40 @@ void bind_integrators(py::module_& m) {
         return std::string(method_name(auto_stiff_method(s, o)));
       },
       py::arg("system"), py::arg("iteration_matrix"), "The implicit method method='auto' hands over to.");
+  m.def("_measures_outputs", &measures_outputs, py::arg("system"), py::arg("options"),
+        "Whether error_on's default for the run is the bodies' displacements (else the state).");
+  m.def(
+      "_method_table",
+      [] {
+        py::list rows;
+        for (const MethodInfo& m : method_table()) {
+          py::list options;
+          for (const char* name : m.options) options.append(name);
+          rows.append(py::dict(py::arg("name") = m.name, py::arg("family") = m.family, py::arg("order") = m.order,
+                               py::arg("error_estimate") = m.error_estimate, py::arg("adaptive") = m.adaptive,
+                               py::arg("measures_outputs") = m.measures_outputs, py::arg("adjoint") = m.adjoint,
+                               py::arg("options") = options,
+                               py::arg("doc") = m.doc));
+        }
+        return rows;
+      },
+      "The C++ methods, each a dict: name, family, order (of the propagated solution), error_estimate, adaptive (by\n"
+      "default), measures_outputs (error_on's default: the bodies, else the state), adjoint (rigidfem.gradient), options\n"
+      "(the names it reads), doc.");
+  m.def(
+      "_option_table",
+      [] {
+        static const char* types[] = {"real", "integer", "flag", "name", "reals", "outputs"};
+        const IntegratorOptions defaults;
+        py::list rows;
+        for (const OptionInfo& o : integrator_options())
+          rows.append(py::dict(py::arg("name") = o.name, py::arg("type") = types[static_cast<int>(o.type)],
+                               py::arg("default") = option_value(o.get(defaults)), py::arg("unit") = o.unit,
+                               py::arg("expected") = o.expected, py::arg("doc") = o.doc,
+                               py::arg("none_allowed") = o.none_allowed));
+        return rows;
+      },
+      "The options of the integrators, each a dict: name, type, default, unit, doc, none_allowed.");
   m.def("_check_options", &check_options, py::arg("system"), py::arg("t0"), py::arg("t_end"), py::arg("q0"),
         py::arg("qd0"), py::arg("t_eval"), py::arg("options"),
         "integrate's checks of the options alone (ValueError naming the first bad one).");

@@ -30,6 +30,7 @@
 #include <cmath>
 #include <complex>
 #include <limits>
+#include <stdexcept>
 
 #include "rigidfem/arms.hpp"
 #include "rigidfem/constraints.hpp"
@@ -961,6 +962,36 @@ class Radau5 final : public ImplicitRk, public RadauAccess {
 std::unique_ptr<Stepper> make_implicit_rk(const System& sys, const IntegratorOptions& o, IntegratorStats& stats) {
   if (o.method == Method::Radau5) return std::make_unique<Radau5>(sys, o, stats);
   return std::make_unique<Esdirk>(sys, o, stats);
+}
+
+namespace {
+
+// radau5's own: it takes the exact tangent only, and no Maxwell arms (esdirk43 takes both).
+void check_radau5(const System& sys, const IntegratorOptions& o) {
+  if (sys.nz > 0)
+    throw std::invalid_argument("method: 'radau5' does not integrate Maxwell arms (the system has " +
+                                std::to_string(sys.nz) + " arm forces as internal variables); use esdirk43, "
+                                "generalized_alpha or dopri5");
+  if (o.iteration_matrix == IterationMatrix::Spring)
+    throw std::invalid_argument("iteration_matrix: radau5 takes the exact tangent ('auto', 'tangent' or 'krylov'), got "
+                                "'spring' ('krylov' is its O(n) form); use esdirk43 for the spring matrix");
+}
+
+}  // namespace
+
+const std::vector<MethodInfo>& implicit_rk_methods() {
+  static const std::vector<MethodInfo> rows = {
+      {Method::Esdirk43, "esdirk43", "implicit Runge-Kutta", 4, true, true, false, false, method_options(true, true),
+       "ESDIRK4(3)6L[2]SA (Kennedy & Carpenter 2003): order 4, L-stable, stiffly accurate, embedded order 3, PI "
+       "control; 5 implicit stages, each a Newton solve for its q̈ with M + γh C + (γh)² K (γ = ¼), dense output "
+       "quintic Hermite",
+       make_implicit_rk, nullptr},
+      {Method::Radau5, "radau5", "implicit Runge-Kutta", 5, true, true, true, true, method_options(true, true),
+       "Radau IIA, 3 stages, order 5, L-stable, stiffly accurate; simplified Newton on all stages in the transformed "
+       "real/complex form (exact tangent only), Hairer's filtered estimate, PI control, dense output quintic Hermite",
+       make_implicit_rk, check_radau5},
+  };
+  return rows;
 }
 
 }  // namespace rigidfem

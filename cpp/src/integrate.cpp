@@ -19,37 +19,62 @@ namespace rigidfem {
 
 namespace {
 
-// The methods: name, order, error estimate, adaptive by default, stepper.
-const MethodInfo methods[] = {
-    {Method::Euler, "euler", 1, false, false, make_runge_kutta},
-    {Method::SymplecticEuler, "symplectic_euler", 1, false, false, make_runge_kutta},
-    {Method::RK4, "rk4", 4, false, false, make_runge_kutta},
-    {Method::Dopri5, "dopri5", 5, true, true, make_runge_kutta},
-    {Method::RKF45, "rkf45", 4, true, true, make_runge_kutta},
-    {Method::Newmark, "newmark", 2, true, false, make_newmark},
-    {Method::HHT, "hht", 2, true, false, make_newmark},
-    {Method::GeneralizedAlpha, "generalized_alpha", 2, true, false, make_newmark},
-    {Method::ImplicitSpring, "implicit_spring", 2, true, false, make_newmark},
-    {Method::Esdirk43, "esdirk43", 4, true, true, make_implicit_rk},
-    {Method::Radau5, "radau5", 5, true, true, make_implicit_rk},
-    {Method::Auto, "auto", 5, true, true, make_runge_kutta},  // dopri5 and its stiff method (auto_method.hpp)
-};
-
 const char* iteration_matrices[] = {"auto", "tangent", "spring", "krylov"};
 
 using Clock = std::chrono::steady_clock;
 
+// auto's own checks: its stiff method is an implicit one with an error estimate, and radau5 takes no arms.
+void check_auto(const System& sys, const IntegratorOptions& o) {
+  const Method stiff = auto_stiff_method(sys, o);
+  if (stiff == Method::Radau5 && sys.nz > 0)
+    throw std::invalid_argument("method: 'radau5' does not integrate Maxwell arms (the system has " +
+                                std::to_string(sys.nz) + " arm forces as internal variables); use esdirk43, "
+                                "generalized_alpha or dopri5");
+  const MethodInfo& m = method_info(stiff);
+  if (!m.error_estimate || std::string(m.family) == "explicit Runge-Kutta" || stiff == Method::Auto)
+    throw std::invalid_argument(std::string("stiff_method: expected an implicit method with an error estimate, got '") +
+                                m.name + "'");
+}
+
 }  // namespace
 
+std::vector<const char*> method_options(bool error_estimate, bool newton, std::initializer_list<const char*> own) {
+  std::vector<const char*> names = error_estimate
+                                       ? std::vector<const char*>{"dt", "rtol", "atol", "error_on", "first_step",
+                                                                  "max_step", "max_steps", "adaptive"}
+                                       : std::vector<const char*>{"dt", "max_steps"};
+  if (newton) names.insert(names.end(), {"newton_tol", "newton_max_iterations", "iteration_matrix"});
+  names.insert(names.end(), own);
+  return names;
+}
+
+const std::vector<MethodInfo>& method_table() {
+  static const std::vector<MethodInfo> table = [] {
+    std::vector<MethodInfo> rows;
+    for (const auto* family : {&runge_kutta_methods(), &newmark_methods(), &implicit_rk_methods()})
+      for (const MethodInfo& m : *family) rows.push_back(m);
+    // dopri5 and its stiff method (auto_method.hpp): the stiff method's order, error measure and options
+    rows.push_back({Method::Auto, "auto", "auto", 5, true, true, true, false, method_options(true, true),
+                    "radau5 (esdirk43 with Maxwell arms or the spring matrix) from the start where the highest "
+                    "frequency at t0 (stats['omega_max'], by power iteration) would hold dopri5 to 200 steps or more "
+                    "for stability alone; otherwise dopri5, handing over for good where its steps sit at the stability "
+                    "limit (from the start if that is in its first window, kept if it beats dopri5's probe by a count "
+                    "of work); stats['method'] says what ran",
+                    make_runge_kutta, check_auto});
+    return rows;
+  }();
+  return table;
+}
+
 const MethodInfo& method_info(Method method) {
-  for (const MethodInfo& m : methods)
+  for (const MethodInfo& m : method_table())
     if (m.method == method) return m;
   throw std::logic_error("method_info: a method without a row in the table");
 }
 
 Method parse_method(const std::string& name) {
   std::string names;
-  for (const MethodInfo& m : methods) {
+  for (const MethodInfo& m : method_table()) {
     if (name == m.name) return m.method;
     names += std::string(names.empty() ? "" : ", ") + m.name;
   }
@@ -57,6 +82,10 @@ Method parse_method(const std::string& name) {
 }
 
 const char* method_name(Method method) { return method_info(method).name; }
+
+bool measures_outputs(const System& sys, const IntegratorOptions& o) {
+  return method_info(o.method == Method::Auto ? auto_stiff_method(sys, o) : o.method).measures_outputs;
+}
 
 IterationMatrix parse_iteration_matrix(const std::string& name) {
   for (int k = 0; k < 4; ++k)
@@ -374,6 +403,119 @@ void check_sensitivities(const System& sys, const IntegratorOptions& o) {
 
 }  // namespace
 
+namespace {
+
+// The conversions of OptionValue the table's rows use.
+double real(const OptionValue& v) { return std::get<double>(v); }
+OptionValue step_or_none(double h) { return h > 0.0 ? OptionValue(h) : OptionValue(); }
+// A step given (dt, first_step): the options hold 0 for "none", so it must be positive on its way in.
+double positive_step(const OptionValue& v, const char* name) {
+  const double h = real(v);
+  if (!(h > 0.0 && std::isfinite(h))) bad(name, "a positive finite step in s", num(h));
+  return h;
+}
+VecX reals(const OptionValue& v) {
+  if (const double* x = std::get_if<double>(&v)) return VecX::Constant(1, *x);
+  const auto& x = std::get<std::vector<double>>(v);
+  return Eigen::Map<const VecX>(x.data(), static_cast<Eigen::Index>(x.size()));
+}
+
+}  // namespace
+
+const std::vector<OptionInfo>& integrator_options() {
+  using O = IntegratorOptions;
+  using V = const OptionValue&;
+  static const std::vector<OptionInfo> table = {
+      {"dt", OptionType::Real, "s", "a positive finite step in s",
+       "Step of the fixed-step methods: steps end on t0 + k·dt exactly, the last on t_end. Given to an adaptive "
+       "method (dopri5, rkf45, bs23, esdirk43, radau5, auto) it sets only the first step, with a UserWarning saying so "
+       "(``adaptive=False`` runs those at fixed steps of dt).",
+       true, [](const O& o) { return step_or_none(o.dt); },
+       [](O& o, V v) { o.dt = std::holds_alternative<double>(v) ? positive_step(v, "dt") : 0.0; }},
+      {"rtol", OptionType::Reals, "1", "a non-negative number or 2 nq of them",
+       "Relative tolerance of adaptive runs (float, or (2 nq,) per component of y = [q, q̇] with "
+       "``error_on='state'``). On outputs each output's local error is held to atol + rtol × scale: for points and "
+       "bodies the model's size L (m, ``stats['model_size']``) or the farthest a centre of mass has moved if larger; "
+       "the largest magnitude reached so far for coordinates, element forces and loop reactions. On the state: "
+       "atol_i + rtol_i |y_i| (atol = 0: purely relative; an exactly zero component counts as exact). SciPy's methods "
+       "raise rtol to their floor 100 ε; scipy:Radau and scipy:BDF take one rtol, the smallest given.",
+       false, [](const O& o) { return OptionValue(o.rtol(0)); }, [](O& o, V v) { o.rtol = reals(v); }},
+      {"atol", OptionType::Reals, "m, rad (per s for rates)", "a non-negative number or 2 nq of them", "Absolute tolerance of adaptive runs, as rtol.", false,
+       [](const O& o) { return OptionValue(o.atol(0)); }, [](O& o, V v) { o.atol = reals(v); }},
+      {"error_on", OptionType::Outputs, "", "points, bodies, coordinates, elements or loops",
+       "What the adaptive C++ methods measure their local error on (``rigidfem.error_control``): a list of points "
+       "and bodies (their positions, m), coordinate names or indices (m or rad), force element names (their axial "
+       "force, N) and loop names (their multipliers, N or N·m), each error mapped from the state's through the "
+       "output's Jacobian, a velocity's held as the displacement it makes over the step. None (the default): "
+       "'bodies' — every body's displacement, the RMS over its material √(|δc|² + δθᵀ I_C δθ/m) — for radau5, the "
+       "adaptive Newmark family and auto's radau5; 'state' for dopri5, rkf45, bs23, esdirk43 and auto's dopri5 phase. "
+       "A mode that no output sees is not resolved: the L-stable radau5 damps it (the released strip of 1 m, m = 32: "
+       "2,800 steps to 1e-6 m instead of 177,000).",
+       true, [](const O&) { return OptionValue(); }, nullptr},
+      {"first_step", OptionType::Real, "s", "a positive finite step in s", "First step of an adaptive run; estimated (Hairer's rule) by default.",
+       true, [](const O&) { return OptionValue(); },
+       [](O& o, V v) {
+         if (std::holds_alternative<double>(v)) o.dt = positive_step(v, "first_step");
+       }},
+      {"max_step", OptionType::Real, "s", "a positive step in s (inf for no limit)", "Largest step of an adaptive run.", false,
+       [](const O& o) { return OptionValue(o.max_step); }, [](O& o, V v) { o.max_step = real(v); }},
+      {"max_steps", OptionType::Integer, "", "a positive number of steps",
+       "A run that needs more steps (accepted and rejected) raises SimulationError carrying the partial result.",
+       false, [](const O& o) { return OptionValue(o.max_steps); },
+       [](O& o, V v) { o.max_steps = std::get<long>(v); }},
+      {"adaptive", OptionType::Flag, "", "None, True or False",
+       "Step-size control: on by default for dopri5, rkf45, bs23, esdirk43 and radau5 (False runs them at the fixed "
+       "step dt), off by default for the Newmark family (True switches on its local error estimate); auto takes None "
+       "or True.",
+       true, [](const O& o) { return o.adaptive < 0 ? OptionValue() : OptionValue(o.adaptive == 1); },
+       [](O& o, V v) { o.adaptive = std::holds_alternative<bool>(v) ? int(std::get<bool>(v)) : -1; }},
+      {"stiffness_warning", OptionType::Flag, "", "True or False",
+       "dopri5 and rkf45 run Hairer's stiffness test (h ρ > 3.25, rkf45 2.95, over 15 accepted steps): the step is "
+       "then bounded by stability, so it costs ~t ω_max/3.3 steps, and at loose tolerances the stiff modes keep "
+       "errors ~rtol ω_max/ω, or grow. It warns (RuntimeWarning) and records the time in ``stats['stiff_at']``; "
+       "False keeps the record and drops the warning.",
+       false, [](const O& o) { return OptionValue(o.stiffness_warning); },
+       [](O& o, V v) { o.stiffness_warning = std::get<bool>(v); }},
+      {"beta", OptionType::Real, "1", "a number", "Newmark's β.", false, [](const O& o) { return OptionValue(o.beta); },
+       [](O& o, V v) { o.beta = real(v); }},
+      {"gamma", OptionType::Real, "1", "a number", "Newmark's γ.", false, [](const O& o) { return OptionValue(o.gamma); },
+       [](O& o, V v) { o.gamma = real(v); }},
+      {"alpha", OptionType::Real, "1", "a number", "HHT's α ∈ [−1/3, 0].", false, [](const O& o) { return OptionValue(o.alpha); },
+       [](O& o, V v) { o.alpha = real(v); }},
+      {"rho_inf", OptionType::Real, "1", "a number", "Generalised-α's spectral radius at infinite frequency ρ∞ ∈ [0, 1].", false,
+       [](const O& o) { return OptionValue(o.rho_inf); }, [](O& o, V v) { o.rho_inf = real(v); }},
+      {"newton_tol", OptionType::Real, "1", "a positive finite tolerance",
+       "Newton stops when the increments of q and q̇ fall below newton_tol (1 + |q|); the Newmark family also holds "
+       "them to 0.03 of the step's local error estimate e_q (q̇'s to 0.03 e_q/√(h T), T the run's length), down to "
+       "1e-3 newton_tol (1 + |q|) and at least 500 ε (1 + |q|), so that small steps keep the method's order; adaptive "
+       "esdirk43 and radau5 runs stop it at 0.03 of the error weights instead.",
+       false, [](const O& o) { return OptionValue(o.newton_tol); }, [](O& o, V v) { o.newton_tol = real(v); }},
+      {"newton_max_iterations", OptionType::Integer, "", "an integer in [1, 1000000]", "Newton iterations per step (or stage) at most.", false,
+       [](const O& o) { return OptionValue(long(o.newton_max_iterations)); },
+       [](O& o, V v) { o.newton_max_iterations = static_cast<int>(std::get<long>(v)); }},
+      {"iteration_matrix", OptionType::Name, "", "'auto', 'tangent', 'spring' or 'krylov'",
+       "Newton matrix of the implicit methods: 'tangent' (the exact tangent M + γ'h ∂r/∂q̇ + β'h² ∂r/∂q, analytic "
+       "for recursive systems, dense LU: O(n³)), 'krylov' (the same tangent, never formed: its products are "
+       "directional derivatives of the inverse dynamics and its solves GMRES preconditioned by the spring matrix, "
+       "O(n) per iteration; recursive systems), 'spring' (the O(n) matrix of implicit_spring: M + diag(γ'h b + β'h² "
+       "c)) or 'auto' (spring for implicit_spring, else krylov for a recursive system of more than 200 coordinates "
+       "and tangent below). radau5 takes the tangent, dense or krylov. ``stats['linear_iterations']`` counts the "
+       "GMRES iterations.",
+       false, [](const O& o) { return OptionValue(std::string(iteration_matrix_name(o.iteration_matrix))); },
+       [](O& o, V v) { o.iteration_matrix = parse_iteration_matrix(std::get<std::string>(v)); }},
+  };
+  return table;
+}
+
+const OptionInfo& option_info(const std::string& name) {
+  std::string names;
+  for (const OptionInfo& option : integrator_options()) {
+    if (name == option.name) return option;
+    names += std::string(names.empty() ? "" : ", ") + option.name;
+  }
+  bad("name", "an option of the integrators (" + names + ")", "'" + name + "'");
+}
+
 void check_options(const System& sys, double t0, double t_end, const VecX& q0, const VecX& qd0,
                    const Eigen::Ref<const VecX>& t_eval, const IntegratorOptions& o) {
   const MethodInfo& m = method_info(o.method);
@@ -381,18 +523,14 @@ void check_options(const System& sys, double t0, double t_end, const VecX& q0, c
     throw std::invalid_argument("t_end: expected a finite end time after t0 = " + num(t0) + " s, got " + num(t_end));
   check_vector(q0, sys.nq, "q0", "nq");
   check_vector(qd0, sys.nq, "qd0", "nq");
-  if (!m.error_estimate && o.adaptive == 1)
-    throw std::invalid_argument(std::string("adaptive: the method '") + m.name +
-                                "' has no error estimate; use dopri5, rkf45, esdirk43, radau5 or the Newmark family");
-  if ((o.method == Method::Radau5 || (o.method == Method::Auto && auto_stiff_method(sys, o) == Method::Radau5)) &&
-      sys.nz > 0)
-    throw std::invalid_argument("method: 'radau5' does not integrate Maxwell arms (the system has " +
-                                std::to_string(sys.nz) + " arm forces as internal variables); use esdirk43, "
-                                "generalized_alpha or dopri5");
+  if (!m.error_estimate && o.adaptive == 1) {
+    std::string adaptive;
+    for (const MethodInfo& other : method_table())
+      if (other.error_estimate && other.method != Method::Auto) adaptive += (adaptive.empty() ? "" : ", ") + std::string(other.name);
+    throw std::invalid_argument(std::string("adaptive: the method '") + m.name + "' has no error estimate; use " +
+                                adaptive);
+  }
   if (o.s0.size() != 0) check_vector(o.s0, sys.nz, "s0", "nz (the Maxwell arms' forces, N or N·m)");
-  if (o.method == Method::Radau5 && o.iteration_matrix == IterationMatrix::Spring)
-    throw std::invalid_argument("iteration_matrix: radau5 takes the exact tangent ('auto', 'tangent' or 'krylov'), got "
-                                "'spring' ('krylov' is its O(n) form); use esdirk43 for the spring matrix");
   if (o.iteration_matrix == IterationMatrix::Krylov && !articulated(sys))
     throw std::invalid_argument("iteration_matrix: 'krylov' needs a system compiled with algorithm='recursive' (its "
                                 "products are the recursive inverse dynamics'); use 'tangent' or 'auto'");
@@ -428,19 +566,7 @@ void check_options(const System& sys, double t0, double t_end, const VecX& q0, c
                                 "got " + std::to_string(o.rtol.size()) + " and " + std::to_string(o.atol.size()));
   if (o.rtol.maxCoeff() == 0.0 && o.atol.minCoeff() == 0.0)
     throw std::invalid_argument("atol: expected positive values when rtol is zero");
-  if (o.method == Method::Newmark && !(o.gamma >= 0.5 && o.beta >= 0.25 * (0.5 + o.gamma) * (0.5 + o.gamma) - 1e-15))
-    throw std::invalid_argument("beta, gamma: expected the unconditionally stable range gamma >= 1/2, "
-                                "beta >= (gamma + 1/2)^2 / 4, got beta = " + num(o.beta) + ", gamma = " + num(o.gamma));
-  if (o.method == Method::HHT && !(o.alpha >= -1.0 / 3.0 && o.alpha <= 0.0))
-    throw std::invalid_argument("alpha: expected a value in [-1/3, 0], got " + num(o.alpha));
-  if ((o.method == Method::GeneralizedAlpha || o.method == Method::ImplicitSpring) &&
-      !(o.rho_inf >= 0.0 && o.rho_inf <= 1.0))
-    throw std::invalid_argument("rho_inf: expected a value in [0, 1], got " + num(o.rho_inf));
-  const Method stiff = auto_stiff_method(sys, o);
-  if (o.method == Method::Auto && (!method_info(stiff).error_estimate || stiff == Method::Dopri5 ||
-                                   stiff == Method::RKF45 || stiff == Method::Auto))
-    throw std::invalid_argument(std::string("stiff_method: expected an implicit method with an error estimate, got '") +
-                                method_name(stiff) + "'");
+  if (m.check) m.check(sys, o);  // the family's own options
   check_sensitivities(sys, o);
 }
 

@@ -10,6 +10,7 @@
 #include <algorithm>
 #include <cmath>
 #include <limits>
+#include <stdexcept>
 
 #include "rigidfem/arms.hpp"
 #include "rigidfem/constraints.hpp"
@@ -436,6 +437,40 @@ std::unique_ptr<Stepper> make_newmark(const System& sys, const IntegratorOptions
 std::unique_ptr<NewmarkStepper> make_newmark_stepper(const System& sys, const IntegratorOptions& o,
                                                      IntegratorStats& stats) {
   return std::make_unique<NewmarkFamily>(sys, o, stats);
+}
+
+namespace {
+
+// The family's own options: Newmark's β, γ in the unconditionally stable range, HHT's α in [−1/3, 0],
+// generalised-α's ρ∞ in [0, 1].
+void check_newmark(const System&, const IntegratorOptions& o) {
+  if (o.method == Method::Newmark && !(o.gamma >= 0.5 && o.beta >= 0.25 * (0.5 + o.gamma) * (0.5 + o.gamma) - 1e-15))
+    throw std::invalid_argument("beta, gamma: expected the unconditionally stable range gamma >= 1/2, "
+                                "beta >= (gamma + 1/2)^2 / 4, got beta = " + num(o.beta) + ", gamma = " + num(o.gamma));
+  if (o.method == Method::HHT && !(o.alpha >= -1.0 / 3.0 && o.alpha <= 0.0))
+    throw std::invalid_argument("alpha: expected a value in [-1/3, 0], got " + num(o.alpha));
+  if ((o.method == Method::GeneralizedAlpha || o.method == Method::ImplicitSpring) &&
+      !(o.rho_inf >= 0.0 && o.rho_inf <= 1.0))
+    throw std::invalid_argument("rho_inf: expected a value in [0, 1], got " + num(o.rho_inf));
+}
+
+}  // namespace
+
+const std::vector<MethodInfo>& newmark_methods() {
+  static const std::vector<MethodInfo> rows = {
+      {Method::Newmark, "newmark", "Newmark", 2, true, false, true, true, method_options(true, true, {"beta", "gamma"}),
+       "Newmark β, γ (average acceleration ¼, ½), Newton", make_newmark, check_newmark},
+      {Method::HHT, "hht", "Newmark", 2, true, false, true, true, method_options(true, true, {"alpha"}),
+       "Hilber–Hughes–Taylor α ∈ [−⅓, 0], Newton", make_newmark, check_newmark},
+      {Method::GeneralizedAlpha, "generalized_alpha", "Newmark", 2, true, false, true,
+       true, method_options(true, true, {"rho_inf"}), "Chung–Hulbert generalised-α with ρ∞, Newton", make_newmark,
+       check_newmark},
+      {Method::ImplicitSpring, "implicit_spring", "Newmark", 2, true, false, true,
+       true, method_options(true, true, {"rho_inf"}),
+       "generalised-α whose Newton matrix is M + diag(γ′h b + β′h² c), O(n) per iteration (ABA)", make_newmark,
+       check_newmark},
+  };
+  return rows;
 }
 
 }  // namespace rigidfem

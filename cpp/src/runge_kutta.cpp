@@ -102,12 +102,20 @@ const Tableau& tableau(Method method) {
        -2.0 / 55},
       4,
       false};
+  // Bogacki & Shampine (1989) 3(2), FSAL (SciPy's RK23): e = b − b̂ with b̂ = (7/24, 1/4, 1/3, 1/8).
+  static const Tableau bs23{{0.0, 0.5, 0.75, 1.0},
+                            {{}, {0.5}, {0.0, 0.75}, {2.0 / 9, 1.0 / 3, 4.0 / 9}},
+                            {2.0 / 9, 1.0 / 3, 4.0 / 9, 0.0},
+                            {-5.0 / 72, 1.0 / 12, 1.0 / 9, -1.0 / 8},
+                            3,
+                            true};
   switch (method) {
     case Method::Euler:
     case Method::SymplecticEuler: return euler;
     case Method::RK4: return rk4;
     case Method::Dopri5: return dopri5;
     case Method::RKF45: return rkf45;
+    case Method::BS23: return bs23;
     default: throw std::logic_error("tableau: not an explicit Runge-Kutta method");
   }
 }
@@ -249,6 +257,28 @@ class RungeKutta final : public Stepper {
 
 std::unique_ptr<Stepper> make_runge_kutta(const System& sys, const IntegratorOptions& o, IntegratorStats& stats) {
   return std::make_unique<RungeKutta>(sys, o, o.method == Method::Auto ? Method::Dopri5 : o.method, stats);
+}
+
+const std::vector<MethodInfo>& runge_kutta_methods() {
+  static const std::vector<MethodInfo> rows = {
+      {Method::Euler, "euler", "explicit Runge-Kutta", 1, false, false, false, false, method_options(false, false),
+       "explicit Euler, order 1", make_runge_kutta, nullptr},
+      {Method::SymplecticEuler, "symplectic_euler", "explicit Runge-Kutta", 1, false, false, false,
+       false, method_options(false, false), "semi-implicit Euler (q̇ first, then q), order 1", make_runge_kutta, nullptr},
+      {Method::RK4, "rk4", "explicit Runge-Kutta", 4, false, false, false, false, method_options(false, false),
+       "classical Runge–Kutta, order 4", make_runge_kutta, nullptr},
+      {Method::Dopri5, "dopri5", "explicit Runge-Kutta", 5, true, true, false,
+       false, method_options(true, false, {"stiffness_warning"}), "Dormand–Prince 5(4), dense output of order 4",
+       make_runge_kutta, nullptr},
+      {Method::RKF45, "rkf45", "explicit Runge-Kutta", 4, true, true, false,
+       false, method_options(true, false, {"stiffness_warning"}), "Runge–Kutta–Fehlberg 4(5) (the book's), 4th order kept",
+       make_runge_kutta, nullptr},
+      {Method::BS23, "bs23", "explicit Runge-Kutta", 3, true, true, false, false, method_options(true, false),
+       "Bogacki–Shampine 3(2) (SciPy's RK23): 3 evaluations a step (FSAL), 3rd order propagated, cubic Hermite dense "
+       "output",
+       make_runge_kutta, nullptr},
+  };
+  return rows;
 }
 
 }  // namespace rigidfem

@@ -38,7 +38,7 @@ from .frames import transform
 from .model import Model, System
 from . import sea  # noqa: E402 (rigidfem.sea: sea states for a moving base)
 from .simulation import Result, load_npz, simulate
-from .options import integrator_options  # noqa: E402 (simulate's options, each listed once)
+from .options import integrator_options, methods  # noqa: E402 (the C++ method and option tables)
 from . import display, export  # noqa: E402 (notebook displays; tables, CSV and NumPy archives)
 from .state_space import NotAnEquilibriumWarning, linearize  # noqa: E402
 from .sweep import sweep
@@ -98,6 +98,7 @@ __all__ = [
     "plots",
     "pseudo_inertia",
     "integrator_options",
+    "methods",
     "joint_transform",
     "joint_transform_derivative",
     "joint_transform_second_derivative",

@@ -27,7 +27,6 @@ their rfes' inertias or of L(t) by differences of μᵀr whole (O(n) per such pa
 
 from __future__ import annotations
 
-import math
 import time
 from dataclasses import dataclass, field
 
@@ -35,11 +34,13 @@ import numpy as np
 
 from . import _checks, _core
 from . import error_control
+from . import options as options_
 from . import parameters as parameters_
 from . import sensitivities as sensitivities_
 
-#: The methods with an adjoint.
-METHODS = ("generalized_alpha", "newmark", "hht", "implicit_spring", "radau5")
+#: The methods with an adjoint (the method table's), the default first.
+METHODS = tuple(sorted((name for name, m in options_.methods().items() if m.adjoint),
+                       key=lambda name: name != "generalized_alpha"))
 
 
 @dataclass
@@ -71,9 +72,7 @@ class Gradient:
 
 def gradient(system, t_end: float, parameters=None, *, outputs, running=None, terminal=None,
              method: str = "generalized_alpha", dt: float, t0: float = 0.0, q0=None, qd0=None,
-             memory: float = 2.0**28, rho_inf: float = 0.8, alpha: float = -0.05, beta: float = 0.25,
-             gamma: float = 0.5, newton_tol: float = 1e-10, newton_max_iterations: int = 10,
-             iteration_matrix: str = "auto") -> Gradient:
+             memory: float = 2.0**28, **options) -> Gradient:
     """J = ∫ L(t, y) dt + Φ(y(t_end)) of a run from ``t0`` to ``t_end`` (s) and dJ/dp by the adjoint.
 
     Parameters
@@ -93,8 +92,10 @@ def gradient(system, t_end: float, parameters=None, *, outputs, running=None, te
     memory : float
         Bytes for the states the backward sweep needs (default 256 MiB): all of them if they fit, else
         checkpoints every ⌈√N⌉ steps and each segment run again.
-    rho_inf, alpha, beta, gamma, newton_tol, newton_max_iterations, iteration_matrix
-        As in ``rigidfem.simulate``.
+    **options
+        The method's options as in ``rigidfem.simulate`` (``rho_inf``, ``alpha``, ``beta``, ``gamma``,
+        ``newton_tol``, ``newton_max_iterations``, ``iteration_matrix``: ``rigidfem.integrator_options(method)``);
+        the run is at fixed steps ``dt``, so ``adaptive`` and ``error_on`` are refused.
 
     Returns
     -------
@@ -103,7 +104,7 @@ def gradient(system, t_end: float, parameters=None, *, outputs, running=None, te
         ``q0``/``qd0`` are the partial derivatives by each coordinate; an initial value named in ``parameters``
         moves along the loops (as ``System.assemble`` would close them).
     """
-    from . import simulation  # the options' conversion (simulation imports the analyses, not this module)
+    from . import simulation  # the loops' check (simulation imports the analyses, not this module)
 
     if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"method: expected one of {list(METHODS)} (the methods with an adjoint), got {method!r}")
@@ -121,8 +122,11 @@ def gradient(system, t_end: float, parameters=None, *, outputs, running=None, te
     n = system.nq
     q0 = np.zeros(n) if q0 is None else _checks.array(q0, (n,), "q0")
     qd0 = np.zeros(n) if qd0 is None else _checks.array(qd0, (n,), "qd0")
-    opt = simulation._options(method, dt, None, [1e-6], [1e-9], math.inf, 1_000_000, False, beta, gamma, alpha,
-                              rho_inf, newton_tol, newton_max_iterations, iteration_matrix)
+    given = options_.resolve(options) and options  # TypeError naming an unknown option
+    for name in ("adaptive", "error_on"):
+        if given.get(name) is not None:
+            raise ValueError(f"{name}: expected None: the adjoint runs at fixed steps dt, got {given[name]!r}")
+    opt = options_.compiled(method, {**given, "dt": dt, "adaptive": False})
     _core._check_options(system, t0, t_end, q0, qd0, np.empty(0), opt)
     if parameters is None:
         parameters = list(system.parameters)

@@ -1,17 +1,24 @@
-"""The options of ``rigidfem.simulate``'s integrators, each written once: its default, its unit and the
-methods that read it.
+"""The integrators' methods and options as the C++ core describes them, each once.
+
+The method table (``cpp/include/rigidfem/stepper.hpp``: a row of ``MethodInfo`` per method, in its family's
+file) and the option table (``integrator_options`` in ``cpp/src/integrate.cpp``: name, type, default, unit,
+doc) are read here through the bindings; ``simulate``'s option handling, its docstring, ``rf.gradient``'s
+options and the site's tables are derived from them. The SciPy adapter's methods (``"scipy:<name>"``, Python's
+own: ``rigidfem.simulation``) are described here too.
 
 ``simulate(system, t_end, method="auto", *, t0, q0, qd0, s0, t_eval, progress, stop, error_estimate, sensitivities,
-**options)`` takes the run's arguments by name and the integrator's options as ``**options``, checked
-against this table: an unknown name is a TypeError listing the options; an option the chosen method
-does not read is accepted and left unused (one set of options can drive a comparison of methods),
-except ``dt`` given to an adaptive method, which warns (see ``dt``).
+**options)`` takes the run's arguments by name and the integrator's options as ``**options``: an unknown name is
+a TypeError listing the options; an option the chosen method does not read is accepted and left unused (one set
+of options can drive a comparison of methods), except ``dt`` given to an adaptive method, which warns (see
+``dt``).
 
 >>> import rigidfem as rf
 >>> sorted(rf.integrator_options("generalized_alpha"))[:4]
-['atol', 'dt', 'error_on', 'first_step']
+['adaptive', 'atol', 'dt', 'error_on']
 >>> rf.integrator_options("generalized_alpha")["rho_inf"].default
 0.8
+>>> rf.methods()["radau5"].order
+5
 """
 
 from __future__ import annotations
@@ -19,95 +26,78 @@ from __future__ import annotations
 import textwrap
 from dataclasses import dataclass
 
-import numpy as np
+from . import _core
 
-#: The C++ methods by family, and SciPy's solvers behind ``"scipy:<name>"``.
-EXPLICIT_FIXED = ("euler", "symplectic_euler", "rk4")
-EXPLICIT_ADAPTIVE = ("dopri5", "rkf45")
-NEWMARK = ("newmark", "hht", "generalized_alpha", "implicit_spring")
-IMPLICIT_RK = ("esdirk43", "radau5")
+#: SciPy's solvers behind ``"scipy:<name>"`` (the Python adapter of ``rigidfem.simulation``) and the options it
+#: reads.
 SCIPY = ("scipy:Radau", "scipy:BDF", "scipy:LSODA", "scipy:RK45", "scipy:DOP853")
-METHODS = ("auto",) + EXPLICIT_FIXED + EXPLICIT_ADAPTIVE + NEWMARK + IMPLICIT_RK + SCIPY
+SCIPY_OPTIONS = ("rtol", "atol", "first_step", "max_step", "max_steps")
 
-_ADAPTIVE_CPP = ("auto",) + EXPLICIT_ADAPTIVE + IMPLICIT_RK + NEWMARK  # the Newmark family with adaptive=True
-_IMPLICIT = ("auto",) + NEWMARK + IMPLICIT_RK
+
+@dataclass(frozen=True)
+class Method:
+    """One integration method (``rf.methods()``): its ``family``, the ``order`` of its propagated solution, whether
+    it has an ``error_estimate`` (so may run adaptive), whether it is ``adaptive`` by default, ``error_on``
+    (what its error is measured on by default: "bodies" or "state"; auto: its stiff method's), whether it has an
+    ``adjoint`` (``rigidfem.gradient``), the ``options`` it reads and its scheme (``doc``)."""
+
+    name: str
+    family: str
+    order: int
+    error_estimate: bool
+    adaptive: bool
+    error_on: str
+    adjoint: bool
+    options: tuple
+    doc: str
 
 
 @dataclass(frozen=True)
 class Option:
     """One option of the integrators: ``name``, its ``default``, its ``unit`` and the ``methods`` that
-    read it, with what it does (``doc``)."""
+    read it, with what it does (``doc``) and what it takes (``expected``)."""
 
     name: str
     default: object
     unit: str
     methods: tuple
     doc: str
+    expected: str = ""
 
 
-OPTIONS = (
-    Option("dt", None, "s", EXPLICIT_FIXED + NEWMARK + IMPLICIT_RK + EXPLICIT_ADAPTIVE + ("auto",),
-           "Step of the fixed-step methods: steps end on t0 + k·dt exactly, the last on t_end. Given to an "
-           "adaptive method (dopri5, rkf45, esdirk43, radau5, auto) it sets only the first step, with a "
-           "UserWarning saying so (``adaptive=False`` runs those at fixed steps of dt)."),
-    Option("rtol", 1e-6, "1", _ADAPTIVE_CPP + SCIPY,
-           "Relative tolerance of adaptive runs (float, or (2 nq,) per component of y = [q, q̇] with "
-           "``error_on='state'``). On outputs each output's local error is held to atol + rtol × scale: for "
-           "points and bodies the model's size L (m, ``stats['model_size']``) or the farthest a centre of mass "
-           "has moved if larger; the largest magnitude reached so far for coordinates, element forces and loop "
-           "reactions. On the state: atol_i + rtol_i |y_i| (atol = 0: purely relative; an exactly zero "
-           "component counts as exact). SciPy's methods raise rtol to their floor 100 ε; scipy:Radau and "
-           "scipy:BDF take one rtol, the smallest given."),
-    Option("atol", 1e-9, "m, rad (per s for rates)", _ADAPTIVE_CPP + SCIPY,
-           "Absolute tolerance of adaptive runs, as rtol."),
-    Option("error_on", None, "", _ADAPTIVE_CPP,
-           "What the adaptive C++ methods measure their local error on (``rigidfem.error_control``): a list "
-           "of points and bodies (their positions, m), coordinate names or indices (m or rad), force element "
-           "names (their axial force, N) and loop names (their multipliers, N or N·m), each error mapped from "
-           "the state's through the output's Jacobian, a velocity's held as the displacement it makes over the "
-           "step. None (the default): 'bodies' — every body's displacement, the RMS over its material "
-           "√(|δc|² + δθᵀ I_C δθ/m) — for radau5, the adaptive Newmark family and auto's radau5; 'state' for "
-           "dopri5, rkf45, esdirk43 and auto's dopri5 phase. A mode that no output sees is not resolved: the "
-           "L-stable radau5 damps it (the released strip of 1 m, m = 32: 2,800 steps to 1e-6 m instead of "
-           "177,000)."),
-    Option("first_step", None, "s", _ADAPTIVE_CPP + SCIPY,
-           "First step of an adaptive run; estimated (Hairer's rule) by default."),
-    Option("max_step", np.inf, "s", _ADAPTIVE_CPP + SCIPY, "Largest step of an adaptive run."),
-    Option("max_steps", 1_000_000, "", METHODS,
-           "A run that needs more steps (accepted and rejected) raises SimulationError carrying the partial "
-           "result."),
-    Option("adaptive", None, "", ("auto",) + EXPLICIT_ADAPTIVE + IMPLICIT_RK + NEWMARK,
-           "Step-size control: on by default for dopri5, rkf45, esdirk43 and radau5 (False runs them at the "
-           "fixed step dt), off by default for the Newmark family (True switches on its local error "
-           "estimate); auto takes None or True."),
-    Option("stiffness_warning", True, "", EXPLICIT_ADAPTIVE,
-           "dopri5 and rkf45 run Hairer's stiffness test (h ρ > 3.25, rkf45 2.95, over 15 accepted steps): "
-           "the step is then bounded by stability, so it costs ~t ω_max/3.3 steps, and at loose tolerances "
-           "the stiff modes keep errors ~rtol ω_max/ω, or grow. It warns (RuntimeWarning) and records the "
-           "time in ``stats['stiff_at']``; False keeps the record and drops the warning."),
-    Option("beta", 0.25, "1", ("newmark",), "Newmark's β."),
-    Option("gamma", 0.5, "1", ("newmark",), "Newmark's γ."),
-    Option("alpha", -0.05, "1", ("hht",), "HHT's α ∈ [−1/3, 0]."),
-    Option("rho_inf", 0.8, "1", ("generalized_alpha", "implicit_spring"),
-           "Generalised-α's spectral radius at infinite frequency ρ∞ ∈ [0, 1]."),
-    Option("newton_tol", 1e-10, "1", _IMPLICIT,
-           "Newton stops when the increments of q and q̇ fall below newton_tol (1 + |q|); the Newmark family "
-           "also holds them to 0.03 of the step's local error estimate e_q (q̇'s to 0.03 e_q/√(h T), T the run's "
-           "length), down to 1e-3 newton_tol (1 + |q|) and at least 500 ε (1 + |q|), so that small steps keep "
-           "the method's order; adaptive esdirk43 "
-           "and radau5 runs stop it at 0.03 of the error weights instead."),
-    Option("newton_max_iterations", 10, "", _IMPLICIT, "Newton iterations per step (or stage) at most."),
-    Option("iteration_matrix", "auto", "", _IMPLICIT,
-           "Newton matrix of the implicit methods: 'tangent' (the exact tangent M + γ'h ∂r/∂q̇ + β'h² ∂r/∂q, "
-           "analytic for recursive systems, dense LU: O(n³)), 'krylov' (the same tangent, never formed: its "
-           "products are directional derivatives of the inverse dynamics and its solves GMRES preconditioned "
-           "by the spring matrix, O(n) per iteration; recursive systems), 'spring' (the O(n) matrix of "
-           "implicit_spring: M + diag(γ'h b + β'h² c)) or 'auto' (spring for implicit_spring, else krylov for "
-           "a recursive system of more than 200 coordinates and tangent below). radau5 takes the tangent, "
-           "dense or krylov. ``stats['linear_iterations']`` counts the GMRES iterations."),
-)
+def _methods() -> dict[str, Method]:
+    rows = {r["name"]: Method(r["name"], r["family"], r["order"], r["error_estimate"], r["adaptive"],
+                              "bodies" if r["measures_outputs"] else "state", r["adjoint"], tuple(r["options"]), r["doc"])
+            for r in _core._method_table()}
+    for name in SCIPY:  # adaptive, their own error control on the state
+        rows[name] = Method(name, "SciPy", 0, True, True, "state", False, SCIPY_OPTIONS,
+                            f"SciPy's {name[6:]} with the C++ rhs and Jacobian, stepped from Python (the slow path); "
+                            "closed chains and Maxwell arms refused (ValueError)"
+                            + ("; one rtol, the smallest given" if name in ("scipy:Radau", "scipy:BDF") else ""))
+    return rows
+
+
+_METHODS = _methods()
+#: Every method's name: "auto" first, then the C++ ones by family, then SciPy's.
+METHODS = ("auto",) + tuple(name for name in _METHODS if name != "auto")
+
+OPTIONS = tuple(Option(r["name"], r["default"], r["unit"], tuple(m for m in METHODS if r["name"] in _METHODS[m].options),
+                       r["doc"], r["expected"])
+                for r in _core._option_table())
 
 _BY_NAME = {o.name: o for o in OPTIONS}
+
+
+def methods() -> dict[str, Method]:
+    """The integration methods (name -> ``Method``): the C++ method table, with SciPy's solvers."""
+    return {name: _METHODS[name] for name in METHODS}
+
+
+def method(name) -> Method:
+    """The method called ``name``; ValueError listing the methods otherwise."""
+    if not isinstance(name, str) or name not in _METHODS:
+        raise ValueError(f"method: expected one of {list(METHODS)}, got {name!r}")
+    return _METHODS[name]
 
 
 def integrator_options(method: str | None = None) -> dict[str, Option]:
@@ -115,9 +105,8 @@ def integrator_options(method: str | None = None) -> dict[str, Option]:
     an unknown method."""
     if method is None:
         return dict(_BY_NAME)
-    if not isinstance(method, str) or method not in METHODS:
-        raise ValueError(f"method: expected one of {list(METHODS)}, got {method!r}")
-    return {o.name: o for o in OPTIONS if method in o.methods}
+    readers = globals()["method"](method).options
+    return {o.name: o for o in OPTIONS if o.name in readers}
 
 
 def resolve(options: dict) -> dict:
@@ -131,12 +120,35 @@ def resolve(options: dict) -> dict:
     return {name: options.get(name, o.default) for name, o in _BY_NAME.items()}
 
 
+def compiled(method: str, options: dict) -> _core.IntegratorOptions:
+    """The C++ options of ``method`` with ``options`` ({name: value}) set, each converted by the bindings' rule
+    (ValueError naming it); error_on, rtol and atol are left to the caller (they depend on the system)."""
+    opt = _core.IntegratorOptions()
+    opt.method = method
+    for name, value in options.items():
+        if name not in ("error_on", "rtol", "atol"):
+            opt.set(name, value)
+    return opt
+
+
+def _readers(o: Option) -> str:
+    return "every method" if set(o.methods) >= set(METHODS) else ", ".join(o.methods)
+
+
 def table() -> str:
     """The options as a markdown table: name, default, unit, the methods that read them."""
     lines = ["| option | default | unit | read by |", "|---|---|---|---|"]
     for o in OPTIONS:
-        readers = "every method" if set(o.methods) >= set(METHODS) else ", ".join(o.methods)
-        lines.append(f"| `{o.name}` | {o.default!r} | {o.unit} | {readers} |")
+        lines.append(f"| `{o.name}` | {o.default!r} | {o.unit} | {_readers(o)} |")
+    return "\n".join(lines)
+
+
+def method_table() -> str:
+    """The methods as a markdown table: name, family, order, adaptive by default, error measured on, scheme."""
+    lines = ["| method | family | order | step | error on | scheme |", "|---|---|---|---|---|---|"]
+    for m in methods().values():
+        step = "rtol/atol" if m.adaptive else ("dt or adaptive" if m.error_estimate else "fixed dt")
+        lines.append(f"| `{m.name}` | {m.family} | {m.order or ''} | {step} | {m.error_on} | {m.doc} |")
     return "\n".join(lines)
 
 
@@ -147,8 +159,7 @@ def docstring(indent: int = 8) -> str:
     pad = " " * indent
     for o in OPTIONS:
         unit = f", {o.unit}" if o.unit and o.unit != "1" else ""
-        readers = "every method" if set(o.methods) >= set(METHODS) else ", ".join(o.methods)
         parts.append(f"{pad}{o.name} : default {o.default!r}{unit}")
-        parts.append(textwrap.fill(f"{o.doc} Read by: {readers}.", 100, initial_indent=pad + "    ",
+        parts.append(textwrap.fill(f"{o.doc} Read by: {_readers(o)}.", 100, initial_indent=pad + "    ",
                                    subsequent_indent=pad + "    "))
     return "\n".join(parts)

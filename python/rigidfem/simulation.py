@@ -1,35 +1,8 @@
 """``rf.simulate``: time integration in C++ (book ch. 5.2) with results as numpy arrays.
 
-Methods (``method=``):
+Methods (``method=``; the C++ method table, ``rigidfem.methods()``, and SciPy's solvers):
 
-=====================  =========================================================  ===========
-name                   scheme                                                     step
-=====================  =========================================================  ===========
-``"euler"``            explicit Euler, order 1                                    fixed ``dt``
-``"symplectic_euler"`` semi-implicit Euler (q̇ first, then q), order 1             fixed ``dt``
-``"rk4"``              classical Runge–Kutta, order 4                             fixed ``dt``
-``"dopri5"``           Dormand–Prince 5(4), dense output of order 4               ``rtol``/``atol``
-``"rkf45"``            Runge–Kutta–Fehlberg 4(5) (the book's), 4th order kept     ``rtol``/``atol``
-``"newmark"``          Newmark β, γ (average acceleration ¼, ½), Newton           ``dt`` or adaptive
-``"hht"``              Hilber–Hughes–Taylor α ∈ [−⅓, 0], Newton                   ``dt`` or adaptive
-``"generalized_alpha"`` Chung–Hulbert generalised-α with ρ∞, Newton                ``dt`` or adaptive
-``"implicit_spring"``  generalised-α whose Newton matrix is                       ``dt`` or adaptive
-                       M + diag(γ′h b + β′h² c), O(n) per iteration (ABA)
-``"esdirk43"``         ESDIRK4(3)6L[2]SA (Kennedy & Carpenter 2003): order 4,     ``rtol``/``atol``
-                       L-stable, stiffly accurate, embedded order 3, PI control;  or ``dt``
-                       5 implicit stages, each a Newton solve for its q̈ with
-                       M + γh C + (γh)² K (γ = ¼), dense output quintic Hermite
-``"radau5"``           Radau IIA, 3 stages, order 5, L-stable, stiffly accurate;  ``rtol``/``atol``
-                       simplified Newton on all stages in the transformed         or ``dt``
-                       real/complex form (exact tangent only), Hairer's filtered
-                       estimate, PI control, dense output quintic Hermite
-``"auto"`` (default)   radau5 (esdirk43 with Maxwell arms) from the start where     ``rtol``/``atol``
-                       ω_max at t0 makes dopri5 take >= 200 steps for stability;
-                       else dopri5, handing over for good where its steps sit at
-                       the stability limit; the choice in ``stats["method"]``
-``"scipy:Radau"`` …    SciPy's solvers (Radau, BDF, LSODA, RK45, DOP853) with the  ``rtol``/``atol``
-                       C++ ``rhs`` and ``jacobian`` (Python per step: the slow path)
-=====================  =========================================================  ===========
+{methods}
 
 The implicit methods solve M(q) q̈ = f(q, q̇, t) at the end of each step by Newton's
 method with the iteration matrix M + γ′h ∂r/∂q̇ + β′h² ∂r/∂q of the residual
@@ -86,7 +59,10 @@ from ._progress import ProgressBar
 from .persistence import Versioned
 from ._core import Body, Point
 
-SCIPY_METHODS = tuple(m[len("scipy:"):] for m in options_.SCIPY)  # the families: rigidfem.options
+__doc__ = __doc__.replace("{methods}", "\n".join(f"- ``{m.name}`` ({m.family}{f', order {m.order}' if m.order else ''}): "
+                                                  f"{m.doc}" for m in options_.methods().values()))
+
+SCIPY_METHODS = tuple(m[len("scipy:"):] for m in options_.SCIPY)  # the adapter's methods: rigidfem.options
 
 
 @dataclass
@@ -400,9 +376,7 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
     """
     o = options_.resolve(options)
     dt, rtol, atol, error_on, first_step = o["dt"], o["rtol"], o["atol"], o["error_on"], o["first_step"]
-    max_step, max_steps, adaptive, stiffness_warning = o["max_step"], o["max_steps"], o["adaptive"], o["stiffness_warning"]
-    beta, gamma, alpha, rho_inf = o["beta"], o["gamma"], o["alpha"], o["rho_inf"]
-    newton_tol, newton_max_iterations, iteration_matrix = o["newton_tol"], o["newton_max_iterations"], o["iteration_matrix"]
+    adaptive, max_steps, max_step = o["adaptive"], o["max_steps"], o["max_step"]
     if not isinstance(system, _core._System):
         got = type(system).__name__ if isinstance(system, _core._Model) else _checks._short(system)
         raise ValueError(f"system: expected a compiled System (call model.compile()), got {got}")
@@ -418,34 +392,33 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
     t_eval = np.zeros(0) if t_eval is None else _checks.vector(t_eval, "t_eval")
     if not isinstance(method, str):
         raise ValueError(f"method: expected a method name such as 'dopri5' (see rigidfem.simulate), got {method!r}")
-    max_steps = _checks.integer(max_steps, "max_steps", minimum=-2**62, maximum=2**62)  # its value: C++'s check
-    max_step = _core._real(max_step, "max_step", "a positive number of s (inf for no limit)")
     rtol, atol = _tolerance(rtol, "rtol", n, 1e-6), _tolerance(atol, "atol", n, 1e-9)
     per_component = np.size(rtol) > 1 or np.size(atol) > 1
     if per_component and error_on is not None and not (isinstance(error_on, str) and error_on == "state"):
         raise ValueError(f"rtol, atol: expected one value each with error_on={error_on!r} (per-component "
                          f"tolerances hold the state: error_on='state'), got {np.size(rtol)} and {np.size(atol)}")
-    fixed = adaptive is False or (method in _FIXED_STEP and adaptive is not True)
-    if error_on is not None and (method.startswith("scipy:") or fixed) and not (
-            isinstance(error_on, str) and error_on == "state"):
+    scipy = method.startswith("scipy:")
+    if scipy and method not in options_.SCIPY:
+        raise ValueError(f"method: expected one of {list(options_.SCIPY)}, got {method!r}")
+    # the C++ options, each converted by the bindings (ValueError naming it); scipy: methods check the C++ ones too
+    # (they use only first_step of them), so that a bad option is named whatever the method
+    opt = options_.compiled("dopri5" if scipy else method, o)
+    opt.rtol, opt.atol = rtol, atol
+    row = options_.method(method)
+    fixed = adaptive is False or (not row.adaptive and adaptive is not True)
+    if error_on is not None and (scipy or fixed) and not (isinstance(error_on, str) and error_on == "state"):
         raise ValueError(f"error_on: expected None or 'state' for {method!r}"
                          f"{' at fixed steps' if fixed else ''} (it controls no error on outputs), got {error_on!r}")
-    state = per_component or method.startswith("scipy:") or (error_on is None and not _measures_outputs(
-        method, system, iteration_matrix))
+    state = per_component or scipy or (error_on is None and not _core._measures_outputs(system, opt))
     outputs = [] if state else error_control.specs(system, error_on)
     if stop is not None and not callable(getattr(stop, "is_set", None)):
         raise ValueError(f"stop: expected None or a threading.Event (an object with is_set()), got {stop!r}")
     nz = system.nz
     s0 = np.zeros(nz) if s0 is None else _checks.array(s0, (nz,), "s0")
-    scipy = method.startswith("scipy:")
-    if scipy and method[6:] not in SCIPY_METHODS:
-        raise ValueError(f"method: expected one of {['scipy:' + m for m in SCIPY_METHODS]}, got {method!r}")
-    # scipy: methods check the options of the C++ ones too (they use only first_step of them); the options
-    # are checked before the loops are, so that a bad option is named whatever the state
-    opt = _options("dopri5" if scipy else method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, beta,
-                   gamma, alpha, rho_inf, newton_tol, newton_max_iterations, iteration_matrix)
     if scipy:
-        opt.adaptive = -1  # SciPy's solvers are adaptive whatever it says (checked above for its type)
+        opt.adaptive = -1  # SciPy's solvers are adaptive whatever it says (its type is checked)
+    if method == "auto" and adaptive is False:
+        raise ValueError("adaptive: expected None or True with method 'auto' (it controls its steps), got False")
     opt.s0 = s0
     opt.set_error_on(outputs)
     names = sensitivities_.directions(system, sensitivities, opt, t0, t_end)
@@ -459,12 +432,13 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
                          f"got {method!r}: SciPy's solvers integrate the constrained accelerations without holding "
                          "g(q) = 0, whose residual drifts (2.5e-4 on a four-bar at rtol = 1e-8); use 'auto', 'radau5', "
                          "'dopri5' or 'generalized_alpha', which close the loops at every output")
-    if nz and method.startswith("scipy:"):
+    if nz and scipy:
         raise ValueError(f"method: expected a C++ method for a system with Maxwell arms ({nz} arm forces as internal "
                          f"variables), got {method!r}; use 'auto', 'esdirk43', 'generalized_alpha' or 'dopri5'")
+    max_steps, max_step = opt.get("max_steps"), opt.get("max_step")
     bar = ProgressBar(t_end - t0, "s", "simulate") if progress else None
     try:
-        if dt is not None and adaptive is None and first_step is None and method in _ADAPTIVE:
+        if dt is not None and adaptive is None and first_step is None and row.adaptive and not scipy:
             warnings.warn(f"dt: {method!r} is adaptive: dt = {opt.dt:g} s only sets its first step; give "
                           "adaptive=False for fixed steps of dt, or first_step= for the first step without this warning",
                           UserWarning, stacklevel=2)
@@ -485,10 +459,8 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
         stats["method"] = method  # the C++ runs say what ran (auto: what it chose)
     if system.nl:
         stats["loop_reactions"] = _reactions_source(own, method)
-    call = dict(method=method, t_end=t_end, t0=t0, q0=q0, qd0=qd0, s0=s0, t_eval=t_eval if len(t_eval) else None,
-                rtol=rtol, atol=atol, dt=dt, first_step=first_step, max_steps=max_steps, max_step=max_step,
-                adaptive=adaptive, beta=beta, gamma=gamma, alpha=alpha, rho_inf=rho_inf, newton_tol=newton_tol,
-                newton_max_iterations=newton_max_iterations, iteration_matrix=iteration_matrix, error_on=error_on)
+    call = dict(o, method=method, t_end=t_end, t0=t0, q0=q0, qd0=qd0, s0=s0, t_eval=t_eval if len(t_eval) else None,
+                rtol=rtol, atol=atol, max_steps=max_steps, max_step=max_step)
     result = Result(system, t, q, qd, stats, method, interrupted, arms, own,
                     dict(call, outputs=bool(outputs), fixed=fixed),
                     sensitivities=sensitivities_.split(system, names, raw) if names else {})
@@ -497,7 +469,7 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
         error = _core.SimulationError(message)
         error.result, error.time, error.cause = result, time, cause
         raise error
-    if stiffness_warning and method != "auto" and np.isfinite(stats.get("stiff_at", np.nan)):
+    if o["stiffness_warning"] and method != "auto" and np.isfinite(stats.get("stiff_at", np.nan)):
         warnings.warn(f"{method}: the problem is stiff from t = {stats['stiff_at']:.6g} s on (h rho at the stability "
                       "boundary): the step is bounded by stability, the cost grows with the highest frequency and at "
                       "loose tolerances the stiff modes keep errors above the tolerance, or grow; an implicit method "
@@ -540,11 +512,6 @@ def _warn_growth(result: Result, q0, qd0) -> None:
                   RuntimeWarning, stacklevel=3)
 
 
-#: The order of each C++ method's propagated solution (Richardson's factor of a fixed-step error estimate).
-_ORDER = {"euler": 1, "symplectic_euler": 1, "rk4": 4, "dopri5": 5, "rkf45": 4, "newmark": 2, "hht": 2,
-          "generalized_alpha": 2, "implicit_spring": 2, "esdirk43": 4, "radau5": 5}
-
-
 def _estimate_error(result: Result):
     """Result.error_estimate: the second run (tolerances / TIGHTER, or dt / 2) at the same output times."""
     run = result.run
@@ -557,7 +524,7 @@ def _estimate_error(result: Result):
     kw["t_eval"], kw["stiffness_warning"] = result.t, False
     if run["fixed"]:
         kw["dt"] = run["dt"] / 2.0
-        order = _ORDER[run["method"]]
+        order = options_.method(run["method"]).order  # Richardson's factor 2^p/(2^p − 1)
     else:
         kw["rtol"], kw["atol"] = run["rtol"] / error_control.TIGHTER, run["atol"] / error_control.TIGHTER
         kw["max_steps"] = 10 * run["max_steps"]
@@ -582,16 +549,9 @@ def _check_closed(system, t0, q0, qd0, tol=1e-8):
                              "system.assemble(q0, qd0, t=t0) finds the nearest ones")
 
 
-#: The methods that run at a fixed step unless told otherwise (adaptive=True: the Newmark family).
-_FIXED_STEP = options_.EXPLICIT_FIXED + options_.NEWMARK
-
 #: The largest initial coordinate (m or rad) simulate takes: beyond it the steps of a coordinate drown in its
 #: rounding (scipy: methods then crawled for minutes at q0 = 1e300; the C++ ones returned q frozen at q0).
 _LARGEST_COORDINATE = 1e15
-
-#: The methods that control their step by default (a dt given to them sets only the first step).
-_ADAPTIVE = ("auto",) + options_.EXPLICIT_ADAPTIVE + options_.IMPLICIT_RK
-
 
 def _reactions_source(own, method: str) -> str:
     """Where ``Result.loop_reactions`` come from, for ``stats["loop_reactions"]``: the method's own
@@ -599,44 +559,6 @@ def _reactions_source(own, method: str) -> str:
     if own is not None:
         return f"{method}'s own multipliers (index 3, linear between its steps' ends)"
     return "the forward dynamics' multipliers at each output's state"
-
-
-def _options(method, dt, first_step, rtol, atol, max_step, max_steps, adaptive, beta, gamma, alpha, rho_inf,
-             newton_tol, newton_max_iterations, iteration_matrix):
-    """The C++ integrator's options, converted by the bindings' rule (``_core._real``, ``_checks.integer``
-    within the C++ field's range); their values are checked once, by ``_core._check_options``. Only a
-    given step is checked here: the C++ options hold 0 for "none", so it must be positive on its way in."""
-    real = _core._real
-    opt = _core.IntegratorOptions()
-    opt.method = method
-    opt.dt = 0.0 if dt is None else _checks.scalar(dt, "dt", positive=True)
-    if first_step is not None:
-        opt.dt = _checks.scalar(first_step, "first_step", positive=True)
-    opt.rtol, opt.atol = rtol, atol
-    opt.max_step, opt.max_steps = max_step, max_steps  # converted by simulate
-    opt.adaptive = -1 if adaptive is None else int(_checks.boolean(adaptive, "adaptive"))
-    opt.beta, opt.gamma = real(beta, "beta", "a number"), real(gamma, "gamma", "a number")
-    opt.alpha, opt.rho_inf = real(alpha, "alpha", "a number"), real(rho_inf, "rho_inf", "a number")
-    opt.newton_tol = real(newton_tol, "newton_tol", "a positive finite tolerance")
-    opt.newton_max_iterations = _checks.integer(newton_max_iterations, "newton_max_iterations",
-                                                minimum=-2**31, maximum=2**31 - 1)
-    if not isinstance(iteration_matrix, str):
-        raise ValueError(f"iteration_matrix: expected 'auto', 'tangent', 'spring' or 'krylov', got {iteration_matrix!r}")
-    opt.iteration_matrix = iteration_matrix
-    if method == "auto":
-        if adaptive is False:
-            raise ValueError("adaptive: expected None or True with method 'auto' (it controls its steps), got False")
-    return opt
-
-
-def _measures_outputs(method: str, system, iteration_matrix: str) -> bool:
-    """Whether ``error_on=None`` measures the bodies' displacements (else the state): for radau5, the
-    adaptive Newmark family and auto when its stiff method is radau5 — the methods whose estimate sees
-    what a step loses of an oscillation. dopri5 and rkf45 hold the state (their stability rests on their
-    error control), esdirk43 too (its filtered estimate hides most of what it damps: error_control)."""
-    if method == "auto":  # a bad iteration_matrix is named by _options
-        return isinstance(iteration_matrix, str) and _core._auto_stiff_method(system, iteration_matrix) == "radau5"
-    return method in ("radau5", "newmark", "hht", "generalized_alpha", "implicit_spring")
 
 
 def _keep_going(bar, stop, t0):

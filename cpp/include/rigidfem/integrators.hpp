@@ -10,6 +10,7 @@
 #include <functional>
 #include <limits>
 #include <string>
+#include <variant>
 #include <vector>
 
 #include "rigidfem/error_measure.hpp"
@@ -24,6 +25,7 @@ enum class Method {
   RK4,               ///< classical Runge–Kutta, order 4, fixed step
   Dopri5,            ///< Dormand–Prince 5(4), adaptive
   RKF45,             ///< Runge–Kutta–Fehlberg 4(5), adaptive
+  BS23,              ///< Bogacki–Shampine 3(2), adaptive
   Newmark,           ///< Newmark β, γ, Newton
   HHT,               ///< Hilber–Hughes–Taylor α
   GeneralizedAlpha,  ///< Chung–Hulbert generalised-α with ρ∞
@@ -34,7 +36,8 @@ enum class Method {
   /// bounded by stability, the stiff method runs a trial and keeps the run if it does less work per simulated second.
   Auto,
 };
-/// The method called `name` ("dopri5", ...); std::invalid_argument listing the methods otherwise.
+/// The method called `name` ("dopri5", ...); std::invalid_argument listing the methods otherwise. The methods and
+/// their facts are listed once, in the method table (stepper.hpp).
 Method parse_method(const std::string& name);
 const char* method_name(Method method);
 
@@ -66,6 +69,9 @@ struct IntegratorOptions {
   /// to a fraction of its local error over it (0: to newton_tol alone).
   double span = 0.0;
   int newton_max_iterations = 10;
+  /// dopri5 and rkf45: whether the Python layer warns (RuntimeWarning) when Hairer's stiffness test fires
+  /// (stats.stiff_at is recorded either way).
+  bool stiffness_warning = true;
   IterationMatrix iteration_matrix = IterationMatrix::Auto;
   /// auto: the implicit method it hands over to; Auto: auto_stiff_method's choice (radau5, or esdirk43 with
   /// Maxwell arms or the spring matrix)
@@ -78,6 +84,35 @@ struct IntegratorOptions {
   /// and the Newmark family; their error is not controlled (the steps are the state's).
   std::vector<SensitivityParameter> sensitivities;
 };
+
+/// An option's value as the Python layer gives and shows it: none, a number, an integer, a flag, a name or
+/// numbers (a tolerance per component).
+using OptionValue = std::variant<std::monostate, double, long, bool, std::string, std::vector<double>>;
+
+/// How the Python layer writes an option: a real number, an integer, True or False, a name, a number or 2 nq of
+/// them (rtol, atol), or outputs (error_on: points, bodies, coordinates, ... converted by the Python layer).
+enum class OptionType { Real, Integer, Flag, Name, Reals, Outputs };
+
+/// One option of integrate(), described once: its name, how it is written, its unit and what it does. Its
+/// default is get(IntegratorOptions{}), the struct's own initialiser; `simulate(**options)`,
+/// rigidfem.integrator_options, simulate's docstring and the site's table of options are read from here, and
+/// which methods read it from the method table (MethodInfo::options).
+struct OptionInfo {
+  const char* name;
+  OptionType type;
+  const char* unit;
+  const char* expected;  ///< what it takes, for the messages ("a positive finite step in s")
+  const char* doc;
+  bool none_allowed;  ///< None is a value (the method's default, or "not given")
+  OptionValue (*get)(const IntegratorOptions&);
+  /// Stores a value (its type converted by the bindings; its range judged by check_options and the families'
+  /// checks); null for Outputs, which the Python layer converts (IntegratorOptions::error_on).
+  void (*set)(IntegratorOptions&, const OptionValue&);
+};
+/// The options, each once.
+const std::vector<OptionInfo>& integrator_options();
+/// The option called `name`; std::invalid_argument listing them otherwise.
+const OptionInfo& option_info(const std::string& name);
 
 struct IntegratorStats {
   std::string method;  ///< what ran: the method's name, or for auto what it chose (auto_description)
@@ -119,6 +154,10 @@ struct Trajectory {
 /// Called about every 0.05 s of wall time with the current time; returning false stops
 /// the run (Ctrl-C), which then returns what it has.
 using Monitor = std::function<bool(double)>;
+
+/// Whether error_on's default for this run is the bodies' displacements (else the state): the method's row, and
+/// for auto its stiff method's (auto_stiff_method).
+bool measures_outputs(const System& sys, const IntegratorOptions& o);
 
 /// The options' checks of integrate(): std::invalid_argument naming the first bad one.
 void check_options(const System& sys, double t0, double t_end, const VecX& q0, const VecX& qd0,

@@ -2,13 +2,15 @@
 ///
 /// integrate() runs one loop for every method, fixed or adaptive: it asks a Stepper to attempt a
 /// step, controls the step size from the error estimate, records outputs by the stepper's dense
-/// output and lands on t_end once. To add a method: write its Stepper (one file per family:
-/// runge_kutta.cpp, newmark.cpp, implicit_rk.cpp), add its Method and a row in the table of
-/// integrate.cpp.
+/// output and lands on t_end once. To add a method: its Method (integrators.hpp), and in its family's
+/// file (runge_kutta.cpp, newmark.cpp, implicit_rk.cpp) its Stepper (or tableau) and its row of
+/// MethodInfo; everything else, the Python layer included, reads the row.
 #pragma once
 
+#include <initializer_list>
 #include <memory>
 #include <string>
+#include <vector>
 
 #include "rigidfem/integrators.hpp"
 
@@ -97,15 +99,35 @@ std::unique_ptr<Stepper> make_runge_kutta(const System& sys, const IntegratorOpt
 std::unique_ptr<Stepper> make_newmark(const System& sys, const IntegratorOptions& o, IntegratorStats& stats);
 std::unique_ptr<Stepper> make_implicit_rk(const System& sys, const IntegratorOptions& o, IntegratorStats& stats);
 
-/// A row of the method table.
+/// A row of the method table: what a method is, described once. The Python layer reads it through the bindings
+/// (rigidfem.methods(), the options each method reads, Richardson's order of its error estimate, whether it runs
+/// at fixed steps by default); nothing outside the table names a method's facts.
 struct MethodInfo {
   Method method;
   const char* name;
+  const char* family;   ///< "explicit Runge-Kutta", "Newmark", "implicit Runge-Kutta", "auto"
   int order;            ///< order of the propagated solution
   bool error_estimate;  ///< an embedded error estimate: may run adaptive
   bool adaptive;        ///< adaptive by default
+  /// error_on's default: the bodies' displacements (true) or the state [q, q̇] (false); auto: its stiff method's
+  bool measures_outputs;
+  bool adjoint;  ///< has a discrete adjoint at fixed steps (adjoint.hpp: rigidfem.gradient)
+  std::vector<const char*> options;  ///< the options (integrator_options()) it reads
+  const char* doc;      ///< the scheme, in a line or two (the site's table of methods)
   std::unique_ptr<Stepper> (*make)(const System&, const IntegratorOptions&, IntegratorStats&);
+  /// The family's own checks of the options it reads (std::invalid_argument naming the first bad one); may be null.
+  void (*check)(const System&, const IntegratorOptions&);
 };
+/// The families' rows (one list per family file) and the table of every method, auto last.
+const std::vector<MethodInfo>& runge_kutta_methods();
+const std::vector<MethodInfo>& newmark_methods();
+const std::vector<MethodInfo>& implicit_rk_methods();
+const std::vector<MethodInfo>& method_table();
 const MethodInfo& method_info(Method method);
+
+/// The options a method reads: dt and max_steps (every method), step-size control's with an error estimate (rtol,
+/// atol, error_on, first_step, max_step, adaptive), Newton's for an implicit method (newton_tol,
+/// newton_max_iterations, iteration_matrix), and its own.
+std::vector<const char*> method_options(bool error_estimate, bool newton, std::initializer_list<const char*> own = {});
 
 }  // namespace rigidfem

@@ -1,0 +1,80 @@
+"""Every kind describes itself once, in C++: the tables the Python layer shows (the methods and their options, ...)
+are the C++ descriptions read through the bindings, and agree with what the C++ code does."""
+
+import numpy as np
+import pytest
+
+import rigidfem as rf
+from rigidfem import _core, adjoint, options
+
+
+def test_the_methods_are_the_cpp_table():
+    table = {row["name"]: row for row in _core._method_table()}
+    methods = rf.methods()
+    assert [m for m in methods if not m.startswith("scipy:")] == ["auto"] + [m for m in table if m != "auto"]
+    for name, row in table.items():
+        m = methods[name]
+        assert (m.family, m.order, m.error_estimate, m.adaptive, m.adjoint, m.options, m.doc) == (
+            row["family"], row["order"], row["error_estimate"], row["adaptive"], row["adjoint"], tuple(row["options"]),
+            row["doc"])
+        assert m.error_on == ("bodies" if row["measures_outputs"] else "state")
+    assert options.METHODS == tuple(methods)
+    with pytest.raises(ValueError, match="^method: expected one of"):
+        rf.methods()["nope"] if False else options.method("nope")
+
+
+def test_each_option_is_described_once_with_the_structs_default_and_its_readers():
+    defaults = _core.IntegratorOptions()
+    rows = _core._option_table()
+    assert [o.name for o in options.OPTIONS] == [r["name"] for r in rows]
+    for row, o in zip(rows, options.OPTIONS):
+        assert o.default == defaults.get(row["name"]) == row["default"], row["name"]
+        assert (o.unit, o.doc, o.expected) == (row["unit"], row["doc"], row["expected"])
+        readers = {m for m, method in rf.methods().items() if o.name in method.options}
+        assert set(o.methods) == readers, o.name
+        assert set(rf.integrator_options(next(iter(readers)))) >= {o.name}
+    # every option a method reads is one of the table's
+    for method in rf.methods().values():
+        assert set(method.options) <= {o.name for o in options.OPTIONS}, method.name
+
+
+def test_an_option_is_converted_by_its_type_with_a_message_naming_it():
+    opt = _core.IntegratorOptions()
+    for name, good, bad in (("dt", 0.01, "x"), ("max_steps", 7, 1.5), ("adaptive", True, 1), ("beta", 0.3, None),
+                            ("iteration_matrix", "spring", 3), ("rtol", [1e-6, 1e-7], "tight")):
+        opt.set(name, good)
+        got = opt.get(name)
+        assert got == good or (isinstance(good, list) and got == good[0]), name
+        with pytest.raises(ValueError, match=f"^{name}: expected "):
+            opt.set(name, bad)
+    with pytest.raises(ValueError, match="^dt: expected a positive finite step in s, got -1"):
+        opt.set("dt", -1.0)
+    with pytest.raises(ValueError, match="^name: expected an option of the integrators"):
+        opt.set("nope", 1.0)
+
+
+def test_the_methods_with_an_adjoint_are_those_the_cpp_adjoint_runs():
+    assert set(adjoint.METHODS) == {name for name, m in rf.methods().items() if m.adjoint}
+    model, h = rf.samples.pendulum()
+    system = model.compile()
+    for name, m in rf.methods().items():
+        if name.startswith("scipy:"):
+            continue
+        opt = options.compiled(name, {"dt": 0.01})
+        if m.adjoint:
+            _core._Adjoint(system, opt, [("coordinate", 0, np.zeros(3))], 1e6)
+        else:
+            with pytest.raises(ValueError, match="^method: expected generalized_alpha"):
+                _core._Adjoint(system, opt, [("coordinate", 0, np.zeros(3))], 1e6)
+
+
+def test_a_fixed_step_error_estimate_takes_the_tables_order():
+    """Richardson's factor 2^p/(2^p − 1) of Result.error_estimate at fixed steps is the method's order from the table:
+    bs23 (order 3) on a pendulum estimates its own error within 30 % of the error against a tight reference."""
+    model, h = rf.samples.pendulum()
+    system = model.compile()
+    ref = rf.simulate(system, 1.0, "dopri5", q0=[1.0], rtol=1e-12, atol=1e-14, t_eval=[1.0])
+    r = rf.simulate(system, 1.0, "bs23", q0=[1.0], dt=0.02, adaptive=False, t_eval=[1.0])
+    estimate = r.error_estimate.of(lambda x: x.q[:, 0])
+    actual = abs(r.q[-1, 0] - ref.q[-1, 0])
+    assert 0.7 * actual < estimate < 1.3 * actual, (estimate, actual)
