@@ -53,11 +53,12 @@ def _copy_notebooks() -> None:
 
 
 def _write_options_table() -> None:
-    """docs/_generated/options.md and methods.md: simulate's options and methods, from the C++ tables
-    (rigidfem.options reads them)."""
+    """docs/_generated/options.md, methods.md and laws.md: simulate's options and methods and the kinds of law,
+    from the C++ descriptions (rigidfem.options and rigidfem.laws read them)."""
     out = HERE / "_generated"
     out.mkdir(exist_ok=True)
-    for name, text in (("options.md", options.table()), ("methods.md", options.method_table())):
+    for name, text in (("options.md", options.table()), ("methods.md", options.method_table()),
+                       ("laws.md", rigidfem.laws.table())):
         path = out / name
         if not path.exists() or path.read_text() != text + "\n":
             path.write_text(text + "\n")

@@ -1503,6 +1503,8 @@ class Gen:
             fn = "model.add_spring_damper" if kind == "spring" else "model.add_rope"
             if kind == "rope":
                 kw["EA"] = kw.pop("stiffness")
+                if "damping" in kw:
+                    kw["DA"] = kw.pop("damping")
             self.emit(fn, [A(a, bad=bad_a, names=ROLE_NAMES["point"]), A(b)], ["a", "b"], kw, label=fn.split(".")[1],
                       ambiguous=not bad)
 
@@ -1544,6 +1546,19 @@ class Gen:
         free = [c for c in b["coords"] if c not in b["prescribed"]]
         c = self.choice(free)
         kw = {"coordinate": A(repr(c))} if len(b["coords"]) > 1 or self.chance(0.3) else {}
+        if self.chance(0.15):  # a friction law (rigidfem.laws), its constants sometimes out of their bounds
+            values = {"breakaway": fl(self.choice([0.0, 1.0, 5.0])), "coulomb": fl(self.choice([0.0, 0.5, 2.0])),
+                      "stribeck": fl(self.choice([1e-3, 0.01, 1.0])), "viscous": fl(self.choice([0.0, 0.1, 10.0])),
+                      "smoothing": fl(self.choice([1e-4, 1e-3, 0.1]))}
+            bad = self.chance(0.1)
+            if bad:
+                key = self.choice(list(values))
+                values[key] = self.choice(["-1.0", "nan", "inf", "'x'", "None"] + (["0.0"] if key in ("stribeck", "smoothing")
+                                                                                 else []))
+            law = "rf.laws.Friction(" + ", ".join(f"{k}={v}" for k, v in values.items()) + ")"
+            self.emit("model.add_joint_law", [A(self.handle(b)), A(law, bad=bad, names=tuple(values))], ("body", "law"),
+                      kw, label="add_joint_law")
+            return
         law_taken = (b["index"], c) in self.laws
         if self.chance(0.4):
             laws = list(GOOD_LAWS)

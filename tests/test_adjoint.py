@@ -30,7 +30,7 @@ def boom_and_rope():
     boom = m.add_body("boom", m.ground, rf.Joint.revolute("z"), 10.0, (1.0, 1.0, 1.0), com=(1.0, 0.0, 0.0))
     m.prescribe(boom, rf.motion.harmonic(0.3, 1.5))
     load = m.add_body("load", boom, rf.Joint.free(), 5.0, (0.1, 0.1, 0.1), placement=rf.transform((2.0, 0, 0)))
-    m.add_rope(boom.point((2.0, 0.0, 0.0)), load, EA=1e6, damping=1e3, length=rf.motion.ramp(-0.2, 0.0, 0.5, start=1.0),
+    m.add_rope(boom.point((2.0, 0.0, 0.0)), load, EA=1e6, DA=1e3, length=rf.motion.ramp(-0.2, 0.0, 0.5, start=1.0),
                name="rope")
     return m.compile(), load.origin, [0.0, 0.0, -1.0 - 5 * G / 1e6, 0.0, 0.0, 0.0]
 
@@ -121,7 +121,7 @@ def test_drives_winches_and_ropes():
     sensitivities, and one drive number against central differences of whole runs."""
     s, point, q0 = boom_and_rope()
     names = ["boom.rz.drive.amplitude", "boom.rz.drive.omega", "boom.rz.drive.offset", "rope.length.rate",
-             "rope.length.duration", "rope.EA", "rope.damping", "load.mass", "load.x.stiffness"]
+             "rope.length.duration", "rope.EA", "rope.DA", "load.mass", "load.x.stiffness"]
     run = dict(dt=1e-3, q0=q0, newton_tol=1e-14)
     g = rf.gradient(s, 1.0, names, outputs={"p": point}, running=running, terminal=terminal, **run)
     _, expected = forward_gradient(s, point, names, 1.0, **run)

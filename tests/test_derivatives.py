@@ -94,7 +94,7 @@ def sprung_beams(gravity=(0.0, -9.81, 0.0), flowing=True):
     arm = model.add_beam("arm", model.ground, 1.0, rf.Material(E=2e9, rho=2700.0), rf.Section.rectangle(0.02, 0.01), 3,
                          joint=rf.Joint.spherical(), placement=rf.transform((0.0, 1.0, 0.0)))
     model.add_spring_damper(tape.tip, arm.tip, stiffness=50.0, damping=2.0, length=0.3)
-    model.add_rope(arm.point(0.5), model.ground, EA=1e4, damping=10.0, length=0.5)
+    model.add_rope(arm.point(0.5), model.ground, EA=1e4, DA=10.0, length=0.5)
     model.add_force(arm.tip, (0.0, 1.0, 2.0), follower=True)
     model.add_force(tape.tip, (1.0, 0.0, -2.0))
     model.add_torque(arm.rfes[1], (0.3, 0.0, 0.1), follower=True)

@@ -78,3 +78,30 @@ def test_a_fixed_step_error_estimate_takes_the_tables_order():
     estimate = r.error_estimate.of(lambda x: x.q[:, 0])
     actual = abs(r.q[-1, 0] - ref.q[-1, 0])
     assert 0.7 * actual < estimate < 1.3 * actual, (estimate, actual)
+
+
+def test_every_law_kind_is_the_cpp_description_and_what_parameters_and_viewer_read():
+    """For every kind of force element: a law of it with the defaults is added by the one generic builder, its
+    parameters are the constants the description marks (units, docs, bounds), and the viewer draws it as the
+    C++ law says (no table of kinds in Python)."""
+    kinds = rf.laws.kinds()
+    assert {k: v["acts_on"] for k, v in kinds.items()} == {row["kind"]: row["acts_on"]
+                                                             for row in _core._Model._law_kinds()}
+    model = rf.Model(gravity=None)
+    body = model.add_body("b", model.ground, rf.Joint.prismatic("x"), mass=1.0, inertia=(1, 1, 1))
+    elements = [k for k, info in kinds.items() if info["acts_on"] == "element"]
+    for k, kind in enumerate(elements):
+        model.add_force_element(model.ground.point((0.0, 1.0 + k, 0.0)), body, getattr(rf.laws, kind)(), name=kind)
+    system = model.compile()
+    for k, kind in enumerate(elements):
+        info = kinds[kind]
+        marked = {c["name"]: c for c in info["constants"] if c["parameter"]}
+        listed = {name.split(".", 1)[1]: p for name, p in system.parameters.items() if name.startswith(kind + ".")}
+        assert set(listed) == set(marked), kind
+        for name, p in listed.items():
+            c = marked[name]
+            assert (p.unit, p.description, p.minimum, p.positive) == (c["unit"], c["doc"], c["lower"], c["positive"])
+            assert p.value == c["default"]
+        law_kind, values, drawn = model._element_law(k)
+        assert law_kind == kind and values == [c["default"] for c in info["constants"]]
+        assert rf.view(system).data["segments"][k]["kind"] == drawn

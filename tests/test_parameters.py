@@ -24,7 +24,7 @@ def build(E=2e11, Gm=8e10, rho=7800.0, mu=1e-4, A=1e-4, Iy=2.0e-10, Iz=3.3e-9, J
                    placement=rf.transform((0.1, 0.0, 0.0)))
     m.add_spring_damper(b.point(0.5), m.ground, stiffness=ks, damping=cs, length=0.5, name="spring")
     m.add_cylinder(b.tip, m.ground, F0, name="cylinder")
-    m.add_rope(b.tip, m.ground, EA=EA, damping=DA, length=0.9, name="rope")
+    m.add_rope(b.tip, m.ground, EA=EA, DA=DA, length=0.9, name="rope")
     m.add_force(b.tip, (0.0, -force, 0.0), name="push")
     m.add_torque(b.rfes[2], (0.0, 0.0, torque), name="twist")
     return m.compile()
@@ -35,7 +35,7 @@ CHANGES = [  # parameter, new value, keyword of build
     ("strip.A", 3e-4, "A"), ("strip.Iy", 5e-10, "Iy"), ("strip.Iz", 1e-9, "Iz"), ("strip.J", 2e-9, "J"),
     ("hub.mass", 0.7, "hub"), ("hub.rz.stiffness", 50.0, "k"), ("hub.rz.damping", 0.0, "c"), ("hub.rz.force", -2.0, "Q"),
     ("spring.stiffness", 1e3, "ks"), ("spring.damping", 4.0, "cs"), ("cylinder.force", -1.5, "F0"),
-    ("rope.EA", 1e5, "EA"), ("rope.damping", 0.0, "DA"), ("push.force", 7.0, "force"), ("twist.torque", 0.9, "torque"),
+    ("rope.EA", 1e5, "EA"), ("rope.DA", 0.0, "DA"), ("push.force", 7.0, "force"), ("twist.torque", 0.9, "torque"),
 ]
 
 

@@ -142,7 +142,7 @@ def test_rope_across_slack_phases():
     rope stays taut they agree to the differences' own 1e-8."""
     model = rf.Model(gravity=(0.0, 0.0, -G))
     load = model.add_body("load", model.ground, rf.Joint.prismatic("z"), 500.0, (1.0, 1.0, 1.0))
-    model.add_rope(model.ground, load, EA=2e6, length=10.0, damping=1e3, name="rope")
+    model.add_rope(model.ground, load, EA=2e6, length=10.0, DA=1e3, name="rope")
     s = model.compile()
     t = np.linspace(0, 1.5, 7)
     errors = []
@@ -336,7 +336,7 @@ def test_profile_numbers_converge():
     boom = m.add_body("boom", m.ground, rf.Joint.revolute("z"), 10.0, (1.0, 1.0, 1.0), com=(1.0, 0.0, 0.0))
     m.prescribe(boom, rf.motion.harmonic(0.3, 1.5))
     load = m.add_body("load", boom, rf.Joint.free(), 5.0, (0.1, 0.1, 0.1), placement=rf.transform((2.0, 0, 0)))
-    m.add_rope(boom.point((2.0, 0.0, 0.0)), load, EA=1e6, damping=1e3, length=rf.motion.ramp(-0.2, 0.0, 0.5, start=1.0),
+    m.add_rope(boom.point((2.0, 0.0, 0.0)), load, EA=1e6, DA=1e3, length=rf.motion.ramp(-0.2, 0.0, 0.5, start=1.0),
                name="rope")  # hoisting from rest, smoothly: the rope stays taut
     s = m.compile()
     r = _converges(s, ["rope.length.rate", "rope.length.duration", "rope.EA"], "generalized_alpha",

@@ -70,8 +70,8 @@ def test_public_classes_and_functions_have_docstrings():
 # The C++ core's layers, bottom to top: a file includes headers of its own layer or below only.
 CPP = PACKAGE.parents[1] / "cpp"
 LAYERS = [
-    {"errors", "transforms", "profiles"},
-    {"joint_motion", "loops", "force_elements", "flows"},
+    {"errors", "transforms", "profiles", "laws"},
+    {"joint_motion", "loops", "force_elements", "coordinate_laws", "flows"},
     {"model"},
     {"system", "parameters"},                  # a compiled system, and its copies with other constants
     {"arms"},                                  # internal variables of the state (system level)

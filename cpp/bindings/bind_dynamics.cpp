@@ -17,9 +17,9 @@ namespace {
 using RefV = Eigen::Ref<const VecX>;
 
 // One field of every free coordinate, in q order.
-VecX free_coordinate_values(const System& s, double Coordinate::*field) {
+VecX free_coordinate_values(const System& s, double SpringDamping::*field) {
   VecX v(s.nq);
-  for (int k = 0; k < s.nq; ++k) v(k) = s.coords[s.free_coords[k]].*field;
+  for (int k = 0; k < s.nq; ++k) v(k) = s.coords[s.free_coords[k]].spring.*field;
   return v;
 }
 
@@ -94,7 +94,8 @@ void bind_dynamics(py::module_& m) {
              return std::const_pointer_cast<System>(model.compile(a));
            }),
            py::arg("model"), py::arg("algorithm"))
-      .def(py::init([](const System& base, const std::vector<std::tuple<int, int, double, double, double>>& coordinates,
+      .def(py::init([](const System& base,
+                       const std::vector<std::tuple<int, int, int, std::string, double>>& coordinates,
                        const std::vector<std::pair<int, Mat4>>& bodies,
                        const std::vector<std::tuple<int, std::string, double>>& elements,
                        const std::vector<std::tuple<int, Vec3, Vec3>>& loads,
@@ -102,7 +103,8 @@ void bind_dynamics(py::module_& m) {
              // a copy of `base` with new constants and profiles (parameters.hpp): what named parameters set
              ConstantChanges c;
              for (const auto& [what, body, index, profile] : profiles) c.profiles.push_back({what, body, index, profile});
-             for (const auto& [body, slot, k, b, F] : coordinates) c.coordinates.push_back({body, slot, k, b, F});
+             for (const auto& [body, slot, law, name, value] : coordinates)
+               c.coordinates.push_back({body, slot, law, name, value});
              for (const auto& [body, H] : bodies) c.bodies.push_back({body, H});
              for (const auto& [element, name, value] : elements) c.elements.push_back({element, name, value});
              for (const auto& [load, F, tau] : loads) c.loads.push_back({load, F, tau});
@@ -134,13 +136,13 @@ void bind_dynamics(py::module_& m) {
       .def_property_readonly("prescribed_names", &System::prescribed_names,
                              "Names of the prescribed coordinates, in the order of driving_forces().")
       .def_property_readonly(
-          "stiffness", [](const System& s) { return free_coordinate_values(s, &Coordinate::stiffness); },
+          "stiffness", [](const System& s) { return free_coordinate_values(s, &SpringDamping::stiffness); },
           "Spring stiffness c_i of each free coordinate (nq,), N/m or N m/rad.")
       .def_property_readonly(
-          "damping", [](const System& s) { return free_coordinate_values(s, &Coordinate::damping); },
+          "damping", [](const System& s) { return free_coordinate_values(s, &SpringDamping::damping); },
           "Damping coefficient b_i of each free coordinate (nq,), N s/m or N m s/rad.")
       .def_property_readonly(
-          "rest", [](const System& s) { return free_coordinate_values(s, &Coordinate::rest); },
+          "rest", [](const System& s) { return free_coordinate_values(s, &SpringDamping::rest); },
           "Spring rest value q_i^0 of each free coordinate (nq,), m or rad.")
       .def_readonly("masses", &System::mass, "Mass of every body (nbodies), kg.")
       .def_readonly("centres_of_mass", &System::com, "Centre of mass of every body in its own frame (m).")
@@ -204,7 +206,22 @@ void bind_dynamics(py::module_& m) {
             for (const ForceElement& E : s.elements) names.push_back(E.name);
             return names;
           },
-          "Names of the force elements (spring-dampers and cylinders), in the order of element_states().")
+          "Names of the force elements (spring-dampers, cylinders, ropes), in the order of element_states().")
+      .def_property_readonly(
+          "_segments",
+          [](const System& s) {
+            // what the viewer draws between two points: each force element as its law says, each loop (an actuator
+            // as one, the others as a joint between their frames' origins)
+            py::list out;
+            for (const ForceElement& E : s.elements)
+              out.append(py::make_tuple(E.law->drawn_as(), E.body_a, E.point_a, E.body_b, E.point_b));
+            for (const Loop& L : s.loops)
+              out.append(py::make_tuple(L.actuator ? "actuator" : "loop", L.body_a,
+                                        Vec3(L.frame_a.topRightCorner<3, 1>()), L.body_b,
+                                        Vec3(L.frame_b.topRightCorner<3, 1>())));
+            return out;
+          },
+          "(how it is drawn, body a, point on a (m), body b, point on b) of every force element and loop.")
       .def(
           "element_states",
           [](const System& s, double t, const RefV& q, const RefV& qd) {

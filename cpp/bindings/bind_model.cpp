@@ -2,7 +2,6 @@
 // rigidfem/model.py; these are the primitives it calls.
 #include <cmath>
 #include <memory>
-#include <optional>
 
 #include "bindings.hpp"
 #include "rigidfem/errors.hpp"
@@ -87,6 +86,53 @@ ForceLaw python_law(const py::function& f, const std::string& on, const char* x 
                         "force: expected " + what + " to return " + expected + ", got " + got + " at t = " +
                             num(t, 10) + " s, " + state);
   };
+}
+
+// The kind of force element or of joint-coordinate law called `kind`; ValueError listing the kinds otherwise.
+const ElementLawKind& element_kind(const std::string& kind) {
+  std::string names;
+  for (const ElementLawKind& k : element_law_kinds()) {
+    if (kind == k.info().kind) return k;
+    names += std::string(names.empty() ? "" : ", ") + k.info().kind;
+  }
+  bad("law", "a law of a force element (" + names + ")", "'" + kind + "'");
+}
+
+const CoordinateLawKind& coordinate_kind(const std::string& kind) {
+  std::string names;
+  for (const CoordinateLawKind& k : coordinate_law_kinds()) {
+    if (kind == k.info().kind) return k;
+    names += std::string(names.empty() ? "" : ", ") + k.info().kind;
+  }
+  bad("law", "a law of a joint coordinate beyond its own spring-damping law (" + names + ")", "'" + kind + "'");
+}
+
+// The constants' values of a law from a dict {name: number} (the defaults for those not given), each a real
+// number by the bindings' rule (ValueError naming it); their bounds are the law's validate().
+std::vector<double> law_values(const LawInfo& info, const py::dict& given) {
+  std::vector<double> values = defaults(info);
+  for (const auto& [key, value] : given) {
+    const std::string name = py::str(key);
+    const int k = constant_index(info, name);
+    values[k] = real_arg(value, name, std::string("a number in ") + info.constants[k].unit);
+  }
+  return values;
+}
+
+// A law's description as a dict (rigidfem.laws reads it).
+py::dict law_kind(const LawInfo& info, bool addable) {
+  py::list constants;
+  for (const Constant& c : info.constants)
+    constants.append(py::dict(py::arg("name") = c.name, py::arg("unit") = c.unit,
+                              py::arg("rotation_unit") = c.rotation_unit ? c.rotation_unit : c.unit,
+                              py::arg("default") = c.value, py::arg("lower") = c.lower,
+                              py::arg("positive") = c.positive, py::arg("doc") = c.doc,
+                              py::arg("parameter") = c.parameter));
+  auto text = [](const char* s) -> py::object { return s ? py::object(py::str(s)) : py::object(py::none()); };
+  return py::dict(py::arg("kind") = info.kind, py::arg("acts_on") = info.acts_on, py::arg("doc") = info.doc,
+                  py::arg("constants") = constants, py::arg("profile") = text(info.profile),
+                  py::arg("profile_name") = text(info.profile_name), py::arg("profile_units") = text(info.profile_units),
+                  py::arg("function") = text(info.function), py::arg("addable") = addable);
 }
 
 }  // namespace
@@ -290,13 +336,13 @@ void bind_model(py::module_& m) {
       .def(
           "_add_loop",
           [](Model& model, const std::string& name, const std::string& kind, int a, const Mat4& frame_a, int b,
-             const Mat4& frame_b, double length, ProfilePtr drive) {
-            const int k =
-                model.add_loop({name, parse_loop_kind(kind, "kind"), a, b, frame_a, frame_b, length, std::move(drive)});
+             const Mat4& frame_b, double length, ProfilePtr drive, bool actuator) {
+            const int k = model.add_loop(
+                {name, parse_loop_kind(kind, "kind"), a, b, frame_a, frame_b, length, std::move(drive), actuator});
             return model.loops()[k].name;
           },
           py::arg("name"), py::arg("kind"), py::arg("a"), py::arg("frame_a"), py::arg("b"), py::arg("frame_b"),
-          py::arg("length"), py::arg("drive"))
+          py::arg("length"), py::arg("drive"), py::arg("actuator") = false)
       .def_static(
           "_loop_kinds",
           [] {
@@ -310,28 +356,69 @@ void bind_model(py::module_& m) {
       .def(
           "_add_force_element",
           [](Model& model, const std::string& name, int a, const Vec3& point_a, int b, const Vec3& point_b,
-             double stiffness, double damping, double length, double force, ProfilePtr profile,
-             const std::optional<py::function>& law) {
+             const std::string& kind, const py::dict& values, ProfilePtr profile, const py::object& function) {
+            const ElementLawKind& k = element_kind(kind);
             const std::string label = name.empty() ? "element" + std::to_string(model.force_elements().size()) : name;
-            AxialFunction f = law ? AxialFunction(python_law(*law, "force element '" + label + "'", "l", "ld", "N"))
-                                  : AxialFunction();
+            const AxialFunction f = function.is_none()
+                                        ? AxialFunction()
+                                        : python_law(function, "force element '" + label + "'", "l", "ld", "N");
             const ForceElement e{name, a, b, point_a, point_b,
-                                 std::make_shared<SpringDamper>(stiffness, damping, length, force, std::move(profile),
-                                                                std::move(f))};
+                                 k.make(law_values(k.info(), values), std::move(profile), f)};
             return model.force_elements()[model.add_force_element(e)].name;
           },
-          py::arg("name"), py::arg("a"), py::arg("point_a"), py::arg("b"), py::arg("point_b"), py::arg("stiffness"),
-          py::arg("damping"), py::arg("length"), py::arg("force"), py::arg("profile"), py::arg("law"))
+          py::arg("name"), py::arg("a"), py::arg("point_a"), py::arg("b"), py::arg("point_b"), py::arg("kind"),
+          py::arg("values"), py::arg("profile"), py::arg("function"),
+          "Adds a force element of the law `kind` (its constants' values by name, the rest their defaults), with its\n"
+          "profile and Python function where the kind takes them; returns its name.")
       .def(
-          "_add_rope",
-          [](Model& model, const std::string& name, int a, const Vec3& point_a, int b, const Vec3& point_b, double EA,
-             double DA, double length, ProfilePtr unstretched) {
-            const ForceElement e{name, a, b, point_a, point_b,
-                                 std::make_shared<Rope>(EA, DA, length, std::move(unstretched))};
-            return model.force_elements()[model.add_force_element(e)].name;
+          "_add_coordinate_law",
+          [](Model& model, int body, int coordinate, const std::string& kind, const py::dict& values,
+             const py::object& function) {
+            const CoordinateLawKind& k = coordinate_kind(kind);
+            const std::string name = model.coordinate_name(body, coordinate);  // checks body and coordinate
+            const ScalarFunction f = function.is_none() ? ScalarFunction() : python_law(function, "coordinate '" + name + "'");
+            return model.add_coordinate_law(body, coordinate, k.make(law_values(k.info(), values), f));
           },
-          py::arg("name"), py::arg("a"), py::arg("point_a"), py::arg("b"), py::arg("point_b"), py::arg("EA"),
-          py::arg("DA"), py::arg("length"), py::arg("unstretched"))
+          py::arg("body"), py::arg("coordinate"), py::arg("kind"), py::arg("values"), py::arg("function"),
+          "Adds a law of `kind` on a joint coordinate (-1: the joint's only one); returns its index among the\n"
+          "coordinate's laws.")
+      .def(
+          "_element_law",
+          [](const Model& model, int k) {
+            if (k < 0 || k >= static_cast<int>(model.force_elements().size()))
+              bad("element", "a force element of this model", std::to_string(k));
+            const ElementLaw& law = *model.force_elements()[k].law;
+            return py::make_tuple(law.info().kind, law.values(), law.drawn_as());
+          },
+          py::arg("element"), "(kind, the constants' values, how it is drawn) of force element k's law.")
+      .def_static(
+          "_law_kinds",
+          [] {
+            py::list kinds;
+            kinds.append(law_kind(SpringDamping::description(), false));
+            for (const ElementLawKind& k : element_law_kinds()) kinds.append(law_kind(k.info(), true));
+            for (const CoordinateLawKind& k : coordinate_law_kinds()) kinds.append(law_kind(k.info(), true));
+            return kinds;
+          },
+          "Every kind of law, each a dict: kind, acts_on ('element' or 'coordinate'), doc, constants (name, unit,\n"
+          "rotation_unit, default, lower, positive, doc, parameter), profile, profile_name, profile_units, function,\n"
+          "addable (False: every coordinate's own spring-damping law).")
+      .def_static(
+          "_check_law",
+          [](const std::string& kind, const py::dict& values, ProfilePtr profile) {
+            std::shared_ptr<const Law> law;
+            for (const ElementLawKind& k : element_law_kinds())
+              if (kind == k.info().kind) law = k.make(law_values(k.info(), values), std::move(profile), {});
+            if (!law) {
+              const CoordinateLawKind& k = coordinate_kind(kind);
+              law = k.make(law_values(k.info(), values), {});
+            }
+            law->validate();
+            return law->values();
+          },
+          py::arg("kind"), py::arg("values"), py::arg("profile"),
+          "The constants' values of a law of `kind` (defaults for those not given), each converted and judged\n"
+          "against its bounds (ValueError naming the first out of them).")
       .def(
           "_add_flow",
           [](Model& model, ProfilePtr length, int first, int elements) {

@@ -74,9 +74,7 @@ ParameterVjp::ParameterVjp(const System& sys, const std::vector<SensitivityParam
         if (X->H[b] != sys.H[b]) add(Component::Body, b);
       for (int i = 0; i < sys.nc; ++i) {
         const Coordinate &a = X->coords[i], &c = sys.coords[i];
-        if (c.free_index >= 0 && (a.stiffness != c.stiffness || a.damping != c.damping || a.force != c.force ||
-                                  a.rest != c.rest))
-          add(Component::Coordinate, i);
+        if (c.free_index >= 0 && (a.spring != c.spring || a.laws != c.laws)) add(Component::Coordinate, i);
         if (a.drive != c.drive) add(Component::Drive, i);
       }
       for (std::size_t e = 0; e < sys.elements.size(); ++e)

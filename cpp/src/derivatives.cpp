@@ -14,18 +14,6 @@ namespace {
 // δI x for δI = s ×* I − I s ×m (the inertia turned by the twist s), without forming δI.
 Vec6 turned_inertia_times(const Vec6& s, const Mat6& I, const Vec6& x) { return crossf(s, I * x) - I * crossm(s, x); }
 
-// ∂Q/∂x of a scalar force law Q(t, q_i, q̇_i) by a central difference in x (q or q̇).
-double law_derivative(const Coordinate& c, const Data& d, int i, bool rate) {
-  double q = d.qa(i), qd = d.qda(i);
-  double& x = rate ? qd : q;
-  const double x0 = x, h = difference_step(x0);
-  x = x0 + h;
-  const double up = c.force_law(d.t, q, qd);
-  x = x0 - h;
-  const double down = c.force_law(d.t, q, qd);
-  return (up - down) / (2.0 * h);
-}
-
 // Tangents of the RNEA quantities along one direction (one coordinate's q or q̇, or any (δq, δq̇, δq̈)).
 struct Tangent {
   explicit Tangent(const System& sys)
@@ -216,11 +204,13 @@ VecX rnea_directional_derivative(const System& sys, Data& d, const VecX& dq, con
   for (int k = 0; k < sys.nq; ++k) {
     const int i = sys.free_coords[k], b = sys.coords[i].body, u = sys.q_use[k];
     out(k) = d.axes[u].dot(w.f[b]) + crossm(W_before[u], d.axes[u]).dot(d.sf[b]);
-    // −δQ of the coordinate's own spring, damper and force law
+    // −δQ of the coordinate's own spring-damping law and its further laws
     const Coordinate& c = sys.coords[i];
-    out(k) += d.spring_scale(i) * (c.stiffness * dq(k) + c.damping * dqd(k));
-    if (c.force_law)
-      out(k) -= d.load_factor * (law_derivative(c, d, i, false) * dq(k) + law_derivative(c, d, i, true) * dqd(k));
+    out(k) += c.spring.variation(dq(k), dqd(k), d.spring_scale(i));
+    if (!c.laws.empty()) {
+      const auto [dQ_dq, dQ_dqd] = coordinate_derivatives(sys, d, i);
+      out(k) -= dQ_dq * dq(k) + dQ_dqd * dqd(k);
+    }
   }
   return out;
 }
@@ -245,11 +235,13 @@ ResidualVjp rnea_vector_jacobian_product(const System& sys, Data& d, const VecX&
     const Coordinate& c = sys.coords[i];
     G[b] += d.axes[u] * mu(k);
     Wu[u] += mu(k) * crossf(d.axes[u], d.sf[b]);  // (W ×m s)·f = W·(s ×* f)
-    out.q(k) += d.spring_scale(i) * c.stiffness * mu(k);
-    out.qd(k) += d.spring_scale(i) * c.damping * mu(k);
-    if (c.force_law) {
-      out.q(k) -= d.load_factor * law_derivative(c, d, i, false) * mu(k);
-      out.qd(k) -= d.load_factor * law_derivative(c, d, i, true) * mu(k);
+    const auto [k_own, c_own] = c.spring.derivatives(d.spring_scale(i));
+    out.q(k) -= k_own * mu(k);
+    out.qd(k) -= c_own * mu(k);
+    if (!c.laws.empty()) {
+      const auto [dQ_dq, dQ_dqd] = coordinate_derivatives(sys, d, i);
+      out.q(k) -= dQ_dq * mu(k);
+      out.qd(k) -= dQ_dqd * mu(k);
     }
   }
   // subtree sums transposed: each body's δf meets the adjoints of its own and its ancestors' sums
@@ -354,13 +346,15 @@ std::pair<MatX, MatX> rnea_derivatives(const System& sys, Data& d) {
     interruption_point();
     tangent_column(sys, d, loads, elements, flows, u, b, true, w, dq.col(j));
     tangent_column(sys, d, loads, elements, flows, u, b, false, w, dqd.col(j));
-    // −∂Q_j/∂(q_j, q̇_j) of the coordinate's own spring, damper and force law.
+    // −∂Q_j/∂(q_j, q̇_j) of the coordinate's own spring-damping law and its further laws.
     const Coordinate& c = sys.coords[i];
-    dq(j, j) += d.spring_scale(i) * c.stiffness;
-    dqd(j, j) += d.spring_scale(i) * c.damping;
-    if (c.force_law) {
-      dq(j, j) -= d.load_factor * law_derivative(c, d, i, false);
-      dqd(j, j) -= d.load_factor * law_derivative(c, d, i, true);
+    const auto [k_own, c_own] = c.spring.derivatives(d.spring_scale(i));
+    dq(j, j) -= k_own;
+    dqd(j, j) -= c_own;
+    if (!c.laws.empty()) {
+      const auto [dQ_dq, dQ_dqd] = coordinate_derivatives(sys, d, i);
+      dq(j, j) -= dQ_dq;
+      dqd(j, j) -= dQ_dqd;
     }
   }
   return {dq, dqd};

@@ -363,8 +363,7 @@ std::pair<MatX, MatX> force_jacobians(const System& sys, Data& d, double t, cons
     VecX g = d.f;
     for (int k = 0; k < sys.nq; ++k) {
       const int i = sys.free_coords[k];
-      const Coordinate& c = sys.coords[i];
-      g(k) += d.spring_scale(i) * (c.stiffness * (x(k) - c.rest) + c.damping * xd(k));
+      g(k) -= sys.coords[i].spring.elastic_force(x(k), xd(k), d.spring_scale(i));
     }
     return g;
   };
@@ -376,9 +375,9 @@ std::pair<MatX, MatX> force_jacobians(const System& sys, Data& d, double t, cons
   }
   for (int k = 0; k < sys.nq; ++k) {  // the scales at t (the state of the last evaluation)
     const int i = sys.free_coords[k];
-    const Coordinate& c = sys.coords[i];
-    dq(k, k) -= d.spring_scale(i) * c.stiffness;
-    dqd(k, k) -= d.spring_scale(i) * c.damping;
+    const auto [k_own, c_own] = sys.coords[i].spring.derivatives(d.spring_scale(i));
+    dq(k, k) += k_own;
+    dqd(k, k) += c_own;
   }
   return {dq, dqd};
 }

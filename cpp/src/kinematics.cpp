@@ -208,10 +208,20 @@ std::pair<AppliedLoad, AppliedLoad> element_loads(const ElementState& s) {
 
 double passive_force(const System& sys, const Data& d, int i) {
   const Coordinate& c = sys.coords[i];
-  double applied = c.force;
-  if (c.force_law) applied += c.force_law(d.t, d.qa(i), d.qda(i));
-  return -d.spring_scale(i) * (c.stiffness * (d.qa(i) - c.rest) + c.damping * d.qda(i)) - d.arm_force(i) +
-         d.load_factor * applied;
+  // −s (k (q − q⁰) + c q̇) − Σ s_arm + λ Q₀ + Σ Q_law
+  double Q = c.spring.elastic_force(d.qa(i), d.qda(i), d.spring_scale(i)) - d.arm_force(i) + d.load_factor * c.spring.force;
+  for (const auto& law : c.laws) Q += law->force(d.t, d.qa(i), d.qda(i), d.load_factor);
+  return Q;
+}
+
+std::pair<double, double> coordinate_derivatives(const System& sys, const Data& d, int i) {
+  const Coordinate& c = sys.coords[i];
+  std::pair<double, double> dQ{0.0, 0.0};
+  for (const auto& law : c.laws) {
+    const auto [dq, dqd] = law->derivatives(d.t, d.qa(i), d.qda(i), d.load_factor);
+    dQ.first += dq, dQ.second += dqd;
+  }
+  return dQ;
 }
 
 namespace {

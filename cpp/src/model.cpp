@@ -275,11 +275,23 @@ void Model::add_generalized_force(int body, int coordinate, double value, ForceL
   const int k = resolve_coordinate(body, coordinate);
   if (!std::isfinite(value)) bad("force", "a finite generalised force (N or N·m)", num8(value));
   auto& c = coords_[body][k];
+  if (law)
+    for (const auto& other : c.laws)
+      if (&other->info() == &ForceFunction::description()) bad("force", "at most one force law per coordinate", "a second one");
   c.force += value;
-  if (law) {
-    if (c.force_law) bad("force", "at most one force law per coordinate", "a second one");
-    c.force_law = std::move(law);
-  }
+  if (law) c.laws.push_back(std::make_shared<ForceFunction>(std::vector<double>{}, std::move(law)));
+}
+
+int Model::add_coordinate_law(int body, int coordinate, std::shared_ptr<const CoordinateLaw> law) {
+  const int k = resolve_coordinate(body, coordinate);
+  if (!law) bad("law", "a law of a joint coordinate (rigidfem.laws)", "None");
+  law->validate();
+  coords_[body][k].laws.push_back(std::move(law));
+  return static_cast<int>(coords_[body][k].laws.size()) - 1;
+}
+
+const std::vector<std::shared_ptr<const CoordinateLaw>>& Model::coordinate_laws(int body, int coordinate) const {
+  return coords_[body][resolve_coordinate(body, coordinate)].laws;
 }
 
 void Model::add_maxwell_arm(int body, int coordinate, const MaxwellArm& arm) {

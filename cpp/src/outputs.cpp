@@ -27,9 +27,11 @@ double gravity_energy(const System& sys, const Data& d) {
 double elastic_energy(const System& sys, const Data& d) {
   check_data(sys, d);
   double V = 0.0;
-  for (int i = 0; i < sys.nc; ++i)  // the coordinates without a spring add nothing (not 0 · ∞ at a huge q)
-    if (sys.coords[i].stiffness != 0.0)
-      V += 0.5 * d.spring_scale(i) * sys.coords[i].stiffness * std::pow(d.qa(i) - sys.coords[i].rest, 2);
+  for (int i = 0; i < sys.nc; ++i) {  // what each coordinate's laws store (coordinate_laws.hpp)
+    const Coordinate& c = sys.coords[i];
+    V += c.spring.energy(d.qa(i), d.spring_scale(i));
+    for (const auto& law : c.laws) V += law->energy(d.t, d.qa(i));
+  }
   for (const ForceElement& E : sys.elements)  // what each element's law stores (force_elements.hpp)
     if (E.law->elastic()) V += E.law->energy(d.t, element_state(d, E, false).l);
   return V;
@@ -38,7 +40,11 @@ double elastic_energy(const System& sys, const Data& d) {
 double dissipated_power(const System& sys, const Data& d) {
   check_data(sys, d);
   double P = 0.0;
-  for (int i = 0; i < sys.nc; ++i) P += d.spring_scale(i) * sys.coords[i].damping * d.qda(i) * d.qda(i);
+  for (int i = 0; i < sys.nc; ++i) {  // what each coordinate's laws dissipate (coordinate_laws.hpp)
+    const Coordinate& c = sys.coords[i];
+    P += c.spring.power(d.qda(i), d.spring_scale(i));
+    for (const auto& law : c.laws) P += law->power(d.t, d.qa(i), d.qda(i));
+  }
   for (const ForceElement& E : sys.elements)  // what each element's law dissipates (force_elements.hpp)
     if (E.law->dissipative()) {
       const ElementState s = element_state(d, E, false);

@@ -41,9 +41,14 @@ std::shared_ptr<System> with_constants(const System& sys, const ConstantChanges&
   System& s = *copy;
   for (const auto& c : changes.coordinates) {
     Coordinate& coordinate = s.coords[coordinate_at(s, c.body, c.slot)];
-    if (!std::isnan(c.stiffness)) coordinate.stiffness = c.stiffness;
-    if (!std::isnan(c.damping)) coordinate.damping = c.damping;
-    if (!std::isnan(c.force)) coordinate.force = c.force;
+    if (c.law < 0) {
+      coordinate.spring.set(constant_index(SpringDamping::description(), c.name), c.value);
+      continue;
+    }
+    if (c.law >= static_cast<int>(coordinate.laws.size()))
+      bad("law", "a law of coordinate '" + coordinate.name + "' (0.." + std::to_string(coordinate.laws.size()) + " - 1)",
+          std::to_string(c.law));
+    coordinate.laws[c.law] = coordinate.laws[c.law]->with_constant(c.name, c.value);
   }
   for (const auto& b : changes.bodies) set_inertia(s, b.body, b.H);
   for (const auto& e : changes.elements) {

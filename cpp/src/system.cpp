@@ -49,11 +49,8 @@ std::shared_ptr<const System> Model::compile(Algorithm algorithm) const {
       c.body = p;
       c.slot = k;
       c.axis = b.joint.axes[k];
-      c.stiffness = b.joint.stiffness[k];
-      c.rest = b.joint.rest[k];
-      c.damping = b.joint.damping[k];
-      c.force = coords_[p][k].force;
-      c.force_law = coords_[p][k].force_law;
+      c.spring = {b.joint.stiffness[k], b.joint.rest[k], b.joint.damping[k], coords_[p][k].force};
+      c.laws = coords_[p][k].laws;
       c.drive = coords_[p][k].drive;
       c.name = b.name + "." + axis_name(c.axis);
       const int index = static_cast<int>(s.coords.size());

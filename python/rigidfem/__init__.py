@@ -8,7 +8,7 @@ C++ core. SI units throughout.
 
 import importlib
 
-from . import motion, plots, samples, stages, study
+from . import laws, motion, plots, samples, stages, study
 from ._core import (
     R1,
     R2,
@@ -102,6 +102,7 @@ __all__ = [
     "joint_transform",
     "joint_transform_derivative",
     "joint_transform_second_derivative",
+    "laws",
     "linearize",
     "load_npz",
     "modal_analysis",

@@ -70,16 +70,17 @@ def add_actuator(model, a, b, length, *, name: str | None = None) -> str:
     ia, Fa = _frame(model, a, None, "a")
     ib, Fb = _frame(model, b, None, "b")
     if isinstance(length, Profile):
-        name = _add(model, name, "distance", ia, Fa, ib, Fb, 0.0, length)
+        name = _add(model, name, "distance", ia, Fa, ib, Fb, 0.0, length, actuator=True)
         parameters.register(model, parameters.ProfileGroup(f"{name}.length", "loop", -1, model._nloops - 1, length,
                                                            "the actuator's (m, s, m/s)"))
         return name
-    return _add(model, name, "distance", ia, Fa, ib, Fb, _checks.scalar(length, "length", positive=True), None)
+    return _add(model, name, "distance", ia, Fa, ib, Fb, _checks.scalar(length, "length", positive=True), None,
+                actuator=True)
 
 
-def _add(model, name, kind, ia, Fa, ib, Fb, length, drive) -> str:
+def _add(model, name, kind, ia, Fa, ib, Fb, length, drive, actuator=False) -> str:
     """The loop added (its name: ``name``, or "loop<k>" when None)."""
-    return model._add_loop("" if name is None else str(name), kind, ia, Fa, ib, Fb, length, drive)
+    return model._add_loop("" if name is None else str(name), kind, ia, Fa, ib, Fb, length, drive, actuator)
 
 
 def assemble(system, q, qd=None, *, t: float | None = None, tol: float = 1e-12, max_iterations: int = 50):

@@ -10,7 +10,8 @@ from collections.abc import Callable
 
 import numpy as np
 
-from . import _checks, _contract, _core, _deprecation, display, force_elements, joints, loops, parameters, persistence
+from . import _checks, _contract, _core, _deprecation, display, force_elements, joints, laws, loops, parameters
+from . import persistence
 from ._core import Body, JointSpec, Point, Profile
 from .beams import add_beam
 from .frames import transform  # noqa: F401 (re-exported: rigidfem.model.transform)
@@ -177,13 +178,13 @@ class Model(_core._Model):
         return body
 
     def _declare_coordinates(self, body: Body, joint: JointSpec) -> None:
-        """The named parameters stiffness, damping and force of each coordinate of a body's joint."""
+        """The named parameters of each coordinate's own spring-damping law (stiffness, damping, force)."""
+        info = laws.SpringDamping.info
         for slot, c in enumerate(joint.coordinates):
-            rotation = c.startswith("r")
-            units = ("N m/rad", "N m s/rad", "N m") if rotation else ("N/m", "N s/m", "N")
-            parameters.register(self, parameters.CoordinateGroup(f"{body.name}.{c}", body.index, slot,
-                                                                 joint.stiffness[slot], joint.damping[slot], 0.0,
-                                                                 units))
+            values = {"stiffness": joint.stiffness[slot], "rest": joint.rest[slot], "damping": joint.damping[slot],
+                      "force": 0.0}
+            parameters.register(self, parameters.LawGroup(f"{body.name}.{c}", ("coordinate", body.index, slot, -1),
+                                                          info, values, rotation=c.startswith("r")))
 
     def _coordinate(self, body: Body, coordinate: str | None) -> int:
         if not isinstance(body, Body) or body.index < 0 or not self._owns(body):
@@ -264,7 +265,7 @@ class Model(_core._Model):
             self._add_generalized_force(body.index, k, value, None)
             group = self._parameter_groups.get(self._coordinate_name(body.index, k))
             if group is not None:  # the total constant force on the coordinate
-                parameters.register(self, group.with_force(group.parameters["force"].value + value))
+                parameters.register(self, group.with_values(force=group.values["force"] + value))
 
     @recorded
     def add_maxwell_arm(self, body: Body, stiffness: float, tau: float, coordinate: str | None = None) -> None:
@@ -362,16 +363,27 @@ class Model(_core._Model):
         return loops.add_actuator(self, a, b, length, name=name)
 
     @recorded
+    def add_force_element(self, a, b, law, *, name: str | None = None) -> str:
+        """A force element of ``law`` (``rigidfem.laws``: ``SpringDamper``, ``Rope``, ...) between the points ``a``
+        and ``b`` (Point, Body or ``model.ground``; rigid bodies or rfes of a beam), acting along the line between
+        them with the law's axial force F(t, l, l̇) (N, > 0 pushing the points apart). No constraint: it acts on
+        trees and closed chains alike (``rigidfem.force_elements``). Its constants marked as parameters become
+        ``"<name>.<constant>"`` (``System.parameters``). Returns its name ("element<k>" by default), which
+        ``System.element_names`` lists."""
+        return force_elements.add_force_element(self, a, b, law, name=name)
+
+    @recorded
     def add_spring_damper(self, a, b, *, stiffness: float, length: float, damping: float = 0.0,
                           name: str | None = None) -> str:
         """A linear spring-damper between the points ``a`` and ``b`` (Point, Body or
         ``model.ground``; rigid bodies or rfes of a beam): axial force
         F = −k (l − l₀) − c l̇ (N, > 0 pushing the points apart) with ``stiffness`` k (N/m),
-        rest ``length`` l₀ (m) and ``damping`` c (N·s/m). No constraint: it acts on trees and
-        closed chains alike (``rigidfem.force_elements``). Returns its name ("element<k>" by
+        rest ``length`` l₀ (m) and ``damping`` c (N·s/m): ``add_force_element(a, b,
+        rf.laws.SpringDamper(stiffness=k, length=l₀, damping=c))``. Returns its name ("element<k>" by
         default), which ``System.element_names`` lists."""
-        return force_elements.add_force_element(self, a, b, stiffness=stiffness, damping=damping, length=length,
-                                                name=name)
+        force_elements.points(self, a, b)  # named before the law's constants
+        law = laws.SpringDamper(stiffness=stiffness, length=length, damping=damping)
+        return force_elements.add_force_element(self, a, b, law, name=name)
 
     @recorded
     def add_cylinder(self, a, b, force, *, damping: float = 0.0, name: str | None = None) -> str:
@@ -379,19 +391,48 @@ class Model(_core._Model):
         them apart with ``force`` (N; negative pulls) — a number, a ``rigidfem.motion`` profile
         F(t) or a Python function ``force(t, l, ld)`` of time (s), length (m) and its rate (m/s)
         (the slow path: called under the GIL at every evaluation) — less its ``damping`` c l̇
-        (N·s/m). Position control is ``add_actuator``. Returns its name ("element<k>" by
-        default); ``System.element_states`` and ``Result.element_forces`` give its force."""
-        return force_elements.add_force_element(self, a, b, damping=damping, force=force, name=name)
+        (N·s/m): a ``rf.laws.SpringDamper`` without a spring. Position control is ``add_actuator``. Returns its
+        name ("element<k>" by default); ``System.element_states`` and ``Result.element_forces`` give its force."""
+        force_elements.points(self, a, b)  # named before the law's constants
+        law = laws.SpringDamper(damping=damping, **force_elements.cylinder_force(force))
+        return force_elements.add_force_element(self, a, b, law, name=name)
 
     @recorded
-    def add_rope(self, a, b, *, EA: float, length, damping: float = 0.0, name: str | None = None) -> str:
+    def add_rope(self, a, b, *, EA: float, length, DA: float = 0.0, name: str | None = None) -> str:
         """A massless rope between the points ``a`` and ``b`` (book ch. 7.1: a hoisting rope): it
         only pulls, with the tension T = (EA (l − l_u) + DA (l̇ − l̇_u))/l_u while positive, 0 when
-        slack. ``EA`` (N) is its axial stiffness, ``damping`` DA (N·s) its axial damping, and
-        ``length`` its unstretched length l_u (m): a number or a ``rigidfem.motion`` profile
-        l_u(t) paid out by a winch. Returns its name; ``System.element_states`` gives its
-        force F = −T (N)."""
-        return force_elements.add_rope(self, a, b, EA=EA, length=length, damping=damping, name=name)
+        slack. ``EA`` (N) is its axial stiffness, ``DA`` (N·s) its axial damping, and ``length`` its unstretched
+        length l_u (m): a number or a ``rigidfem.motion`` profile l_u(t) paid out by a winch
+        (``rf.laws.Rope``). Returns its name; ``System.element_states`` gives its force F = −T (N)."""
+        force_elements.points(self, a, b)  # named before the law's constants
+        law = laws.Rope(EA=EA, DA=DA, **force_elements.unstretched(length))
+        return force_elements.add_force_element(self, a, b, law, name=name)
+
+    @recorded
+    def add_joint_law(self, body: Body, law, coordinate: str | None = None, *, name: str | None = None) -> str:
+        """A law of a joint coordinate (``rigidfem.laws``: ``Friction``, ``ForceFunction``) on the coordinate
+        ``coordinate`` ("x", ..., "rx"; None: the joint's only one) of ``body``'s joint, adding its generalised
+        force Q(t, q, q̇) (N or N·m) to the coordinate's own spring-damping law. Its constants marked as parameters
+        become ``"<name>.<constant>"`` (``System.parameters``, in the coordinate's units: N or N·m for a rotation's
+        forces). Returns its name ("<body>.<axis>.<kind>" in lower case by default, "...2" for a second one of a
+        kind)."""
+        if not isinstance(law, laws.Law) or law.info["acts_on"] != "coordinate" or not law.info["addable"]:
+            kinds = [k for k, i in laws.kinds().items() if i["acts_on"] == "coordinate" and i["addable"]]
+            raise ValueError(f"law: expected a law of a joint coordinate ({', '.join(kinds)} from rigidfem.laws), "
+                             f"got {law!r}")
+        k = self._coordinate(body, coordinate)
+        axis = self._coordinate_name(body.index, k)
+        if name is None:
+            base, n = f"{axis}.{law.kind.lower()}", 1
+            while (name := base if n == 1 else f"{base}{n}") in self._parameter_groups:
+                n += 1
+        elif not isinstance(name, str) or name in self._parameter_groups:
+            raise ValueError(f"name: expected a name not yet given to a body, coordinate, element or law, got {name!r}")
+        index = self._add_coordinate_law(body.index, k, law.kind, law.values, law.function)
+        group = parameters.LawGroup(str(name), ("coordinate", body.index, max(k, 0), index), law.info, law.values,
+                                    rotation=axis.rsplit(".", 1)[1].startswith("r"))
+        parameters.register(self, group)
+        return group.prefix
 
     @recorded
     def add_beam(self, name: str, parent, length, material, section, elements: int,

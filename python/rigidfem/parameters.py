@@ -13,7 +13,9 @@ Every builder declares the constants it was given as parameters named ``"<what>.
 - ``<body>.<axis>.stiffness``, ``.damping``, ``.force``: a joint coordinate's spring, damper and constant
   applied force (N/m, N·s/m, N; N·m/rad, N·m·s/rad, N·m for rotations).
 - ``<element>.stiffness``, ``.damping``, ``.force``: a spring-damper's or cylinder's k, c and constant
-  push F₀ (N/m, N·s/m, N); ``<rope>.EA``, ``.damping``: a rope's axial stiffness and damping (N, N·s).
+  push F₀ (N/m, N·s/m, N); ``<rope>.EA``, ``.DA``: a rope's axial stiffness and damping (N, N·s).
+- ``<law>.<constant>``: the constants of any law (``rigidfem.laws``: a force element's, a joint coordinate's
+  friction) that its kind's description marks as parameters, in its units.
 - ``<load>.force``, ``.torque`` (N, N·m): the magnitude of a point force or torque, its direction kept.
 
 Beams take parameters when their material and section are one ``Material`` and one ``Section``
@@ -72,7 +74,7 @@ class Parameter:
 class Changes:
     """Constants of a compiled system to set (the arguments of ``_core._System(base, ...)``)."""
 
-    coordinates: list = field(default_factory=list)  #: tuples (body, slot, k, c, Q) of joint coordinates (NaN: kept)
+    coordinates: list = field(default_factory=list)  #: tuples (body, slot, law, name, x) of joint coordinates' laws
     bodies: list = field(default_factory=list)       #: tuples (body, H) with H the (4, 4) pseudo-inertia
     elements: list = field(default_factory=list)     #: tuples (element, constant's name, value)
     loads: list = field(default_factory=list)        #: tuples (load, F (3,), τ (3,))
@@ -153,8 +155,8 @@ class BeamGroup(Group):
         b = v["damping"] * c
         out = Changes(bodies=list(zip(self.rfes.tolist(), H)))
         for col, slot in enumerate(self.slots):
-            out.coordinates += [(body, slot, k, d, math.nan) for body, k, d in
-                                zip(self.sdes.tolist(), c[:, col].tolist(), b[:, col].tolist())]
+            for body, k, d in zip(self.sdes.tolist(), c[:, col].tolist(), b[:, col].tolist()):
+                out.coordinates += [(body, slot, -1, "stiffness", k), (body, slot, -1, "damping", d)]
         return out
 
 
@@ -170,46 +172,29 @@ class BodyGroup(Group):
         return Changes(bodies=[(self.body, _core.pseudo_inertia(m, self.com, self.inertia))])
 
 
-class CoordinateGroup(Group):
-    """A joint coordinate's spring, damper and constant applied force."""
+class LawGroup(Group):
+    """The constants of a law that are named parameters (its kind's description, ``rigidfem.laws``), at the values
+    it was built with: a force element's law (``target`` ("element", k)) or a joint coordinate's (("coordinate",
+    body, slot, law): law −1 is the coordinate's own spring-damping law, k ≥ 0 its further law k). ``rotation``:
+    the coordinate is a rotation (the constants' rotation units)."""
 
-    def __init__(self, prefix, body: int, slot: int, stiffness: float, damping: float, force: float, units: tuple):
-        k_unit, c_unit, f_unit = units
-        super().__init__(prefix, dict([
-            _parameter(prefix, "stiffness", stiffness, k_unit, "the coordinate's spring"),
-            _parameter(prefix, "damping", damping, c_unit, "the coordinate's damper"),
-            ("force", Parameter(f"{prefix}.force", float(force), f_unit,
-                                "the constant generalised force on the coordinate", -math.inf))]))
-        self.body, self.slot, self.units = body, slot, units
+    def __init__(self, prefix, target: tuple, info: dict, values: dict, rotation: bool = False):
+        super().__init__(prefix, {c["name"]: Parameter(f"{prefix}.{c['name']}", float(values[c["name"]]),
+                                                       c["rotation_unit"] if rotation else c["unit"], c["doc"],
+                                                       c["lower"], c["positive"])
+                                  for c in info["constants"] if c["parameter"]})
+        self.target, self.info, self.values, self.rotation = tuple(target), info, dict(values), rotation
 
-    def with_force(self, force: float) -> CoordinateGroup:
-        """The group with another constant force (``Model.add_generalized_force`` adds to it)."""
-        p = self.parameters
-        return CoordinateGroup(self.prefix, self.body, self.slot, p["stiffness"].value, p["damping"].value, force,
-                               self.units)
+    def with_values(self, **values) -> LawGroup:
+        """The group with some constants at other values (``Model.add_generalized_force`` adds to the force)."""
+        return LawGroup(self.prefix, self.target, self.info, {**self.values, **values}, self.rotation)
 
     def changes(self, values: dict) -> Changes:
         v = {k: values.get(k, p.value) for k, p in self.parameters.items()}
-        return Changes(coordinates=[(self.body, self.slot, v["stiffness"], v["damping"], v["force"])])
-
-
-class ElementGroup(Group):
-    """A force element's constants (``Model.add_spring_damper``, ``add_cylinder``, ``add_rope``)."""
-
-    UNITS = {"stiffness": ("N/m", "the element's spring k"), "damping": ("N s/m", "the element's damper c"),
-             "force": ("N", "the element's constant push F0"), "EA": ("N", "the rope's axial stiffness EA")}
-
-    def __init__(self, prefix, element: int, constants: dict, rope: bool = False):
-        params = {}
-        for k, value in constants.items():
-            unit, what = ("N s", "the rope's axial damping DA") if rope and k == "damping" else self.UNITS[k]
-            params[k] = Parameter(f"{prefix}.{k}", float(value), unit, what, -math.inf if k == "force" else 0.0,
-                                  k == "EA")
-        super().__init__(prefix, params)
-        self.element = element
-
-    def changes(self, values: dict) -> Changes:
-        return Changes(elements=[(self.element, k, values.get(k, p.value)) for k, p in self.parameters.items()])
+        if self.target[0] == "element":
+            return Changes(elements=[(self.target[1], k, x) for k, x in v.items()])
+        _, body, slot, law = self.target
+        return Changes(coordinates=[(body, slot, law, k, x) for k, x in v.items()])
 
 
 class LoadGroup(Group):

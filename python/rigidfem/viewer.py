@@ -33,11 +33,6 @@ from ._core import Body, Point
 
 ASSETS = Path(__file__).resolve().parent / "viewer_assets"
 
-#: The force elements and loops of a model, by the call that added them: (kind, the parameters of its two points).
-_SEGMENTS = {"add_spring_damper": "spring", "add_cylinder": "cylinder", "add_rope": "rope",
-             "add_actuator": "actuator", "add_loop_joint": "loop"}
-
-
 class Viewer:
     """A scene and its frames (``rf.view``): shows itself in a notebook (``_repr_html_``: an iframe, no
     network) and writes a self-contained HTML file (``to_html``)."""
@@ -196,7 +191,7 @@ def _scene(system, times, states, trails, title) -> dict:
     origins = poses[:, :, 9:].reshape(-1, 3).astype(float)
     lo, hi = (origins.min(axis=0), origins.max(axis=0)) if len(origins) else (np.zeros(3), np.zeros(3))
     size = float(max(np.linalg.norm(hi - lo), 1e-3))
-    beams, segments, in_beam, base = [], [], set(), set()
+    beams, in_beam, base = [], set(), set()
     for name, a in _calls(system):
         if name == "add_beam":
             rfes = [index[n] for n in names if n.startswith(a["name"] + ".rfe")]
@@ -207,10 +202,11 @@ def _scene(system, times, states, trails, title) -> dict:
             beams.append({"name": a["name"], "bodies": rfes, "tip": [float(a["length"]) - along, 0.0, 0.0],
                           "radius": radius})
             in_beam.update(rfes)
-        elif name in _SEGMENTS:
-            segments.append({"kind": _SEGMENTS[name], "a": _point(a["a"]), "b": _point(a["b"])})
         elif name == "add_moving_base":
             base.add(index.get(a["name"], -1))
+    # the force elements as their laws say, the loops as their kinds do (System._segments)
+    segments = [{"kind": kind, "a": [int(ia), [float(x) for x in ra]], "b": [int(ib), [float(x) for x in rb]]}
+                for kind, ia, ra, ib, rb in system._segments]
     bodies = []
     for i, n in enumerate(names):
         box = None if i in in_beam else _equivalent_box(float(system.masses[i]), np.asarray(system.inertias[i]))

@@ -18,9 +18,6 @@
 
 namespace rigidfem {
 
-/// Step of the central differences at x: ∝ ε^(1/3) for an error O(ε^(2/3)).
-inline double difference_step(double x) { return 6e-6 * std::max(1.0, std::abs(x)); }
-
 /// Column j of ∂g/∂x by central differences, g() reading x by reference; x is restored.
 template <class G>
 VecX central_difference(G&& g, VecX& x, int j) {

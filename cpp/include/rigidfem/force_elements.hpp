@@ -14,23 +14,22 @@
 #include <utility>
 
 #include "rigidfem/errors.hpp"
+#include "rigidfem/laws.hpp"
 #include "rigidfem/profiles.hpp"
 #include "rigidfem/transforms.hpp"
 
 namespace rigidfem {
 
 /// An axial force function F(t, l, l̇) (N) of an element's length l (m) and rate l̇ (m/s): a Python law.
-using AxialFunction = std::function<double(double, double, double)>;
+using AxialFunction = ScalarFunction;
 
-/// What a kind of force element knows, in one class per kind (SpringDamper, Rope below): its parameters'
-/// checks, its axial force and the force's derivatives, the energy it stores and the power it dissipates.
-/// A new kind is a class here, its maker in bind_model.cpp and its builder in force_elements.py.
-class ElementLaw {
+/// What a kind of force element knows, in one class per kind (SpringDamper, Rope below), each describing itself
+/// (laws.hpp: its constants, profile and function): its axial force and the force's derivatives, the energy it
+/// stores, the power it dissipates and how it is drawn. A new kind is a class here and its row in
+/// element_law_kinds(); the bindings, the Python layer (rigidfem.laws, Model.add_force_element, the named
+/// parameters, the viewer) and the site's table read the row.
+class ElementLaw : public Law {
  public:
-  virtual ~ElementLaw() = default;
-  /// std::invalid_argument naming the first bad parameter (Model::add_force_element calls it after the
-  /// points' checks).
-  virtual void validate() const = 0;
   /// SimulationError where the law cannot be evaluated at t (element `name`); nothing by default.
   virtual void check(double /*t*/, const std::string& /*name*/) const {}
   /// F(t, l, l̇) (N, > 0 pushing the points apart), its applied part scaled by the load factor λ (as loads
@@ -44,41 +43,64 @@ class ElementLaw {
   /// The energy (J) it stores at length l, and the power (W) it dissipates at (l, l̇) with the force F.
   virtual double energy(double t, double l) const = 0;
   virtual double power(double t, double l, double ld, double F) const = 0;
+  /// How the viewer draws the element: "spring", "cylinder", "rope".
+  virtual const char* drawn_as() const = 0;
   /// A copy with the constant `name` set to `value` (a named parameter: parameters.hpp), unchecked;
   /// std::invalid_argument for a name the law does not have.
-  virtual std::shared_ptr<const ElementLaw> with_constant(const std::string& name, double value) const = 0;
+  std::shared_ptr<const ElementLaw> with_constant(const std::string& name, double value) const {
+    auto law = clone();
+    law->set(constant_index(name), value);
+    return law;
+  }
   /// A copy with its profile (a cylinder's F(t), a winch's l_u(t)) replaced; std::invalid_argument if it has none.
-  virtual std::shared_ptr<const ElementLaw> with_profile(ProfilePtr profile) const = 0;
-};
+  std::shared_ptr<const ElementLaw> with_profile(ProfilePtr profile) const {
+    if (!profile_) bad("profile", std::string("an element with a profile (") + info().kind + " takes one)", "one without");
+    auto law = clone();
+    law->profile_ = std::move(profile);
+    return law;
+  }
+  const ProfilePtr& profile() const { return profile_; }
 
-/// std::invalid_argument for a constant a law does not have.
-[[noreturn]] inline void unknown_constant(const std::string& name, const char* constants) {
-  bad("name", std::string("a constant of the element's law (") + constants + ")", "'" + name + "'");
-}
+ protected:
+  ElementLaw(std::vector<double> values, ProfilePtr profile) : Law(std::move(values)), profile_(std::move(profile)) {}
+  virtual std::shared_ptr<ElementLaw> clone() const = 0;
+  ProfilePtr profile_;  ///< its profile (laws.hpp: LawInfo::profile), or null
+};
 
 /// A spring-damper (or a cylinder under force control):
 ///   F = −k (l − l₀) − c l̇ + λ (F₀ + F(t) + F_law(t, l, l̇)),  stores ½ k (l − l₀)², dissipates c l̇².
 class SpringDamper final : public ElementLaw {
  public:
-  SpringDamper(double stiffness, double damping, double length, double force, ProfilePtr profile, AxialFunction law)
-      : k_(stiffness), c_(damping), l0_(length), F0_(force), profile_(std::move(profile)), law_(std::move(law)) {}
-  void validate() const override {
-    for (const auto& [value, name, expected] :
-         {std::tuple<double, const char*, const char*>{k_, "stiffness", "a finite stiffness >= 0 in N/m"},
-          {c_, "damping", "a finite damping coefficient >= 0 in N·s/m"},
-          {l0_, "length", "a finite rest length >= 0 in m"}})
-      if (!(value >= 0.0 && std::isfinite(value))) bad(name, expected, num(value, 8));
-    if (!std::isfinite(F0_)) bad("force", "a finite force in N", num(F0_, 8));
+  enum { K, C, L0, F0 };  // the constants' indices
+  static const LawInfo& description() {
+    static const LawInfo info{
+        "SpringDamper", "element",
+        "F = −k (l − l₀) − c l̇ + F₀ + F(t) + F(t, l, l̇) (N, > 0 pushing the points apart): a spring-damper, or a "
+        "hydraulic cylinder under force control; stores ½ k (l − l₀)², dissipates c l̇²",
+        {{"stiffness", "N/m", nullptr, 0.0, 0.0, false, "the element's spring k", true},
+         {"damping", "N s/m", nullptr, 0.0, 0.0, false, "the element's damper c", true},
+         {"length", "m", nullptr, 0.0, 0.0, false, "the spring's rest length l₀", false},
+         {"force", "N", nullptr, 0.0, -std::numeric_limits<double>::infinity(), false, "the element's constant push F0",
+          true}},
+        "a force F(t) (its value, N) added to F₀",
+        "profile",
+        "the force profile's (N, s, rad/s)",
+        "a force F(t, l, ld) (N) of time (s), length (m) and its rate (m/s), added to F₀, its derivatives by central "
+        "differences"};
+    return info;
   }
+  SpringDamper(std::vector<double> values, ProfilePtr profile, AxialFunction law)
+      : ElementLaw(std::move(values), std::move(profile)), law_(std::move(law)) {}
+  const LawInfo& info() const override { return description(); }
   double force(double t, double l, double ld, double load_factor) const override {
-    double applied = F0_;
+    double applied = c_[F0];
     if (profile_) applied += profile_->at(t).q;
     if (law_) applied += law_(t, l, ld);
-    return -k_ * (l - l0_) - c_ * ld + load_factor * applied;
+    return -c_[K] * (l - c_[L0]) - c_[C] * ld + load_factor * applied;
   }
   /// −k and −c, plus λ times the law's by central differences (steps 6e-6 max(1, |x|)).
   std::pair<double, double> derivatives(double t, double l, double ld, double load_factor) const override {
-    std::pair<double, double> dF{-k_, -c_};
+    std::pair<double, double> dF{-c_[K], -c_[C]};
     if (law_) {
       const double hl = 6e-6 * std::max(1.0, std::abs(l)), hd = 6e-6 * std::max(1.0, std::abs(ld));
       dF.first += load_factor * (law_(t, l + hl, ld) - law_(t, l - hl, ld)) / (2.0 * hl);
@@ -86,32 +108,18 @@ class SpringDamper final : public ElementLaw {
     }
     return dF;
   }
-  bool elastic() const override { return k_ != 0.0; }
-  bool dissipative() const override { return c_ != 0.0; }
-  double energy(double, double l) const override { return 0.5 * k_ * std::pow(l - l0_, 2); }
-  double power(double, double, double ld, double) const override { return c_ * std::pow(ld, 2); }
-  std::shared_ptr<const ElementLaw> with_constant(const std::string& name, double value) const override {
-    auto law = std::make_shared<SpringDamper>(*this);
-    if (name == "stiffness") law->k_ = value;
-    else if (name == "damping") law->c_ = value;
-    else if (name == "force") law->F0_ = value;
-    else unknown_constant(name, "stiffness, damping, force");
-    return law;
-  }
-  std::shared_ptr<const ElementLaw> with_profile(ProfilePtr profile) const override {
-    if (!profile_) bad("profile", "an element with a force profile F(t)", "one without");
-    auto law = std::make_shared<SpringDamper>(*this);
-    law->profile_ = std::move(profile);
-    return law;
+  bool elastic() const override { return c_[K] != 0.0; }
+  bool dissipative() const override { return c_[C] != 0.0; }
+  double energy(double, double l) const override { return 0.5 * c_[K] * std::pow(l - c_[L0], 2); }
+  double power(double, double, double ld, double) const override { return c_[C] * std::pow(ld, 2); }
+  /// A cylinder where it has no spring and pushes (a force, its profile or its function), else a spring.
+  const char* drawn_as() const override {
+    return c_[K] == 0.0 && (c_[F0] != 0.0 || profile_ || law_) ? "cylinder" : "spring";
   }
 
  private:
-  double k_;   ///< N/m
-  double c_;   ///< N·s/m
-  double l0_;  ///< m: the length at which the spring is relaxed
-  double F0_;  ///< N: a constant push
-  ProfilePtr profile_;  ///< F(t), N (its value), or null
-  AxialFunction law_;   ///< F_law(t, l, l̇), N (the slow path through Python), or null
+  std::shared_ptr<ElementLaw> clone() const override { return std::make_shared<SpringDamper>(*this); }
+  AxialFunction law_;  ///< F_law(t, l, l̇), N (the slow path through Python), or null
 };
 
 /// A rope (book ch. 7.1: the hoisting rope of a crane), massless and tension-only, of axial stiffness EA
@@ -121,13 +129,32 @@ class SpringDamper final : public ElementLaw {
 /// stretched and dissipates DA/l_u (l̇ − l̇_u)² while it pulls.
 class Rope final : public ElementLaw {
  public:
-  Rope(double EA, double DA, double length, ProfilePtr unstretched)
-      : EA_(EA), DA_(DA), length_(length), unstretched_(std::move(unstretched)) {}
+  enum { EA, DA, LENGTH };  // the constants' indices
+  static const LawInfo& description() {
+    static const LawInfo info{
+        "Rope", "element",
+        "T = (EA (l − l_u) + DA (l̇ − l̇_u)) / l_u while positive, 0 when slack (N, pulling: F = −T): a massless "
+        "tension-only rope of unstretched length l_u, constant or paid out by a winch l_u(t); stores ½ EA/l_u (l − "
+        "l_u)² while stretched, dissipates DA/l_u (l̇ − l̇_u)² while it pulls",
+        {{"EA", "N", nullptr, 1.0, 0.0, true, "the rope's axial stiffness EA", true},
+         {"DA", "N s", nullptr, 0.0, 0.0, false, "the rope's axial damping DA", true},
+         {"length", "m", nullptr, 1.0, 0.0, true, "the rope's unstretched length l_u (without a winch)", false}},
+        "the unstretched length l_u(t) (m) a winch pays out, instead of length",
+        "length",
+        "the winch's (m, s, m/s)",
+        nullptr};
+    return info;
+  }
+  Rope(std::vector<double> values, ProfilePtr unstretched, AxialFunction = {})
+      : ElementLaw(std::move(values), std::move(unstretched)) {
+    if (profile_) c_[LENGTH] = profile_->at(0.0).q;  // l_u(0), for the record: the winch's profile is what counts
+  }
+  const LawInfo& info() const override { return description(); }
+  /// A winch's l_u(0) > 0 first (a profile that starts slack names its profile), then the constants.
   void validate() const override {
-    if (!(length_ >= 0.0 && std::isfinite(length_))) bad("length", "a finite rest length >= 0 in m", num(length_, 8));
-    if (!(EA_ > 0.0 && std::isfinite(EA_))) bad("EA", "a positive axial stiffness EA in N", num(EA_, 8));
-    if (!(DA_ >= 0.0 && std::isfinite(DA_))) bad("DA", "a finite axial damping DA >= 0 in N·s", num(DA_, 8));
-    if (!unstretched_ && !(length_ > 0.0)) bad("length", "a positive unstretched length in m", num(length_, 8));
+    if (profile_ && !(c_[LENGTH] > 0.0 && std::isfinite(c_[LENGTH])))
+      bad("length", "a profile l_u(t) with a positive length at t = 0 in m", num(c_[LENGTH], 8));
+    ElementLaw::validate();
   }
   void check(double t, const std::string& name) const override {
     const double lu = unstretched_length(t).first;
@@ -139,7 +166,7 @@ class Rope final : public ElementLaw {
   /// The active branch: EA/l_u, DA/l_u while taut, nothing while slack.
   std::pair<double, double> derivatives(double t, double l, double ld, double) const override {
     const double lu = unstretched_length(t).first;
-    return tension(t, l, ld) > 0.0 ? std::pair<double, double>{-EA_ / lu, -DA_ / lu}
+    return tension(t, l, ld) > 0.0 ? std::pair<double, double>{-c_[EA] / lu, -c_[DA] / lu}
                                    : std::pair<double, double>{0.0, 0.0};
   }
   bool elastic() const override { return true; }
@@ -147,43 +174,50 @@ class Rope final : public ElementLaw {
   double energy(double t, double l) const override {
     const double lu = unstretched_length(t).first;
     const double stretch = std::max(0.0, l - lu);
-    return 0.5 * EA_ / lu * stretch * stretch;
+    return 0.5 * c_[EA] / lu * stretch * stretch;
   }
   double power(double t, double, double ld, double F) const override {
     const auto [lu, lud] = unstretched_length(t);
-    return F < 0.0 ? DA_ / lu * (ld - lud) * (ld - lud) : 0.0;
+    return F < 0.0 ? c_[DA] / lu * (ld - lud) * (ld - lud) : 0.0;
   }
-  std::shared_ptr<const ElementLaw> with_constant(const std::string& name, double value) const override {
-    auto law = std::make_shared<Rope>(*this);
-    if (name == "EA") law->EA_ = value;
-    else if (name == "damping") law->DA_ = value;
-    else unknown_constant(name, "EA, damping");
-    return law;
-  }
-  std::shared_ptr<const ElementLaw> with_profile(ProfilePtr profile) const override {
-    if (!unstretched_) bad("profile", "a rope paid out by a winch (a profile l_u(t))", "one of constant length");
-    auto law = std::make_shared<Rope>(*this);
-    law->unstretched_ = std::move(profile);
-    return law;
-  }
+  const char* drawn_as() const override { return "rope"; }
   /// l_u and l̇_u at t (m, m/s).
   std::pair<double, double> unstretched_length(double t) const {
-    if (!unstretched_) return {length_, 0.0};
-    const MotionState s = unstretched_->at(t);
+    if (!profile_) return {c_[LENGTH], 0.0};
+    const MotionState s = profile_->at(t);
     return {s.q, s.qd};
   }
   /// T ≥ 0 (N).
   double tension(double t, double l, double ld) const {
     const auto [lu, lud] = unstretched_length(t);
-    return std::max(0.0, (EA_ * (l - lu) + DA_ * (ld - lud)) / lu);
+    return std::max(0.0, (c_[EA] * (l - lu) + c_[DA] * (ld - lud)) / lu);
   }
 
  private:
-  double EA_;            ///< N: axial stiffness times the unstretched length
-  double DA_;            ///< N·s: axial damping times the unstretched length
-  double length_;        ///< m: l_u without a winch
-  ProfilePtr unstretched_;  ///< l_u(t), m (a winch), or null: l_u = length
+  std::shared_ptr<ElementLaw> clone() const override { return std::make_shared<Rope>(*this); }
 };
+
+/// A kind of force element as the bindings make it: its description, and its maker from the constants' values
+/// (in the description's order), a profile and a Python function (each null where the kind takes none).
+struct ElementLawKind {
+  const LawInfo& (*info)();
+  std::shared_ptr<const ElementLaw> (*make)(std::vector<double> values, ProfilePtr profile, AxialFunction function);
+};
+
+/// Every kind of force element, each once.
+inline const std::vector<ElementLawKind>& element_law_kinds() {
+  static const std::vector<ElementLawKind> kinds = {
+      {SpringDamper::description,
+       [](std::vector<double> v, ProfilePtr p, AxialFunction f) -> std::shared_ptr<const ElementLaw> {
+         return std::make_shared<SpringDamper>(std::move(v), std::move(p), std::move(f));
+       }},
+      {Rope::description,
+       [](std::vector<double> v, ProfilePtr p, AxialFunction f) -> std::shared_ptr<const ElementLaw> {
+         return std::make_shared<Rope>(std::move(v), std::move(p), std::move(f));
+       }},
+  };
+  return kinds;
+}
 
 /// One force element as the user describes it: two points, and its kind's law. Body −1 is the ground.
 struct ForceElement {

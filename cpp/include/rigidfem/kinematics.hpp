@@ -99,9 +99,12 @@ void for_each_body_load(const System& sys, const Data& d, bool spatial, Visit&& 
   });
 }
 
-/// Q_i of springs, dampers and applied generalised forces on coordinate i (all coordinates):
-/// −c_i (q_i − q_i⁰) − b_i q̇_i − Σ s (its Maxwell arms, d.arm_force) + λ (Q_i + Q_i(t, q_i, q̇_i)).
+/// Q_i of the laws on coordinate i (all coordinates): its spring-damping law −s (k (q − q⁰) + c q̇) + λ Q₀, its
+/// Maxwell arms' −Σ s (d.arm_force) and its further laws' Q(t, q, q̇) (coordinate_laws.hpp).
 double passive_force(const System& sys, const Data& d, int i);
+/// (∂Q/∂q_i, ∂Q/∂q̇_i) of coordinate i's further laws (coordinate_laws.hpp) at d's state: the spring-damping
+/// law's own are exact constants the callers take from Coordinate::spring, and the arms' are internal variables.
+std::pair<double, double> coordinate_derivatives(const System& sys, const Data& d, int i);
 
 /// SimulationError if a ZYX joint sits at pitch ±π/2, where its mass matrix is singular.
 void check_gimbal_lock(const System& sys, const Data& d);

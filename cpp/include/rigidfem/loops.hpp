@@ -30,6 +30,7 @@ struct Loop {
   Mat4 frame_b = Mat4::Identity();  ///< pose of frame B in body b's frame
   double length = 0.0;              ///< Distance: l in m when `drive` is null
   ProfilePtr drive;                 ///< Distance: prescribed length l(t) (an actuator under position control)
+  bool actuator = false;            ///< Distance: a linear actuator (Model.add_actuator), drawn as one
 };
 
 /// The number of constraint equations of a loop joint of that kind.

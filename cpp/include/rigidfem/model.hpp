@@ -9,6 +9,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "rigidfem/coordinate_laws.hpp"
 #include "rigidfem/errors.hpp"
 #include "rigidfem/flows.hpp"
 #include "rigidfem/force_elements.hpp"
@@ -66,7 +67,7 @@ struct Point {
 };
 
 /// Generalised force law Q(t, q, q̇) of one coordinate (the slow path through Python).
-using ForceLaw = std::function<double(double, double, double)>;
+using ForceLaw = ScalarFunction;
 
 /// A force law that returned no finite number. Called by a System method it is bad input (its
 /// what() reads "force: expected ..., got ...", Python ValueError); inside a simulation the
@@ -117,7 +118,7 @@ struct MaxwellArm {
 struct CoordinateSpec {
   ProfilePtr drive;         ///< prescribed motion, or null
   double force = 0.0;       ///< constant applied generalised force (N or N·m)
-  ForceLaw force_law;       ///< or a law Q(t, q, q̇) of the coordinate itself
+  std::vector<std::shared_ptr<const CoordinateLaw>> laws;  ///< further laws (coordinate_laws.hpp), in order
   std::vector<MaxwellArm> arms;  ///< Maxwell arms (free coordinates only: compile checks)
 };
 
@@ -142,8 +143,13 @@ class Model {
   void truncate(int n);
   /// Prescribes coordinate `coordinate` (−1: the joint's only one) of a body's joint, once.
   void prescribe(int body, int coordinate, ProfilePtr motion);
-  /// Adds a constant generalised force, or a law Q(t, q, q̇), on one joint coordinate.
+  /// Adds a constant generalised force, or a law Q(t, q, q̇) (a ForceFunction: at most one), on one joint coordinate.
   void add_generalized_force(int body, int coordinate, double value, ForceLaw law);
+  /// Adds a law (coordinate_laws.hpp) on one joint coordinate (−1: the joint's only one), its constants checked;
+  /// returns its index among that coordinate's laws.
+  int add_coordinate_law(int body, int coordinate, std::shared_ptr<const CoordinateLaw> law);
+  /// The laws of a body's joint coordinate (−1: the joint's only one), in order.
+  const std::vector<std::shared_ptr<const CoordinateLaw>>& coordinate_laws(int body, int coordinate) const;
   /// Adds a Maxwell arm (stiffness k > 0, relaxation time τ > 0) on one joint coordinate.
   void add_maxwell_arm(int body, int coordinate, const MaxwellArm& arm);
   void add_load(const Load& load);

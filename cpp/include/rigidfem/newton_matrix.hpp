@@ -41,8 +41,7 @@ void spring_armature(const System& sys, const Data& d, Scalar c1, Scalar c2, Eig
   delta.resize(sys.nq);
   for (int k = 0; k < sys.nq; ++k) {
     const int i = sys.free_coords[k];
-    const Coordinate& c = sys.coords[i];
-    delta(k) = d.spring_scale(i) * (c1 * c.damping + c2 * c.stiffness);
+    delta(k) = sys.coords[i].spring.armature(c1, c2, d.spring_scale(i));
   }
 }
 

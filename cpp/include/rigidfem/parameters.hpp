@@ -1,7 +1,8 @@
 /// A compiled system with some of its constants or profiles changed, without compiling its model again: what
 /// a named parameter of the Python API (rigidfem/parameters.py) sets. The constants are those the equations of
-/// motion are linear in — a body's pseudo-inertia H, a coordinate's spring k, damper c and applied force, a
-/// force element's constants, a load's force and torque — so a parameter's derivative of the residual
+/// motion are linear in — a body's pseudo-inertia H, a coordinate's laws' constants (its spring k, damper c and
+/// applied force, a friction's forces), a force element's constants, a load's force and torque — so a parameter's
+/// derivative of the residual
 /// r = M q̈ − f is the difference of two such systems' residuals (sensitivities.hpp). The profiles — a
 /// coordinate's drive, a force element's profile (a winch's l_u(t), a cylinder's F(t)), a load's scale and an
 /// actuator's length — carry the coefficients of the motions (the residual is not linear in those).
@@ -15,11 +16,14 @@
 
 namespace rigidfem {
 
-/// New values of some constants of a System. NaN in a coordinate's field keeps its value.
+/// New values of some constants of a System.
 struct ConstantChanges {
-  struct CoordinateValues {
+  /// A constant of a joint coordinate's law (coordinate_laws.hpp), by the name its description gives it.
+  struct CoordinateConstant {
     int body = -1, slot = 0;  ///< the coordinate: slot `slot` of body `body`'s joint
-    double stiffness = 0.0, damping = 0.0, force = 0.0;  ///< k (N/m, N·m/rad), c (N·s/m, N·m·s/rad), Q (N, N·m)
+    int law = -1;             ///< −1: its spring-damping law; k ≥ 0: its further law k
+    std::string name;         ///< "stiffness", "damping", "force", "breakaway", ...
+    double value = 0.0;
   };
   struct BodyInertia {
     int body = -1;
@@ -41,7 +45,7 @@ struct ConstantChanges {
     int body = -1, index = -1;
     ProfilePtr profile;
   };
-  std::vector<CoordinateValues> coordinates;
+  std::vector<CoordinateConstant> coordinates;
   std::vector<BodyInertia> bodies;
   std::vector<ElementConstant> elements;
   std::vector<LoadValues> loads;

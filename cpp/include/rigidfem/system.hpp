@@ -20,9 +20,8 @@ struct Coordinate {
   Axis axis = Axis::X;
   int free_index = -1;     ///< index in q (free coordinates) or −1
   int drive_index = -1;    ///< index in the prescribed list or −1
-  double stiffness = 0.0, rest = 0.0, damping = 0.0;
-  double force = 0.0;      ///< constant applied generalised force
-  ForceLaw force_law;      ///< optional Q(t, q, q̇)
+  SpringDamping spring;    ///< its own spring, damper and constant applied force (coordinate_laws.hpp)
+  std::vector<std::shared_ptr<const CoordinateLaw>> laws;  ///< further laws (a Python function, friction)
   ProfilePtr drive;        ///< prescribed motion, or null
   std::string name;        ///< "body.rz"
 };
