@@ -105,3 +105,28 @@ def test_every_law_kind_is_the_cpp_description_and_what_parameters_and_viewer_re
         law_kind, values, drawn = model._element_law(k)
         assert law_kind == kind and values == [c["default"] for c in info["constants"]]
         assert rf.view(system).data["segments"][k]["kind"] == drawn
+
+
+def test_every_profile_kind_is_the_cpp_table_with_its_numbers_as_parameters():
+    """The named parameters read a profile's numbers by the names of its kind's row (no table in Python), and every
+    kind pickles through the one generic maker as its recipe."""
+    import pickle
+
+    from rigidfem import parameters
+
+    table = {k["maker"]: [a["name"] for a in k["arguments"]] for k in _core._profile_kinds()}
+    assert parameters.PROFILE_ARGUMENTS == {k: tuple(v) for k, v in table.items()}
+    made = [rf.motion.constant(1.0), rf.motion.polynomial([1.0, 2.0]), rf.motion.harmonic(1.0, 2.0),
+            rf.motion.harmonics([1.0], [2.0]), rf.motion.spin_up(1.0, 2.0), rf.motion.spline([0.0, 1.0], [0.0, 1.0]),
+            rf.motion.rest_to_rest(0.0, 1.0, 0.0, 1.0), rf.motion.ramp(1.0, 0.0, 1.0),
+            rf.motion.constant(1.0) + rf.motion.harmonic(1.0, 2.0), rf.motion.constant(1.0).shifted(0.5),
+            rf.motion.piecewise([rf.motion.constant(0.0), rf.motion.constant(0.0)], [1.0])]
+    assert {p.__reduce__()[1][0] for p in made} == set(table)  # every kind made by a builder of rigidfem.motion
+    for p in made:
+        make, args = p.__reduce__()
+        assert make is _core._make_profile and len(args) == 1 + len(table[args[0]])
+        back = pickle.loads(pickle.dumps(p))
+        assert repr(back) == repr(p) and back(0.7) == p(0.7)
+    assert rf.motion.LAWS == tuple(_core._point_to_point_laws())
+    with pytest.raises(ValueError, match="^law: expected one of 'quintic', 'cycloidal', 'trapezoidal', got 'sine'"):
+        rf.motion.ramp(1.0, 0.0, 1.0, law="sine")

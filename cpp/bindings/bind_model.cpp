@@ -88,23 +88,23 @@ ForceLaw python_law(const py::function& f, const std::string& on, const char* x 
   };
 }
 
-// The kind of force element or of joint-coordinate law called `kind`; ValueError listing the kinds otherwise.
-const ElementLawKind& element_kind(const std::string& kind) {
+// The kind called `kind` among `kinds` (element_law_kinds(), coordinate_law_kinds()); ValueError listing them.
+template <class Kinds>
+const typename Kinds::value_type& kind_called(const Kinds& kinds, const std::string& kind, const std::string& what) {
   std::string names;
-  for (const ElementLawKind& k : element_law_kinds()) {
+  for (const auto& k : kinds) {
     if (kind == k.info().kind) return k;
     names += std::string(names.empty() ? "" : ", ") + k.info().kind;
   }
-  bad("law", "a law of a force element (" + names + ")", "'" + kind + "'");
+  bad("law", what + " (" + names + ")", "'" + kind + "'");
+}
+
+const ElementLawKind& element_kind(const std::string& kind) {
+  return kind_called(element_law_kinds(), kind, "a law of a force element");
 }
 
 const CoordinateLawKind& coordinate_kind(const std::string& kind) {
-  std::string names;
-  for (const CoordinateLawKind& k : coordinate_law_kinds()) {
-    if (kind == k.info().kind) return k;
-    names += std::string(names.empty() ? "" : ", ") + k.info().kind;
-  }
-  bad("law", "a law of a joint coordinate beyond its own spring-damping law (" + names + ")", "'" + kind + "'");
+  return kind_called(coordinate_law_kinds(), kind, "a law of a joint coordinate beyond its own spring-damping law");
 }
 
 // The constants' values of a law from a dict {name: number} (the defaults for those not given), each a real

@@ -103,6 +103,49 @@ void bind_transforms(py::module_& m) {
       py::arg("coordinates"), py::arg("q"), py::arg("i"), py::arg("j"), "d2T/dq_i dq_j of joint_transform (4, 4).");
 }
 
+namespace {
+
+// The kind of profile whose maker is `maker`; ValueError listing them otherwise.
+const ProfileKind& profile_kind(const std::string& maker) {
+  std::string names;
+  for (const ProfileKind& k : profile_kinds()) {
+    if (maker == k.maker) return k;
+    names += std::string(names.empty() ? "" : ", ") + k.maker;
+  }
+  bad("maker", "a kind of profile (" + names + ")", "'" + maker + "'");
+}
+
+// A Python value as a profile maker's argument of its type (ValueError naming the argument otherwise).
+ProfileValue profile_value(const ProfileArgument& a, const py::handle& x) {
+  switch (a.type) {
+    case ProfileArgument::Number: return real_arg(x, a.name, a.expected);
+    case ProfileArgument::Integer: return static_cast<int>(int_arg(x, a.name, a.expected));
+    case ProfileArgument::Numbers: {
+      const VecX v = vector_arg(x, a.name, a.expected);
+      return std::vector<double>(v.data(), v.data() + v.size());
+    }
+    case ProfileArgument::Name:
+      if (!PyUnicode_Check(x.ptr())) bad(a.name, a.expected, arg_repr(x));
+      return x.cast<std::string>();
+    case ProfileArgument::Part:
+      if (!py::isinstance<Profile>(x)) bad(a.name, a.expected, arg_repr(x));
+      return x.cast<ProfilePtr>();
+    case ProfileArgument::Parts: {
+      if (py::isinstance<Profile>(x) || PyUnicode_Check(x.ptr()) || !py::isinstance<py::sequence>(x))
+        bad(a.name, a.expected, arg_repr(x));
+      std::vector<ProfilePtr> parts;
+      for (const py::handle p : py::reinterpret_borrow<py::sequence>(x)) {
+        if (!py::isinstance<Profile>(p)) bad(a.name, a.expected, arg_repr(x));
+        parts.push_back(p.cast<ProfilePtr>());
+      }
+      return parts;
+    }
+  }
+  bad(a.name, a.expected, arg_repr(x));
+}
+
+}  // namespace
+
 void bind_profiles(py::module_& m) {
   py::class_<Profile, ProfilePtr> profile(m, "Profile", "A prescribed motion q(t) with its rates (see rigidfem.motion).",
                                           py::dynamic_attr());
@@ -133,7 +176,10 @@ void bind_profiles(py::module_& m) {
             py::tuple arguments(r.arguments.size());
             for (size_t k = 0; k < r.arguments.size(); ++k)
               arguments[k] = std::visit([](const auto& a) { return py::cast(a); }, r.arguments[k]);
-            return py::make_tuple(py::module_::import("rigidfem._core").attr(r.maker.c_str()), arguments);
+            py::tuple maker_and_arguments(r.arguments.size() + 1);
+            maker_and_arguments[0] = r.maker;
+            for (size_t k = 0; k < r.arguments.size(); ++k) maker_and_arguments[k + 1] = arguments[k];
+            return py::make_tuple(py::module_::import("rigidfem._core").attr("_make_profile"), maker_and_arguments);
           });
   // Composition, each a C++ profile holding its parts: p ± r, p ± c, c ± p, c·p, p/c, −p (c a number; anything
   // else: NotImplemented, Python's TypeError) and p.shifted(delay). The result's Python object keeps its parts'
@@ -195,22 +241,44 @@ void bind_profiles(py::module_& m) {
             return composed(shifted_profile(p.cast<ProfilePtr>(), d), py::make_tuple(p));
           },
           py::arg("delay"), "The same motion `delay` s later: q(t − delay), with its rates.");
-  m.def("constant_profile", &constant_profile, py::arg("value"));
-  m.def("polynomial_profile", &polynomial_profile, py::arg("coefficients"));
-  m.def("harmonic_profile", &harmonic_profile, py::arg("amplitude"), py::arg("omega"), py::arg("phase"),
-        py::arg("offset"));
-  m.def("harmonic_series_profile", &harmonic_series_profile, py::arg("amplitudes"), py::arg("omegas"),
-        py::arg("phases"), py::arg("offset"));
-  m.def("spin_up_profile", &spin_up_profile, py::arg("omega"), py::arg("duration"));
-  m.def("spline_profile", &spline_profile, py::arg("t"), py::arg("q"));
-  m.def("rest_to_rest_profile", &rest_to_rest_profile, py::arg("law"), py::arg("start"), py::arg("end"), py::arg("t0"),
-        py::arg("duration"), py::arg("fraction"));
-  m.def("ramp_profile", &ramp_profile, py::arg("law"), py::arg("rate"), py::arg("t0"), py::arg("duration"),
-        py::arg("start"), py::arg("fraction"));
-  m.def("sum_profile", &sum_profile, py::arg("weights"), py::arg("parts"), py::arg("offset"), py::keep_alive<0, 2>());
-  m.def("shifted_profile", &shifted_profile, py::arg("profile"), py::arg("delay"), py::keep_alive<0, 1>());
-  m.def("piecewise_profile", &piecewise_profile, py::arg("pieces"), py::arg("breaks"), py::arg("continuity"),
-        py::keep_alive<0, 1>());
+  // Every kind of profile through its row of profile_kinds(): the arguments converted by their types (ValueError
+  // naming one of the wrong type), judged by the maker (naming the first bad one); a part's Python object is kept
+  // (`_parts`) so that a part made by rigidfem.motion.function still pickles as its function.
+  m.def(
+      "_make_profile",
+      [composed](const std::string& maker, const py::args& args) {
+        const ProfileKind& kind = profile_kind(maker);
+        if (args.size() != kind.arguments.size())
+          bad("arguments", std::to_string(kind.arguments.size()) + " for " + maker,
+              std::to_string(args.size()));
+        std::vector<ProfileValue> values;
+        py::list parts;
+        for (std::size_t k = 0; k < args.size(); ++k) {
+          values.push_back(profile_value(kind.arguments[k], args[k]));
+          if (kind.arguments[k].type == ProfileArgument::Part) parts.append(args[k]);
+          if (kind.arguments[k].type == ProfileArgument::Parts)
+            for (const py::handle part : args[k]) parts.append(part);
+        }
+        return composed(kind.make(values), py::tuple(parts));
+      },
+      py::arg("maker"),
+      "The profile of the kind `maker` (a row of _profile_kinds) from its arguments, in the row's order.");
+  m.def(
+      "_profile_kinds",
+      [] {
+        static const char* types[] = {"number", "integer", "numbers", "name", "profile", "profiles"};
+        py::list kinds;
+        for (const ProfileKind& k : profile_kinds()) {
+          py::list arguments;
+          for (const ProfileArgument& a : k.arguments)
+            arguments.append(py::dict(py::arg("name") = a.name, py::arg("type") = types[a.type],
+                                      py::arg("expected") = a.expected));
+          kinds.append(py::dict(py::arg("maker") = k.maker, py::arg("arguments") = arguments));
+        }
+        return kinds;
+      },
+      "The kinds of profile, each a dict: maker, arguments (name, type, expected) in the maker's order.");
+  m.def("_point_to_point_laws", &point_to_point_laws, "The laws of rest_to_rest_profile and ramp_profile, by name.");
   m.def(
       "callback_profile",
       [](std::function<std::tuple<double, double, double>(double)> f) {

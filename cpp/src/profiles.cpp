@@ -176,9 +176,7 @@ struct Law {
   enum class Kind { Quintic, Cycloidal, Trapezoidal } kind;
   double f = 0.0;  // trapezoidal: the fraction of T spent accelerating (and decelerating), 0 < f ≤ 1/2; else 0
 
-  std::string name() const {
-    return kind == Kind::Quintic ? "quintic" : kind == Kind::Cycloidal ? "cycloidal" : "trapezoidal";
-  }
+  std::string name() const { return point_to_point_laws()[static_cast<int>(kind)]; }
   /// (s, s', s'') at τ.
   MotionState at(double tau) const {
     switch (kind) {
@@ -221,16 +219,27 @@ struct Law {
   }
 };
 
+// "one of 'quintic', 'cycloidal', 'trapezoidal'": what a law's name is, for the messages.
+const char* law_names() {
+  static const std::string names = [] {
+    std::string s = "one of ";
+    for (const std::string& n : point_to_point_laws()) s += (s.size() > 7 ? ", '" : "'") + n + "'";
+    return s;
+  }();
+  return names.c_str();
+}
+
 Law make_law(const std::string& name, double fraction) {
-  if (name == "quintic") return {Law::Kind::Quintic, 0.0};
-  if (name == "cycloidal") return {Law::Kind::Cycloidal, 0.0};
-  if (name == "trapezoidal") {
-    if (!(fraction > 0.0 && fraction <= 0.5))
-      throw std::invalid_argument("fraction: expected the share of the duration spent accelerating, in (0, 0.5], got " +
-                                  num(fraction));
-    return {Law::Kind::Trapezoidal, fraction};
-  }
-  throw std::invalid_argument("law: expected 'quintic', 'cycloidal' or 'trapezoidal', got '" + name + "'");
+  const auto& names = point_to_point_laws();
+  const auto k = std::find(names.begin(), names.end(), name) - names.begin();
+  if (k == static_cast<long>(names.size()))
+    throw std::invalid_argument(std::string("law: expected ") + law_names() + ", got '" + name + "'");
+  const Law::Kind kind = static_cast<Law::Kind>(k);
+  if (kind != Law::Kind::Trapezoidal) return {kind, 0.0};
+  if (!(fraction > 0.0 && fraction <= 0.5))
+    throw std::invalid_argument("fraction: expected the share of the duration spent accelerating, in (0, 0.5], got " +
+                                num(fraction));
+  return {kind, fraction};
 }
 
 class RestToRest final : public Profile {
@@ -504,6 +513,73 @@ ProfilePtr piecewise_profile(const std::vector<ProfilePtr>& pieces, const std::v
 ProfilePtr callback_profile(std::function<MotionState(double)> f) {
   if (!f) throw std::invalid_argument("function: expected a callable, got None");
   return std::make_shared<Callback>(std::move(f));
+}
+
+const std::vector<std::string>& point_to_point_laws() {
+  static const std::vector<std::string> names{"quintic", "cycloidal", "trapezoidal"};  // the order of Law::Kind
+  return names;
+}
+
+namespace {
+
+// The arguments of a maker's row, by type.
+using Arguments = std::vector<ProfileValue>;
+double number(const Arguments& a, int k) { return std::get<double>(a[k]); }
+const std::vector<double>& numbers(const Arguments& a, int k) { return std::get<std::vector<double>>(a[k]); }
+const std::string& name(const Arguments& a, int k) { return std::get<std::string>(a[k]); }
+
+}  // namespace
+
+const std::vector<ProfileKind>& profile_kinds() {
+  using P = ProfileArgument;
+  static const char* finite = "a finite number";
+  static const char* values = "a 1-D sequence of finite numbers";
+  static const std::vector<ProfileKind> kinds = {
+      {"constant_profile", {{"value", P::Number, finite}}, [](const Arguments& a) { return constant_profile(number(a, 0)); }},
+      {"polynomial_profile", {{"coefficients", P::Numbers, values}},
+       [](const Arguments& a) { return polynomial_profile(numbers(a, 0)); }},
+      {"harmonic_profile",
+       {{"amplitude", P::Number, finite}, {"omega", P::Number, finite}, {"phase", P::Number, finite},
+        {"offset", P::Number, finite}},
+       [](const Arguments& a) { return harmonic_profile(number(a, 0), number(a, 1), number(a, 2), number(a, 3)); }},
+      {"harmonic_series_profile",
+       {{"amplitudes", P::Numbers, values}, {"omegas", P::Numbers, values}, {"phases", P::Numbers, values},
+        {"offset", P::Number, finite}},
+       [](const Arguments& a) {
+         return harmonic_series_profile(numbers(a, 0), numbers(a, 1), numbers(a, 2), number(a, 3));
+       }},
+      {"spin_up_profile", {{"omega", P::Number, finite}, {"duration", P::Number, "a positive time in s"}},
+       [](const Arguments& a) { return spin_up_profile(number(a, 0), number(a, 1)); }},
+      {"spline_profile", {{"t", P::Numbers, values}, {"q", P::Numbers, values}},
+       [](const Arguments& a) { return spline_profile(numbers(a, 0), numbers(a, 1)); }},
+      {"rest_to_rest_profile",
+       {{"law", P::Name, law_names()}, {"start", P::Number, finite}, {"end", P::Number, finite},
+        {"t0", P::Number, finite}, {"duration", P::Number, "a positive time in s"}, {"fraction", P::Number, finite}},
+       [](const Arguments& a) {
+         return rest_to_rest_profile(name(a, 0), number(a, 1), number(a, 2), number(a, 3), number(a, 4), number(a, 5));
+       }},
+      {"ramp_profile",
+       {{"law", P::Name, law_names()}, {"rate", P::Number, finite}, {"t0", P::Number, finite},
+        {"duration", P::Number, "a positive time in s"}, {"start", P::Number, finite}, {"fraction", P::Number, finite}},
+       [](const Arguments& a) {
+         return ramp_profile(name(a, 0), number(a, 1), number(a, 2), number(a, 3), number(a, 4), number(a, 5));
+       }},
+      {"sum_profile",
+       {{"weights", P::Numbers, values}, {"parts", P::Parts, "a list of rigidfem.motion profiles"},
+        {"offset", P::Number, finite}},
+       [](const Arguments& a) {
+         return sum_profile(numbers(a, 0), std::get<std::vector<ProfilePtr>>(a[1]), number(a, 2));
+       }},
+      {"shifted_profile", {{"profile", P::Part, "a rigidfem.motion profile"}, {"delay", P::Number, "a finite time in s"}},
+       [](const Arguments& a) { return shifted_profile(std::get<ProfilePtr>(a[0]), number(a, 1)); }},
+      {"piecewise_profile",
+       {{"pieces", P::Parts, "a list of rigidfem.motion profiles"}, {"breaks", P::Numbers, values},
+        {"continuity", P::Integer, "0 (q), 1 (q and qd) or 2 (q, qd and qdd)"}},
+       [](const Arguments& a) {
+         return piecewise_profile(std::get<std::vector<ProfilePtr>>(a[0]), numbers(a, 1), std::get<int>(a[2]));
+       }},
+  };
+  return kinds;
 }
 
 }  // namespace rigidfem

@@ -10,8 +10,9 @@ from collections.abc import Callable
 
 import numpy as np
 
-from . import _checks, _contract, _core, _deprecation, display, force_elements, joints, laws, loops, parameters
-from . import persistence
+from . import _checks, _contract, _core, _deprecation, display, force_elements, joints, laws, loops
+from . import parameters, persistence
+from .motion import constant as _constant
 from ._core import Body, JointSpec, Point, Profile
 from .beams import add_beam
 from .frames import transform  # noqa: F401 (re-exported: rigidfem.model.transform)
@@ -54,9 +55,9 @@ def _base_profiles(motion) -> dict[str, Profile]:
         if c in out:
             raise ValueError(f"motion: {dof!r} gives coordinate {c!r} a second motion")
         if not isinstance(value, Profile):
-            value = _core.constant_profile(_checks.scalar(value, f"motion[{dof!r}]"))
+            value = _constant(_checks.scalar(value, f"motion[{dof!r}]"))
         out[c] = value
-    return {c: out[c] if c in out else _core.constant_profile(0.0) for c in BASE_DOFS.values()}
+    return {c: out[c] if c in out else _constant(0.0) for c in BASE_DOFS.values()}
 
 
 def _scale(scale):

@@ -19,20 +19,29 @@ import numpy as np
 from . import _checks, _core
 
 
+#: The point-to-point laws s(τ) of ``rest_to_rest`` and ``ramp`` (the C++ table's).
+LAWS = tuple(_core._point_to_point_laws())
+
+
+def _make(maker: str, *arguments) -> _core.Profile:
+    """The profile of the kind ``maker`` (``cpp/src/profiles.cpp``: its row of ``profile_kinds``, which converts and
+    judges the arguments, naming the first bad one)."""
+    return _core._make_profile(maker, *arguments)
+
+
 def constant(value: float) -> _core.Profile:
     """q(t) = value (a locked coordinate)."""
-    return _core.constant_profile(_checks.scalar(value, "value"))
+    return _make("constant_profile", value)
 
 
 def polynomial(coefficients: Sequence[float]) -> _core.Profile:
     """q(t) = c0 + c1 t + c2 t² + ... (``coefficients`` = [c0, c1, ...])."""
-    return _core.polynomial_profile(list(_checks.vector(coefficients, "coefficients")))
+    return _make("polynomial_profile", coefficients)
 
 
 def harmonic(amplitude: float, omega: float, phase: float = 0.0, offset: float = 0.0) -> _core.Profile:
     """q(t) = offset + amplitude · sin(omega t + phase); omega in rad/s."""
-    return _core.harmonic_profile(_checks.scalar(amplitude, "amplitude"), _checks.scalar(omega, "omega"),
-                                  _checks.scalar(phase, "phase"), _checks.scalar(offset, "offset"))
+    return _make("harmonic_profile", amplitude, omega, phase, offset)
 
 
 def harmonics(amplitudes: Sequence[float], omegas: Sequence[float], phases: Sequence[float] | None = None,
@@ -45,28 +54,21 @@ def harmonics(amplitudes: Sequence[float], omegas: Sequence[float], phases: Sequ
     component; ``offset`` c likewise in m or rad. A base motion per degree of freedom
     (``Model.add_moving_base``) and a sea state's responses (``rigidfem.sea``) are such sums.
     """
-    a = _checks.vector(amplitudes, "amplitudes", min_length=1)
-    w = _checks.vector(omegas, "omegas")
-    phi = np.zeros_like(a) if phases is None else _checks.vector(phases, "phases")
-    for values, name in ((w, "omegas"), (phi, "phases")):
-        if values.size != a.size:
-            raise ValueError(f"{name}: expected {a.size} values (len(amplitudes)), got {values.size}")
-    return _core.harmonic_series_profile(list(a), list(w), list(phi), _checks.scalar(offset, "offset"))
+    if phases is None:
+        phases = np.zeros(np.size(amplitudes)) if np.ndim(amplitudes) == 1 else amplitudes  # the maker names a bad one
+    return _make("harmonic_series_profile", amplitudes, omegas, phases, offset)
 
 
 def spin_up(omega: float, duration: float) -> _core.Profile:
     """Kane's spin-up of a hub to the rate ``omega`` (rad/s) over ``duration`` T (s):
     θ = (Ω/T)[t²/2 + (T/2π)²(cos(2πt/T) − 1)] for t < T, θ = Ω(t − T/2) after."""
-    return _core.spin_up_profile(_checks.scalar(omega, "omega"), _checks.scalar(duration, "duration"))
+    return _make("spin_up_profile", omega, duration)
 
 
 def spline(t: Sequence[float], q: Sequence[float]) -> _core.Profile:
     """Natural cubic spline through tabulated (t, q); outside the table q continues
     linearly with the end slope."""
-    return _core.spline_profile(list(_checks.vector(t, "t")), list(_checks.vector(q, "q")))
-
-
-LAWS = ("quintic", "cycloidal", "trapezoidal")
+    return _make("spline_profile", t, q)
 
 
 def rest_to_rest(start: float, end: float, t0: float, duration: float, law: str = "quintic",
@@ -82,11 +84,9 @@ def rest_to_rest(start: float, end: float, t0: float, duration: float, law: str 
     - ``"cycloidal"``: s = τ − sin(2πτ)/(2π); likewise, peak rate 2 Δ/T;
     - ``"trapezoidal"``: constant acceleration over the first and last ``fraction`` (0 < f ≤ 1/2) of
       the duration, constant rate 1/(1 − f) · Δ/T between; q̈ jumps at four instants (an adaptive
-      method steps onto them).
+      method steps onto them). The other laws leave ``fraction`` unread.
     """
-    return _core.rest_to_rest_profile(_law(law), _checks.scalar(start, "start"), _checks.scalar(end, "end"),
-                                      _checks.scalar(t0, "t0"), _checks.scalar(duration, "duration"),
-                                      _fraction(law, fraction))
+    return _make("rest_to_rest_profile", law, start, end, t0, duration, fraction)
 
 
 def ramp(rate: float, t0: float, duration: float, law: str = "cycloidal", start: float = 0.0,
@@ -95,9 +95,7 @@ def ramp(rate: float, t0: float, duration: float, law: str = "cycloidal", start:
     rad/s) at ``t0 + duration`` by the rest-to-rest ``law`` s (see ``rest_to_rest``), then stays; q =
     start + rate · T · S(τ) with S(τ) = ∫₀^τ s, and q = start + rate (t − t0 − T/2) after the ramp. A winch
     paying out a rope, a hub spun up (``law="cycloidal"`` is Kane's ``spin_up`` from ``t0``)."""
-    return _core.ramp_profile(_law(law), _checks.scalar(rate, "rate"), _checks.scalar(t0, "t0"),
-                              _checks.scalar(duration, "duration"), _checks.scalar(start, "start"),
-                              _fraction(law, fraction))
+    return _make("ramp_profile", law, rate, t0, duration, start, fraction)
 
 
 def piecewise(pieces: Sequence[_core.Profile], breaks: Sequence[float], continuity: int = 1) -> _core.Profile:
@@ -108,28 +106,7 @@ def piecewise(pieces: Sequence[_core.Profile], breaks: Sequence[float], continui
     At every break the two pieces must meet — in q (``continuity=0``), in q and q̇ (1, the default:
     a drive without a jump of velocity), or in q, q̇ and q̈ (2) — to 1e-9 (1 + |x|); otherwise a
     ValueError names the break and the jump."""
-    if isinstance(pieces, _core.Profile) or not isinstance(pieces, Sequence) or \
-            not all(isinstance(p, _core.Profile) for p in pieces):
-        raise ValueError(f"pieces: expected a list of rigidfem.motion profiles, got {pieces!r}")
-    if isinstance(continuity, bool) or not isinstance(continuity, (int, np.integer)):
-        raise ValueError(f"continuity: expected 0 (q), 1 (q and qd) or 2 (q, qd and qdd), got {continuity!r}")
-    return _core.piecewise_profile(list(pieces), list(_checks.vector(breaks, "breaks")), int(continuity))
-
-
-def _law(law) -> str:
-    if law not in LAWS:
-        raise ValueError(f"law: expected one of {', '.join(map(repr, LAWS))}, got {law!r}")
-    return law
-
-
-def _fraction(law: str, fraction) -> float:
-    """The trapezoidal law's acceleration share, in (0, 1/2]; checked (and passed) for that law only."""
-    if law != "trapezoidal":
-        return 0.0
-    f = _checks.scalar(fraction, "fraction")
-    if not 0.0 < f <= 0.5:
-        raise ValueError(f"fraction: expected the share of the duration spent accelerating, in (0, 0.5], got {f}")
-    return f
+    return _make("piecewise_profile", pieces, breaks, continuity)
 
 
 def function(f: Callable[[float], tuple[float, float, float]]) -> _core.Profile:

@@ -370,27 +370,20 @@ class Parameters:
 
 # ----------------------------------------------------------------- profiles
 
-#: The arguments of each profile maker (``_core.*_profile``), in the order of its recipe (``Profile.__reduce__``).
-PROFILE_ARGUMENTS = {
-    "constant_profile": ("value",), "polynomial_profile": ("coefficients",),
-    "harmonic_profile": ("amplitude", "omega", "phase", "offset"),
-    "harmonic_series_profile": ("amplitudes", "omegas", "phases", "offset"),
-    "spin_up_profile": ("omega", "duration"), "spline_profile": ("t", "q"),
-    "rest_to_rest_profile": ("law", "start", "end", "t0", "duration", "fraction"),
-    "ramp_profile": ("law", "rate", "t0", "duration", "start", "fraction"),
-    "sum_profile": ("weights", "parts", "offset"), "shifted_profile": ("profile", "delay"),
-    "piecewise_profile": ("pieces", "breaks", "continuity"),
-}
+#: The arguments of each kind of profile, in the order of its recipe (``Profile.__reduce__``): the C++ table's
+#: (``profile_kinds`` in ``cpp/src/profiles.cpp``).
+PROFILE_ARGUMENTS = {k["maker"]: tuple(a["name"] for a in k["arguments"]) for k in _core._profile_kinds()}
 
 
 def _recipe(profile):
     """(maker, argument names, arguments) of a remakeable profile, or None (a Python function's)."""
     try:
-        maker, args = profile.__reduce__()
+        make, args = profile.__reduce__()
     except (TypeError, ValueError):
         return None
-    names = PROFILE_ARGUMENTS.get(getattr(maker, "__name__", ""))
-    return None if names is None else (maker, names, list(args))
+    if make is not _core._make_profile or not args or args[0] not in PROFILE_ARGUMENTS:
+        return None
+    return args[0], PROFILE_ARGUMENTS[args[0]], list(args[1:])
 
 
 def profile_leaves(profile, path: str = "") -> dict[str, float]:
@@ -440,7 +433,7 @@ def remade(profile, values: dict[str, float], path: str = ""):
         elif isinstance(arg, float):
             arg = values.get(here, arg)
         new.append(arg)
-    return maker(*new)
+    return _core._make_profile(maker, *new)
 
 
 class ProfileGroup(Group):

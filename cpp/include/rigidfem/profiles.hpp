@@ -18,12 +18,16 @@ struct MotionState {
 class Profile;
 using ProfilePtr = std::shared_ptr<Profile>;  // profiles are immutable: only const methods
 
-/// How a profile was made: the name of its maker below (e.g. "harmonic_profile") and the maker's
-/// arguments, enough to make it again bit for bit (pickling; a composite names its parts). Empty
+/// A value a profile's maker takes and its recipe keeps: a number, an integer, numbers, a name, a profile or profiles
+/// (the order of ProfileArgument::Type).
+using ProfileValue = std::variant<double, int, std::vector<double>, std::string, ProfilePtr, std::vector<ProfilePtr>>;
+
+/// How a profile was made: the name of its maker (a row of profile_kinds(), e.g. "harmonic_profile") and the
+/// maker's arguments, enough to make it again bit for bit (pickling; a composite names its parts). Empty
 /// maker: not remakeable (a Python function, an internal profile).
 struct ProfileRecipe {
   std::string maker;
-  std::vector<std::variant<double, int, std::vector<double>, std::string, ProfilePtr, std::vector<ProfilePtr>>> arguments;
+  std::vector<ProfileValue> arguments;
 };
 
 class Profile {
@@ -50,6 +54,8 @@ ProfilePtr spin_up_profile(double omega, double duration);
 /// Natural cubic spline through (t_k, q_k); beyond the table q continues linearly
 /// with the end slope (q̈ = 0).
 ProfilePtr spline_profile(const std::vector<double>& t, const std::vector<double>& q);
+/// The point-to-point laws of rest_to_rest_profile and ramp_profile, by name.
+const std::vector<std::string>& point_to_point_laws();
 /// Rest to rest: q = start for t ≤ t0, q = end for t ≥ t0 + T, and in between
 /// q = start + (end − start) s(τ), τ = (t − t0)/T, q̇ = (end − start) s'(τ)/T, q̈ = (end − start) s''(τ)/T², with
 /// the law s named: "quintic" (10τ³ − 15τ⁴ + 6τ⁵: q̇ = q̈ = 0 at both ends),
@@ -72,5 +78,25 @@ ProfilePtr shifted_profile(const ProfilePtr& profile, double delay);
 ProfilePtr piecewise_profile(const std::vector<ProfilePtr>& pieces, const std::vector<double>& breaks, int continuity);
 /// A user function t -> (q, q̇, q̈): the slow path (called through Python).
 ProfilePtr callback_profile(std::function<MotionState(double)> f);
+
+/// One argument of a profile's maker: its name (also its numbers' path as named parameters), which of
+/// ProfileValue's alternatives it takes, and what it takes, for the messages.
+struct ProfileArgument {
+  enum Type { Number, Integer, Numbers, Name, Part, Parts };
+  const char* name;
+  Type type;
+  const char* expected;
+};
+
+/// A kind of profile, described once: its maker's name, its arguments in order (its recipe's), and the maker, which
+/// judges them (std::invalid_argument naming the first bad one). The bindings make every kind through this table
+/// (rigidfem._core._make_profile) and the named parameters read a profile's numbers by these names, so a new kind
+/// is its class and its row in profiles.cpp, and its builder in rigidfem.motion.
+struct ProfileKind {
+  const char* maker;
+  std::vector<ProfileArgument> arguments;
+  ProfilePtr (*make)(const std::vector<ProfileValue>& arguments);
+};
+const std::vector<ProfileKind>& profile_kinds();
 
 }  // namespace rigidfem
