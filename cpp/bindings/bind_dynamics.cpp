@@ -85,6 +85,8 @@ class Workspace {
 }  // namespace
 
 void bind_dynamics(py::module_& m) {
+  // Data is registered first, so that the signatures of System's methods name it (the stub's types).
+  py::class_<Data> data(m, "Data", "Workspace of the algorithms; after each stage it holds that stage's results.");
   py::class_<System, std::shared_ptr<System>>(m, "_System")
       // The System is immutable: only const methods are bound.
       .def(py::init([](const Model& model, const std::string& algorithm) {
@@ -414,8 +416,7 @@ void bind_dynamics(py::module_& m) {
           "make_data", [](const System& s) { return std::make_unique<Data>(s); },
           "A fresh workspace for the stage functions (allocated in place: a Data is never copied or moved).");
 
-  py::class_<Data>(m, "Data", "Workspace of the algorithms; after each stage it holds that stage's results.")
-      .def_readonly("t", &Data::t)
+  data.def_readonly("t", &Data::t)
       .def_readonly("qa", &Data::qa, "All coordinates (nc,), free and prescribed.")
       .def_readonly("qda", &Data::qda)
       .def_readonly("qdda", &Data::qdda)

@@ -8,7 +8,7 @@ import numpy.typing
 import typing
 from . import stages
 from . import _bench
-__all__: list[str] = ['Body', 'Data', 'ForceLawError', 'IntegratorOptions', 'JointSpec', 'Point', 'Profile', 'R1', 'R2', 'R3', 'SimulationError', 'callback_profile', 'constant_profile', 'euler_zyx', 'harmonic_profile', 'harmonic_series_profile', 'homogeneous', 'inverse', 'joint_transform', 'joint_transform_derivative', 'joint_transform_second_derivative', 'polynomial_profile', 'pseudo_inertia', 'skew', 'spin_up_profile', 'spline_profile', 'stages']
+__all__: list[str] = ['Body', 'Data', 'ForceLawError', 'IntegratorOptions', 'JointSpec', 'Point', 'Profile', 'R1', 'R2', 'R3', 'SimulationError', 'callback_profile', 'euler_zyx', 'homogeneous', 'inverse', 'joint_transform', 'joint_transform_derivative', 'joint_transform_second_derivative', 'pseudo_inertia', 'skew', 'stages']
 class SimulationError(RuntimeError):
     """
     A numerical failure, a RuntimeError whose message names the time (s) and the cause: a singular mass or iteration matrix, a step size below the minimum, a NaN or inf state, Newton divergence in a step or a load step of the statics, max_steps, gimbal lock of ZYX Euler angles.
@@ -17,14 +17,37 @@ class Profile:
     """
     A prescribed motion q(t) with its rates (see rigidfem.motion).
     """
+    __array_ufunc__ = None
+    def __add__(self, arg0: typing.Any) -> typing.Any:
+        ...
     def __call__(self, t: typing.Any) -> tuple[float, float, float]:
         """
         (q, qd, qdd) at time t (s).
         """
+    def __mul__(self, arg0: typing.Any) -> typing.Any:
+        ...
+    def __neg__(self) -> typing.Any:
+        ...
+    def __pos__(self) -> typing.Any:
+        ...
+    def __radd__(self, arg0: typing.Any) -> typing.Any:
+        ...
     def __reduce__(self) -> tuple:
         ...
     def __repr__(self) -> str:
         ...
+    def __rmul__(self, arg0: typing.Any) -> typing.Any:
+        ...
+    def __rsub__(self, arg0: typing.Any) -> typing.Any:
+        ...
+    def __sub__(self, arg0: typing.Any) -> typing.Any:
+        ...
+    def __truediv__(self, arg0: typing.Any) -> typing.Any:
+        ...
+    def shifted(self, delay: typing.Any) -> typing.Any:
+        """
+        The same motion `delay` s later: q(t − delay), with its rates.
+        """
 class ForceLawError(SimulationError, ValueError):
     """
     A Python force law returned no finite number (None, a string, an array, NaN or inf): a ValueError
@@ -147,6 +170,24 @@ class Point:
     def r(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
         ...
 class _Model:
+    @staticmethod
+    def _check_law(kind: str, values: dict, profile: Profile) -> list[float]:
+        """
+        The constants' values of a law of `kind` (defaults for those not given), each converted and judged
+        against its bounds (ValueError naming the first out of them).
+        """
+    @staticmethod
+    def _law_kinds() -> list:
+        """
+        Every kind of law, each a dict: kind, acts_on ('element' or 'coordinate'), doc, constants (name, unit,
+        rotation_unit, default, lower, positive, doc, parameter), profile, profile_name, profile_units, function,
+        addable (False: every coordinate's own spring-damping law).
+        """
+    @staticmethod
+    def _loop_kinds() -> dict:
+        """
+        The loop kinds and their numbers of constraint rows.
+        """
     def __init__(self, gravity: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]) -> None:
         ...
     def _add_bodies(self, names: collections.abc.Sequence[str], parents: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], joint: JointSpec, stiffness: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"], damping: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"], placements: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"], masses: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], coms: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"], inertias: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"]) -> list[Body]:
@@ -156,27 +197,28 @@ class _Model:
         """
     def _add_body(self, name: str, parent: typing.SupportsInt | typing.SupportsIndex, joint: JointSpec, placement: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"], mass: typing.SupportsFloat | typing.SupportsIndex, com: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], inertia: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 3]"]) -> Body:
         ...
+    def _add_coordinate_law(self, body: typing.SupportsInt | typing.SupportsIndex, coordinate: typing.SupportsInt | typing.SupportsIndex, kind: str, values: dict, function: typing.Any) -> int:
+        """
+        Adds a law of `kind` on a joint coordinate (-1: the joint's only one); returns its index among the
+        coordinate's laws.
+        """
     def _add_flow(self, length: Profile, first: typing.SupportsInt | typing.SupportsIndex, elements: typing.SupportsInt | typing.SupportsIndex) -> None:
         ...
-    @staticmethod
-    def _loop_kinds() -> dict:
+    def _add_force_element(self, name: str, a: typing.SupportsInt | typing.SupportsIndex, point_a: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], b: typing.SupportsInt | typing.SupportsIndex, point_b: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], kind: str, values: dict, profile: Profile, function: typing.Any) -> str:
         """
-        The loop kinds and their numbers of constraint rows.
+        Adds a force element of the law `kind` (its constants' values by name, the rest their defaults), with its
+        profile and Python function where the kind takes them; returns its name.
         """
-    def _add_force_element(self, name: str, a: typing.SupportsInt | typing.SupportsIndex, point_a: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], b: typing.SupportsInt | typing.SupportsIndex, point_b: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], stiffness: typing.SupportsFloat | typing.SupportsIndex, damping: typing.SupportsFloat | typing.SupportsIndex, length: typing.SupportsFloat | typing.SupportsIndex, force: typing.SupportsFloat | typing.SupportsIndex, profile: Profile, law: collections.abc.Callable | None) -> str:
-        ...
     def _add_generalized_force(self, body: typing.SupportsInt | typing.SupportsIndex, coordinate: typing.SupportsInt | typing.SupportsIndex, value: typing.SupportsFloat | typing.SupportsIndex, law: typing.Any) -> None:
         ...
     def _add_load(self, body: typing.SupportsInt | typing.SupportsIndex, point: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], force: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], torque: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], follower: bool, scale: Profile) -> None:
         ...
-    def _add_loop(self, name: str, kind: str, a: typing.SupportsInt | typing.SupportsIndex, frame_a: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"], b: typing.SupportsInt | typing.SupportsIndex, frame_b: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"], length: typing.SupportsFloat | typing.SupportsIndex, drive: Profile) -> str:
+    def _add_loop(self, name: str, kind: str, a: typing.SupportsInt | typing.SupportsIndex, frame_a: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"], b: typing.SupportsInt | typing.SupportsIndex, frame_b: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"], length: typing.SupportsFloat | typing.SupportsIndex, drive: Profile, actuator: bool = False) -> str:
         ...
     def _add_maxwell_arms(self, bodies: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], coordinates: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], stiffness: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], tau: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
         """
         Adds Maxwell arms (k in N/m or N·m/rad, tau in s) on joint coordinates (-1: the joint's only one).
         """
-    def _add_rope(self, name: str, a: typing.SupportsInt | typing.SupportsIndex, point_a: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], b: typing.SupportsInt | typing.SupportsIndex, point_b: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], EA: typing.SupportsFloat | typing.SupportsIndex, DA: typing.SupportsFloat | typing.SupportsIndex, length: typing.SupportsFloat | typing.SupportsIndex, unstretched: Profile) -> str:
-        ...
     def _adopt_id(self, id: typing.SupportsInt | typing.SupportsIndex) -> None:
         """
         Takes the id of the model this one copies (unpickling).
@@ -187,12 +229,32 @@ class _Model:
         ...
     def _coordinate_index(self, body: typing.SupportsInt | typing.SupportsIndex, coordinate: str) -> int:
         ...
+    def _coordinate_name(self, body: typing.SupportsInt | typing.SupportsIndex, coordinate: typing.SupportsInt | typing.SupportsIndex) -> str:
+        """
+        'body.axis' of coordinate `coordinate` (-1: the joint's only one) of a body's joint.
+        """
+    def _element_law(self, element: typing.SupportsInt | typing.SupportsIndex) -> tuple[str, list[float], str]:
+        """
+        (kind, the constants' values, how it is drawn) of force element k's law.
+        """
     def _prescribe(self, body: typing.SupportsInt | typing.SupportsIndex, coordinate: typing.SupportsInt | typing.SupportsIndex, motion: Profile) -> None:
         ...
     def _truncate(self, n: typing.SupportsInt | typing.SupportsIndex) -> None:
         """
         Removes the bodies n, n + 1, ... (undo of a failed builder).
         """
+    @property
+    def _nelements(self) -> int:
+        ...
+    @property
+    def _nflows(self) -> int:
+        ...
+    @property
+    def _nloads(self) -> int:
+        ...
+    @property
+    def _nloops(self) -> int:
+        ...
     @property
     def body_names(self) -> list[str]:
         ...
@@ -212,11 +274,99 @@ class _Model:
     @property
     def nbodies(self) -> int:
         ...
+class Data:
+    """
+    Workspace of the algorithms; after each stage it holds that stage's results.
+    """
+    @property
+    def A(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        """
+        Mass matrix (nq, nq).
+        """
+    @property
+    def Hbar(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
+        """
+        Subtree sums of T_p H_p T_p^T.
+        """
+    @property
+    def T(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
+        """
+        Global pose T_p (4, 4) of every body.
+        """
+    @property
+    def Td(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
+        """
+        dT_p/dt.
+        """
+    @property
+    def Tdd(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
+        """
+        d2T_p/dt2 (with the free accelerations zero unless driving_forces ran).
+        """
+    @property
+    def U(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
+        """
+        U (4, 4) of every coordinate use: dT_p/dq_i = U_i T_p for the bodies p below
+        coordinate i (without linear-model couplings, use i is coordinate i).
+        """
+    @property
+    def Wbar(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
+        """
+        Subtree sums of T_p H_p Tdd_p^T.
+        """
+    @property
+    def Zbar(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
+        """
+        Subtree sums of the load moments.
+        """
+    @property
+    def f(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        Right-hand side (nq,).
+        """
+    @property
+    def qa(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        All coordinates (nc,), free and prescribed.
+        """
+    @property
+    def qda(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def qdd(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        Accelerations (nq,).
+        """
+    @property
+    def qdda(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        ...
+    @property
+    def t(self) -> float:
+        ...
+    @property
+    def tau(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        Driving forces (np,).
+        """
 class _System:
+    @typing.overload
     def __init__(self, model: _Model, algorithm: str) -> None:
+        ...
+    @typing.overload
+    def __init__(self, base: _System, coordinates: collections.abc.Sequence[tuple[typing.SupportsInt | typing.SupportsIndex, typing.SupportsInt | typing.SupportsIndex, typing.SupportsInt | typing.SupportsIndex, str, typing.SupportsFloat | typing.SupportsIndex]], bodies: collections.abc.Sequence[tuple[typing.SupportsInt | typing.SupportsIndex, typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"]]], elements: collections.abc.Sequence[tuple[typing.SupportsInt | typing.SupportsIndex, str, typing.SupportsFloat | typing.SupportsIndex]], loads: collections.abc.Sequence[tuple[typing.SupportsInt | typing.SupportsIndex, typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]]], profiles: collections.abc.Sequence[tuple[str, typing.SupportsInt | typing.SupportsIndex, typing.SupportsInt | typing.SupportsIndex, Profile]]) -> None:
         ...
     def _assemble(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], tol: typing.SupportsFloat | typing.SupportsIndex, max_iterations: typing.SupportsInt | typing.SupportsIndex) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]]:
         ...
+    def _inverse_dynamics_direction(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qdd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], dq: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], dqd: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], dqdd: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+        """
+        (dr/dq) dq + (dr/dqd) dqd + A dqdd (nq): the RNEA's forward-mode derivative along one direction (recursive:
+        exact, O(n)), central differences (lagrange).
+        """
+    def _inverse_dynamics_vjp(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qdd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], mu: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]]:
+        """
+        ((dr/dq)^T mu, (dr/dqd)^T mu, A mu), each (nq), and d(mu^T r)/d of the prescribed coordinates' q, qd,
+        qdd, each (np): the RNEA's reverse mode (recursive systems), O(n).
+        """
     def _position(self, point: Point, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
         ...
     def _positions(self, points: collections.abc.Sequence[Point], t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
@@ -225,7 +375,8 @@ class _System:
         ...
     def acceleration_derivatives(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]]:
         """
-        (dqdd/dq, dqdd/dqd), each (nq, nq): -A^-1 (dr/dq, dr/dqd) at the forward-dynamics qdd.
+        (dqdd/dq, dqdd/dqd), each (nq, nq): -A^-1 (dr/dq, dr/dqd) at the forward-dynamics qdd; with loop
+        closures, of the constrained qdd (multipliers and constraint Jacobian varying too), by central differences.
         """
     def dissipated_power(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> float:
         """
@@ -300,7 +451,7 @@ class _System:
         origin) in frame A's axes; for a distance loop (an actuator) the force along the line in column 0,
         positive pushing b away from a.
         """
-    def make_data(self) -> ...:
+    def make_data(self) -> Data:
         """
         A fresh workspace for the stage functions (allocated in place: a Data is never copied or moved).
         """
@@ -315,6 +466,8 @@ class _System:
     def rhs(self, t: typing.SupportsFloat | typing.SupportsIndex, y: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
         dy/dt = [qd, qdd] for y = [q, qd] (2 nq,): the signature of scipy's solve_ivp.
+        With loop closures qdd holds them at the acceleration level only: g(q) = 0 drifts under solve_ivp
+        (rigidfem.simulate's methods project onto the loops).
         """
     def static_forces(self, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], load_factor: typing.SupportsFloat | typing.SupportsIndex = 1.0) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
@@ -323,6 +476,11 @@ class _System:
     def transform(self, body: typing.SupportsInt | typing.SupportsIndex, t: typing.SupportsFloat | typing.SupportsIndex, q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
         """
         Pose T_p (4, 4) of a body (by index) in the global frame.
+        """
+    @property
+    def _segments(self) -> list:
+        """
+        (how it is drawn, body a, point on a (m), body b, point on b) of every force element and loop.
         """
     @property
     def algorithm(self) -> str:
@@ -355,7 +513,7 @@ class _System:
     @property
     def element_names(self) -> list[str]:
         """
-        Names of the force elements (spring-dampers and cylinders), in the order of element_states().
+        Names of the force elements (spring-dampers, cylinders, ropes), in the order of element_states().
         """
     @property
     def gravity(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]:
@@ -440,80 +598,6 @@ class _System:
         """
         Spring stiffness c_i of each free coordinate (nq,), N/m or N m/rad.
         """
-class Data:
-    """
-    Workspace of the algorithms; after each stage it holds that stage's results.
-    """
-    @property
-    def A(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
-        """
-        Mass matrix (nq, nq).
-        """
-    @property
-    def Hbar(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
-        """
-        Subtree sums of T_p H_p T_p^T.
-        """
-    @property
-    def T(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
-        """
-        Global pose T_p (4, 4) of every body.
-        """
-    @property
-    def Td(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
-        """
-        dT_p/dt.
-        """
-    @property
-    def Tdd(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
-        """
-        d2T_p/dt2 (with the free accelerations zero unless driving_forces ran).
-        """
-    @property
-    def U(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
-        """
-        U (4, 4) of every coordinate use: dT_p/dq_i = U_i T_p for the bodies p below
-        coordinate i (without linear-model couplings, use i is coordinate i).
-        """
-    @property
-    def Wbar(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
-        """
-        Subtree sums of T_p H_p Tdd_p^T.
-        """
-    @property
-    def Zbar(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]]:
-        """
-        Subtree sums of the load moments.
-        """
-    @property
-    def f(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
-        """
-        Right-hand side (nq,).
-        """
-    @property
-    def qa(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
-        """
-        All coordinates (nc,), free and prescribed.
-        """
-    @property
-    def qda(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
-        ...
-    @property
-    def qdd(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
-        """
-        Accelerations (nq,).
-        """
-    @property
-    def qdda(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
-        ...
-    @property
-    def t(self) -> float:
-        ...
-    @property
-    def tau(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
-        """
-        Driving forces (np,).
-        """
 class IntegratorOptions:
     """
     Options of the C++ integrators (see rigidfem.simulate).
@@ -523,6 +607,18 @@ class IntegratorOptions:
     stiff_method: str
     def __init__(self) -> None:
         ...
+    def add_sensitivity(self, plus: _System, minus: _System, h: typing.SupportsFloat | typing.SupportsIndex, S0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> None:
+        """
+        A direction of the forward sensitivities: the system at p + h and, for a central difference, at p - h (None, None: an initial value), and [dq0/dp, dqd0/dp] (2 nq).
+        """
+    def get(self, name: str) -> typing.Any:
+        """
+        The option `name` as Python shows it.
+        """
+    def set(self, name: str, value: typing.Any) -> None:
+        """
+        Sets the option `name` from a Python value of its type (integrator_options: ValueError naming it otherwise).
+        """
     def set_error_on(self, outputs: collections.abc.Sequence[tuple[str, typing.SupportsInt | typing.SupportsIndex, typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]]]) -> None:
         """
         The outputs the error is measured on: (kind, index, r) each; [] for the state.
@@ -609,6 +705,17 @@ class IntegratorOptions:
     @s0.setter
     def s0(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> None:
         ...
+class _Adjoint:
+    def __init__(self, system: _System, options: IntegratorOptions, outputs: collections.abc.Sequence[tuple[str, typing.SupportsInt | typing.SupportsIndex, typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"]]], memory: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        ...
+    def backward(self, ybar: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], dict]:
+        """
+        (dJ/dp, dJ/dq0, dJ/dqd0, stats) for ybar = dJ/dy (N + 1, K).
+        """
+    def forward(self, t0: typing.SupportsFloat | typing.SupportsIndex, t_end: typing.SupportsFloat | typing.SupportsIndex, q0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], qd0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]]:
+        """
+        (t (N + 1), y (N + 1, K)) of the run.
+        """
 def R1(phi1: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
     """
     Rotation matrix about x by phi1 (rad), (3, 3).
@@ -621,24 +728,65 @@ def R3(phi3: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64]
     """
     Rotation matrix about z by phi3 (rad), (3, 3).
     """
-def _evaluate_outputs(system: _System, t: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"], s: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"], lambda_: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]]:
+def _auto_stiff_method(system: _System, iteration_matrix: str) -> str:
+    """
+    The implicit method method='auto' hands over to.
+    """
+def _check_options(system: _System, t0: typing.SupportsFloat | typing.SupportsIndex, t_end: typing.SupportsFloat | typing.SupportsIndex, q0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], qd0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], t_eval: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], options: IntegratorOptions) -> None:
+    """
+    integrate's checks of the options alone (ValueError naming the first bad one).
+    """
+def _evaluate_outputs(system: _System, t: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"], qd: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"], s: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"], lambda_: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"]) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]]:
     ...
-def _integrate(system: _System, t0: typing.SupportsFloat | typing.SupportsIndex, t_end: typing.SupportsFloat | typing.SupportsIndex, q0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], qd0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], t_eval: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], options: IntegratorOptions, keep_going: typing.Any) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], dict, bool, typing.Any, typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]]:
+def _integer(x: typing.Any, name: str, expected: str, lo: typing.SupportsInt | typing.SupportsIndex, hi: typing.SupportsInt | typing.SupportsIndex) -> int:
+    """
+    x as an int in [lo, hi]: a Python or numpy integer (not a bool or float), else the ValueError.
+    """
+def _integrate(system: _System, t0: typing.SupportsFloat | typing.SupportsIndex, t_end: typing.SupportsFloat | typing.SupportsIndex, q0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], qd0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], t_eval: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], options: IntegratorOptions, keep_going: typing.Any) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], dict, bool, typing.Any, typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]]:
     ...
+def _make_profile(maker: str, *args) -> typing.Any:
+    """
+    The profile of the kind `maker` (a row of _profile_kinds) from its arguments, in the row's order.
+    """
+def _measures_outputs(system: _System, options: IntegratorOptions) -> bool:
+    """
+    Whether error_on's default for the run is the bodies' displacements (else the state).
+    """
+def _method_table() -> list:
+    """
+    The C++ methods, each a dict: name, family, order (of the propagated solution), error_estimate, adaptive (by
+    default), measures_outputs (error_on's default: the bodies, else the state), adjoint (rigidfem.gradient), options
+    (the names it reads), doc.
+    """
+def _option_table() -> list:
+    """
+    The options of the integrators, each a dict: name, type, default, unit, doc, none_allowed.
+    """
 def _point_positions(system: _System, body: typing.SupportsInt | typing.SupportsIndex, r: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], frame: typing.SupportsInt | typing.SupportsIndex, t: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
     ...
+def _point_to_point_laws() -> list[str]:
+    """
+    The laws of rest_to_rest_profile and ramp_profile, by name.
+    """
+def _profile_kinds() -> list:
+    """
+    The kinds of profile, each a dict: maker, arguments (name, type, expected) in the maker's order.
+    """
+def _real(x: typing.Any, name: str, expected: str) -> float:
+    """
+    x as a float: a real number (int, float, numpy real scalar or 0-d array), else ValueError
+    '<name>: expected <expected>, got <repr>'. NaN and inf pass.
+    """
+def _real_array(x: typing.Any, name: str, expected: str) -> numpy.typing.NDArray[numpy.float64]:
+    """
+    x as a float64 array of any shape (bindings.hpp's real_array_arg), else the ValueError.
+    """
 def callback_profile(function: collections.abc.Callable[[float], tuple[typing.SupportsFloat | typing.SupportsIndex, typing.SupportsFloat | typing.SupportsIndex, typing.SupportsFloat | typing.SupportsIndex]]) -> Profile:
-    ...
-def constant_profile(value: typing.SupportsFloat | typing.SupportsIndex) -> Profile:
     ...
 def euler_zyx(phi3: typing.Any, phi2: typing.Any, phi1: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
     """
     R3(phi3) R2(phi2) R1(phi1), book eq. (2.7): yaw, pitch, roll in rad. (3, 3).
     """
-def harmonic_profile(amplitude: typing.SupportsFloat | typing.SupportsIndex, omega: typing.SupportsFloat | typing.SupportsIndex, phase: typing.SupportsFloat | typing.SupportsIndex, offset: typing.SupportsFloat | typing.SupportsIndex) -> Profile:
-    ...
-def harmonic_series_profile(amplitudes: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], omegas: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], phases: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], offset: typing.SupportsFloat | typing.SupportsIndex) -> Profile:
-    ...
 def homogeneous(R: typing.Any, r: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
     """
     [[R, r], [0, 1]] (4, 4); r in m.
@@ -647,21 +795,19 @@ def inverse(T: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float6
     """
     Inverse of a homogeneous transform, [[R^T, -R^T r], [0, 1]] (4, 4).
     """
-def joint_transform(coordinates: collections.abc.Sequence[str], q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
+def joint_transform(coordinates: typing.Any, q: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
     """
     Joint transform Trans(x, y, z) R3(phi3) R2(phi2) R1(phi1) restricted to `coordinates`
     (names from 'x', 'y', 'z', 'rz', 'ry', 'rx', taken in the book's order); q in m and rad. (4, 4).
     """
-def joint_transform_derivative(coordinates: collections.abc.Sequence[str], q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], i: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
+def joint_transform_derivative(coordinates: typing.Any, q: typing.Any, i: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
     """
     dT/dq_i of joint_transform (4, 4).
     """
-def joint_transform_second_derivative(coordinates: collections.abc.Sequence[str], q: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], i: typing.SupportsInt | typing.SupportsIndex, j: typing.SupportsInt | typing.SupportsIndex) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
+def joint_transform_second_derivative(coordinates: typing.Any, q: typing.Any, i: typing.Any, j: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
     """
     d2T/dq_i dq_j of joint_transform (4, 4).
     """
-def polynomial_profile(coefficients: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> Profile:
-    ...
 def pseudo_inertia(mass: typing.Any, com: typing.Any, inertia: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
     """
     Pseudo-inertia H = int r r^T dm (4, 4) of a body: mass (kg), centre of mass com (3,) m and
@@ -671,7 +817,3 @@ def skew(w: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64],
     """
     Skew-symmetric S(w) with S(w) x = w x x. (3, 3).
     """
-def spin_up_profile(omega: typing.SupportsFloat | typing.SupportsIndex, duration: typing.SupportsFloat | typing.SupportsIndex) -> Profile:
-    ...
-def spline_profile(t: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], q: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> Profile:
-    ...
