@@ -45,7 +45,6 @@ from collections import Counter, defaultdict, deque
 from pathlib import Path
 
 import rigidfem as rf
-from rigidfem import _contract
 
 HERE = Path(__file__).resolve().parent
 CORPUS = HERE / "fuzz_corpus"
@@ -980,20 +979,37 @@ def load_corpus(directory: Path = CORPUS) -> list[tuple[Path, dict]]:
 
 AXES = ("x", "y", "z")
 ROT = {"x": "rx", "y": "ry", "z": "rz"}
-METHODS = ("euler", "symplectic_euler", "rk4", "dopri5", "rkf45", "newmark", "hht", "generalized_alpha",
-           "implicit_spring", "esdirk43", "radau5", "scipy:Radau", "scipy:BDF", "scipy:LSODA", "scipy:RK45",
-           "scipy:DOP853")
-FIXED_STEP = ("euler", "symplectic_euler", "rk4", "newmark", "hht", "generalized_alpha", "implicit_spring")
+METHODS = tuple(m for m in rf.methods() if m != "auto")  # the method table's (with SciPy's)
+FIXED_STEP = tuple(m for m, d in rf.methods().items() if not d.adaptive)
+
+
+def _compiled_parameters(function) -> tuple:
+    """(name, has a default) of each parameter of a compiled method, from the signature line pybind11 writes first
+    in its docstring (``name(self: ..., t: float, q: ..., load_factor: float = 1.0) -> ...``)."""
+    line = function.__doc__.splitlines()[0]
+    inside = line[line.index("(") + 1:line.rindex(") ->")]
+    parts, depth, quoted, start = [], 0, False, 0
+    for i, c in enumerate(inside + ","):
+        if c == '"':
+            quoted = not quoted
+        elif not quoted and c in "[(":
+            depth += 1
+        elif not quoted and c in "])":
+            depth -= 1
+        elif not quoted and depth == 0 and c == ",":
+            parts.append(inside[start:i].strip())
+            start = i + 1
+    return tuple((part.split(":")[0].strip(), " = " in part) for part in parts)
 
 def _parameters(name: str) -> tuple:
     """The parameters of System.<name> after self, a "?" after those with a default: from the Python
-    signature, or for a compiled method from its binding's (rigidfem._contract.compiled_parameters)."""
+    signature, or for a compiled method from its binding's (_compiled_parameters)."""
     function = getattr(rf.System, name)
     try:
         parameters = list(inspect.signature(function).parameters.values())[1:]
         return tuple(p.name + "?" * (p.default is not p.empty) for p in parameters)
-    except (TypeError, ValueError):  # a compiled method (its guard wraps it): no Python signature
-        return tuple(p + "?" * default for p, default in _contract.compiled_parameters(function)[1:])
+    except (TypeError, ValueError):  # a compiled method: no Python signature
+        return tuple(p + "?" * default for p, default in _compiled_parameters(function)[1:])
 
 
 #: System methods: parameter lists ("t?" is t with a default, required when the system has drives).
@@ -1975,12 +1991,12 @@ class Gen:
         if kind == "centerline":
             args = [A("system"), self.vector_arg("q")]
             params = ["system", "q"]
+            kw = {}
             if self.chance(0.5) or self.n_prescribed:
                 t = self.time_arg()
                 t["role"] = "topt"  # None is the default: fine without drives
-                args.append(t)
-                params.append("t")
-            return self.emit(f"{bm['var']}.centerline", args, params, label="Beam.centerline")
+                kw["t"] = t  # a keyword (t comes by keyword in functions about an operating point)
+            return self.emit(f"{bm['var']}.centerline", args, params, kw, label="Beam.centerline")
         s = self.choice([0.0, bm["length"], bm["length"] * 0.3]) if self.chance(0.8) else None
         a = A(fl(s)) if s is not None else A(self.choice(["-0.1", fl(bm["length"] * 1.5), "nan", "'x'", "None"]),
                                              bad=True)

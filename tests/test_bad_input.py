@@ -319,7 +319,7 @@ def test_bad_input_does_not_crash_the_interpreter():
                     raise SystemExit("no error")
         for index in (-1, 2, 10**6):
             point = t.rf.Point(index, np.zeros(3))
-            for f in (lambda: s.transform(index, np.zeros(2)), lambda: s.position(point, np.zeros(2))):
+            for f in (lambda: s.transform(index, 0.0, np.zeros(2)), lambda: s.position(point, 0.0, np.zeros(2))):
                 try:
                     f()
                 except ValueError:

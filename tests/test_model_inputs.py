@@ -234,13 +234,13 @@ def test_poses_need_t_when_drives_move_the_bodies():
                                3, deform="bend_z")
     beam_model.prescribe(hub2, rf.motion.harmonic(amplitude=0.5, omega=2.0))
     beam_system = beam_model.compile()
-    # version 0.1's order without t (deprecated) keeps its rule; centerline's t is a keyword
-    calls = {"position": lambda: system.position(tip, q), "velocity": lambda: system.velocity(tip, q, qd),
-             "transform": lambda: system.transform(link, q)}
+    # t comes first and has no default (version 0.1's order, t last or left out, is gone); centerline's t is a
+    # keyword, required with drives
+    with pytest.raises(TypeError):
+        system.position(tip, q)
+    with pytest.raises(ValueError, match=r"^t: expected a finite time in s, got \[0.2\]"):
+        system.velocity(tip, q, qd, 0.0)
     required = r"^t: required because the system has prescribed coordinates \(hub\.rz\)"
-    for name, call in calls.items():
-        with pytest.warns(DeprecationWarning, match=f"{name}.*t first"), pytest.raises(ValueError, match=required):
-            call()
     with pytest.raises(ValueError, match=required):
         beam.centerline(beam_system, np.zeros(beam_system.nq))
     t = 0.7
@@ -254,25 +254,22 @@ def test_poses_need_t_when_drives_move_the_bodies():
     np.testing.assert_allclose(line, [rz(theta) @ [x, 0.0, 0.0] for x in s], atol=1e-15)
 
 
-def test_a_bad_vector_is_named_before_the_missing_t():
-    """An energy without t of a system with drives, and a q that could not be one (found by
-    scripts/fuzz.py): the ValueError names q, the argument that is wrong, not the t left out."""
+def test_a_state_first_call_is_refused_naming_t_or_the_vector():
+    """Version 0.1's order (the state first, t last or left out) is gone: a call in it names t (a vector where t
+    comes) or is a TypeError (an argument missing); in the order (t, q, qd) the compiled checks name the vector."""
     model, _ = rf.samples.kane_beam(omega=6.0, duration=15.0, elements=3)
     system = model.compile()
     n = system.nq
-    # version 0.1's order, t left out (deprecated)
-    with pytest.warns(DeprecationWarning), pytest.raises(ValueError, match=r"^q: .*NaN or inf"):
+    with pytest.raises(ValueError, match=r"^t: expected a finite time in s, got array"):
+        system.kinetic_energy(np.zeros(n), np.zeros(n), 0.0)
+    with pytest.raises(TypeError):
         system.kinetic_energy(np.full(n, -np.inf), np.zeros(n))
-    # a first vector of another size than nq cannot be the old order's q: the new order's bad t is named
-    with pytest.raises(ValueError, match=r"^t: expected a finite time"):
-        system.dissipated_power(np.zeros(n + 1), np.zeros(n))
-    with pytest.warns(DeprecationWarning), pytest.raises(ValueError, match=r"^qd: "):
-        system.kinetic_energy(np.zeros(n), np.zeros(n + 2))
-    with pytest.warns(DeprecationWarning), pytest.raises(ValueError, match=r"^t: required"):
-        system.kinetic_energy(np.zeros(n), np.zeros(n))
-    # and in the new order the compiled checks name the vector
+    with pytest.raises(ValueError, match=r"^q: expected \d+ \(nq\) finite values, got NaN or inf"):
+        system.kinetic_energy(0.0, np.full(n, -np.inf), np.zeros(n))
     with pytest.raises(ValueError, match=r"^q: "):
         system.dissipated_power(0.0, np.zeros(n + 1), np.zeros(n))
+    with pytest.raises(ValueError, match=r"^qd: "):
+        system.kinetic_energy(0.0, np.zeros(n), np.zeros(n + 2))
 
 
 def test_poses_default_to_t_0_without_drives():
@@ -282,10 +279,6 @@ def test_poses_default_to_t_0_without_drives():
     np.testing.assert_allclose(system.position(tip, 0.0, [0.5]), rz(0.5) @ [1.0, 0.0, 0.0], atol=1e-15)
     np.testing.assert_allclose(system.velocity(tip, 0.0, [0.5], [-1.0]), -rz(0.5) @ [0.0, 1.0, 0.0], atol=1e-15)
     np.testing.assert_allclose(system.transform(link, 0.0, [0.5])[:3, :3], rz(0.5), atol=1e-15)
-    # a locked coordinate (constant drive) still needs t: it is a drive like any other
-    model.prescribe(link, rf.motion.constant(0.5))
-    with pytest.warns(DeprecationWarning), pytest.raises(ValueError, match=r"^t: required"):
-        model.compile().position(tip, [])  # version 0.1's order, t left out
 
 
 # --- c) force laws that return something else than a number -----------------------------------

@@ -25,7 +25,7 @@ def four_bar(arm: bool = False):
 def test_loop_and_element_methods_name_a_bad_q(name, bad, says):
     _, system, q, _ = four_bar()
     value = {"complex": q.astype(complex), "row": q[None, :], "text": "abc"}[bad]
-    with pytest.raises(ValueError, match=f"^q: expected an array of nq = 3 coordinates.*{says}"):
+    with pytest.raises(ValueError, match=f"^q: expected a 1-D array of coordinates.*{says}"):
         getattr(system, name)(0.0, value, np.zeros(3))
 
 

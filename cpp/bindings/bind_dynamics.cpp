@@ -82,6 +82,36 @@ class Workspace {
   std::unique_ptr<Data> fresh_;
 };
 
+// Whether every number of a result is finite.
+bool all_finite(double x) { return std::isfinite(x); }
+template <class D>
+bool all_finite(const Eigen::DenseBase<D>& m) { return m.allFinite(); }
+template <class A, class B>
+bool all_finite(const std::pair<A, B>& p) { return all_finite(p.first) && all_finite(p.second); }
+
+// The result of a call whose inputs were finite: NaN or inf in it can only come from overflowing the range of
+// doubles, a SimulationError naming the call, its time and the largest inputs.
+template <class R, class... V>
+R finite(R result, const char* call, double t, const V&... inputs) {
+  if (all_finite(result)) return result;
+  std::string sizes;
+  ((sizes += (sizes.empty() ? "largest |" : ", largest |") + std::string(V::name) + "| = " + num(inputs.largest(), 3)),
+   ...);
+  throw SimulationError(t, std::string(call) + "() overflowed: finite inputs (" + sizes +
+                               ") gave NaN or inf, beyond the range of doubles");
+}
+
+// The system and the workspace of a stage: ValueError naming the argument for another type.
+const System& system_of(const py::handle& x) {
+  if (!py::isinstance<System>(x)) bad("system", "a System from Model.compile()", arg_repr(x));
+  return x.cast<const System&>();
+}
+
+Data& data_of(const py::handle& x) {
+  if (!py::isinstance<Data>(x)) bad("data", "a workspace from system.make_data()", arg_repr(x));
+  return x.cast<Data&>();
+}
+
 }  // namespace
 
 void bind_dynamics(py::module_& m) {
@@ -173,7 +203,7 @@ void bind_dynamics(py::module_& m) {
           "Kind of every loop closure ('revolute', ..., 'distance').")
       .def(
           "loop_constraints",
-          [](const System& s, double t, const RefV& q, const RefV& qd) {
+          [](const System& s, Time t, Coordinates q, Rates qd) {
             Workspace d(s);
             loop_equations(s, *d, t, q, qd);
             return py::make_tuple(VecX((*d).g), VecX((*d).gd), free_jacobian(s, *d));
@@ -183,19 +213,19 @@ void bind_dynamics(py::module_& m) {
           "rows), their rates gd = G qd + dg/dt (nl,) and the Jacobian G = dg/dq (nl, nq).")
       .def(
           "loop_multipliers",
-          [](const System& s, double t, const RefV& q, const RefV& qd) {
+          [](const System& s, Time t, Coordinates q, Rates qd) {
             Workspace d(s);
             rigidfem::forward_dynamics(s, *d, t, q, qd);
-            return VecX((*d).lambda);
+            return finite(VecX((*d).lambda), "loop_multipliers", t, q, qd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"),
           "Multipliers lambda (nl,) of M qdd = f + G^T lambda at the forward-dynamics accelerations.")
       .def(
           "loop_reactions",
-          [](const System& s, double t, const RefV& q, const RefV& qd) {
+          [](const System& s, Time t, Coordinates q, Rates qd) {
             Workspace d(s);
             rigidfem::forward_dynamics(s, *d, t, q, qd);
-            return rigidfem::loop_reactions(s, *d, (*d).lambda);
+            return finite(rigidfem::loop_reactions(s, *d, (*d).lambda), "loop_reactions", t, q, qd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"),
           "Reaction of every loop closure on its body b (nloops, 6): force (N) and torque (N m, about frame B's\n"
@@ -226,9 +256,9 @@ void bind_dynamics(py::module_& m) {
           "(how it is drawn, body a, point on a (m), body b, point on b) of every force element and loop.")
       .def(
           "element_states",
-          [](const System& s, double t, const RefV& q, const RefV& qd) {
+          [](const System& s, Time t, Coordinates q, Rates qd) {
             Workspace d(s);
-            return rigidfem::element_states(s, *d, t, q, qd);
+            return finite(rigidfem::element_states(s, *d, t, q, qd), "element_states", t, q, qd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"),
           "Length l (m), rate dl/dt (m/s) and axial force F (N, positive pushing the two points apart) of every\n"
@@ -236,80 +266,81 @@ void bind_dynamics(py::module_& m) {
 
       .def(
           "_assemble",
-          [](const System& s, double t, const RefV& q, const RefV& qd, double tol, int max_iterations) {
+          [](const System& s, Time t, Coordinates q, Rates qd, double tol, int max_iterations) {
             Workspace d(s);
-            VecX x = q, xd = qd;
+            VecX x = q.vector(), xd = qd.vector();
             project_onto_loops(s, *d, t, x, xd, tol, max_iterations);
             return py::make_tuple(x, xd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("tol"), py::arg("max_iterations"))
       .def(
-          "forward_dynamics", [](const System& s, double t, const RefV& q, const RefV& qd) {
+          "forward_dynamics", [](const System& s, Time t, Coordinates q, Rates qd) {
             Workspace d(s);
-            return VecX(rigidfem::forward_dynamics(s, *d, t, q, qd));
+            return finite(VecX(rigidfem::forward_dynamics(s, *d, t, q, qd)), "forward_dynamics", t, q, qd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"),
           "Accelerations qdd (nq,) solving A(q) qdd = f(q, qd, t); t in s, q in m/rad, qd in m/s, rad/s.")
       .def(
-          "mass_matrix", [](const System& s, double t, const RefV& q) {
+          "mass_matrix", [](const System& s, Time t, Coordinates q) {
             Workspace d(s);
-            return rigidfem::mass_matrix(s, *d, t, q);
+            return finite(rigidfem::mass_matrix(s, *d, t, q), "mass_matrix", t, q);
           },
           py::arg("t"), py::arg("q"), "Mass matrix A(q) (nq, nq), a_ij = sum_p tr(T_p,i H_p T_p,j^T).")
       .def(
           "generalized_forces",
-          [](const System& s, double t, const RefV& q, const RefV& qd, double load_factor) {
+          [](const System& s, Time t, Coordinates q, Rates qd, LoadFactor load_factor) {
             Workspace d(s);
-            return rigidfem::generalized_forces(s, *d, t, q, qd, load_factor);
+            return finite(rigidfem::generalized_forces(s, *d, t, q, qd, load_factor), "generalized_forces", t, q, qd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("load_factor") = 1.0,
           "Right-hand side f (nq,) of A qdd = f: loads, gravity, springs, dampers minus velocity terms (N, N m).\n"
           "load_factor scales gravity, loads and applied generalised forces.")
       .def(
           "static_forces",
-          [](const System& s, double t, const RefV& q, double load_factor) {
+          [](const System& s, Time t, Coordinates q, LoadFactor load_factor) {
             Workspace d(s);
-            return rigidfem::static_forces(s, *d, t, q, load_factor);
+            return finite(rigidfem::static_forces(s, *d, t, q, load_factor), "static_forces", t, q);
           },
           py::arg("t"), py::arg("q"), py::arg("load_factor") = 1.0,
           "Static residual f(q) (nq,): generalised forces at rest, prescribed coordinates held at their values at t.")
       .def(
           "force_jacobians",
-          [](const System& s, double t, const RefV& q, const RefV& qd, double load_factor, bool static_drives) {
+          [](const System& s, Time t, Coordinates q, Rates qd, LoadFactor load_factor, StaticFlag static_drives) {
+            if (static_drives) check_vector(qd, s.nq, "qd", "nq");  // unread then, but judged all the same
             Workspace d(s);
-            return rigidfem::force_jacobians(s, *d, t, q, qd, load_factor, static_drives);
+            return finite(rigidfem::force_jacobians(s, *d, t, q, qd, load_factor, static_drives), "force_jacobians", t, q, qd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("load_factor") = 1.0, py::arg("static") = false,
           "(df/dq, df/dqd), each (nq, nq): analytic for recursive systems, central differences for\n"
           "algorithm='lagrange'. -df/dq is the tangent stiffness K,\n"
           "-df/dqd the damping and gyroscopic matrix C. static=True holds the prescribed coordinates at t.")
       .def(
-          "driving_forces", [](const System& s, double t, const RefV& q, const RefV& qd) {
+          "driving_forces", [](const System& s, Time t, Coordinates q, Rates qd) {
             Workspace d(s);
-            return rigidfem::driving_forces(s, *d, t, q, qd);
+            return finite(rigidfem::driving_forces(s, *d, t, q, qd), "driving_forces", t, q, qd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"),
           "Forces/torques (np,) the drives exert on the prescribed coordinates (N or N m).")
       .def(
-          "rhs", [](const System& s, double t, const RefV& y) {
+          "rhs", [](const System& s, Time t, States y) {
             Workspace d(s);
-            return rigidfem::rhs(s, *d, t, y);
+            return finite(rigidfem::rhs(s, *d, t, y), "rhs", t, y);
           },
           py::arg("t"), py::arg("y"), "dy/dt = [qd, qdd] for y = [q, qd] (2 nq,): the signature of scipy's solve_ivp.\n"
           "With loop closures qdd holds them at the acceleration level only: g(q) = 0 drifts under solve_ivp\n"
           "(rigidfem.simulate's methods project onto the loops).")
       .def(
-          "jacobian", [](const System& s, double t, const RefV& y) {
+          "jacobian", [](const System& s, Time t, States y) {
             Workspace d(s);
-            return rhs_jacobian(s, *d, t, y);
+            return finite(rhs_jacobian(s, *d, t, y), "jacobian", t, y);
           },
           py::arg("t"), py::arg("y"), "d(rhs)/dy (2 nq, 2 nq) for solve_ivp(jac=...): analytic for recursive systems (see\n"
           "acceleration_derivatives), central differences for algorithm='lagrange'.")
       .def(
           "inverse_dynamics",
-          [](const System& s, double t, const RefV& q, const RefV& qd, const RefV& qdd) {
+          [](const System& s, Time t, Coordinates q, Rates qd, Accelerations qdd) {
             Workspace d(s);
-            return rigidfem::inverse_dynamics(s, *d, t, q, qd, qdd);
+            return finite(rigidfem::inverse_dynamics(s, *d, t, q, qd, qdd), "inverse_dynamics", t, q, qd, qdd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("qdd"),
           "r = A(q) qdd - f(q, qd, t) (nq,): the generalised forces (N or N m) the free coordinates\n"
@@ -317,16 +348,16 @@ void bind_dynamics(py::module_& m) {
           "equations of motion; zero at the forward-dynamics accelerations).")
       .def(
           "inverse_dynamics_derivatives",
-          [](const System& s, double t, const RefV& q, const RefV& qd, const RefV& qdd) {
+          [](const System& s, Time t, Coordinates q, Rates qd, Accelerations qdd) {
             Workspace d(s);
-            return rigidfem::inverse_dynamics_derivatives(s, *d, t, q, qd, qdd);
+            return finite(rigidfem::inverse_dynamics_derivatives(s, *d, t, q, qd, qdd), "inverse_dynamics_derivatives", t, q, qd, qdd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("qdd"),
           "(dr/dq, dr/dqd), each (nq, nq), of r = A qdd - f: analytic through the RNEA for recursive\n"
           "systems (O(n) per column), central differences for algorithm='lagrange'.")
       .def(
           "_inverse_dynamics_direction",
-          [](const System& s, double t, const RefV& q, const RefV& qd, const RefV& qdd, const VecX& dq, const VecX& dqd,
+          [](const System& s, Time t, Coordinates q, Rates qd, Accelerations qdd, const VecX& dq, const VecX& dqd,
              const VecX& dqdd) {
             check_vector(dq, s.nq, "dq", "nq"), check_vector(dqd, s.nq, "dqd", "nq"), check_vector(dqdd, s.nq, "dqdd", "nq");
             Workspace d(s);
@@ -337,7 +368,7 @@ void bind_dynamics(py::module_& m) {
           "exact, O(n)), central differences (lagrange).")
       .def(
           "_inverse_dynamics_vjp",
-          [](const System& s, double t, const RefV& q, const RefV& qd, const RefV& qdd, const VecX& mu) {
+          [](const System& s, Time t, Coordinates q, Rates qd, Accelerations qdd, const VecX& mu) {
             check_vector(mu, s.nq, "mu", "nq");
             Workspace d(s);
             const ResidualVjp r = rigidfem::inverse_dynamics_vjp(s, *d, t, q, qd, qdd, mu);
@@ -348,67 +379,67 @@ void bind_dynamics(py::module_& m) {
           "qdd, each (np): the RNEA's reverse mode (recursive systems), O(n).")
       .def(
           "acceleration_derivatives",
-          [](const System& s, double t, const RefV& q, const RefV& qd) {
+          [](const System& s, Time t, Coordinates q, Rates qd) {
             Workspace d(s);
-            return rigidfem::acceleration_derivatives(s, *d, t, q, qd);
+            return finite(rigidfem::acceleration_derivatives(s, *d, t, q, qd), "acceleration_derivatives", t, q, qd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"),
           "(dqdd/dq, dqdd/dqd), each (nq, nq): -A^-1 (dr/dq, dr/dqd) at the forward-dynamics qdd; with loop\n"
           "closures, of the constrained qdd (multipliers and constraint Jacobian varying too), by central differences.")
       .def(
-          "transform", [](const System& s, int body, double t, const RefV& q) {
+          "transform", [](const System& s, BodyArgument body, Time t, Coordinates q) {
             Workspace d(s);
-            return body_pose(s, *d, body, t, q);
+            return finite(body_pose(s, *d, body, t, q), "transform", t, q);
           },
           py::arg("body"), py::arg("t"), py::arg("q"), "Pose T_p (4, 4) of a body (by index) in the global frame.")
       .def(
-          "_position", [](const System& s, const Point& p, double t, const RefV& q) {
+          "_position", [](const System& s, PointArgument p, Time t, Coordinates q) {
             Workspace d(s);
-            return point_position(s, *d, p, t, q);
+            return finite(point_position(s, *d, p, t, q), "position", t, q);
           },
           py::arg("point"), py::arg("t"), py::arg("q"))
       .def(
           "_positions",
-          [](const System& s, const std::vector<Point>& points, double t, const RefV& q) {
+          [](const System& s, PointsArgument points, Time t, Coordinates q) {
             Workspace d(s);
-            return point_positions(s, *d, points, t, q);
+            return finite(point_positions(s, *d, points, t, q), "positions", t, q);
           },
           py::arg("points"), py::arg("t"), py::arg("q"))
       .def(
-          "_velocity", [](const System& s, const Point& p, double t, const RefV& q, const RefV& qd) {
+          "_velocity", [](const System& s, PointArgument p, Time t, Coordinates q, Rates qd) {
             Workspace d(s);
-            return point_velocity(s, *d, p, t, q, qd);
+            return finite(point_velocity(s, *d, p, t, q, qd), "velocity", t, q, qd);
           },
           py::arg("point"), py::arg("t"), py::arg("q"), py::arg("qd"))
       .def(
-          "kinetic_energy", [](const System& s, double t, const RefV& q, const RefV& qd) {
+          "kinetic_energy", [](const System& s, Time t, Coordinates q, Rates qd) {
             Workspace d(s);
-            return energies(s, *d, t, q, qd).kinetic;
+            return finite(energies(s, *d, t, q, qd).kinetic, "kinetic_energy", t, q, qd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"), "Kinetic energy 1/2 sum tr(dT H dT^T) (J).")
       .def(
-          "gravity_energy", [](const System& s, double t, const RefV& q) {
+          "gravity_energy", [](const System& s, Time t, Coordinates q) {
             Workspace d(s);
-            return energies(s, *d, t, q, VecX::Zero(s.nq)).gravity;
+            return finite(energies(s, *d, t, q, VecX::Zero(s.nq)).gravity, "gravity_energy", t, q);
           },
           py::arg("t"), py::arg("q"), "Potential energy of gravity -sum m g^T r_C (J).")
       .def(
-          "elastic_energy", [](const System& s, double t, const RefV& q) {
+          "elastic_energy", [](const System& s, Time t, Coordinates q) {
             Workspace d(s);
-            return energies(s, *d, t, q, VecX::Zero(s.nq)).elastic;
+            return finite(energies(s, *d, t, q, VecX::Zero(s.nq)).elastic, "elastic_energy", t, q);
           },
           py::arg("t"), py::arg("q"), "Energy of the joint springs 1/2 sum c (q - q_rest)^2 and of the force elements' springs\n"
           "1/2 sum k (l - l0)^2 (J).")
       .def(
-          "potential_energy", [](const System& s, double t, const RefV& q) {
+          "potential_energy", [](const System& s, Time t, Coordinates q) {
             Workspace d(s);
-            return energies(s, *d, t, q, VecX::Zero(s.nq)).potential();
+            return finite(energies(s, *d, t, q, VecX::Zero(s.nq)).potential(), "potential_energy", t, q);
           },
           py::arg("t"), py::arg("q"), "Gravity plus elastic energy (J).")
       .def(
-          "dissipated_power", [](const System& s, double t, const RefV& q, const RefV& qd) {
+          "dissipated_power", [](const System& s, Time t, Coordinates q, Rates qd) {
             Workspace d(s);
-            return energies(s, *d, t, q, qd).dissipated;
+            return finite(energies(s, *d, t, q, qd).dissipated, "dissipated_power", t, q, qd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"), "Power dissipated by the joint dampers, sum b qd^2, and by the force elements' dampers,\n"
           "sum c (dl/dt)^2 (W).")
@@ -434,22 +465,43 @@ void bind_dynamics(py::module_& m) {
       .def_readonly("tau", &Data::tau, "Driving forces (np,).");
 
   auto stages = m.def_submodule("stages", "The named stages of forward dynamics, each writing into a Data.");
-  stages.def("set_state", &set_state, py::arg("system"), py::arg("data"), py::arg("t"), py::arg("q"), py::arg("qd"),
-             "(t, q, qd) => data.qa, qda, qdda (drives evaluated).");
   stages.def(
-      "kinematics", [](const System& s, Data& d) { rigidfem::kinematics(s, d); }, py::arg("system"), py::arg("data"),
-      "(qa, qda, qdda) => data.T, Td, Tdd, U.");
+      "set_state",
+      [](const py::object& s, const py::object& d, Time t, Coordinates q, Rates qd) {
+        rigidfem::set_state(system_of(s), data_of(d), t, q, qd);
+      },
+      py::arg("system"), py::arg("data"), py::arg("t"), py::arg("q"), py::arg("qd"),
+      "(t, q, qd) => data.qa, qda, qdda (drives evaluated).");
   stages.def(
-      "generalized_forces", [](const System& s, Data& d) { rigidfem::generalized_forces(s, d); return d.f; },
+      "kinematics", [](const py::object& s, const py::object& d) { rigidfem::kinematics(system_of(s), data_of(d)); },
+      py::arg("system"), py::arg("data"), "(qa, qda, qdda) => data.T, Td, Tdd, U.");
+  stages.def(
+      "generalized_forces",
+      [](const py::object& s, const py::object& d) {
+        rigidfem::generalized_forces(system_of(s), data_of(d));
+        return data_of(d).f;
+      },
       py::arg("system"), py::arg("data"), "=> data.f (loads, velocity terms, springs, dampers); returns it.");
   stages.def(
-      "mass_matrix", [](const System& s, Data& d) { rigidfem::mass_matrix(s, d); return d.A; }, py::arg("system"),
-      py::arg("data"), "=> data.A; returns it.");
+      "mass_matrix",
+      [](const py::object& s, const py::object& d) {
+        rigidfem::mass_matrix(system_of(s), data_of(d));
+        return data_of(d).A;
+      },
+      py::arg("system"), py::arg("data"), "=> data.A; returns it.");
   stages.def(
-      "accelerations", [](const System& s, Data& d) { rigidfem::accelerations(s, d); return d.qdd; },
+      "accelerations",
+      [](const py::object& s, const py::object& d) {
+        rigidfem::accelerations(system_of(s), data_of(d));
+        return data_of(d).qdd;
+      },
       py::arg("system"), py::arg("data"), "=> data.qdd solving A qdd = f; returns it.");
   stages.def(
-      "driving_forces", [](const System& s, Data& d) { rigidfem::driving_forces(s, d); return d.tau; },
+      "driving_forces",
+      [](const py::object& s, const py::object& d) {
+        rigidfem::driving_forces(system_of(s), data_of(d));
+        return data_of(d).tau;
+      },
       py::arg("system"), py::arg("data"), "=> data.tau (needs accelerations); returns it.");
 }
 

@@ -10,6 +10,7 @@
 #include <string>
 
 #include "rigidfem/errors.hpp"
+#include "rigidfem/model.hpp"
 #include "rigidfem/transforms.hpp"
 
 namespace rigidfem::bindings {
@@ -143,6 +144,100 @@ inline std::vector<std::string> names_arg(const py::handle& x, const std::string
   return out;
 }
 
+// The arguments of a state, each a type that knows its role's name and converts by the rules above, so that a
+// binding reads `[](const System& s, Time t, Coordinates q, Rates qd)` and a wrong type or shape is a ValueError
+// naming the argument ("q: expected a 1-D array of coordinates (m, rad), got 'x'"); the sizes and values are the
+// core's to judge (check_vector: "q: expected 2 (nq) values, got 3"). An array that is already 1-D float64 and
+// contiguous is taken as it is (no copy).
+
+/// A time t (s): a real number, finite.
+struct Time {
+  double value = 0.0;
+  operator double() const { return value; }  // NOLINT: the time itself
+};
+
+/// A vector of real numbers in a role (q, q̇, q̈, y): the float64 array it was given or converted to.
+struct VectorArgument {
+  py::array_t<double> array;
+  operator Eigen::Ref<const VecX>() const {  // NOLINT: the values themselves, without a copy
+    return Eigen::Map<const VecX>(array.data(), array.size());
+  }
+  VecX vector() const { return Eigen::Map<const VecX>(array.data(), array.size()); }
+  /// The largest |x| (for the message of an overflow), 0 for none.
+  double largest() const { return array.size() ? Eigen::Map<const VecX>(array.data(), array.size()).cwiseAbs().maxCoeff() : 0.0; }
+};
+struct Coordinates : VectorArgument {
+  static constexpr const char* name = "q";
+  static constexpr const char* expected = "a 1-D array of coordinates (m, rad)";
+};
+struct Rates : VectorArgument {
+  static constexpr const char* name = "qd";
+  static constexpr const char* expected = "a 1-D array of rates (m/s, rad/s)";
+};
+struct Accelerations : VectorArgument {
+  static constexpr const char* name = "qdd";
+  static constexpr const char* expected = "a 1-D array of accelerations (m/s², rad/s²)";
+};
+struct States : VectorArgument {
+  static constexpr const char* name = "y";
+  static constexpr const char* expected = "a 1-D array of 2 nq values [q, qd]";
+};
+
+/// x as a VectorArgument of role T (ValueError naming T::name otherwise).
+template <class T>
+T vector_argument(const py::handle& x) {
+  T v;
+  PyObject* o = x.ptr();
+  if (py::isinstance<py::array_t<double>>(x) && py::reinterpret_borrow<py::array>(x).ndim() == 1 &&
+      (py::reinterpret_borrow<py::array>(x).flags() & py::array::c_style) && !PyBool_Check(o)) {
+    v.array = py::reinterpret_borrow<py::array_t<double>>(x);  // the fast path: taken as it is
+    return v;
+  }
+  auto a = real_array_arg(x, T::name, T::expected);
+  if (a.ndim() != 1) {
+    std::string shape;
+    for (py::ssize_t k = 0; k < a.ndim(); ++k) shape += (k ? ", " : "") + std::to_string(a.shape(k));
+    bad(T::name, T::expected, "shape (" + shape + (a.ndim() == 1 ? ",)" : ")"));
+  }
+  v.array = py::array_t<double, py::array::c_style | py::array::forcecast>::ensure(a);
+  return v;
+}
+
+/// The load factor λ of statics: a real number, finite.
+struct LoadFactor {
+  double value = 1.0;
+  operator double() const { return value; }  // NOLINT: the factor itself
+};
+/// static=: True or False.
+struct StaticFlag {
+  bool value = false;
+  operator bool() const { return value; }  // NOLINT: the flag itself
+};
+/// A material point of the system: a Point, or a Body (its origin).
+struct PointArgument {
+  Point value;
+  operator const Point&() const { return value; }  // NOLINT: the point itself
+};
+/// Points of the system, each a Point or a Body.
+struct PointsArgument {
+  std::vector<Point> value;
+  operator const std::vector<Point>&() const { return value; }  // NOLINT: the points themselves
+};
+/// A body of the system: a Body or its index.
+struct BodyArgument {
+  int value = -1;
+  operator int() const { return value; }  // NOLINT: the index itself
+};
+
+/// True or False (a numpy bool too), named `name`.
+inline bool flag_arg(const py::handle& x, const char* name) {
+  if (PyBool_Check(x.ptr())) return x.ptr() == Py_True;
+  if (py::hasattr(x, "dtype") && py::str(x.attr("dtype")).cast<std::string>() == "bool" &&
+      py::hasattr(x, "ndim") && x.attr("ndim").cast<int>() == 0)
+    return x.cast<bool>();
+  bad(name, "True or False", arg_repr(x));
+}
+
 void bind_arguments(py::module_& m);
 void bind_transforms(py::module_& m);
 void bind_model(py::module_& m);
@@ -150,3 +245,112 @@ void bind_dynamics(py::module_& m);
 void bind_profiles(py::module_& m);
 void bind_integrators(py::module_& m);
 }  // namespace rigidfem::bindings
+
+namespace pybind11::detail {
+
+// The casters of the roles: a wrong argument is the ValueError naming it, not pybind11's TypeError listing signatures.
+template <>
+struct type_caster<rigidfem::bindings::Time> {
+  PYBIND11_TYPE_CASTER(rigidfem::bindings::Time, const_name("float"));
+  bool load(handle src, bool) {
+    value.value = rigidfem::bindings::real_arg(src, "t", "a finite time in s");
+    if (!std::isfinite(value.value)) rigidfem::bad("t", "a finite time in s", rigidfem::num(value.value));
+    return true;
+  }
+  static handle cast(const rigidfem::bindings::Time& t, return_value_policy, handle) { return PyFloat_FromDouble(t.value); }
+};
+
+template <>
+struct type_caster<rigidfem::bindings::LoadFactor> {
+  PYBIND11_TYPE_CASTER(rigidfem::bindings::LoadFactor, const_name("float"));
+  bool load(handle src, bool) {
+    value.value = rigidfem::bindings::real_arg(src, "load_factor", "a finite number");
+    if (!std::isfinite(value.value)) rigidfem::bad("load_factor", "a finite number", rigidfem::num(value.value));
+    return true;
+  }
+  static handle cast(const rigidfem::bindings::LoadFactor& x, return_value_policy, handle) {
+    return PyFloat_FromDouble(x.value);
+  }
+};
+
+template <>
+struct type_caster<rigidfem::bindings::StaticFlag> {
+  PYBIND11_TYPE_CASTER(rigidfem::bindings::StaticFlag, const_name("bool"));
+  bool load(handle src, bool) {
+    value.value = rigidfem::bindings::flag_arg(src, "static");
+    return true;
+  }
+  static handle cast(const rigidfem::bindings::StaticFlag& x, return_value_policy, handle) {
+    return handle(x.value ? Py_True : Py_False).inc_ref();
+  }
+};
+
+template <>
+struct type_caster<rigidfem::bindings::PointArgument> {
+  PYBIND11_TYPE_CASTER(rigidfem::bindings::PointArgument, const_name("Point"));
+  bool load(handle src, bool) {
+    if (isinstance<rigidfem::Point>(src))
+      value.value = src.cast<rigidfem::Point>();
+    else if (isinstance<rigidfem::Body>(src))
+      value.value = rigidfem::Point(src.cast<rigidfem::Body>());
+    else
+      rigidfem::bad("point", "a Point or Body of this system", rigidfem::bindings::arg_repr(src));
+    return true;
+  }
+  static handle cast(const rigidfem::bindings::PointArgument& x, return_value_policy p, handle parent) {
+    return type_caster_base<rigidfem::Point>::cast(x.value, p, parent);
+  }
+};
+
+template <>
+struct type_caster<rigidfem::bindings::PointsArgument> {
+  PYBIND11_TYPE_CASTER(rigidfem::bindings::PointsArgument, const_name("list[Point]"));
+  bool load(handle src, bool) {
+    if (!isinstance<sequence>(src) || isinstance<str>(src))
+      rigidfem::bad("points", "a list of Points of this system", rigidfem::bindings::arg_repr(src));
+    for (const handle p : reinterpret_borrow<sequence>(src)) {
+      if (isinstance<rigidfem::Point>(p))
+        value.value.push_back(p.cast<rigidfem::Point>());
+      else if (isinstance<rigidfem::Body>(p))
+        value.value.emplace_back(p.cast<rigidfem::Body>());
+      else
+        rigidfem::bad("points", "a list of Points of this system", rigidfem::bindings::arg_repr(src));
+    }
+    return true;
+  }
+  static handle cast(const rigidfem::bindings::PointsArgument&, return_value_policy, handle) { return none().release(); }
+};
+
+template <>
+struct type_caster<rigidfem::bindings::BodyArgument> {
+  PYBIND11_TYPE_CASTER(rigidfem::bindings::BodyArgument, const_name("Body | int"));
+  bool load(handle src, bool) {
+    value.value = isinstance<rigidfem::Body>(src)
+                      ? src.cast<rigidfem::Body>().index
+                      : static_cast<int>(rigidfem::bindings::int_arg(src, "body", "a Body of this system or its index"));
+    return true;
+  }
+  static handle cast(const rigidfem::bindings::BodyArgument& x, return_value_policy, handle) {
+    return PyLong_FromLong(x.value);
+  }
+};
+
+template <class T>
+struct vector_role_caster {
+  PYBIND11_TYPE_CASTER(T, const_name("numpy.typing.ArrayLike"));
+  bool load(handle src, bool) {
+    value = rigidfem::bindings::vector_argument<T>(src);
+    return true;
+  }
+  static handle cast(const T& v, return_value_policy, handle) { return v.array.inc_ref(); }
+};
+template <>
+struct type_caster<rigidfem::bindings::Coordinates> : vector_role_caster<rigidfem::bindings::Coordinates> {};
+template <>
+struct type_caster<rigidfem::bindings::Rates> : vector_role_caster<rigidfem::bindings::Rates> {};
+template <>
+struct type_caster<rigidfem::bindings::Accelerations> : vector_role_caster<rigidfem::bindings::Accelerations> {};
+template <>
+struct type_caster<rigidfem::bindings::States> : vector_role_caster<rigidfem::bindings::States> {};
+
+}  // namespace pybind11::detail

@@ -297,11 +297,24 @@ PYBIND11_MODULE(_core, m) {
   namespace py = pybind11;
   using namespace rigidfem::bindings;
   m.doc() = "rigidfem C++ core: transforms, models, kinematics, the Lagrange and recursive formulations, integrators.";
-  py::register_exception<rigidfem::SimulationError>(m, "SimulationError", PyExc_RuntimeError)
-      .attr("__doc__") =
+  static PyObject* simulation_error = nullptr;  // the Python type, for the translator below
+  auto& registered = py::register_exception<rigidfem::SimulationError>(m, "SimulationError", PyExc_RuntimeError);
+  simulation_error = registered.ptr();
+  registered.attr("__doc__") =
       "A numerical failure, a RuntimeError whose message names the time (s) and the cause: a singular mass or "
       "iteration matrix, a step size below the minimum, a NaN or inf state, Newton divergence in a step or a load "
-      "step of the statics, max_steps, gimbal lock of ZYX Euler angles.";
+      "step of the statics, max_steps, gimbal lock of ZYX Euler angles. Its `time` (s) and `cause` say when and why.";
+  // Every SimulationError carries its time and cause (ForceLawError's own translator, registered later, comes first).
+  py::register_exception_translator([](std::exception_ptr p) {
+    try {
+      if (p) std::rethrow_exception(p);
+    } catch (const rigidfem::SimulationError& e) {
+      py::object error = py::reinterpret_borrow<py::object>(simulation_error)(e.what());
+      error.attr("time") = e.time;
+      error.attr("cause") = e.cause;
+      PyErr_SetObject(simulation_error, error.ptr());
+    }
+  });
   bind_arguments(m);
   bind_transforms(m);
   bind_profiles(m);

@@ -48,8 +48,8 @@ void full_state(const System& sys, Data& d, double t, const Eigen::Ref<const Vec
 // ... and the free accelerations q̈.
 void full_state(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
                 const Eigen::Ref<const VecX>& qd, const Eigen::Ref<const VecX>& qdd) {
+  check_vector(qdd, sys.nq, "qdd", "nq");  // before the drives are evaluated (one at a huge t may fail first)
   set_state(sys, d, t, q, qd);
-  check_vector(qdd, sys.nq, "qdd", "nq");
   set_accelerations(sys, d, qdd);
   tree_kinematics(sys, d);
 }

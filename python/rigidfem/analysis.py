@@ -33,7 +33,7 @@ import scipy.linalg
 import scipy.optimize
 from scipy.linalg import lapack
 
-from . import _checks, _core, _deprecation, _interrupt, analysis_sensitivities, display, export
+from . import _checks, _core, _interrupt, analysis_sensitivities, display, export
 from ._core import SimulationError
 from .persistence import Versioned
 
@@ -61,6 +61,18 @@ def _require_finite(t: float, what: str, **matrices) -> None:
         if not np.all(np.isfinite(a)):
             raise SimulationError(f"{_frame(t, what)}: {name} has NaN or inf entries (forces, drives or "
                                   "their derivatives overflow at this time and configuration)")
+
+
+def _compiled(t: float, what: str, name: str, function, *args):
+    """``function(*args)``, a compiled System method whose binding holds its results finite: its overflow (the
+    SimulationError whose cause starts "<function>() overflowed") is `what`'s, naming the matrix ``name``."""
+    try:
+        return function(*args)
+    except SimulationError as e:
+        if not str(getattr(e, "cause", "")).startswith(f"{function.__name__}() overflowed"):
+            raise
+        raise SimulationError(f"{_frame(t, what)}: {name} has NaN or inf entries (forces, drives or their derivatives "
+                              "overflow at this time and configuration)") from None
 
 
 def _row_scale(A: np.ndarray) -> np.ndarray:
@@ -256,9 +268,6 @@ def _integer_at_least_one(x, name: str) -> int:
     if v < 1:
         raise ValueError(f"{name}: expected an integer >= 1, got {v}")
     return v
-
-
-@_deprecation.keyword_only("t", "load_steps", "tol", "max_iterations")
 def static_equilibrium(system, q0=None, *, t: float = 0.0, load_steps: int = 10, tol: float = 1e-10,
                        max_iterations: int = 50, sensitivities=None) -> Equilibrium:
     """Solve f(q) = 0 by Newton's method with load stepping.
@@ -322,7 +331,8 @@ def _static_equilibrium(system, q0, t, load_steps, tol, max_iterations) -> Equil
         what = f"statics at load factor {lam:.4g}"
         f = system.static_forces(t, q, lam)
         for it in range(1, max_iterations + 1):
-            K = -_core._System.force_jacobians(system, t, q, np.zeros(n), lam, True)[0]
+            K = -_compiled(t, what, "tangent stiffness K", _core._System.force_jacobians, system, t, q, np.zeros(n), lam,
+                           True)[0]
             _require_finite(t, what, **{"f(q)": f, "tangent stiffness K": K})
             dq = _solve_tangent(K, f)
             if dq is None:
@@ -382,7 +392,7 @@ def _constrained_statics(system, q: np.ndarray, t: float, steps: int, tol: float
         f, g, c = state(q, lf)
         lam = c.multipliers(-f)
         for it in range(1, max_iterations + 1):
-            K = -_core._System.force_jacobians(system, t, q, zero, lf, True)[0]
+            K = -_compiled(t, what, "tangent stiffness K", _core._System.force_jacobians, system, t, q, zero, lf, True)[0]
             _require_finite(t, what, **{"f(q)": f, "tangent stiffness K": K, "loop Jacobian G": c.G, "g(q)": g})
             Kt = K + _constraint_stiffness(system, t, q, lam)
             _require_finite(t, what, **{"geometric stiffness of the loops": Kt})
@@ -545,9 +555,6 @@ def _roots(W: np.ndarray, Kt: np.ndarray, Ct: np.ndarray, basis: np.ndarray):
         rows, cols = scipy.optimize.linear_sum_assignment(-P[np.ix_(empty, unused)])
         pick[empty[rows]] = unused[cols]
     return ev[pick], Y[:, pick]
-
-
-@_deprecation.keyword_only("t")
 def modal_analysis(system, q=None, qd=None, *, t: float = 0.0, sensitivities=None) -> Modes:
     """Natural frequencies, damping ratios and mode shapes of the system linearised about (q, q̇) at t.
 
@@ -622,8 +629,9 @@ def _modal_analysis(system, q, qd, t) -> Modes:
                       "out: K and C are those of the relaxed structure (E = E_inf); rigidfem.linearize keeps the arms' "
                       "forces as states (the eigenvalues of its A are the viscoelastic modes')", UserWarning,
                       stacklevel=3)
-    M = _core._System.mass_matrix(system, t, q)
-    dfdq, dfdqd = _core._System.force_jacobians(system, t, q, qd)
+    M = _compiled(t, "modal analysis", "mass matrix", _core._System.mass_matrix, system, t, q)
+    dfdq, dfdqd = _compiled(t, "modal analysis", "stiffness K = −∂f/∂q or damping/gyroscopic matrix C = −∂f/∂q̇",
+                            _core._System.force_jacobians, system, t, q, qd)
     K, C = -dfdq, -dfdqd
     _require_finite(t, "modal analysis", **{"mass matrix": M, "stiffness K = −∂f/∂q": K,
                                             "damping/gyroscopic matrix C = −∂f/∂q̇": C})

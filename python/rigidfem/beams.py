@@ -20,7 +20,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _checks, _core, _deprecation, parameters
+from . import _checks, _core, parameters
 from ._core import Body, Point
 from .joints import Joint
 from .materials import Material, Section
@@ -305,8 +305,6 @@ class Beam:
         origin = result.position(last.origin)
         axis = result.position(last.point((1.0, 0.0, 0.0))) - origin
         return origin + axis * (self.length_at(result.t) / (2 * self.elements))[:, None]
-
-    @_deprecation.keyword_only("t")
     def rates_at_rest(self, system, q, *, t: float = 0.0) -> np.ndarray:
         """Joint rates q̇ (nq,) that leave this beam's deformed shape in place at time ``t`` (s) while its
         material slides through the guide at v = L̇ (a link of varying length; zeros for a constant one).
@@ -364,8 +362,6 @@ class Beam:
         step = np.diff(self.frames)
         sde = [self.rfes[i - 1].point((step[i - 1], 0.0, 0.0)) for i in range(1, self.elements + 1)]
         return (self.rfes[0].origin, *sde, self.tip)
-
-    @_deprecation.keyword_only("t")
     def centerline(self, system, q, *, t: float | None = None) -> np.ndarray:
         """Deformed centre line (m + 2, 3) in the global frame (m): root, sde points, tip, from one
         positions-only kinematics pass. ``t`` (s) is required when the system has prescribed

@@ -10,7 +10,7 @@ from collections.abc import Callable
 
 import numpy as np
 
-from . import _checks, _contract, _core, _deprecation, display, force_elements, joints, laws, loops
+from . import _checks, _core, display, force_elements, joints, laws, loops
 from . import parameters, persistence
 from .motion import constant as _constant
 from ._core import Body, JointSpec, Point, Profile
@@ -546,46 +546,25 @@ class System(_core._System):
         unpickled (bitwise identical results in any process)."""
         return _system_from_state, (self._state,)
 
-    @_deprecation.required("q")
-    def position(self, point, t, q=_deprecation.MISSING) -> np.ndarray:
+    def position(self, point, t, q) -> np.ndarray:
         """Global position (3,) in m of a ``Point`` (or a ``Body``'s origin) of this system's model at
-        time ``t`` (s) and coordinates ``q`` (m, rad). (``position(point, q, t)``, the order of version
-        0.1, still works with a DeprecationWarning.)"""
+        time ``t`` (s) and coordinates ``q`` (m, rad)."""
         _checks.same_model(point, self, "point")
-        t, q = self._time_first("position", ("q", "t"), t, q)
         return self._position(point, t, q)
 
-    @_deprecation.required("q", "qd")
-    def velocity(self, point, t, q=_deprecation.MISSING, qd=_deprecation.MISSING) -> np.ndarray:
+    def velocity(self, point, t, q, qd) -> np.ndarray:
         """Global velocity (3,) in m/s of a ``Point`` (or a ``Body``'s origin) at time ``t`` (s),
         coordinates ``q`` and rates ``qd`` (m/s, rad/s)."""
         _checks.same_model(point, self, "point")
-        t, q, qd = self._time_first("velocity", ("q", "qd", "t"), t, q, qd)
         return self._velocity(point, t, q, qd)
 
-    @_deprecation.required("q")
-    def transform(self, body, t, q=_deprecation.MISSING) -> np.ndarray:
+    def transform(self, body, t, q) -> np.ndarray:
         """Pose T_p (4, 4) in the global frame of a body (a ``Body`` handle or its index) at time ``t``
         (s) and coordinates ``q``."""
         if isinstance(body, Body):
             _checks.same_model(body, self, "body", "a Body of the model this system was compiled from")
-            body = body.index
-        t, q = self._time_first("transform", ("q", "t"), t, q)
-        return _transform(self, body, t, q)
+        return _core._System.transform(self, body, t, q)
 
-    def _time_first(self, name: str, old: tuple, *state):
-        """The state (t, q, ...) of a call, reordered from version 0.1's (q, ..., t) with a
-        DeprecationWarning when t holds a vector (``_deprecation.time_first``)."""
-        args = tuple(v for v in state if v is not _deprecation.MISSING)
-        new = ("t",) + old[:-1]
-        args, _ = _deprecation.time_first(name, old, new, args, {}, lambda: _checks.pose_time(self, None),
-                                          "body, " if name == "transform" else "point, ", nq=self.nq)
-        if len(args) < len(new):
-            raise TypeError(f"{name}() missing the arguments {list(new[len(args):])}: call {name}(..., "
-                            f"{', '.join(new)})")
-        return args
-
-    @_deprecation.keyword_only("t", "tol", "max_iterations")
     def assemble(self, q, qd=None, *, t: float | None = None, tol: float = 1e-12, max_iterations: int = 50):
         """(q, qd) closing every loop, nearest to the guess: Gauss–Newton on g(q, t) = 0 with
         mass-weighted least-norm corrections M⁻¹Gᵀ(G M⁻¹Gᵀ)⁺g while they gain (max |g| <= ``tol``
@@ -623,6 +602,3 @@ def _system_from_state(state: dict) -> System:
     system = _model_from_state(state["model"]).compile(state["algorithm"])
     return system.with_parameters(state["parameters"]) if state.get("parameters") else system
 
-
-_contract.guard_methods(System)
-_transform = _contract.guard("transform", _core._System.transform, ("body", "t", "q"))

@@ -18,7 +18,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from . import _checks, _deprecation
+from . import _checks
 from ._core import Body, Point
 from .beams import Beam
 
@@ -235,8 +235,6 @@ class Skeleton:
         row = self.rows
         self.fixed[row] = r
         return row
-
-    @_deprecation.keyword_only("t", "frame_size")
     def pose(self, q, *, t: float | None = None, frame_size: float | None = None) -> Pose:
         """The points at the state ``q`` (m, rad) and time ``t`` (s; required with drives).
         ``frame_size``: the triads' length in m; default 8 % of the shape's extent."""
@@ -363,9 +361,6 @@ def drawn(ax) -> np.ndarray:
     three = ax.name == "3d"
     rows = [np.column_stack(line.get_data_3d()) if three else line.get_xydata() for line in ax.get_lines()]
     return np.vstack(rows) if rows else np.zeros((0, 3 if three else 2))
-
-
-@_deprecation.keyword_only("t")
 def shape(system, q, *, t: float | None = None, ax=None, plane: str | None = None, beams=(), segments=(),
           frame_size: float | None = None):
     """Draw ``system`` at the state ``q`` (m, rad) and time ``t`` (s; required when the system

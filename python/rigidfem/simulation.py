@@ -51,7 +51,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
-from . import _checks, _core, _deprecation, _interrupt, display, error_control, export
+from . import _checks, _core, _interrupt, display, error_control, export
 from . import sensitivities as sensitivities_
 from . import parameters as parameters_
 from . import options as options_
@@ -261,12 +261,6 @@ def load_npz(path, system=None) -> Result:
     coordinate names must match; ValueError otherwise) to use the outputs that need it: positions,
     energies, ``to_dataframe``."""
     return Result(system, **export.read_npz(path, system))
-
-
-@_deprecation.keyword_only("dt", "rtol", "atol", "t_eval", "q0", "qd0", "t0", "progress", "first_step",
-                           "stiffness_warning", "max_steps", "max_step", "adaptive", "beta", "gamma", "alpha",
-                           "rho_inf", "newton_tol", "newton_max_iterations", "iteration_matrix", "stop", "s0",
-                           "error_on", "error_estimate")
 def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=None, qd0=None, s0=None,
              t_eval=None, progress: bool = False, stop=None, error_estimate: bool = False, sensitivities=None,
              **options) -> Result:

@@ -40,7 +40,7 @@ import warnings
 import numpy as np
 import scipy.signal
 
-from . import _checks, _core, _deprecation, _interrupt
+from . import _checks, _core, _interrupt
 from ._core import Body, Point
 from .analysis import _EPS, _loop_tangent, _require_finite
 from .export import RATE
@@ -58,9 +58,6 @@ EQUILIBRIUM_TOL = 1e-6
 class NotAnEquilibriumWarning(UserWarning):
     """``rf.linearize`` about a state that is not an equilibrium (q̈ ≠ 0): the linear model holds
     for small deviations along the trajectory through that state only."""
-
-
-@_deprecation.keyword_only("t", "inputs", "outputs", "dt")
 def linearize(system, q, qd=None, *, t: float = 0.0, inputs=(), outputs=None, dt: float | None = None):
     """The system linearised about (q, q̇) at t: a ``scipy.signal.StateSpace`` (A, B, C, D).
 
