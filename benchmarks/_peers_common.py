@@ -22,7 +22,7 @@ import numpy as np
 
 import rigidfem
 from rigidfem import SimulationError
-from rigidfem.study import Table
+from rigidfem.studies.study import Table
 
 from ._common import machine
 from .peers import _require

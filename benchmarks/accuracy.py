@@ -37,7 +37,7 @@ from pathlib import Path
 import numpy as np
 
 import rigidfem as rf
-from rigidfem.study import Scene, Table, scenes
+from rigidfem.studies.study import Scene, Table, scenes
 
 from ._common import machine, report
 

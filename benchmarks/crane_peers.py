@@ -75,7 +75,7 @@ import numpy as np
 
 import rigidfem as rf
 from rigidfem import SimulationError, simulate
-from rigidfem.study import Table
+from rigidfem.studies.study import Table
 
 from ._common import compile_mujoco_callback, report
 from ._peers_common import (CODES, OutputTimes, check_agreement, exudyn_settings, first_run, least_cpu_times,

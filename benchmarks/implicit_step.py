@@ -20,7 +20,7 @@ import numpy as np
 import rigidfem as rf
 from rigidfem import samples
 from rigidfem._core._bench import implicit_step_parts_seconds
-from rigidfem.study import Table
+from rigidfem.studies.study import Table
 
 from ._common import machine, report
 

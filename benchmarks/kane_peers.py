@@ -47,7 +47,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from rigidfem import samples, simulate
-from rigidfem.study import Table
+from rigidfem.studies.study import Table
 
 from . import _peers_common as common
 from ._common import compile_mujoco_callback, report

@@ -88,7 +88,7 @@ import numpy as np
 
 import rigidfem as rf
 from rigidfem import simulate
-from rigidfem.study import Table
+from rigidfem.studies.study import Table
 
 from . import _peers_common as common
 from ._common import compile_mujoco_callback, report

@@ -19,7 +19,7 @@ import time
 import numpy as np
 
 import rigidfem as rf
-from rigidfem.study import Table
+from rigidfem.studies.study import Table
 
 from ._common import cpp_seconds_per_call, machine, report
 

@@ -14,7 +14,7 @@ from __future__ import annotations
 
 import numpy as np
 
-from rigidfem.study import Table, reference, scenes, work_precision
+from rigidfem.studies.study import Table, reference, scenes, work_precision
 
 from ._common import machine, report
 

@@ -36,7 +36,7 @@ import numpy as np
 
 import rigidfem
 from rigidfem import Material, Point, SimulationError, samples, simulate, static_equilibrium
-from rigidfem.study import Table, cheapest
+from rigidfem.studies.study import Table, cheapest
 
 from ._common import cpp_seconds_per_call, machine, report
 

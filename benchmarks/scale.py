@@ -14,7 +14,7 @@ import numpy as np
 
 import rigidfem as rf
 from rigidfem import samples
-from rigidfem.study import Table
+from rigidfem.studies.study import Table
 
 from ._common import cpp_seconds_per_call, machine, report
 

@@ -24,7 +24,7 @@ import numpy as np
 
 from rigidfem import samples
 from rigidfem.simulation import simulate
-from rigidfem.study import Table
+from rigidfem.studies.study import Table
 
 from ._common import cpp_seconds_per_call, machine, report
 

@@ -27,7 +27,7 @@ import time
 import numpy as np
 
 import rigidfem as rf
-from rigidfem.study import Table
+from rigidfem.studies.study import Table
 
 from ._common import machine, report
 
@@ -110,7 +110,7 @@ def run(output_dir="bench", quick: bool = False):
                      "forward_cpu_s": adjoint[m, method][0], "gradient_cpu_s": adjoint[m, method][1],
                      "adjoint_over_forward": adjoint[m, method][1] / adjoint[m, method][0],
                      "backward_cpu_s": adjoint[m, method][2]["backward_time"],
-                     "gmres_per_step": adjoint[m, method][2]["gmres_iterations"] / adjoint[m, method][2]["steps"]}
+                     "gmres_per_step": adjoint[m, method][2]["linear_iterations"] / adjoint[m, method][2]["steps"]}
                     for m in sizes for method in ADJOINT_METHODS]
     rows = []
     for m in sizes:

@@ -58,7 +58,7 @@ import numpy as np
 import scipy.linalg
 
 from rigidfem import simulate
-from rigidfem.study import Table
+from rigidfem.studies.study import Table
 
 from . import _peers_common as common
 from ._common import cpp_seconds_per_call, report

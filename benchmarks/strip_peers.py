@@ -56,7 +56,7 @@ from pathlib import Path
 import numpy as np
 
 from rigidfem import SimulationError, simulate
-from rigidfem.study import Table
+from rigidfem.studies.study import Table
 
 from . import _peers_common as common
 from ._common import report

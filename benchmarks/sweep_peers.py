@@ -59,7 +59,7 @@ import numpy as np
 
 import rigidfem as rf
 from rigidfem import SimulationError, samples
-from rigidfem.study import Table
+from rigidfem.studies.study import Table
 
 from . import _peers_common as common
 from . import kane_peers as kp

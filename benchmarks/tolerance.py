@@ -30,7 +30,7 @@ import warnings
 import numpy as np
 
 from rigidfem import simulate
-from rigidfem.study import Table, reference, scenes
+from rigidfem.studies.study import Table, reference, scenes
 
 from ._common import machine, report
 

@@ -18,7 +18,7 @@ from pathlib import Path
 import numpy as np
 
 import rigidfem as rf
-from rigidfem.study import Table
+from rigidfem.studies.study import Table
 
 from ._common import machine, report
 

@@ -10,12 +10,17 @@ simulate's options is written from ``rigidfem.options`` at build time.
 
 from __future__ import annotations
 
+import importlib
 import re
 import shutil
+import sys
 from pathlib import Path
 
 import rigidfem
 from rigidfem import options
+
+# rf.animation is imported on first use (matplotlib.animation costs 0.1 s); its page needs its short path too
+sys.modules.setdefault("rigidfem.animation", importlib.import_module("rigidfem.viz.animation"))
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent

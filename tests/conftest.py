@@ -4,7 +4,7 @@ import os
 
 # One BLAS thread, set before NumPy loads OpenBLAS: the suite's matrices are small (and on 2 cores a threaded
 # eigh measured 3-7 times slower). The exit hang once seen after tests/test_interrupt.py (gotoblas_quit joining a
-# server thread) was a LAPACK call still in flight in a worker a Ctrl-C had left: rigidfem._interrupt now waits
+# server thread) was a LAPACK call still in flight in a worker a Ctrl-C had left: rigidfem.base._interrupt now waits
 # for such workers at exit.
 os.environ.setdefault("OPENBLAS_NUM_THREADS", "1")
 

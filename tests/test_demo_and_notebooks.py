@@ -9,7 +9,7 @@ import nbclient
 import nbformat
 import pytest
 
-from rigidfem import demo
+from rigidfem.studies import demo
 from rigidfem.__main__ import main
 
 NOTEBOOKS = sorted((pathlib.Path(__file__).parent.parent / "notebooks").glob("*.ipynb"))

@@ -5,7 +5,8 @@ import numpy as np
 import pytest
 
 import rigidfem as rf
-from rigidfem import _core, adjoint, options
+from rigidfem import _core, options
+from rigidfem.analysis import adjoint
 
 
 def test_the_methods_are_the_cpp_table():

@@ -1,4 +1,4 @@
-"""Ctrl-C in every long phase (rigidfem._interrupt, errors.hpp's InterruptScope): a System method,
+"""Ctrl-C in every long phase (rigidfem.base._interrupt, errors.hpp's InterruptScope): a System method,
 an analysis in LAPACK, a run inside one long step, and a sweep answer within a fraction of a second
 and keep what they have. Ctrl-C is a real SIGINT sent by a child process (a Python thread could not
 send it while the main thread holds the GIL in C++, where a terminal's Ctrl-C does arrive). Each phase takes several seconds uninterrupted (measured: 1.6-4.7 s), so a
@@ -15,7 +15,7 @@ import pytest
 
 import rigidfem as rf
 from rigidfem import samples
-from rigidfem.sweep import INTERRUPTED
+from rigidfem.studies.sweep import INTERRUPTED
 
 ANSWER = 1.0  # s: generous against the 0.05 s the checks run at, far below the phases' own times
 

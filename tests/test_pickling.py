@@ -1,4 +1,4 @@
-"""Pickling (rigidfem.persistence): Models, Systems, Results, Modes, Equilibria, tables and the
+"""Pickling (rigidfem.base.persistence): Models, Systems, Results, Modes, Equilibria, tables and the
 handles and profiles in them, within a process and across processes, bit for bit."""
 
 import concurrent.futures
@@ -10,7 +10,7 @@ import numpy as np
 import pytest
 
 import rigidfem as rf
-from rigidfem import persistence
+from rigidfem.base import persistence
 
 MATERIAL = rf.Material(E=2.1e9, rho=7850.0, damping=1e-3)
 SECTION = rf.Section.rectangle(0.02, 0.004)

@@ -37,7 +37,7 @@ def test_resolve_meets_the_elastica(k, tol):
     ref = elastica_tip(k)
     tip = plan.system.position(plan.handles["tip"], 0.0, plan.solution.q)[:2]
     true = np.linalg.norm(tip - ref)
-    assert true <= rf.resolution.SPACE * tol and 0.5 < plan.space_error / true < 2, (plan.space_error, true)
+    assert true <= rf.studies.resolution.SPACE * tol and 0.5 < plan.space_error / true < 2, (plan.space_error, true)
     assert np.linalg.norm(plan.limit["tip"][:2] - ref) < 0.1 * tol
     assert plan.deform == ("bend_z",) and set(plan.dropped) == {"bend_y", "torsion"}
     assert plan.beams == {"b": plan.elements} and abs(plan.order - 2.0) < 0.1
@@ -66,7 +66,7 @@ def test_resolve_keeps_torsion_only_where_it_matters():
     assert "torsion" not in centred.deform and "bend_y" in centred.deform
     eccentric = rf.resolve(loaded(0.02), "tip", tol=1e-5)
     assert "torsion" in eccentric.deform and "bend_y" in eccentric.deform
-    assert eccentric.kept["torsion"] > rf.resolution.DROP * 1e-5
+    assert eccentric.kept["torsion"] > rf.studies.resolution.DROP * 1e-5
 
 
 def test_resolve_on_kanes_beam_meets_its_richardson_limit():
@@ -88,7 +88,7 @@ def test_resolve_on_kanes_beam_meets_its_richardson_limit():
     chosen = plan.handles["tip"](plan.system, plan.solution)
     assert np.linalg.norm(chosen - limit, axis=1).max() < tol
     assert np.linalg.norm(plan.limit["tip"] - limit, axis=1).max() < 0.2 * tol
-    assert plan.time_error > 0 and plan.simulate_options == {"atol": rf.resolution.TIME * tol, "rtol": 0.0}
+    assert plan.time_error > 0 and plan.simulate_options == {"atol": rf.studies.resolution.TIME * tol, "rtol": 0.0}
 
 
 def test_resolve_bad_input_keeps_the_runs():

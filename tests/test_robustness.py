@@ -140,7 +140,7 @@ def test_modes_of_a_closed_chain_beyond_doubles_are_simulation_errors():
     """A four-bar whose crank spring overflows the loops' geometric stiffness, and an eigenproblem whose matrices
     hold inf: SimulationErrors naming what overflowed (no RuntimeWarning, no SciPy 'array must not contain infs'
     ValueError)."""
-    from rigidfem import analysis
+    from rigidfem.analysis import modes
 
     model, _ = rf.samples.four_bar(crank_spring=dict(stiffness=1.7e308))
     system = model.compile()
@@ -149,7 +149,7 @@ def test_modes_of_a_closed_chain_beyond_doubles_are_simulation_errors():
         rf.modal_analysis(system, q=q)
     M, K = np.eye(2), np.array([[np.inf, 0.0], [0.0, 1.0]])
     with pytest.raises(rf.SimulationError, match="modal analysis: the eigen"):
-        analysis._solved_modes(M, K, np.zeros((2, 2)), 0.0)
+        modes._solved_modes(M, K, np.zeros((2, 2)), 0.0)
 
 
 def test_scipy_methods_refuse_closed_chains():

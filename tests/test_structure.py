@@ -10,19 +10,54 @@ import rigidfem as rf
 PACKAGE = Path(rf.__file__).resolve().parent
 
 
-def _imports(path: Path, modules: set) -> set:
-    """The package's modules that ``path`` imports relatively (``from . import x``,
-    ``from .x import y``, ``from .x.y import z``), anywhere in the file (lazy imports too);
-    a name that is not a module (``from . import __version__``) is the package itself."""
+#: The Python package's layers, bottom to top: a module imports from its own layer or the layers below (and the
+#: compiled core) only, lazily or not.
+PYTHON_LAYERS = ["base", "model", "simulation", "analysis", "viz", "studies"]
+
+
+def _modules() -> dict:
+    """{"layer.module": path} of the package's modules (the top package's own files as "top.<name>")."""
+    out = {}
+    for path in PACKAGE.rglob("*.py"):
+        parts = path.relative_to(PACKAGE).with_suffix("").parts
+        out["top." + parts[0] if len(parts) == 1 else ".".join(parts)] = path
+    return out
+
+
+def _imports(name: str, path: Path, modules: dict) -> set:
+    """The package's modules that module ``name`` imports (relative imports anywhere in the file, lazy ones too):
+    "layer.module", or the layer itself for an import of its face (``from ..model import X``)."""
+    layer = None if name.startswith("top.") else name.split(".")[0]
     found = set()
     for node in ast.walk(ast.parse(path.read_text(encoding="utf-8"))):
-        if not isinstance(node, ast.ImportFrom) or node.level != 1:
+        if isinstance(node, ast.Import):  # the compiled core only, by its absolute name
+            assert all(a.name == "rigidfem._core" or not a.name.startswith("rigidfem") for a in node.names), name
             continue
-        if node.module:
-            found.add(node.module.split(".")[0])
+        if isinstance(node, ast.ImportFrom) and node.level == 0 and (node.module or "").startswith("rigidfem"):
+            raise AssertionError(f"{name}: imports {node.module} by its absolute name (relative imports in the package)")
+        if not isinstance(node, ast.ImportFrom) or node.level == 0:
+            continue
+        if node.level == 1 and layer is not None:
+            base = [layer]
+        elif (node.level == 2 and layer is not None) or (node.level == 1 and layer is None):
+            base = []
         else:
-            found |= {a.name if a.name in modules else "__init__" for a in node.names}
-    return found & modules
+            raise AssertionError(f"{name}: an import from {node.level} levels up")
+        target = base + (node.module.split(".") if node.module else [])
+        if not target or target[0] == "_core":
+            continue
+        if len(target) == 1:  # from .layer import module, from . import module
+            candidates = [f"{target[0]}.{a.name}" for a in node.names]
+            known = [c for c in candidates if c in modules]
+            found |= set(known) if known else {target[0]}
+        else:
+            found.add(".".join(target[:2]))
+    return found
+
+
+def _layer(module: str) -> int:
+    head = module.split(".")[0]
+    return len(PYTHON_LAYERS) if head == "top" else PYTHON_LAYERS.index(head)
 
 
 def _cycle(graph: dict) -> list:
@@ -32,7 +67,9 @@ def _cycle(graph: dict) -> list:
 
     def visit(node):
         state[node], _ = 1, path.append(node)
-        for nxt in sorted(graph[node]):
+        for nxt in sorted(graph.get(node, ())):
+            if nxt not in state:
+                continue
             if state[nxt] == 1:
                 return path[path.index(nxt):] + [nxt]
             if state[nxt] == 0 and (found := visit(nxt)):
@@ -46,18 +83,27 @@ def _cycle(graph: dict) -> list:
     return []
 
 
-def test_python_modules_import_without_cycles():
-    files = {p.stem: p for p in PACKAGE.glob("*.py")}
-    modules = set(files) | {"_core"}  # the compiled core imports nothing of the package
-    graph = {name: _imports(path, modules) - {name} for name, path in files.items()}
-    graph["_core"] = set()
-    # The package imports its submodules; a submodule importing the package back is a cycle too.
-    for name in graph:
-        if name != "__init__":
-            assert "__init__" not in graph[name], f"{name}.py imports names from the package's __init__"
-    graph["__init__"] = set()  # the entry point: its edges close no cycle once no submodule imports it
-    assert not _cycle(graph), f"import cycle: {' -> '.join(_cycle(graph))}"
-    assert "beams" in graph["model"] and "model" not in graph["beams"]  # the cycle this test was written for
+def test_python_layers_import_downwards_only_and_without_cycles():
+    modules = _modules()
+    assert {m.split(".")[0] for m in modules} == {"top", *PYTHON_LAYERS}, "a module outside the layers"
+    graph = {name: _imports(name, path, modules) - {name} for name, path in modules.items()}
+    upward = sorted((name, imported) for name, targets in graph.items() for imported in targets
+                    if _layer(imported) > _layer(name))
+    assert not upward, f"imports of a higher layer: {upward}"
+    faces = {f"{layer}.__init__" for layer in PYTHON_LAYERS}
+    assert not any(graph[name] & set(PYTHON_LAYERS) for name in modules if name.split(".")[0] in PYTHON_LAYERS
+                   and name not in faces and name.split(".")[0] in graph[name]), "a module imports its own face"
+    module_graph = {n: {t for t in g if t in modules} for n, g in graph.items()}
+    assert not _cycle(module_graph), f"import cycle: {' -> '.join(_cycle(module_graph))}"
+    assert "model.beams" in graph["model.model"] and "model.model" not in graph["model.beams"]
+
+
+def test_the_simulation_and_the_analyses_are_split_by_topic():
+    """simulate, its Result and SciPy's adapter are three files; statics, modes and what they share likewise."""
+    sizes = {name: len(path.read_text(encoding="utf-8").splitlines()) for name, path in _modules().items()}
+    for name in ("simulation.integration", "simulation.result", "simulation.scipy_ivp", "analysis.statics",
+                 "analysis.modes", "analysis.operating_point"):
+        assert name in sizes and sizes[name] < 500, (name, sizes.get(name))
 
 
 def test_public_classes_and_functions_have_docstrings():
@@ -124,10 +170,11 @@ def test_one_table_of_loop_kinds():
     documented table of rigidfem.loops says the same."""
     import re
 
-    from rigidfem import analysis, loops
+    from rigidfem import loops
+    from rigidfem.analysis import operating_point
 
     table = rf._core._Model._loop_kinds()
-    assert loops.KINDS == tuple(table) and analysis._LOOP_ROWS == table
+    assert loops.KINDS == tuple(table) and operating_point._LOOP_ROWS == table
     documented = dict((k, int(r)) for k, r in re.findall(r'``"(\w+)"``\s+(\d+)', loops.__doc__))
     assert documented == table
     for kind, rows in table.items():  # each kind's rows as the compiled system counts them

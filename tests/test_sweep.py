@@ -9,7 +9,7 @@ import numpy as np
 import pytest
 
 import rigidfem as rf
-from rigidfem.study import Table
+from rigidfem.studies.study import Table
 
 
 def pendulum(length, damping=0.0, angle=0.5):
@@ -107,7 +107,7 @@ def test_processes_and_dask_get_the_cases_in_batches():
     """A task per case cost Dask ~3 ms (a sweep of 5 ms runs ran slower on a 2-worker LocalCluster than
     serially): pools and clusters get BATCHES_PER_WORKER batches per worker, threads one case a task;
     the batches cover the cases once, in order, and the rows stay the serial run's."""
-    from rigidfem.sweep import BATCHES_PER_WORKER, _batches
+    from rigidfem.studies.sweep import BATCHES_PER_WORKER, _batches
 
     with concurrent.futures.ProcessPoolExecutor(2) as pool:
         for n in (1, 7, 8, 19, 64):

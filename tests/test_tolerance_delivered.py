@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import rigidfem as rf
-from rigidfem.study import reference, scenes
+from rigidfem.studies.study import reference, scenes
 
 
 @pytest.fixture(scope="module")

@@ -134,7 +134,7 @@ def test_the_widget_and_the_page_follow_each_other_in_a_browser(kane, tmp_path):
     Python side shows that frame in the page, and moving the page's slider sets ``frame``."""
     import json
 
-    from rigidfem.viewer import ASSETS
+    from rigidfem.viz.viewer import ASSETS
 
     *_, viewer, _ = kane
     esm = (ASSETS / "widget.js").read_text(encoding="utf-8")

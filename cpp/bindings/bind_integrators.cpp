@@ -272,7 +272,7 @@ void bind_integrators(py::module_& m) {
             stats["recomputed_steps"] = st.recomputed_steps;
             stats["checkpoints"] = st.checkpoints;
             stats["checkpoint_interval"] = st.interval;
-            stats["gmres_iterations"] = st.gmres_iterations;
+            stats["linear_iterations"] = st.linear_iterations;
             stats["preconditioner_refreshes"] = st.preconditioner_refreshes;
             stats["forward_time"] = st.forward_time;
             stats["backward_time"] = st.backward_time;

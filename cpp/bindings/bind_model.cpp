@@ -1,5 +1,5 @@
 // Joint, Body, Point, Load and Model. The friendly keyword API lives in
-// rigidfem/model.py; these are the primitives it calls.
+// rigidfem/model/model.py; these are the primitives it calls.
 #include <cmath>
 #include <memory>
 

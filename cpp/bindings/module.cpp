@@ -12,7 +12,7 @@
 
 namespace rigidfem::bindings {
 
-/// The argument conversions of bindings.hpp for the Python layer (rigidfem._checks, rigidfem._contract):
+/// The argument conversions of bindings.hpp for the Python layer (rigidfem.base._checks, rigidfem._contract):
 /// one rule for what counts as a real number, an integer or an array of reals, wherever it is checked.
 void bind_arguments(py::module_& m) {
   m.def(
@@ -168,7 +168,7 @@ void bind_profiles(py::module_& m) {
             const ProfileRecipe r = self.cast<const Profile&>().recipe();
             if (r.maker.empty()) {
               if (py::hasattr(self, "function"))
-                return py::make_tuple(py::module_::import("rigidfem.motion").attr("function"),
+                return py::make_tuple(py::module_::import("rigidfem.model.motion").attr("function"),
                                       py::make_tuple(self.attr("function")));
               throw py::type_error("cannot pickle the profile " + self.cast<const Profile&>().describe() +
                                    ": it is internal to a model (pickle the Model instead)");

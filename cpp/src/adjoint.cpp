@@ -90,7 +90,7 @@ class Transposes : public AdjointSteps {
     }
     VecX x;
     last_iterations_ = gmres_.solve(S, P, b, x, 1e-11, 300);
-    stats->gmres_iterations += last_iterations_;
+    stats->linear_iterations += last_iterations_;
     if (!x.allFinite()) throw SimulationError(t, "the adjoint became NaN or inf");
     return x;
   }
@@ -512,7 +512,7 @@ VecX Adjoint::backward(const Eigen::Ref<const RowMatX>& ybar) {
   if (ybar.rows() != N + 1 || ybar.cols() != Y_.cols())
     bad("ybar", "an array (" + std::to_string(N + 1) + ", " + std::to_string(Y_.cols()) + ")",
         "(" + std::to_string(ybar.rows()) + ", " + std::to_string(ybar.cols()) + ")");
-  stats_.recomputed_steps = stats_.gmres_iterations = stats_.preconditioner_refreshes = 0;
+  stats_.recomputed_steps = stats_.linear_iterations = stats_.preconditioner_refreshes = 0;
   const int P = params_->count();
   VecX grad = VecX::Zero(P), bars = VecX::Zero(steps_->adjoint_size() * n);
   std::vector<StepRecord> states;

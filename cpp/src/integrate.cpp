@@ -443,7 +443,7 @@ const std::vector<OptionInfo>& integrator_options() {
       {"atol", OptionType::Reals, "m, rad (per s for rates)", "a non-negative number or 2 nq of them", "Absolute tolerance of adaptive runs, as rtol.", false,
        [](const O& o) { return OptionValue(o.atol(0)); }, [](O& o, V v) { o.atol = reals(v); }},
       {"error_on", OptionType::Outputs, "", "points, bodies, coordinates, elements or loops",
-       "What the adaptive C++ methods measure their local error on (``rigidfem.error_control``): a list of points "
+       "What the adaptive C++ methods measure their local error on (``rigidfem.simulation.error_control``): a list of points "
        "and bodies (their positions, m), coordinate names or indices (m or rad), force element names (their axial "
        "force, N) and loop names (their multipliers, N or N·m), each error mapped from the state's through the "
        "output's Jacobian, a velocity's held as the displacement it makes over the step. None (the default): "

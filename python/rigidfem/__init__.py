@@ -7,8 +7,10 @@ C++ core. SI units throughout.
 """
 
 import importlib
+import sys
 
-from . import laws, motion, plots, samples, stages, study
+# The layers, bottom to top (tests/test_structure.py holds their imports downwards): base, model, simulation,
+# analysis, viz, studies. Every public name is here, and the modules users reach as rf.<module>.
 from ._core import (
     R1,
     R2,
@@ -29,25 +31,33 @@ from ._core import (
     joint_transform_second_derivative,
     skew,
 )
-from .analysis import Equilibrium, Modes, modal_analysis, static_equilibrium
-from .beams import Beam, rfe_parameters, sde_parameters
-from . import loops  # noqa: E402 (rigidfem.loops: the loop kinds)
-from .joints import Joint
-from .materials import Material, Section
-from .frames import transform
-from .model import Model, System
-from . import sea  # noqa: E402 (rigidfem.sea: sea states for a moving base)
-from .simulation import Result, load_npz, simulate
-from .options import integrator_options, methods  # noqa: E402 (the C++ method and option tables)
-from . import display, export  # noqa: E402 (notebook displays; tables, CSV and NumPy archives)
-from .state_space import NotAnEquilibriumWarning, linearize  # noqa: E402
-from .sweep import sweep
-from .resolution import Plan, ResolveError, resolve  # noqa: E402 (rf.resolve: elements and deformations for a tolerance)
-from .error_control import ErrorEstimate  # noqa: E402
-from .viewer import Viewer, view  # noqa: E402 (the 3D viewer: notebooks and HTML files)
-from . import parameters, sensitivities  # noqa: E402 (named parameters; forward sensitivities)
-from .parameters import Parameter  # noqa: E402
-from .adjoint import Gradient, gradient  # noqa: E402 (adjoint gradients of an objective of a run)
+from .base import display, export  # notebook displays; tables, CSV and NumPy archives
+from .model import laws, loops, motion, parameters, samples, sea, stages
+from .model.beams import Beam, rfe_parameters, sde_parameters
+from .model.frames import transform
+from .model.joints import Joint
+from .model.materials import Material, Section
+from .model.model import Model, System
+from .model.parameters import Parameter
+from .simulation import options, sensitivities  # the C++ method and option tables; forward sensitivities
+from .simulation.error_control import ErrorEstimate
+from .simulation.integration import simulate
+from .simulation.options import integrator_options, methods
+from .simulation.result import Result, load_npz
+from .analysis import Equilibrium, Gradient, Modes, NotAnEquilibriumWarning, gradient, linearize, modal_analysis
+from .analysis import static_equilibrium
+from .viz import plots
+from .viz.viewer import Viewer, view  # the 3D viewer: notebooks and HTML files
+from .studies import study
+from .studies.resolution import Plan, ResolveError, resolve  # elements and deformations for a tolerance
+from .studies.sweep import sweep
+
+# The public modules keep their short paths: `import rigidfem.motion`, `from rigidfem.laws import Rope`, and the
+# documentation's pages (rigidfem.animation, lazy, is reached as rf.animation).
+for _module in (display, export, laws, loops, motion, parameters, samples, sea, stages, options, sensitivities, plots,
+                study):
+    sys.modules.setdefault(f"{__name__}.{_module.__name__.rsplit('.', 1)[1]}", _module)
+del _module
 
 __version__ = "0.1.0"
 
@@ -56,7 +66,7 @@ def __getattr__(name: str):
     """``rigidfem.animation`` and ``rigidfem.animate`` on first use: they import
     matplotlib.animation (about 0.1 s), which ``import rigidfem`` does without."""
     if name in ("animation", "animate"):
-        animation = importlib.import_module(".animation", __name__)  # also sets rigidfem.animation
+        animation = importlib.import_module(".viz.animation", __name__)
         return animation if name == "animation" else animation.animate
     raise AttributeError(f"module 'rigidfem' has no attribute {name!r}")
 

@@ -4,7 +4,7 @@
 import argparse
 import sys
 
-from . import demo
+from .studies import demo
 
 
 def main(argv=None) -> int:
@@ -20,7 +20,7 @@ def main(argv=None) -> int:
     if args.command == "demo":
         demo.run(t_end=args.t_end, output=args.output)
     elif args.command == "bench":
-        from . import study
+        from .studies import study
 
         study.bench(args.output, quick=args.quick)
     return 0

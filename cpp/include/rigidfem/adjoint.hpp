@@ -131,7 +131,7 @@ struct StepRecord {
 
 struct AdjointStats {
   long steps = 0, recomputed_steps = 0, checkpoints = 0, interval = 1;
-  long gmres_iterations = 0, preconditioner_refreshes = 0;
+  long linear_iterations = 0, preconditioner_refreshes = 0;
   double forward_time = 0.0, backward_time = 0.0;  // s
 };
 

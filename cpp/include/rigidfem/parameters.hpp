@@ -1,5 +1,5 @@
 /// A compiled system with some of its constants or profiles changed, without compiling its model again: what
-/// a named parameter of the Python API (rigidfem/parameters.py) sets. The constants are those the equations of
+/// a named parameter of the Python API (rigidfem/model/parameters.py) sets. The constants are those the equations of
 /// motion are linear in — a body's pseudo-inertia H, a coordinate's laws' constants (its spring k, damper c and
 /// applied force, a friction's forces), a force element's constants, a load's force and torque — so a parameter's
 /// derivative of the residual

@@ -1,0 +1,116 @@
+"""Argument checks shared by the Python layer: clear ValueErrors naming the argument.
+
+What counts as a real number or an array of them is the C++ bindings' rule (``bindings.hpp``:
+``real_arg``, ``real_array_arg``, reached as ``_core._real`` and ``_core._real_array``), the one
+conversion layer of the package; these functions add the checks of values (finite, positive, shape).
+"""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+import rigidfem._core as _core  # the compiled core, by its absolute name
+from .._core import Body, Point
+
+
+def _floats(x, name: str, expected: str) -> np.ndarray:
+    """``x`` as a float array by the bindings' rule: complex numbers (numpy would drop their imaginary
+    parts), strings (numpy would parse them), None and whatever else is not a number are refused."""
+    return _core._real_array(x, name, expected)
+
+
+def _short(x) -> str:
+    s = repr(x)
+    return s if len(s) <= 200 else s[:197] + "..."
+
+
+def array(x, shape: tuple[int, ...], name: str) -> np.ndarray:
+    """``x`` as a finite float array of exactly ``shape`` (real numbers: complex ones are refused)."""
+    a = _floats(x, name, f"numbers of shape {shape}")
+    if a.shape != shape:
+        raise ValueError(f"{name}: expected shape {shape}, got {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name}: expected finite values, got NaN or inf")
+    return a
+
+
+def vector(x, name: str, min_length: int = 0) -> np.ndarray:
+    """``x`` as a finite 1-D float array of at least ``min_length`` values (real numbers)."""
+    a = _floats(x, name, "a 1-D sequence of real numbers")
+    if a.ndim != 1 or a.size < min_length:
+        raise ValueError(f"{name}: expected a 1-D sequence of at least {min_length} numbers, got shape {a.shape}")
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name}: expected finite values, got NaN or inf")
+    return a
+
+
+def vec3(x, name: str) -> np.ndarray:
+    return array(x, (3,), name)
+
+
+def scalar(x, name: str, *, positive: bool = False, nonnegative: bool = False, unit: str = "") -> float:
+    """``x`` as a finite float: a real number (not a string, not a bool), positive or non-negative
+    if asked; ``unit`` goes into the messages."""
+    expected = ("positive " if positive else "non-negative " if nonnegative else "") + "number" + \
+        (f" in {unit}" if unit else "")
+    v = _core._real(x, name, f"a {expected}")
+    if not math.isfinite(v):
+        raise ValueError(f"{name}: expected a finite {expected}, got {v}")
+    if (positive and not v > 0.0) or (nonnegative and not v >= 0.0):
+        raise ValueError(f"{name}: expected a {expected}, got {v}")
+    return v
+
+
+def pose_time(system, t) -> float:
+    """The time (s) of a pose of ``system``: ``t``, or 0 when omitted, which only a system without
+    prescribed coordinates allows (their drives make the pose depend on t)."""
+    if t is not None:
+        return t
+    if system.np:
+        names = system.prescribed_names
+        listed = ", ".join(names[:3]) + (f" and {len(names) - 3} more" if len(names) > 3 else "")
+        raise ValueError(f"t: required because the system has prescribed coordinates ({listed}) whose drives "
+                         "make the pose depend on time; pass t in s")
+    return 0.0
+
+
+def same_model(handle, system, name: str, expected: str = "a Point or Body of the model this system was compiled "
+                                                          "from") -> None:
+    """Raise ValueError if the Body or Point ``handle`` was made by another model than the one
+    ``system`` was compiled from (handles and systems of unknown origin pass)."""
+    if isinstance(handle, (Body, Point)):
+        own = getattr(system, "_model_id", 0)  # 0: a system made without Model.compile
+        if handle.model and own and handle.model != own:
+            raise ValueError(f"{name}: expected {expected}, got {handle!r} of another model")
+
+
+def per_coordinate(x, n: int, name: str, *, nonnegative: bool = False) -> list[float]:
+    """A scalar (same for every coordinate) or a sequence of ``n`` values."""
+    if np.ndim(x) == 0:
+        return [scalar(x, name, nonnegative=nonnegative)] * n
+    if np.ndim(x) != 1:
+        raise ValueError(f"{name}: expected a number or a 1-D sequence of {n} values, got shape {np.shape(x)}")
+    values = list(x)
+    if len(values) != n:
+        raise ValueError(f"{name}: expected a number or {n} values (one per joint coordinate), got {len(values)}")
+    return [scalar(v, name, nonnegative=nonnegative) for v in values]
+
+
+def integer(x, name: str, *, minimum: int | None = None, maximum: int | None = None) -> int:
+    """``x`` as an int (an integral real number by the bindings' rule, not a bool) within [minimum, maximum]."""
+    v = _core._real(x, name, "an integer")
+    if not math.isfinite(v) or v != int(v):
+        raise ValueError(f"{name}: expected an integer, got {x!r}")
+    v = int(x) if isinstance(x, (int, np.integer)) else int(v)
+    if (minimum is not None and v < minimum) or (maximum is not None and v > maximum):
+        raise ValueError(f"{name}: expected an integer in [{minimum}, {maximum}], got {v}")
+    return v
+
+
+def boolean(x, name: str) -> bool:
+    """``x`` as a bool: True, False (or numpy's bools)."""
+    if not isinstance(x, (bool, np.bool_)):
+        raise ValueError(f"{name}: expected True or False, got {x!r}")
+    return bool(x)

@@ -1,0 +1,96 @@
+"""Loop closures: joints that close a kinematic loop between two bodies, and length actuators.
+
+Each adds constraint equations g(q, t) = 0 to the tree's equations (book ch. 2.6, 7.3):
+
+    M(q) q̈ = f(q, q̇, t) + Gᵀ λ,   g(q, t) = 0,   G = ∂g/∂q,
+
+with the multipliers λ the reactions. A loop joint joins frame A on body ``a`` and frame B on
+body ``b``, which coincide when the loop is assembled; the joint kind says what it leaves free:
+
+=================  ====  ==========================================================
+kind               rows  free relative motion of frame B in frame A
+=================  ====  ==========================================================
+``"revolute"``        5  rotation about the common z axis
+``"spherical"``       3  every rotation about the common origin
+``"universal"``       4  rotations about A's x axis and B's y axis (the cross)
+``"prismatic"``       5  translation along z
+``"cylindrical"``     4  translation along and rotation about z
+``"fixed"``           6  none
+``"distance"``        1  everything but the distance |r_B − r_A| = l
+=================  ====  ==========================================================
+
+An actuator (``Model.add_actuator``) is a distance loop whose length l(t) is prescribed: a
+hydraulic cylinder under position control; its force is the loop's reaction.
+"""
+
+from __future__ import annotations
+
+import numpy as np
+
+from ..base import _checks
+from . import parameters
+import rigidfem._core as _core  # the compiled core, by its absolute name
+from .._core import Point, Profile
+from .force_elements import point_of
+
+KINDS = tuple(_core._Model._loop_kinds())  # the C++ table of kinds (constraints.cpp)
+
+
+def _frame(model, where, frame, name: str):
+    """(body index, 4x4 frame in that body) of a Body (its frame), a Point (the body's axes at the
+    point) or the ground; ``frame`` (4, 4) in the body's frame replaces the default."""
+    body, origin = point_of(model, where, name)
+    if frame is None:
+        F = np.eye(4)
+        F[:3, 3] = origin
+    else:
+        if isinstance(where, Point) and np.any(origin != 0.0):
+            raise ValueError(f"frame_{name}: give either a Point or a frame on a Body, not both")
+        F = _checks.array(frame, (4, 4), f"frame_{name}")
+    return body, F
+
+
+def add_loop_joint(model, kind: str, a, b, *, frame_a=None, frame_b=None, length: float | None = None,
+                   name: str | None = None) -> str:
+    """Close a loop between ``a`` and ``b`` (see ``Model.add_loop_joint``); returns its name."""
+    if kind not in KINDS:
+        raise ValueError(f"kind: expected one of {', '.join(KINDS)}, got {kind!r}")
+    ia, Fa = _frame(model, a, frame_a, "a")
+    ib, Fb = _frame(model, b, frame_b, "b")
+    if kind == "distance":
+        if length is None:
+            raise ValueError("length: expected a positive distance in m for a distance loop, got None")
+        length = _checks.scalar(length, "length", positive=True)
+    elif length is not None:
+        raise ValueError(f"length: expected None for a {kind} loop (only distance loops have a length), got {length!r}")
+    return _add(model, name, kind, ia, Fa, ib, Fb, length or 0.0, None)
+
+
+def add_actuator(model, a, b, length, *, name: str | None = None) -> str:
+    """A linear actuator between points ``a`` and ``b`` with prescribed length (see
+    ``Model.add_actuator``); returns its name."""
+    ia, Fa = _frame(model, a, None, "a")
+    ib, Fb = _frame(model, b, None, "b")
+    if isinstance(length, Profile):
+        name = _add(model, name, "distance", ia, Fa, ib, Fb, 0.0, length, actuator=True)
+        parameters.register(model, parameters.ProfileGroup(f"{name}.length", "loop", -1, model._nloops - 1, length,
+                                                           "the actuator's (m, s, m/s)"))
+        return name
+    return _add(model, name, "distance", ia, Fa, ib, Fb, _checks.scalar(length, "length", positive=True), None,
+                actuator=True)
+
+
+def _add(model, name, kind, ia, Fa, ib, Fb, length, drive, actuator=False) -> str:
+    """The loop added (its name: ``name``, or "loop<k>" when None)."""
+    return model._add_loop("" if name is None else str(name), kind, ia, Fa, ib, Fb, length, drive, actuator)
+
+
+def assemble(system, q, qd=None, *, t: float | None = None, tol: float = 1e-12, max_iterations: int = 50):
+    """Coordinates (q, q̇) on the loops' constraint manifold nearest to a guess (see
+    ``System.assemble``)."""
+    q = _checks.array(q, (system.nq,), "q")
+    qd = np.zeros(system.nq) if qd is None else _checks.array(qd, (system.nq,), "qd")
+    t = _checks.scalar(_checks.pose_time(system, t), "t")
+    tol = _checks.scalar(tol, "tol", positive=True)
+    max_iterations = _checks.integer(max_iterations, "max_iterations", minimum=1, maximum=10_000)
+    return system._assemble(t, q, qd, tol, max_iterations)

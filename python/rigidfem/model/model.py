@@ -1,0 +1,607 @@
+"""Model (the mutable description) and System (the compiled, immutable system).
+
+Build a Model body by body, then ``compile()`` it into a System whose methods
+evaluate the book's equations of motion A(q) q̈ = f(q, q̇, t). SI units throughout.
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+
+import numpy as np
+
+from ..base import _checks, display
+import rigidfem._core as _core  # the compiled core, by its absolute name
+from . import force_elements, joints, laws, loops
+from . import parameters
+from ..base import persistence
+from .motion import constant as _constant
+from .._core import Body, JointSpec, Point, Profile
+from .beams import add_beam
+from .frames import transform  # noqa: F401 (re-exported: rigidfem.model.transform)
+from ..base.persistence import recorded
+
+
+def _inertia(inertia) -> np.ndarray:
+    try:
+        a = np.asarray(inertia, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"inertia: expected principal moments (3,) or a tensor (3, 3) in kg·m², got {inertia!r}") from None
+    if a.shape == (3,):
+        a = np.diag(a)
+    if a.shape != (3, 3):
+        raise ValueError(
+            f"inertia: expected principal moments (3,) or a tensor (3, 3) in kg·m², got shape {np.shape(inertia)}"
+        )
+    return _checks.array(a, (3, 3), "inertia")
+
+
+# A moving base's degrees of freedom: ship names and the free joint's coordinates (ZYX angles:
+# yaw ψ = rz, pitch θ = ry, roll φ = rx), in the joint's order x, y, z, rz, ry, rx.
+BASE_DOFS = {"surge": "x", "sway": "y", "heave": "z", "yaw": "rz", "pitch": "ry", "roll": "rx"}
+
+
+def _base_profiles(motion) -> dict[str, Profile]:
+    """The six profiles of a moving base, by coordinate name ("x" ... "rx"), from ``motion``: a
+    dict of ship names or coordinate names to profiles or numbers; missing ones are held at 0."""
+    if motion is None:
+        motion = {}
+    if not isinstance(motion, dict):
+        raise ValueError(f"motion: expected a dict of degrees of freedom to profiles, got {motion!r}")
+    coordinate_of = {**BASE_DOFS, **{c: c for c in BASE_DOFS.values()}}
+    out: dict[str, Profile] = {}
+    for dof, value in motion.items():
+        if dof not in coordinate_of:
+            raise ValueError(f"motion: expected keys from {list(BASE_DOFS)} or {list(BASE_DOFS.values())}, "
+                             f"got {dof!r}")
+        c = coordinate_of[dof]
+        if c in out:
+            raise ValueError(f"motion: {dof!r} gives coordinate {c!r} a second motion")
+        if not isinstance(value, Profile):
+            value = _constant(_checks.scalar(value, f"motion[{dof!r}]"))
+        out[c] = value
+    return {c: out[c] if c in out else _constant(0.0) for c in BASE_DOFS.values()}
+
+
+def _scale(scale):
+    if scale is not None and not isinstance(scale, Profile):
+        raise ValueError(f"scale: expected None or a profile from rigidfem.motion, got {scale!r}")
+    return scale
+
+
+class Model(_core._Model):
+    """A multibody system under construction.
+
+    Parameters
+    ----------
+    gravity : (3,) array or None
+        Gravitational acceleration in m/s², global frame; ``None`` for none.
+        Default ``(0, 0, -9.81)``.
+
+    Bodies are added after their parents, so the compiled system has parent[p] < p.
+    """
+
+    def __init__(self, gravity=(0.0, 0.0, -9.81)):
+        g = np.zeros(3) if gravity is None else _checks.vec3(gravity, "gravity")
+        super().__init__(g)
+        self._gravity0, self._calls, self._building = np.array(g, dtype=float), [], False  # the recipe (pickling)
+        self._parameter_groups = {}  # prefix -> parameters.Group: the named parameters the builders declared
+
+    @property
+    def gravity(self) -> np.ndarray:
+        """Gravitational acceleration (3,) in m/s², global frame."""
+        return _core._Model.gravity.fget(self)
+
+    @gravity.setter
+    def gravity(self, g) -> None:
+        self._set_gravity(g)
+
+    @recorded
+    def _set_gravity(self, g) -> None:
+        _core._Model.gravity.fset(self, _checks.vec3(g, "gravity"))
+
+    def __reduce__(self):
+        """Pickled as its recipe (rigidfem.base.persistence): unpickling replays the builder calls."""
+        return _model_from_state, (persistence.model_state(self),)
+
+    @property
+    def ground(self) -> Body:
+        """The ground (global frame), parent of the first bodies."""
+        return Body()
+
+    def body(self, name: str) -> Body:
+        """The handle of the body called ``name``."""
+        if not isinstance(name, str):
+            raise ValueError(f"name: expected the name (str) of a body of this model or 'ground', got {name!r}")
+        try:
+            index = self._body_index(name)
+        except ValueError:
+            raise ValueError(f"name: expected the name of a body of this model or 'ground', got {name!r}") from None
+        return Body() if index < 0 else self._handle(index)
+
+    def _handle(self, index: int) -> Body:
+        return Body(index, self._body_name(index), self.id)
+
+    def _owns(self, body: Body) -> bool:
+        """Whether the handle names a body of this model (or the ground): made by this model, or,
+        for a handle of unknown origin (built by hand), with the name of the body at its index."""
+        if body.index == -1:
+            return True
+        if not 0 <= body.index < self.nbodies:
+            return False
+        return body.model == self.id if body.model else self._body_name(body.index) == body.name
+
+    def _parent_index(self, parent) -> int:
+        if isinstance(parent, Body):
+            if not self._owns(parent):
+                raise ValueError(f"parent: expected a body of this model, got {parent!r}")
+            return parent.index
+        if isinstance(parent, str):
+            return self._body_index(parent)
+        raise ValueError(f"parent: expected a Body handle or a body name, got {parent!r}")
+
+    @recorded
+    def add_body(
+        self,
+        name: str,
+        parent,
+        joint: JointSpec,
+        mass: float,
+        inertia,
+        com=(0.0, 0.0, 0.0),
+        placement=None,
+    ) -> Body:
+        """Add a rigid body hanging from ``parent`` through ``joint``.
+
+        Parameters
+        ----------
+        name : str
+            Unique name.
+        parent : Body or str
+            ``model.ground`` or an earlier body (handle or name).
+        joint : JointSpec
+            From ``rigidfem.Joint``: how the body moves relative to the joint frame.
+        mass : float
+            Mass in kg, positive.
+        inertia : (3,) or (3, 3) array
+            Principal moments (Ixx, Iyy, Izz) or the full tensor about the centre of
+            mass in body axes, kg·m². Positive definite, triangle inequality.
+        com : (3,) array
+            Centre of mass in the body frame, m.
+        placement : (4, 4) array, optional
+            Pose of the joint frame in the parent's frame (``rigidfem.transform``);
+            identity by default. The body frame is the joint frame moved by the joint.
+        """
+        if not isinstance(joint, JointSpec):
+            raise ValueError(f"joint: expected a joint from rigidfem.Joint, got {joint!r}")
+        B = np.eye(4) if placement is None else _checks.array(placement, (4, 4), "placement")
+        mass, com, inertia = _checks.scalar(mass, "mass"), _checks.vec3(com, "com"), _inertia(inertia)
+        body = self._add_body(str(name), self._parent_index(parent), joint, B, mass, com, inertia)
+        parameters.register(self, parameters.BodyGroup(body.name, body.index, mass, com, inertia))
+        self._declare_coordinates(body, joint)
+        return body
+
+    def _declare_coordinates(self, body: Body, joint: JointSpec) -> None:
+        """The named parameters of each coordinate's own spring-damping law (stiffness, damping, force)."""
+        info = laws.SpringDamping.info
+        for slot, c in enumerate(joint.coordinates):
+            values = {"stiffness": joint.stiffness[slot], "rest": joint.rest[slot], "damping": joint.damping[slot],
+                      "force": 0.0}
+            parameters.register(self, parameters.LawGroup(f"{body.name}.{c}", ("coordinate", body.index, slot, -1),
+                                                          info, values, rotation=c.startswith("r")))
+
+    def _coordinate(self, body: Body, coordinate: str | None) -> int:
+        if not isinstance(body, Body) or body.index < 0 or not self._owns(body):
+            raise ValueError(f"body: expected a body of this model, got {body!r}")
+        if coordinate is not None and not isinstance(coordinate, str):
+            raise ValueError(f"coordinate: expected None or a coordinate name such as 'x' or 'rz', got {coordinate!r}")
+        return -1 if coordinate is None else self._coordinate_index(body.index, coordinate)
+
+    @recorded
+    def prescribe(self, body: Body, motion: Profile, coordinate: str | None = None) -> None:
+        """Drive a coordinate of ``body``'s joint by ``motion`` (``rigidfem.motion.*``).
+
+        The coordinate leaves the unknowns q; ``System.driving_forces`` reports the
+        force (N) or torque (N·m) the drive must exert. ``coordinate`` names it
+        ("x", ..., "rx") when the joint has more than one. A coordinate takes one motion:
+        prescribing it again is a ValueError.
+        """
+        if not isinstance(motion, Profile):
+            raise ValueError(f"motion: expected a profile from rigidfem.motion, got {motion!r}")
+        k = self._coordinate(body, coordinate)
+        self._prescribe(body.index, k, motion)
+        name = self._coordinate_name(body.index, k)
+        parameters.register(self, parameters.ProfileGroup(f"{name}.drive", "drive", body.index, max(k, 0), motion,
+                                                          "the drive's (m or rad, s, rad/s: rigidfem.motion)"))
+
+    @recorded
+    def add_moving_base(self, name: str, motion=None, *, mass: float = 1e-6, inertia=(1e-6, 1e-6, 1e-6),
+                        com=(0.0, 0.0, 0.0), placement=None) -> Body:
+        """Add a base body moving with a prescribed 6-DOF motion; returns its ``Body``.
+
+        The base hangs from the ground by ``Joint.free()``, T̃ = Trans(x, y, z) R3(ψ) R2(θ) R1(φ),
+        whose six coordinates are all prescribed, so the bodies added on it feel its motion as a
+        known base acceleration (both engines), and ``System.driving_forces`` reports the
+        forces (N) and torques (N·m) that drive it.
+
+        Parameters
+        ----------
+        name : str
+            The base body's name.
+        motion : dict
+            Degree of freedom -> ``rigidfem.motion`` profile (or a number: held constant). Keys are
+            ship names — ``"surge"`` x, ``"sway"`` y, ``"heave"`` z (m), ``"yaw"`` ψ = rz,
+            ``"pitch"`` θ = ry, ``"roll"`` φ = rx (rad; ZYX angles) — or the coordinate names
+            themselves. Missing ones are held at 0. ``rigidfem.sea.Waves.motion`` makes such a dict
+            from a sea state.
+        mass, inertia, com
+            The base's own mass (kg, positive; default 1e-6, negligible), inertia (kg·m²) and
+            centre of mass (m), as in ``add_body``; they only enter the driving forces.
+        placement : (4, 4) array, optional
+            Pose of the frame in which the motion is given (the base's rest pose), in the global
+            frame; identity by default.
+        """
+        profiles = _base_profiles(motion)
+        base = self.add_body(name, self.ground, joints.Joint.free(), mass=mass, inertia=inertia, com=com,
+                             placement=placement)
+        for coordinate, profile in profiles.items():
+            self.prescribe(base, profile, coordinate=coordinate)
+        return base
+
+    @recorded
+    def add_generalized_force(
+        self, body: Body, force: float | Callable[[float, float, float], float], coordinate: str | None = None
+    ) -> None:
+        """Apply a generalised force (N or N·m) on a joint coordinate of ``body``.
+
+        ``force`` is a constant or a Python function ``Q(t, q, qd)`` of that
+        coordinate's own value and rate (slow path: called from C++ under the GIL). The
+        function must return a finite number: anything else (None, a string, an array, NaN,
+        inf) raises a ValueError naming the law, the coordinate, the value and the time where
+        a System method calls it, and ``rigidfem.SimulationError`` at that time in a simulation
+        (both are ``rigidfem._core.ForceLawError``). Exceptions the function raises propagate.
+        """
+        k = self._coordinate(body, coordinate)
+        if callable(force):
+            self._add_generalized_force(body.index, k, 0.0, force)
+        else:
+            value = _checks.scalar(force, "force")
+            self._add_generalized_force(body.index, k, value, None)
+            group = self._parameter_groups.get(self._coordinate_name(body.index, k))
+            if group is not None:  # the total constant force on the coordinate
+                parameters.register(self, group.with_values(force=group.values["force"] + value))
+
+    @recorded
+    def add_maxwell_arm(self, body: Body, stiffness: float, tau: float, coordinate: str | None = None) -> None:
+        """Add a Maxwell arm — a spring ``stiffness`` k (N/m or N·m/rad) in series with a dashpot k τ
+        (``tau``: the relaxation time, s) — on a free joint coordinate of ``body``, in parallel with
+        its spring and damper: the standard linear solid (Zener) with one arm, a generalised Maxwell
+        model (Prony series) with several.
+
+        The arm's force s (N or N·m) is an internal variable of the state, ṡ = k q̇ − s/τ, acting as
+        Q = −s on the coordinate; it stores s²/(2k) and dissipates s²/(kτ). A mode of the joint's
+        stiffness c with one arm has its eigenvalues at the roots of (1 + λτ)(m λ² + c) + k τ λ = 0.
+        ``rigidfem.simulate`` integrates s (initial value ``s0``, zero by default) and returns it
+        as ``Result.arm_forces``; ``rigidfem.Material(prony=...)`` puts arms in every sde of a beam.
+        """
+        k = self._coordinate(body, coordinate)
+        stiffness = _checks.scalar(stiffness, "stiffness", positive=True, unit="N/m or N·m/rad (arm stiffness)")
+        tau = _checks.scalar(tau, "tau", positive=True, unit="s (relaxation time)")
+        self._add_maxwell_arms([body.index], [k], [stiffness], [tau])
+
+    @recorded
+    def add_force(self, point, force, *, follower: bool = False, scale: Profile | None = None,
+                  name: str | None = None) -> str:
+        """Apply a point force (N) at ``point`` (a ``Point`` or a ``Body``'s origin).
+
+        ``force`` has global components, or body components turning with the body
+        when ``follower=True``. ``scale`` (a ``rigidfem.motion`` profile) multiplies
+        it by its value q(t). Returns its ``name`` ("load<k>" by default), whose parameter
+        ``"<name>.force"`` is its magnitude (``System.parameters``).
+        """
+        p = self._point(point)
+        return self._load(name, p.body, p.r, _checks.vec3(force, "force"), np.zeros(3), follower, scale)
+
+    @recorded
+    def add_torque(self, body: Body, torque, *, follower: bool = False, scale: Profile | None = None,
+                   name: str | None = None) -> str:
+        """Apply a torque (N·m) on ``body``: global components, or body ones if ``follower``. Returns its
+        ``name`` ("load<k>" by default), whose parameter ``"<name>.torque"`` is its magnitude."""
+        p = self._point(body)
+        return self._load(name, p.body, np.zeros(3), np.zeros(3), _checks.vec3(torque, "torque"), follower, scale)
+
+    def _load(self, name, body, r, force, torque, follower, scale) -> str:
+        name = f"load{self._nloads}" if name is None else name
+        if not isinstance(name, str) or name in self._parameter_groups:
+            raise ValueError(f"name: expected a new name (str) for the load, got {name!r}")
+        self._add_load(body, r, force, torque, bool(follower), _scale(scale))
+        parameters.register(self, parameters.LoadGroup(name, self._nloads - 1, force, torque))
+        if scale is not None:
+            parameters.register(self, parameters.ProfileGroup(f"{name}.scale", "load", -1, self._nloads - 1, scale,
+                                                              "the scale's (rigidfem.motion)"))
+        return name
+
+    def _point(self, point) -> Point:
+        if isinstance(point, Body):
+            if not self._owns(point):
+                raise ValueError(f"point: expected a Point or Body of this model, got {point!r}")
+            point = point.origin
+        if not isinstance(point, Point) or not 0 <= point.body < self.nbodies or point.model not in (0, self.id):
+            raise ValueError(f"point: expected a Point or Body of this model, got {point!r}")
+        return point
+
+    @recorded
+    def add_loop_joint(self, kind: str, a, b, *, frame_a=None, frame_b=None, length: float | None = None,
+                       name: str | None = None) -> str:
+        """Close a kinematic loop: a joint of ``kind`` between ``a`` and ``b`` (book ch. 2.6).
+
+        Parameters
+        ----------
+        kind : str
+            "revolute", "spherical", "universal", "prismatic", "cylindrical", "fixed" or
+            "distance" (``rigidfem.loops`` tabulates what each leaves free; axes are those of
+            frame A, z for revolute, prismatic and cylindrical joints).
+        a, b : Body, Point or ``model.ground``
+            The two bodies (rigid bodies or rfes of a beam). A Point places the joint frame at
+            that point with the body's axes; a Body at its frame.
+        frame_a, frame_b : (4, 4) array, optional
+            Pose of the joint frame in the body's frame (``rigidfem.transform``), for a Body.
+            Frames A and B coincide when the loop is closed (distance: their origins are
+            ``length`` apart).
+        length : float
+            m, distance loops only.
+        name : str, optional
+            Names its reaction in ``System.loop_names``; "loop<k>" by default.
+
+        Returns the loop's name. The initial coordinates of a simulation must close every loop:
+        ``System.assemble`` finds them from a guess.
+        """
+        return loops.add_loop_joint(self, kind, a, b, frame_a=frame_a, frame_b=frame_b, length=length, name=name)
+
+    @recorded
+    def add_actuator(self, a, b, length, *, name: str | None = None) -> str:
+        """A linear actuator (hydraulic cylinder under position control) between the points ``a``
+        and ``b`` (Point or Body): their distance is held at ``length`` (m), a number or a
+        ``rigidfem.motion`` profile l(t). Its force (N, positive pushing the points apart) is the
+        loop's reaction, column 0 of ``System.loop_reactions``. Returns its name."""
+        return loops.add_actuator(self, a, b, length, name=name)
+
+    @recorded
+    def add_force_element(self, a, b, law, *, name: str | None = None) -> str:
+        """A force element of ``law`` (``rigidfem.laws``: ``SpringDamper``, ``Rope``, ...) between the points ``a``
+        and ``b`` (Point, Body or ``model.ground``; rigid bodies or rfes of a beam), acting along the line between
+        them with the law's axial force F(t, l, l̇) (N, > 0 pushing the points apart). No constraint: it acts on
+        trees and closed chains alike (``rigidfem.model.force_elements``). Its constants marked as parameters become
+        ``"<name>.<constant>"`` (``System.parameters``). Returns its name ("element<k>" by default), which
+        ``System.element_names`` lists."""
+        return force_elements.add_force_element(self, a, b, law, name=name)
+
+    @recorded
+    def add_spring_damper(self, a, b, *, stiffness: float, length: float, damping: float = 0.0,
+                          name: str | None = None) -> str:
+        """A linear spring-damper between the points ``a`` and ``b`` (Point, Body or
+        ``model.ground``; rigid bodies or rfes of a beam): axial force
+        F = −k (l − l₀) − c l̇ (N, > 0 pushing the points apart) with ``stiffness`` k (N/m),
+        rest ``length`` l₀ (m) and ``damping`` c (N·s/m): ``add_force_element(a, b,
+        rf.laws.SpringDamper(stiffness=k, length=l₀, damping=c))``. Returns its name ("element<k>" by
+        default), which ``System.element_names`` lists."""
+        force_elements.points(self, a, b)  # named before the law's constants
+        law = laws.SpringDamper(stiffness=stiffness, length=length, damping=damping)
+        return force_elements.add_force_element(self, a, b, law, name=name)
+
+    @recorded
+    def add_cylinder(self, a, b, force, *, damping: float = 0.0, name: str | None = None) -> str:
+        """A hydraulic cylinder under force control between the points ``a`` and ``b``: it pushes
+        them apart with ``force`` (N; negative pulls) — a number, a ``rigidfem.motion`` profile
+        F(t) or a Python function ``force(t, l, ld)`` of time (s), length (m) and its rate (m/s)
+        (the slow path: called under the GIL at every evaluation) — less its ``damping`` c l̇
+        (N·s/m): a ``rf.laws.SpringDamper`` without a spring. Position control is ``add_actuator``. Returns its
+        name ("element<k>" by default); ``System.element_states`` and ``Result.element_forces`` give its force."""
+        force_elements.points(self, a, b)  # named before the law's constants
+        law = laws.SpringDamper(damping=damping, **force_elements.cylinder_force(force))
+        return force_elements.add_force_element(self, a, b, law, name=name)
+
+    @recorded
+    def add_rope(self, a, b, *, EA: float, length, DA: float = 0.0, name: str | None = None) -> str:
+        """A massless rope between the points ``a`` and ``b`` (book ch. 7.1: a hoisting rope): it
+        only pulls, with the tension T = (EA (l − l_u) + DA (l̇ − l̇_u))/l_u while positive, 0 when
+        slack. ``EA`` (N) is its axial stiffness, ``DA`` (N·s) its axial damping, and ``length`` its unstretched
+        length l_u (m): a number or a ``rigidfem.motion`` profile l_u(t) paid out by a winch
+        (``rf.laws.Rope``). Returns its name; ``System.element_states`` gives its force F = −T (N)."""
+        force_elements.points(self, a, b)  # named before the law's constants
+        law = laws.Rope(EA=EA, DA=DA, **force_elements.unstretched(length))
+        return force_elements.add_force_element(self, a, b, law, name=name)
+
+    @recorded
+    def add_joint_law(self, body: Body, law, coordinate: str | None = None, *, name: str | None = None) -> str:
+        """A law of a joint coordinate (``rigidfem.laws``: ``Friction``, ``ForceFunction``) on the coordinate
+        ``coordinate`` ("x", ..., "rx"; None: the joint's only one) of ``body``'s joint, adding its generalised
+        force Q(t, q, q̇) (N or N·m) to the coordinate's own spring-damping law. Its constants marked as parameters
+        become ``"<name>.<constant>"`` (``System.parameters``, in the coordinate's units: N or N·m for a rotation's
+        forces). Returns its name ("<body>.<axis>.<kind>" in lower case by default, "...2" for a second one of a
+        kind)."""
+        if not isinstance(law, laws.Law) or law.info["acts_on"] != "coordinate" or not law.info["addable"]:
+            kinds = [k for k, i in laws.kinds().items() if i["acts_on"] == "coordinate" and i["addable"]]
+            raise ValueError(f"law: expected a law of a joint coordinate ({', '.join(kinds)} from rigidfem.laws), "
+                             f"got {law!r}")
+        k = self._coordinate(body, coordinate)
+        axis = self._coordinate_name(body.index, k)
+        if name is None:
+            base, n = f"{axis}.{law.kind.lower()}", 1
+            while (name := base if n == 1 else f"{base}{n}") in self._parameter_groups:
+                n += 1
+        elif not isinstance(name, str) or name in self._parameter_groups:
+            raise ValueError(f"name: expected a name not yet given to a body, coordinate, element or law, got {name!r}")
+        index = self._add_coordinate_law(body.index, k, law.kind, law.values, law.function)
+        group = parameters.LawGroup(str(name), ("coordinate", body.index, max(k, 0), index), law.info, law.values,
+                                    rotation=axis.rsplit(".", 1)[1].startswith("r"))
+        parameters.register(self, group)
+        return group.prefix
+
+    @recorded
+    def add_beam(self, name: str, parent, length, material, section, elements: int,
+                 formulation: str = "modified", deform=None, linear: bool = False, joint=None, placement=None,
+                 tip_mass: float = 0.0, tip_inertia=(0.0, 0.0, 0.0), tip_offset=(0.0, 0.0, 0.0)):
+        """Add a flexible beam divided into ``elements`` sdes and ``elements + 1`` rfes.
+
+        Parameters
+        ----------
+        name : str
+            The rfes are named ``name.rfe0`` ... ``name.rfe<m>``.
+        parent : Body or str
+            What the beam's first rfe hangs from.
+        length : float or rigidfem.motion profile
+            L, m; the beam lies along the x axis of its frame. A profile L(t) makes a link of
+            varying free length sliding out of (L̇ > 0) or into its guide, the beam's frame
+            (the equations in ``cpp/include/rigidfem/flows.hpp``: uniform beams without axial deformation, tip mass or the
+            linear model).
+        material : Material, function of s, or list of m
+            ``rigidfem.Material`` (constant), a function of the arc length s (m), or one
+            per segment (stepped beams).
+        section : Section, function of s, or list of m
+            ``rigidfem.Section``, likewise (tapered beams).
+        elements : int
+            1 <= m <= 100 000 (``rigidfem.model.beams.MAX_ELEMENTS``), the number of sdes (primary division).
+        formulation : "classical" or "modified"
+            Classical: rfes with up to 6 relative coordinates (axial, shear, torsion,
+            bending); modified: spherical joints, 3 rotations at most.
+        deform : sequence of str
+            Deformations given coordinates, from ``axial, shear_y, shear_z, torsion,
+            bend_y, bend_z`` (modified: the last three only); the rest are rigid.
+            Default: all the formulation allows. ``bend_z`` bends in the x–y plane.
+        linear : bool
+            The book's linear model: each sde's relative transformation is linearised to
+            first order in its coordinates (sin φ ≈ φ, cos φ ≈ 1, products dropped:
+            T̃ = [[1 + S(φ1, φ2, φ3), (x, y, z)], [0, 1]]); the equations are then
+            derived exactly from these transformations, and the beam's rigid motion
+            (its joint on the parent) stays exact. Loses geometric stiffening.
+        joint : JointSpec
+            How rfe 0 sits on the parent; default ``Joint.fixed()`` (clamped root).
+        placement : (4, 4) array
+            Pose of that joint's frame on the parent.
+        tip_mass, tip_inertia, tip_offset
+            A concentrated body (kg; kg·m² about its c.o.m.; offset in m of its c.o.m.
+            from the tip, beam axes) merged into the last rfe.
+
+        Returns
+        -------
+        Beam
+            Handle with ``tip``, ``point(s)``, ``rfes``, ``centerline(system, q)``, and
+            the rfe/sde parameters ``rfe`` and ``sde``.
+        """
+        return add_beam(self, name, parent, length, material, section, elements, formulation, deform, linear,
+                        joint, placement, tip_mass, tip_inertia, tip_offset)
+
+    def compile(self, algorithm: str = "recursive") -> System:
+        """Freeze the model into an immutable ``System``.
+
+        ``algorithm``: "recursive" (default; O(n) forward dynamics by the articulated-body
+        algorithm, RNEA and CRBA for the right-hand side and mass matrix) or "lagrange" (the
+        book's formulation, kept as the reference). Systems with linear joints (the linear
+        beam model) always use Lagrange.
+        """
+        return System(self, algorithm)
+
+    def _repr_html_(self) -> str:
+        """Notebook display: bodies, parents, joints, coordinates, beams, loops (``rigidfem.display``)."""
+        return display.model_html(self)
+
+
+class System(_core._System):
+    """A compiled multibody system: the book's A(q) q̈ = f(q, q̇, t).
+
+    q holds the free joint coordinates (``coordinate_names``; m and rad), body by
+    body in the order the bodies were added, within a joint in the order x, y, z,
+    rz, ry, rx. Prescribed coordinates are not part of q; their drives are
+    evaluated at time t (s), which is why some methods take ``t``.
+    """
+
+    def __init__(self, model, algorithm: str = "recursive"):
+        if not isinstance(algorithm, str):
+            raise ValueError(f"algorithm: expected 'recursive' or 'lagrange', got {algorithm!r}")
+        super().__init__(model, algorithm)
+        self._model_id = model.id  # handles of other models are refused (_checks.same_model)
+        self._state = {"rigidfem_state": persistence.STATE_VERSION, "model": persistence.model_state(model),
+                       "algorithm": algorithm, "parameters": {}}
+        self._parameters = parameters.Parameters(model._parameter_groups)
+
+    @property
+    def parameters(self) -> dict:
+        """The named parameters (``rigidfem.parameters``: ``"<beam>.E"``, ``"<body>.mass"``, ...) with their
+        values at which this system was made, units and what they set: a dict of name to ``Parameter``."""
+        return self._parameters.listing()
+
+    def with_parameters(self, values: dict) -> System:
+        """This system with the named parameters ``values`` ({name: value}, units of ``System.parameters``)
+        changed: a new System (O(n), the model is not compiled again) that simulates exactly as the model
+        built with those values. ValueError naming an unknown parameter or a value out of its range."""
+        values = self._parameters.checked(values)
+        new = System.__new__(System)
+        changes = self._parameters.changes(values)
+        _core._System.__init__(new, self, *changes.arguments())
+        new._model_id = self._model_id
+        new._state = {**self._state, "parameters": {**self._state["parameters"], **values}}
+        new._parameters = self._parameters.updated(values)
+        return new
+
+    def __reduce__(self):
+        """Pickled as its model's recipe at compile time and the algorithm; compiled again when
+        unpickled (bitwise identical results in any process)."""
+        return _system_from_state, (self._state,)
+
+    def position(self, point, t, q) -> np.ndarray:
+        """Global position (3,) in m of a ``Point`` (or a ``Body``'s origin) of this system's model at
+        time ``t`` (s) and coordinates ``q`` (m, rad)."""
+        _checks.same_model(point, self, "point")
+        return self._position(point, t, q)
+
+    def velocity(self, point, t, q, qd) -> np.ndarray:
+        """Global velocity (3,) in m/s of a ``Point`` (or a ``Body``'s origin) at time ``t`` (s),
+        coordinates ``q`` and rates ``qd`` (m/s, rad/s)."""
+        _checks.same_model(point, self, "point")
+        return self._velocity(point, t, q, qd)
+
+    def transform(self, body, t, q) -> np.ndarray:
+        """Pose T_p (4, 4) in the global frame of a body (a ``Body`` handle or its index) at time ``t``
+        (s) and coordinates ``q``."""
+        if isinstance(body, Body):
+            _checks.same_model(body, self, "body", "a Body of the model this system was compiled from")
+        return _core._System.transform(self, body, t, q)
+
+    def assemble(self, q, qd=None, *, t: float | None = None, tol: float = 1e-12, max_iterations: int = 50):
+        """(q, qd) closing every loop, nearest to the guess: Gauss–Newton on g(q, t) = 0 with
+        mass-weighted least-norm corrections M⁻¹Gᵀ(G M⁻¹Gᵀ)⁺g while they gain (max |g| <= ``tol``
+        required, m or the cosine of direction rows; up to 1e-9 accepted where G has lost rank), then
+        the velocities projected onto G q̇ + ∂g/∂t = 0 in the mass metric (the kinetic energy never rises). Raises ``SimulationError`` naming the
+        loop that cannot be closed from this guess. ``t`` (s, keyword) for prescribed motions; q in m
+        and rad, qd per s (zero by default)."""
+        return loops.assemble(self, q, qd, t=t, tol=tol, max_iterations=max_iterations)
+
+    def coordinate_index(self, name: str) -> int:
+        """Index in q of the coordinate called ``name`` (e.g. ``"link1.rz"``)."""
+        names = self.coordinate_names
+        if name not in names:
+            raise ValueError(f"name: expected one of {names}, got {name!r}")
+        return names.index(name)
+
+    def __repr__(self) -> str:
+        loops_ = f", {len(self.loop_names)} loops ({self.nl} constraints)" if self.nl else ""
+        return f"<rigidfem System: {self.nbodies} bodies, nq={self.nq}, {self.np} prescribed{loops_}>"
+
+    def _repr_html_(self) -> str:
+        """Notebook display: bodies, parents, joints, coordinates, beams, loops (``rigidfem.display``)."""
+        return display.system_html(self)
+
+
+def _model_from_state(state: dict) -> Model:
+    """Unpickling: a Model made again from its recipe (``persistence.model_state``)."""
+    persistence.check_version(state, "Model")
+    return persistence.replay(Model(gravity=state["gravity"]), state)
+
+
+def _system_from_state(state: dict) -> System:
+    """Unpickling: a System compiled again from the recipe of its model at compile time."""
+    persistence.check_version(state, "System")
+    system = _model_from_state(state["model"]).compile(state["algorithm"])
+    return system.with_parameters(state["parameters"]) if state.get("parameters") else system
+

@@ -1,0 +1,221 @@
+"""Sea states for a moving base (``Model.add_moving_base``): the JONSWAP wave spectrum,
+its discretisation into harmonic components with seeded random phases, and response
+amplitude operators (RAOs) that turn the wave elevation into a vessel's six motions.
+
+Conventions (SI; angles in rad):
+
+- the wave elevation at the vessel's reference point is η(t) = Σ_k a_k sin(ω_k t + φ_k) (m);
+- an RAO is the complex transfer function H(ω) from η to one motion, whose response is
+  x(t) = Σ_k |H(ω_k)| a_k sin(ω_k t + φ_k + arg H(ω_k)). |H| is in m/m for surge, sway and
+  heave and in rad/m for roll, pitch and yaw (convert tables in deg/m with ``np.radians``);
+  arg H is in rad, positive when the motion leads the elevation. RAOs are those of one wave
+  heading: the sea state is long-crested.
+
+>>> waves = rf.sea.jonswap_waves(hs=2.0, tp=8.0, n=200, seed=1)
+>>> deck = model.add_moving_base("deck", waves.motion({"heave": rf.sea.RAO.oscillator(6.0, 0.1),
+...                                                      "roll": np.radians(2.0)}))
+"""
+
+from __future__ import annotations
+
+from collections.abc import Callable
+from dataclasses import dataclass
+
+import numpy as np
+
+from ..base import _checks
+from . import motion
+from .._core import Profile
+from .model import BASE_DOFS
+
+GAMMA_RANGE = (1.0, 7.0)  # peak enhancement factors for which DNV-RP-C205's A_γ holds
+
+
+def _finite(x, name: str) -> np.ndarray:
+    try:
+        a = np.asarray(x, dtype=float)
+    except (TypeError, ValueError):
+        raise ValueError(f"{name}: expected numbers in rad/s, got {x!r}") from None
+    if not np.all(np.isfinite(a)):
+        raise ValueError(f"{name}: expected finite values, got NaN or inf")
+    return a
+
+
+def _gamma(gamma) -> float:
+    g = _checks.scalar(gamma, "gamma")
+    if not GAMMA_RANGE[0] <= g <= GAMMA_RANGE[1]:
+        raise ValueError(f"gamma: expected a peak enhancement factor in [1, 7], got {g}")
+    return g
+
+
+def jonswap(omega, hs: float, tp: float, gamma: float = 3.3) -> np.ndarray:
+    """The JONSWAP spectrum S(ω) in m²·s/rad (DNV-RP-C205, 3.5.5) at ``omega`` (rad/s):
+
+    S(ω) = A_γ S_PM(ω) γ^exp(−½ ((ω − ω_p)/(σ ω_p))²),
+    S_PM(ω) = (5/16) H_s² ω_p⁴ ω⁻⁵ exp(−(5/4)(ω/ω_p)⁻⁴),
+
+    with ω_p = 2π/T_p, σ = 0.07 for ω ≤ ω_p and 0.09 above, and A_γ = 1 − 0.287 ln γ, which
+    keeps m0 = ∫S dω ≈ H_s²/16. ``hs`` H_s (m) and ``tp`` T_p (s) are positive, ``gamma``
+    γ in [1, 7] (γ = 1: Pierson–Moskowitz). S = 0 for ω <= 0.
+    """
+    w = _finite(omega, "omega")
+    hs = _checks.scalar(hs, "hs", positive=True, unit="m")
+    wp = 2.0 * np.pi / _checks.scalar(tp, "tp", positive=True, unit="s")
+    g = _gamma(gamma)
+    S = np.zeros_like(w)
+    x = w[w > 0.0]
+    sigma = np.where(x <= wp, 0.07, 0.09)
+    pm = 5.0 / 16.0 * hs**2 * wp**4 * x**-5 * np.exp(-1.25 * (x / wp) ** -4)
+    S[w > 0.0] = (1.0 - 0.287 * np.log(g)) * pm * g ** np.exp(-0.5 * ((x - wp) / (sigma * wp)) ** 2)
+    return S
+
+
+class RAO:
+    """A response amplitude operator H(ω): ``rao(omega)`` gives H as complex numbers, |H| in m/m
+    (translations) or rad/m (rotations), arg H in rad. Made by ``RAO.table``, ``RAO.constant``,
+    ``RAO.oscillator`` or from a function ``H(omega) -> complex array`` of ω (rad/s)."""
+
+    def __init__(self, function: Callable[[np.ndarray], np.ndarray], description: str = "function"):
+        if not callable(function):
+            raise ValueError(f"function: expected a callable H(omega) -> complex array, got {function!r}")
+        self._h = function
+        self._description = description
+
+    def __call__(self, omega) -> np.ndarray:
+        w = _finite(omega, "omega")
+        try:
+            H = np.asarray(self._h(w), dtype=complex)
+        except (TypeError, ValueError) as error:
+            raise ValueError(f"rao: expected {self} to return complex numbers, got {error!r}") from error
+        if H.shape != w.shape or not np.all(np.isfinite(H)):
+            raise ValueError(f"rao: expected {self} to return finite values of shape {w.shape}, got {H!r}")
+        return H
+
+    def __repr__(self) -> str:
+        return f"<rigidfem RAO {self._description}>"
+
+    @classmethod
+    def table(cls, omega, amplitude, phase=None) -> RAO:
+        """Tabulated |H| (m/m or rad/m) and arg H (rad; zeros when omitted) at increasing
+        ``omega`` (rad/s): both interpolated linearly in ω (the phase unwrapped), held at their
+        end values outside the table."""
+        w = _checks.vector(omega, "omega", min_length=1)
+        if np.any(np.diff(w) <= 0.0):
+            raise ValueError("omega: expected strictly increasing frequencies in rad/s")
+        amp = _checks.vector(amplitude, "amplitude")
+        arg = np.zeros_like(w) if phase is None else np.unwrap(_checks.vector(phase, "phase"))
+        for values, name in ((amp, "amplitude"), (arg, "phase")):
+            if values.size != w.size:
+                raise ValueError(f"{name}: expected {w.size} values (len(omega)), got {values.size}")
+        if np.any(amp < 0.0):
+            raise ValueError("amplitude: expected non-negative values |H|")
+        return cls(lambda x: np.interp(x, w, amp) * np.exp(1j * np.interp(x, w, arg)), f"table({w.size} points)")
+
+    @classmethod
+    def constant(cls, amplitude: float, phase: float = 0.0) -> RAO:
+        """H(ω) = ``amplitude`` e^(i ``phase``) at every ω: the motion is the elevation scaled
+        (amplitude 1, phase 0 for heave: a small buoy riding the waves)."""
+        H = _checks.scalar(amplitude, "amplitude", nonnegative=True) * np.exp(1j * _checks.scalar(phase, "phase"))
+        return cls(lambda x: np.full(np.shape(x), H), f"constant({H:.6g})")
+
+    @classmethod
+    def oscillator(cls, period: float, damping_ratio: float) -> RAO:
+        """The long-wave heave RAO of a floating body with natural ``period`` T_n (s) and
+        ``damping_ratio`` ζ: H(ω) = 1/(1 − r² + 2iζr), r = ω T_n/2π, in m/m (the wave force is
+        its hydrostatic stiffness times η, a fair model for wavelengths long against the body)."""
+        wn = 2.0 * np.pi / _checks.scalar(period, "period", positive=True, unit="s")
+        zeta = _checks.scalar(damping_ratio, "damping_ratio", positive=True)
+        return cls(lambda x: 1.0 / (1.0 - (x / wn) ** 2 + 2j * zeta * x / wn),
+                   f"oscillator(period={2 * np.pi / wn:.6g} s, damping_ratio={zeta:.6g})")
+
+
+def _as_rao(rao, name: str) -> RAO:
+    if isinstance(rao, RAO):
+        return rao
+    try:
+        return RAO.constant(rao)
+    except ValueError:
+        raise ValueError(f"{name}: expected an RAO or a non-negative gain, got {rao!r}") from None
+
+
+@dataclass(frozen=True, eq=False)
+class Waves:
+    """Harmonic components of a sea state: η(t) = Σ_k a_k sin(ω_k t + φ_k) (m) with
+    ``omega`` ω_k (rad/s), ``amplitude`` a_k (m) and ``phase`` φ_k (rad), 1-D arrays of one
+    length (kept as read-only copies). ``jonswap_waves`` makes them from a spectrum."""
+
+    omega: np.ndarray
+    amplitude: np.ndarray
+    phase: np.ndarray
+
+    def __post_init__(self):
+        a = _checks.vector(self.amplitude, "amplitude", min_length=1)
+        for name in ("omega", "phase", "amplitude"):
+            values = np.array(_checks.vector(getattr(self, name), name))  # a copy, then read-only
+            if values.size != a.size:
+                raise ValueError(f"{name}: expected {a.size} values (len(amplitude)), got {values.size}")
+            values.flags.writeable = False
+            object.__setattr__(self, name, values)
+
+    @property
+    def m0(self) -> float:
+        """Variance of η (m²): m0 = Σ a_k²/2, the discrete spectrum's zeroth moment."""
+        return float(0.5 * np.sum(self.amplitude**2))
+
+    @property
+    def hs(self) -> float:
+        """Significant wave height H_s = 4 √m0 (m) of the components."""
+        return 4.0 * np.sqrt(self.m0)
+
+    def elevation(self) -> Profile:
+        """η(t) (m) as a ``rigidfem.motion.harmonics`` profile, evaluated in C++."""
+        return motion.harmonics(self.amplitude, self.omega, self.phase)
+
+    def response(self, rao) -> Profile:
+        """x(t) = Σ_k |H(ω_k)| a_k sin(ω_k t + φ_k + arg H(ω_k)) for an ``RAO`` (or a constant
+        gain), as a harmonics profile: m for translations, rad for rotations."""
+        H = _as_rao(rao, "rao")(self.omega)
+        return motion.harmonics(np.abs(H) * self.amplitude, self.omega, self.phase + np.angle(H))
+
+    def motion(self, raos: dict) -> dict[str, Profile]:
+        """The base motion for ``Model.add_moving_base``: ``raos`` maps degrees of freedom (ship
+        names "surge", "sway", "heave", "roll", "pitch", "yaw", or "x" ... "rx") to an ``RAO``
+        or a constant gain; the result maps them to their responses. Missing ones stay at 0."""
+        if not isinstance(raos, dict):
+            raise ValueError(f"raos: expected a dict of degrees of freedom to RAOs, got {raos!r}")
+        names = list(BASE_DOFS) + list(BASE_DOFS.values())
+        for dof in raos:
+            if dof not in names:
+                raise ValueError(f"raos: expected keys from {names}, got {dof!r}")
+        return {dof: self.response(_as_rao(rao, f"raos[{dof!r}]")) for dof, rao in raos.items()}
+
+
+def jonswap_waves(hs: float, tp: float, gamma: float = 3.3, n: int = 200, omega_range=None, seed=0) -> Waves:
+    """A JONSWAP sea state (``jonswap``) as ``n`` components of equal Δω.
+
+    ω_k = ω_lo + (k − ½) Δω (k = 1 ... n), Δω = (ω_hi − ω_lo)/n, a_k = √(2 S(ω_k) Δω), and
+    phases φ_k uniform in [0, 2π) from ``np.random.default_rng(seed)`` (``seed`` an int or a
+    Generator): one seed, one record. ``omega_range`` (ω_lo, ω_hi) in rad/s defaults to
+    (0.5 ω_p, 5 ω_p), which holds all but 0.2 % of m0. The record's envelope repeats after
+    2π/Δω: raise ``n`` for longer simulations.
+    """
+    wp = 2.0 * np.pi / _checks.scalar(tp, "tp", positive=True, unit="s")
+    if isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer)) or n < 1:
+        raise ValueError(f"n: expected a positive number of components, got {n!r}")
+    lo, hi = (0.5 * wp, 5.0 * wp) if omega_range is None else _omega_range(omega_range)
+    dw = (hi - lo) / n
+    w = lo + (np.arange(n) + 0.5) * dw
+    a = np.sqrt(2.0 * jonswap(w, hs, tp, gamma) * dw)  # a_k² / 2 = S(ω_k) Δω
+    if not isinstance(seed, np.random.Generator):
+        try:
+            seed = np.random.default_rng(seed)
+        except (TypeError, ValueError):
+            raise ValueError(f"seed: expected an int or a numpy Generator, got {seed!r}") from None
+    return Waves(w, a, seed.uniform(0.0, 2.0 * np.pi, n))
+
+
+def _omega_range(omega_range) -> tuple[float, float]:
+    r = _checks.array(omega_range, (2,), "omega_range")
+    if not 0.0 <= r[0] < r[1]:
+        raise ValueError(f"omega_range: expected (lo, hi) with 0 <= lo < hi in rad/s, got {tuple(r)}")
+    return float(r[0]), float(r[1])

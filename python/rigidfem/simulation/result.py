@@ -1,0 +1,242 @@
+"""The result of a simulation: its outputs at the times ``t`` as numpy arrays, computed from (q, q̇) in C++ on first
+use, its error estimate (a second run of the function that made it) and its exports."""
+
+from __future__ import annotations
+
+import dataclasses
+import functools
+from dataclasses import dataclass, field
+
+import numpy as np
+
+from ..base import _checks, display, export
+import rigidfem._core as _core  # the compiled core, by its absolute name
+from . import error_control
+from . import options as options_
+from ..model import parameters as parameters_
+from ..base.persistence import Versioned
+from .._core import Body, Point
+
+
+@dataclass
+class Result(Versioned):
+    """A simulation's output at the times ``t`` (s).
+
+    ``q``, ``qd`` are (len(t), nq) in m, rad and per s; ``arm_forces`` (len(t), nz) the forces s
+    of the Maxwell arms (N or N·m; the viscoelastic sde laws, ``system.arms``), zero columns
+    without arms. The other arrays are computed from them on first use: ``qdd`` (len(t), nq),
+    ``driving_forces`` (len(t), np; N or N·m), energies (len(t),; J; the elastic energy holds the
+    arms' Σ s²/(2k)) and ``dissipated_power`` (len(t),; W). ``stats`` holds steps, rejected_steps,
+    rhs_evaluations, jacobians, factorizations, newton_iterations, linear_iterations (GMRES, of the
+    matrix-free tangent), wall_time (s) and model_size (m: the L that a relative tolerance on outputs
+    refers to; NaN when the run held the state), method (what ran) and, with loops, loop_reactions (whose
+    multipliers ``loop_reactions`` are).
+    ``error_estimate`` is the error bar of the time integration (computed on first use: a second run);
+    ``run`` keeps the arguments of the call that made the result.
+    """
+
+    system: object = field(repr=False)
+    t: np.ndarray
+    q: np.ndarray
+    qd: np.ndarray
+    stats: dict
+    method: str
+    interrupted: bool = False
+    arm_forces: np.ndarray = None
+    #: (len(t), nl) the loop multipliers the method solved for itself at each output (the Newmark family's);
+    #: None where it has none of its own (``loop_reactions`` then takes the forward dynamics')
+    multipliers: np.ndarray = field(default=None, repr=False)
+    run: dict = field(default=None, repr=False)        #: the arguments of the simulate call that made it
+    estimate: object = field(default=None, repr=False)  #: the ErrorEstimate, once computed
+    #: {name: (len(t), 2 nq)} the forward sensitivities [∂q/∂p, ∂q̇/∂p] of ``simulate(sensitivities=...)``
+    sensitivities: dict = field(default_factory=dict, repr=False)
+    #: the function that made it (``rigidfem.simulate``), which its error estimate runs again
+    made_by: object = field(default=None, repr=False)
+
+    def __post_init__(self):
+        if self.arm_forces is None:
+            self.arm_forces = np.zeros((len(self.t), 0 if self.system is None else self.system.nz))
+
+    @functools.cached_property
+    def _outputs(self):
+        nl = 0 if self.system is None else self.system.nl
+        own = np.zeros((0, nl)) if self.multipliers is None else np.ascontiguousarray(self.multipliers, dtype=float)
+        return _core._evaluate_outputs(self.system, self.t, self.q, self.qd, self.arm_forces, own)
+
+    @property
+    def qdd(self) -> np.ndarray:
+        return self._outputs[0]
+
+    @property
+    def driving_forces(self) -> np.ndarray:
+        """Forces/torques of the drives (len(t), np), in ``system.prescribed_names`` order."""
+        return self._outputs[1]
+
+    @property
+    def kinetic_energy(self) -> np.ndarray:
+        return self._outputs[2]
+
+    @property
+    def gravity_energy(self) -> np.ndarray:
+        return self._outputs[3]
+
+    @property
+    def elastic_energy(self) -> np.ndarray:
+        return self._outputs[4]
+
+    @property
+    def potential_energy(self) -> np.ndarray:
+        return self._outputs[3] + self._outputs[4]
+
+    @property
+    def energy(self) -> np.ndarray:
+        """Kinetic + gravity + elastic energy (J)."""
+        return self._outputs[2] + self._outputs[3] + self._outputs[4]
+
+    @property
+    def dissipated_power(self) -> np.ndarray:
+        """Power (W) dissipated by the dampers (Σ b q̇², force elements' c l̇², ropes) and the Maxwell
+        arms (Σ s²/(k τ)): its integral over t closes the energy balance with ``energy``."""
+        return self._outputs[5]
+
+    @property
+    def loop_reactions(self) -> np.ndarray:
+        """Reactions of the loop closures (len(t), nloops, 6): force (N) and torque (N·m) on body
+        b in frame A's axes, per ``system.loop_names``; an actuator's force in column 0.
+        ``stats["loop_reactions"]`` says where they come from:
+
+        - the Newmark family (newmark, hht, generalized_alpha, implicit_spring) solves for its own
+          multipliers λ_{n+1} with q̈_{n+1} at each step's end (index 3, Arnold & Brüls): those, linear
+          between the steps' ends at outputs inside a step. They converge as h² to the exact ones and
+          differ by O(h²) from the forward dynamics' at the output's (q, q̇);
+        - every other method: the multipliers of the forward dynamics at each output's (q, q̇) and
+          Maxwell arms' forces, the same computation as ``qdd``. esdirk43 and radau5 solve the loops at
+          the acceleration level inside their stages and take exactly these at each step's end, after
+          the projection onto the loops; the explicit methods and SciPy's have none of their own.
+
+        ``system.loop_reactions(t, q, qd)`` gives the forward dynamics' at any state."""
+        return self._outputs[6].reshape(len(self.t), len(self.system.loop_names), 6)
+
+    @property
+    def element_forces(self) -> np.ndarray:
+        """Axial forces (len(t), nelements) in N of the force elements (spring-dampers, cylinders, ropes),
+        per ``system.element_names``; positive pushing the two points apart (a rope's −T)."""
+        return self._outputs[7]
+
+    @property
+    def error_estimate(self):
+        """The estimated global time-integration error of the outputs the run measured its error on
+        (``error_on``; "bodies" by default), an ``ErrorEstimate``: computed on first use by a second run
+        at tolerances 10 times smaller (adaptive methods) or at half the step (fixed steps; Richardson's
+        factor 2^p/(2^p − 1) for order p), then kept; ``simulate(..., error_estimate=True)`` computes it
+        with the run. ``res.error_estimate.of(lambda r: r.position(beam.tip))`` estimates any other
+        quantity's error. The model's own (spatial) error is ``rigidfem.resolve``'s."""
+        if self.estimate is None:
+            self.estimate = _estimate_error(self)
+        return self.estimate
+
+    def position(self, point, frame: Body | None = None) -> np.ndarray:
+        """Positions (len(t), 3) in m of a ``Point`` (or a ``Body``'s origin), in the global
+        frame or in the frame of the body ``frame``."""
+        if isinstance(point, Body):
+            point = point.origin
+        if not isinstance(point, Point):
+            raise ValueError(f"point: expected a Point or a Body, got {point!r}")
+        if frame is not None and not isinstance(frame, Body):
+            raise ValueError(f"frame: expected None or a Body, got {frame!r}")
+        _checks.same_model(point, self.system, "point")
+        if frame is not None:
+            _checks.same_model(frame, self.system, "frame", "None or a Body of the model this system was compiled from")
+        return _core._point_positions(self.system, point.body, point.r, -1 if frame is None else frame.index,
+                                      self.t, self.q)
+
+    def sensitivity(self, name: str) -> tuple[np.ndarray, np.ndarray]:
+        """(∂q/∂p, ∂q̇/∂p), each (len(t), nq), by the parameter or initial value ``name`` the run was asked
+        for (``simulate(sensitivities=...)``; units of q and q̇ per unit of the parameter)."""
+        if name not in self.sensitivities:
+            raise ValueError(f"name: expected one of the sensitivities of this run {list(self.sensitivities)}, "
+                             f"got {name!r}")
+        S = self.sensitivities[name]
+        n = self.system.nq
+        return S[:, :n], S[:, n:]
+
+    def position_sensitivity(self, point, name: str, frame: Body | None = None) -> np.ndarray:
+        """dx/dp (len(t), 3) of a point's position x (``position``: global, or in ``frame``'s axes) by
+        ``name``: (∂x/∂q) ∂q/∂p, by a central difference of x along ∂q/∂p at each output (about 1e-10
+        relative; m per unit of the parameter), plus, for a profile's number, ∂x/∂p at fixed q: a drive's
+        number moves its prescribed coordinate, and the point with it (a central difference of x on the
+        systems at p ± h)."""
+        dq, _ = self.sensitivity(name)
+        size = np.max(np.abs(dq), axis=1) / np.maximum(1.0, np.max(np.abs(self.q), axis=1, initial=0.0))
+        eps = 6e-6 / np.where(size > 0.0, size, 1.0)  # the largest relative change of q: 6e-6
+        up, down = (dataclasses.replace(self, q=self.q + sign * eps[:, None] * dq).position(point, frame)
+                    for sign in (1.0, -1.0))
+        dx = (up - down) / (2.0 * eps[:, None])  # zero where ∂q/∂p is
+        params = self.system._parameters
+        if parameters_.initial_value(self.system, name) is None and not params.parameter(name).linear:
+            plus, minus, h = params.profile_pair(self.system, name, self.t[0], self.t[-1])
+            up, down = (dataclasses.replace(self, system=shifted).position(point, frame) for shifted in (plus, minus))
+            dx += (up - down) / (2.0 * h)
+        return dx
+
+    def __repr__(self) -> str:
+        s = self.stats
+        chosen = f" ({s['method']})" if s.get("method", self.method) != self.method else ""
+        bar = ""
+        if self.estimate is not None:
+            bar = ", estimated error " + ", ".join(f"{n} {m:.2g} {u}" for n, u, m in self.estimate.table())
+        return (f"<rigidfem Result {self.method}{chosen}: {len(self.t)} outputs to t = {self.t[-1]:g} s, {s['steps']} steps "
+                f"({s['rejected_steps']} rejected), {s['rhs_evaluations']} rhs, {s['wall_time']:.3g} s{bar}"
+                f"{', interrupted' if self.interrupted else ''}>")
+
+    def _repr_html_(self) -> str:
+        """Notebook display: method, outputs, steps, rhs evaluations, wall time (``rigidfem.display``)."""
+        return display.result_html(self)
+
+    def to_dataframe(self, points=None):
+        """pandas DataFrame indexed by ``t`` (s): a column per coordinate (q, m or rad, named as in
+        ``system.coordinate_names``), ``<name>.dot`` per coordinate (q̇, m/s or rad/s) and, for
+        ``points={"tip": beam.tip}`` (Points or Bodies), ``tip.x``, ``tip.y``, ``tip.z`` (global
+        position, m). ImportError when pandas is not installed (``to_csv`` needs none)."""
+        return export.to_dataframe(self, points)
+
+    def to_csv(self, path, points=None):
+        """Write the table of ``to_dataframe`` as CSV with a header line ``t,<columns>`` (numpy only;
+        17 significant digits). Returns ``path``."""
+        return export.to_csv(self, path, points)
+
+    def to_npz(self, path):
+        """Save t, q, qd, the forward sensitivities (if any), coordinate_names, method, stats and interrupted in a
+        NumPy archive; ``rigidfem.load_npz(path, system)`` reads it back. Returns ``path``."""
+        return export.to_npz(self, path)
+
+
+def load_npz(path, system=None) -> Result:
+    """The Result saved by ``Result.to_npz``. Give the ``system`` it was computed with (its
+    coordinate names must match; ValueError otherwise) to use the outputs that need it: positions,
+    energies, ``to_dataframe``."""
+    return Result(system, **export.read_npz(path, system))
+
+
+def _estimate_error(result: Result):
+    """Result.error_estimate: the second run (tolerances / TIGHTER, or dt / 2) at the same output times."""
+    run = result.run
+    if run is None or result.made_by is None:
+        raise ValueError("result: expected a Result made by rigidfem.simulate (a loaded one has no run to repeat)")
+    if result.interrupted or not len(result.t) or result.t[-1] < run["t_end"]:
+        raise ValueError("result: expected a finished run for its error estimate, got one that stopped at "
+                         f"t = {result.t[-1] if len(result.t) else run['t0']:g} s")
+    kw = {k: v for k, v in run.items() if k not in ("outputs", "fixed")}
+    kw["t_eval"], kw["stiffness_warning"] = result.t, False
+    if run["fixed"]:
+        kw["dt"] = run["dt"] / 2.0
+        order = options_.method(run["method"]).order  # Richardson's factor 2^p/(2^p − 1)
+    else:
+        kw["rtol"], kw["atol"] = run["rtol"] / error_control.TIGHTER, run["atol"] / error_control.TIGHTER
+        kw["max_steps"] = 10 * run["max_steps"]
+        order = None
+    try:
+        rerun = result.made_by(result.system, **kw)
+    except _core.SimulationError as e:
+        raise _core.SimulationError(f"error_estimate: the second run failed {e}") from e
+    return error_control.estimate(result, rerun, order)
