@@ -245,3 +245,72 @@ def test_bad_cylinder_input_and_failures():
         s.forward_dynamics(0.0, [0.0], [0.0])
     with pytest.raises(rf.SimulationError, match="force element 'bad'"):
         rf.simulate(s, 0.1)
+
+
+# --------------------------------------------------------------------------- buffers (Hunt–Crossley)
+
+def _drop_on_buffer(law, m=2.0, v0=1.5, gap=0.3):
+    """A block of mass m (kg) on a prismatic z joint, no gravity, moving down at v0 (m/s) from z = gap + l0 above a
+    buffer from the ground: the buffer touches at z = l0."""
+    model = rf.Model(gravity=None)
+    block = model.add_body("block", model.ground, rf.Joint.prismatic("z"), mass=m, inertia=(0.1, 0.1, 0.1))
+    model.add_force_element(model.ground, block, law, name="stop")
+    return model.compile(), law.values["length"] + gap
+
+
+@pytest.mark.parametrize("n", [1.0, 1.5])
+def test_an_elastic_buffer_returns_the_speed_and_reaches_the_energys_penetration(n):
+    """Without dissipation the block leaves at the speed it came (energy), after pushing in to
+    δ_max = ((n + 1) m v0² / (2 k))^(1/(n + 1)); a linear buffer (n = 1) holds it for π √(m/k)."""
+    m, v0, k, l0 = 2.0, 1.5, 4e4, 0.5
+    system, z0 = _drop_on_buffer(rf.laws.Buffer(stiffness=k, exponent=n, length=l0), m, v0)
+    t = np.linspace(0.0, 1.0, 20001)
+    r = rf.simulate(system, 1.0, "radau5", q0=[z0], qd0=[-v0], t_eval=t, rtol=1e-10, atol=1e-12)
+    assert abs(r.qd[-1, 0] - v0) < 1e-7 * v0
+    depth = ((n + 1) * m * v0**2 / (2 * k)) ** (1 / (n + 1))
+    assert abs((l0 - r.q[:, 0].min()) - depth) < 1e-6 * depth
+    if n == 1.0:
+        inside = t[r.q[:, 0] < l0]
+        assert abs((inside[-1] - inside[0]) - np.pi * np.sqrt(m / k)) < 2 * (t[1] - t[0])
+    assert np.ptp(r.energy) < 2e-7 * 0.5 * m * v0**2  # the touch is a kink radau5 steps over (no event yet)
+
+
+def test_hunt_crossley_restitution_matches_the_impact_integral():
+    """m δ̈ = −k δⁿ (1 + α δ̇) integrates over the contact to v_out − ln(1 + α v_out)/α = v_in − ln(1 + α v_in)/α
+    (δ from 0 back to 0); its root v_out < 0, found here, against the block's speed after the impact, and the energy
+    lost against ∫ P dt of dissipated_power."""
+    from scipy.optimize import brentq
+
+    m, v0, k, n, alpha, l0 = 2.0, 1.5, 4e4, 1.5, 0.3, 0.5
+    system, z0 = _drop_on_buffer(rf.laws.Buffer(stiffness=k, exponent=n, length=l0, dissipation=alpha), m, v0)
+    t = np.linspace(0.0, 1.0, 40001)
+    r = rf.simulate(system, 1.0, "radau5", q0=[z0], qd0=[-v0], t_eval=t, rtol=1e-10, atol=1e-12)
+    g = lambda v: v - np.log1p(alpha * v) / alpha  # noqa: E731
+    v_out = brentq(lambda v: g(v) - g(v0), -1.0 / alpha + 1e-12, -1e-9)  # the other root: leaving
+    assert abs(r.qd[-1, 0] - (-v_out)) < 1e-6 * v0, (r.qd[-1, 0], -v_out)
+    assert -v_out < 0.9 * v0  # it did dissipate
+    lost = r.energy[0] - r.energy[-1]
+    dissipated = np.sum(0.5 * np.diff(t) * (r.dissipated_power[1:] + r.dissipated_power[:-1]))
+    assert abs(lost - dissipated) < 1e-5 * lost
+    assert abs(lost - 0.5 * m * (v0**2 - v_out**2)) < 1e-6 * lost
+
+
+def test_a_buffers_derivatives_are_exact_and_its_constants_are_parameters():
+    law = rf.laws.Buffer(stiffness=3e3, exponent=1.5, length=1.2, dissipation=0.2)
+    model = rf.Model(gravity=(0.0, 0.0, -9.81))
+    arm = model.add_body("arm", model.ground, rf.Joint.revolute("y"), mass=1.0, inertia=(0.1, 0.1, 0.1),
+                         com=(1.0, 0.0, 0.0))
+    model.add_force_element(model.ground.point((1.0, 0.0, -1.0)), arm.point((1.0, 0.0, 0.0)), law, name="stop")
+    s = model.compile()
+    for q, qd in (([0.3], [0.5]), ([0.2], [-0.4]), ([-0.3], [0.1])):  # pushing, leaving, not touching
+        Kq, Kqd = s.force_jacobians(0.0, np.array(q), np.array(qd))
+        Fq, Fqd = central_jacobians(s, 0.0, np.array(q), np.array(qd))
+        np.testing.assert_allclose(Kq, Fq, rtol=1e-6, atol=1e-6)
+        np.testing.assert_allclose(Kqd, Fqd, rtol=1e-6, atol=1e-6)
+    p = s.parameters
+    assert (p["stop.stiffness"].unit, p["stop.dissipation"].unit) == ("N/m^n", "s/m")
+    assert "stop.exponent" not in p and "stop.length" not in p
+    with pytest.raises(ValueError, match=r"^exponent: expected a number >= 1 in 1"):
+        rf.laws.Buffer(stiffness=1.0, exponent=0.5)
+    with pytest.raises(ValueError, match="^profile: expected None"):
+        rf.laws.Buffer(stiffness=1.0, profile=rf.motion.constant(1.0))

@@ -197,6 +197,60 @@ class Rope final : public ElementLaw {
   std::shared_ptr<ElementLaw> clone() const override { return std::make_shared<Rope>(*this); }
 };
 
+/// A buffer (an end stop, a bumper): compression only, with the Hunt–Crossley law of a contact. With the
+/// penetration δ = l₀ − l (> 0 once the points come closer than l₀) and its rate δ̇ = −l̇,
+///   F = k δⁿ (1 + α δ̇)  while δ > 0 and that is positive, else 0,
+/// pushing the points apart: n = 1 a linear buffer, n = 3/2 Hertz's contact of curved bodies; α (s/m) dissipates
+/// in proportion to the force, so F rises from 0 at first touch (no jump), and the coefficient of restitution
+/// follows from α and the impact speed (v_out − ln(1 + α v_out)/α = v_in − ln(1 + α v_in)/α). Stores
+/// k δⁿ⁺¹/(n + 1), dissipates k α δⁿ δ̇² while it pushes.
+class Buffer final : public ElementLaw {
+ public:
+  enum { K, N, L0, ALPHA };  // the constants' indices
+  static const LawInfo& description() {
+    static const LawInfo info{
+        "Buffer", "element",
+        "F = k δⁿ (1 + α δ̇) with δ = l₀ − l while δ > 0 and F > 0, else 0 (N, pushing the points apart): a "
+        "compression-only buffer or end stop with Hunt–Crossley dissipation (n = 1.5: Hertz); stores k δⁿ⁺¹/(n + 1), "
+        "dissipates k α δⁿ δ̇²",
+        {{"stiffness", "N/m^n", nullptr, 0.0, 0.0, false, "the buffer's stiffness k (F = k δⁿ)", true},
+         {"exponent", "1", nullptr, 1.0, 1.0, false, "the exponent n of the penetration (1 linear, 1.5 Hertz)", false},
+         {"length", "m", nullptr, 0.0, 0.0, false, "the length l₀ below which it pushes", false},
+         {"dissipation", "s/m", nullptr, 0.0, 0.0, false, "Hunt–Crossley's α: F = k δⁿ (1 + α δ̇)", true}},
+        nullptr,
+        nullptr,
+        nullptr,
+        nullptr};
+    return info;
+  }
+  Buffer(std::vector<double> values, ProfilePtr, AxialFunction) : ElementLaw(std::move(values), nullptr) {}
+  const LawInfo& info() const override { return description(); }
+  double force(double, double l, double ld, double) const override {
+    const double d = c_[L0] - l;
+    return d > 0.0 ? std::max(0.0, c_[K] * std::pow(d, c_[N]) * (1.0 - c_[ALPHA] * ld)) : 0.0;
+  }
+  /// ∂F/∂l = −k n δⁿ⁻¹ (1 + α δ̇), ∂F/∂l̇ = −k α δⁿ while it pushes, else 0.
+  std::pair<double, double> derivatives(double t, double l, double ld, double lambda) const override {
+    if (!(force(t, l, ld, lambda) > 0.0)) return {0.0, 0.0};
+    const double d = c_[L0] - l;
+    return {-c_[K] * c_[N] * std::pow(d, c_[N] - 1.0) * (1.0 - c_[ALPHA] * ld), -c_[K] * c_[ALPHA] * std::pow(d, c_[N])};
+  }
+  bool elastic() const override { return true; }
+  bool dissipative() const override { return c_[ALPHA] != 0.0; }
+  double energy(double, double l) const override {
+    const double d = c_[L0] - l;
+    return d > 0.0 ? c_[K] * std::pow(d, c_[N] + 1.0) / (c_[N] + 1.0) : 0.0;
+  }
+  double power(double, double l, double ld, double F) const override {
+    const double d = c_[L0] - l;
+    return F > 0.0 ? c_[K] * c_[ALPHA] * std::pow(d, c_[N]) * ld * ld : 0.0;
+  }
+  const char* drawn_as() const override { return "spring"; }
+
+ private:
+  std::shared_ptr<ElementLaw> clone() const override { return std::make_shared<Buffer>(*this); }
+};
+
 /// A kind of force element as the bindings make it: its description, and its maker from the constants' values
 /// (in the description's order), a profile and a Python function (each null where the kind takes none).
 struct ElementLawKind {
@@ -214,6 +268,10 @@ inline const std::vector<ElementLawKind>& element_law_kinds() {
       {Rope::description,
        [](std::vector<double> v, ProfilePtr p, AxialFunction f) -> std::shared_ptr<const ElementLaw> {
          return std::make_shared<Rope>(std::move(v), std::move(p), std::move(f));
+       }},
+      {Buffer::description,
+       [](std::vector<double> v, ProfilePtr p, AxialFunction f) -> std::shared_ptr<const ElementLaw> {
+         return std::make_shared<Buffer>(std::move(v), std::move(p), std::move(f));
        }},
   };
   return kinds;
