@@ -243,3 +243,31 @@ def test_bad_loops_are_value_errors_and_unreachable_ones_simulation_errors():
     mod2.add_actuator(mod2.ground.point((0.0, 0.6, 0.0)), b.origin, 0.5, name="stuck")
     with pytest.raises(rf.SimulationError, match="loop 'stuck' \\(distance, residual 0.1\\)"):
         mod2.compile().assemble([0.3])
+
+
+def test_a_planar_loop_joint_keeps_a_free_body_in_its_plane():
+    """A free body held by a planar loop joint to the ground's x-y plane (added as one row of the table of kinds and
+    its name: two files): under in-plane gravity it falls as y = −g t²/2, drifts at its x rate and spins at its
+    constant ω_z about principal axes, while z and the tilts stay zero; an out-of-plane push P is the loop's
+    reaction, −P along A's z."""
+    g, vx, wz, P = 9.81, 0.4, 2.0, 3.0
+    model = rf.Model(gravity=(0.0, -g, 0.0))
+    body = model.add_body("puck", model.ground, rf.Joint.free(), mass=2.0, inertia=(0.1, 0.2, 0.3))
+    loop = model.add_loop_joint("planar", model.ground, body, name="table")
+    model.add_force(body.origin, (0.0, 0.0, P))
+    s = model.compile()
+    assert (s.nl, loop.kind) == (3, "planar")
+    names = s.coordinate_names
+    qd0 = np.zeros(s.nq)
+    qd0[names.index("puck.x")], qd0[names.index("puck.rz")] = vx, wz
+    t = np.linspace(0.0, 1.0, 11)
+    for method, options in (("radau5", dict(rtol=1e-10, atol=1e-12)), ("generalized_alpha", dict(dt=1e-3))):
+        r = rf.simulate(s, 1.0, method, qd0=qd0, t_eval=t, **options)
+        q = dict(zip(names, r.q.T))
+        tol = 1e-8 if method == "radau5" else 1e-5
+        np.testing.assert_allclose(q["puck.x"], vx * t, atol=tol)
+        np.testing.assert_allclose(q["puck.y"], -0.5 * g * t**2, atol=tol)
+        np.testing.assert_allclose(q["puck.rz"], wz * t, atol=tol)
+        for out_of_plane in ("puck.z", "puck.ry", "puck.rx"):
+            assert np.abs(q[out_of_plane]).max() < 1e-9, (method, out_of_plane)
+        np.testing.assert_allclose(r.loop_reactions[:, 0, :3], np.tile([0.0, 0.0, -P], (len(t), 1)), atol=1e-6)

@@ -426,3 +426,45 @@ def test_centerline_is_every_point_in_one_pass():
     s = np.concatenate([[0.0], (np.arange(1, 301) - 0.5) * 2.0 / 300, [2.0]])
     np.testing.assert_allclose(beam.centerline(system, np.zeros(system.nq)), np.c_[s, 0 * s, 0 * s], atol=1e-15)
     assert beam.points() is not beam.points() and len(beam.points()) == 302  # copies of the kept handles
+
+
+def test_every_builder_returns_a_handle_with_its_name():
+    """Bodies, beams, elements, loads, loops, laws and coordinates: each builder's handle has .name, and the handles
+    of named things are their names (str), so they serve where a name does; they pickle with what they are."""
+    import inspect
+    import pickle
+
+    m = rf.Model()
+    a = m.add_body("a", m.ground, rf.Joint.revolute("z"), mass=1.0, inertia=(1, 1, 1), com=(0.5, 0, 0))
+    b = m.add_body("b", a, rf.Joint.prismatic("x"), mass=1.0, inertia=(1, 1, 1), placement=rf.transform((1, 0, 0)))
+    beam = m.add_beam("strip", b, 1.0, rf.Material(E=2.1e11, rho=7850.0), rf.Section.rectangle(0.02, 0.005), 2,
+                      deform="bend_z")
+    base = m.add_moving_base("deck", {"heave": rf.motion.harmonic(0.1, 1.0)})
+    made = {
+        "add_body": a, "add_beam": beam, "add_moving_base": base,
+        "add_spring_damper": m.add_spring_damper(m.ground.point((0, 1, 0)), b, stiffness=10.0, length=1.0, name="k"),
+        "add_cylinder": m.add_cylinder(m.ground.point((0, 2, 0)), b, 5.0),
+        "add_rope": m.add_rope(base, beam.tip, EA=1e5, length=2.0),
+        "add_force_element": m.add_force_element(m.ground.point((0, 3, 0)), b, rf.laws.Buffer(stiffness=1.0)),
+        "add_force": m.add_force(beam.tip, (0.0, -1.0, 0.0), name="push"),
+        "add_torque": m.add_torque(a, (0.0, 0.0, 1.0)),
+        "add_loop_joint": m.add_loop_joint("distance", m.ground.point((2, 0, 0)), b, length=1.5),
+        "add_actuator": m.add_actuator(m.ground.point((3, 0, 0)), b, 2.5, name="ram"),
+        "add_joint_law": m.add_joint_law(a, rf.laws.Friction(coulomb=0.1)),
+        "add_generalized_force": m.add_generalized_force(a, 0.5),
+        "add_maxwell_arm": m.add_maxwell_arm(b, 10.0, 0.1),
+        "prescribe": m.prescribe(beam.rfes[1], rf.motion.constant(0.0)),
+    }
+    builders = {n for n, f in inspect.getmembers(rf.Model, inspect.isfunction) if n.startswith("add_") or n == "prescribe"}
+    assert builders == set(made), builders ^ set(made)
+    for builder, handle in made.items():
+        assert isinstance(handle.name, str) and handle.name, builder
+    assert (made["add_spring_damper"], made["add_force"], made["add_actuator"]) == ("k", "push", "ram")
+    assert made["add_rope"].kind == "Rope" and made["add_loop_joint"].kind == "distance"
+    assert (made["add_joint_law"], made["prescribe"], made["add_maxwell_arm"]) == ("a.rz.friction", "strip.rfe1.rz",
+                                                                                    "b.x")
+    s = m.compile()
+    assert s.element_names.index(made["add_rope"]) == made["add_rope"].index == 2
+    assert f"{made['add_spring_damper']}.stiffness" in s.parameters
+    back = pickle.loads(pickle.dumps(made["add_loop_joint"]))
+    assert (back, type(back), back.kind, back.index) == ("loop0", type(made["add_loop_joint"]), "distance", 0)

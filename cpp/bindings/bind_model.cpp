@@ -353,6 +353,18 @@ void bind_model(py::module_& m) {
             return kinds;
           },
           "The loop kinds and their numbers of constraint rows.")
+      .def_static(
+          "_loop_kind_table",
+          [] {
+            py::list kinds;
+            for (int k = 0; k < loop_kind_count; ++k) {
+              const auto kind = static_cast<LoopKind>(k);
+              kinds.append(py::dict(py::arg("kind") = loop_kind_name(kind), py::arg("rows") = loop_rows(kind),
+                                    py::arg("free") = loop_kind_doc(kind)));
+            }
+            return kinds;
+          },
+          "The loop kinds, each a dict: kind, rows (constraint equations), free (what it leaves free).")
       .def(
           "_add_force_element",
           [](Model& model, const std::string& name, int a, const Vec3& point_a, int b, const Vec3& point_b,

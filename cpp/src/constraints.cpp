@@ -97,25 +97,35 @@ Track difference(const Track& b, const Track& a) { return {b.x - a.x, b.xd - a.x
 
 enum { X, Y, Z };
 
-/// The rows of a loop kind (not Distance): position rows d·a_i for i < positions (x, y, z; two
-/// for the joints that slide along z), then direction rows b_j·a_i for each pair (j, i).
-struct RowLayout {
-  int positions;
+/// A loop kind's row of the table: its name, what it leaves free, and (not Distance) its rows: position rows d·a_i
+/// for the axes i of A in `positions` (the origins' difference d held along them), then direction rows b_j·a_i for
+/// each pair (j, i) (B's axis j held square to A's axis i).
+struct KindRow {
+  LoopKind kind;
+  const char* name;
+  const char* doc;
+  std::vector<int> positions;
   std::vector<std::pair<int, int>> directions;
 };
 
-const RowLayout& layout(LoopKind kind) {
-  static const RowLayout revolute{3, {{Z, X}, {Z, Y}}}, spherical{3, {}}, universal{3, {{Y, X}}},
-      prismatic{2, {{Z, X}, {Z, Y}, {X, Y}}}, cylindrical{2, {{Z, X}, {Z, Y}}}, fixed{3, {{Z, X}, {Z, Y}, {X, Y}}};
-  switch (kind) {
-    case LoopKind::Revolute: return revolute;
-    case LoopKind::Spherical: return spherical;
-    case LoopKind::Universal: return universal;
-    case LoopKind::Prismatic: return prismatic;
-    case LoopKind::Cylindrical: return cylindrical;
-    case LoopKind::Fixed: return fixed;
-    default: throw std::logic_error("layout: a distance loop has one row of its own");
-  }
+const std::vector<KindRow>& kind_table() {
+  static const std::vector<KindRow> table = {
+      {LoopKind::Revolute, "revolute", "rotation about the common z axis", {X, Y, Z}, {{Z, X}, {Z, Y}}},
+      {LoopKind::Spherical, "spherical", "every rotation about the common origin", {X, Y, Z}, {}},
+      {LoopKind::Universal, "universal", "rotations about A's x axis and B's y axis (the cross)", {X, Y, Z}, {{Y, X}}},
+      {LoopKind::Prismatic, "prismatic", "translation along z", {X, Y}, {{Z, X}, {Z, Y}, {X, Y}}},
+      {LoopKind::Cylindrical, "cylindrical", "translation along and rotation about z", {X, Y}, {{Z, X}, {Z, Y}}},
+      {LoopKind::Fixed, "fixed", "none", {X, Y, Z}, {{Z, X}, {Z, Y}, {X, Y}}},
+      {LoopKind::Planar, "planar", "translation in the x–y plane and rotation about z", {Z}, {{Z, X}, {Z, Y}}},
+      {LoopKind::Distance, "distance", "everything but the distance |r_B − r_A| = l", {}, {}},
+  };
+  return table;
+}
+
+const KindRow& layout(LoopKind kind) {
+  const KindRow& row = kind_table()[static_cast<int>(kind)];  // the table in the enum's order
+  if (row.kind != kind) throw std::logic_error("kind_table: a row out of the enum's order");
+  return row;
 }
 
 /// Row r of the constraints: value, rate, −(second rate at q̈_free = 0), Jacobian.
@@ -160,8 +170,8 @@ void constraint_equations(const System& sys, Data& d, bool spatial) {
       distance_row(d, r, dr, l, L.name);
       continue;
     }
-    const RowLayout& rows = layout(L.kind);
-    for (int i = 0; i < rows.positions; ++i) dot_row(d, r++, dr, a[i]);
+    const KindRow& rows = layout(L.kind);
+    for (int i : rows.positions) dot_row(d, r++, dr, a[i]);
     for (const auto& [j, i] : rows.directions) dot_row(d, r++, b[j], a[i]);
   }
 }
@@ -206,10 +216,10 @@ RowMatX loop_reactions(const System& sys, const Data& d, const VecX& lambda) {
       continue;
     }
     // Force Σ λ_i a_i at B's origin from the position rows; torque Σ λ b_j × a_i from the rest.
-    const RowLayout& rows = layout(L.kind);
+    const KindRow& rows = layout(L.kind);
     Vec3 F = Vec3::Zero(), tau = Vec3::Zero();
     int r = r0;
-    for (int i = 0; i < rows.positions; ++i) F += lambda(r++) * RA.col(i);
+    for (int i : rows.positions) F += lambda(r++) * RA.col(i);
     for (const auto& [j, i] : rows.directions) tau += lambda(r++) * RB.col(j).cross(RA.col(i));
     W.row(k).head<3>() = RA.transpose() * F;
     W.row(k).tail<3>() = RA.transpose() * tau;
@@ -219,21 +229,19 @@ RowMatX loop_reactions(const System& sys, const Data& d, const VecX& lambda) {
 
 int loop_rows(LoopKind kind) {
   if (kind == LoopKind::Distance) return 1;
-  const RowLayout& rows = layout(kind);
-  return rows.positions + static_cast<int>(rows.directions.size());
+  const KindRow& rows = layout(kind);
+  return static_cast<int>(rows.positions.size() + rows.directions.size());
 }
 
-namespace {
-const char* kind_names[] = {"revolute", "spherical", "universal", "prismatic", "cylindrical", "fixed", "distance"};
-}
+const char* loop_kind_name(LoopKind kind) { return layout(kind).name; }
 
-const char* loop_kind_name(LoopKind kind) { return kind_names[static_cast<int>(kind)]; }
+const char* loop_kind_doc(LoopKind kind) { return layout(kind).doc; }
 
 LoopKind parse_loop_kind(const std::string& name, const std::string& argument) {
   std::string names;
-  for (int k = 0; k < loop_kind_count; ++k) {
-    if (name == kind_names[k]) return static_cast<LoopKind>(k);
-    names += std::string(k ? ", " : "") + kind_names[k];
+  for (const KindRow& row : kind_table()) {
+    if (name == row.name) return row.kind;
+    names += std::string(names.empty() ? "" : ", ") + row.name;
   }
   bad(argument, "one of " + names, "'" + name + "'");
 }

@@ -16,10 +16,13 @@ namespace rigidfem {
 ///   Revolute: rotation about the common z axis;        Spherical: every rotation;
 ///   Universal: rotation about A's x and B's y axes;     Prismatic: translation along z;
 ///   Cylindrical: translation along and rotation about z; Fixed: nothing;
+///   Planar: translation in the x–y plane and rotation about z;
 ///   Distance: everything but the distance |r_B − r_A| = l (constant, or l(t) for an actuator).
-enum class LoopKind { Revolute, Spherical, Universal, Prismatic, Cylindrical, Fixed, Distance };
-/// The number of kinds (the table of kinds: constraints.cpp, read by Python through _core._loop_kinds).
-constexpr int loop_kind_count = 7;
+/// A kind is its name here and its row of the table of kinds in constraints.cpp (its constraint rows, what it leaves
+/// free); the Python layer (rigidfem.loops, the analyses) reads the table through _core._loop_kind_table.
+enum class LoopKind { Revolute, Spherical, Universal, Prismatic, Cylindrical, Fixed, Planar, Distance };
+/// The number of kinds.
+constexpr int loop_kind_count = 8;
 
 /// One loop closure as the user describes it. Body −1 is the ground.
 struct Loop {
@@ -37,6 +40,8 @@ struct Loop {
 int loop_rows(LoopKind kind);
 /// "revolute", ...; and back (std::invalid_argument naming `argument` for an unknown kind).
 const char* loop_kind_name(LoopKind kind);
+/// What a loop joint of that kind leaves free, in words (the site's table).
+const char* loop_kind_doc(LoopKind kind);
 LoopKind parse_loop_kind(const std::string& name, const std::string& argument);
 
 }  // namespace rigidfem

@@ -184,6 +184,11 @@ class _Model:
         addable (False: every coordinate's own spring-damping law).
         """
     @staticmethod
+    def _loop_kind_table() -> list:
+        """
+        The loop kinds, each a dict: kind, rows (constraint equations), free (what it leaves free).
+        """
+    @staticmethod
     def _loop_kinds() -> dict:
         """
         The loop kinds and their numbers of constraint rows.

@@ -26,7 +26,7 @@ from __future__ import annotations
 import numpy as np
 
 import rigidfem._core as _core  # the compiled core, by its absolute name
-from . import laws, parameters
+from . import handles, laws, parameters
 from .._core import Body, Point, Profile
 
 
@@ -48,7 +48,7 @@ def points(model, a, b) -> tuple:
     return (*point_of(model, a, "a"), *point_of(model, b, "b"))
 
 
-def add_force_element(model, a, b, law, *, name: str | None = None) -> str:
+def add_force_element(model, a, b, law, *, name: str | None = None) -> handles.Element:
     """The element of ``law`` (a ``rigidfem.laws`` law of a force element) added to ``model`` between ``a`` and
     ``b``; returns its name ("element<k>" when ``name`` is None). Its constants marked as parameters become the
     parameters ``"<name>.<constant>"``, its profile's numbers ``"<name>.<profile name>.<path>"``."""
@@ -64,7 +64,7 @@ def add_force_element(model, a, b, law, *, name: str | None = None) -> str:
     if law.profile is not None:
         parameters.register(model, parameters.ProfileGroup(f"{name}.{info['profile_name']}", "element", -1, k,
                                                            law.profile, info["profile_units"]))
-    return name
+    return handles.Element(name, law.kind, k)
 
 
 def cylinder_force(force) -> dict:

@@ -7,17 +7,7 @@ Each adds constraint equations g(q, t) = 0 to the tree's equations (book ch. 2.6
 with the multipliers λ the reactions. A loop joint joins frame A on body ``a`` and frame B on
 body ``b``, which coincide when the loop is assembled; the joint kind says what it leaves free:
 
-=================  ====  ==========================================================
-kind               rows  free relative motion of frame B in frame A
-=================  ====  ==========================================================
-``"revolute"``        5  rotation about the common z axis
-``"spherical"``       3  every rotation about the common origin
-``"universal"``       4  rotations about A's x axis and B's y axis (the cross)
-``"prismatic"``       5  translation along z
-``"cylindrical"``     4  translation along and rotation about z
-``"fixed"``           6  none
-``"distance"``        1  everything but the distance |r_B − r_A| = l
-=================  ====  ==========================================================
+{kinds}
 
 An actuator (``Model.add_actuator``) is a distance loop whose length l(t) is prescribed: a
 hydraulic cylinder under position control; its force is the loop's reaction.
@@ -34,6 +24,20 @@ from .._core import Point, Profile
 from .force_elements import point_of
 
 KINDS = tuple(_core._Model._loop_kinds())  # the C++ table of kinds (constraints.cpp)
+
+
+def _kinds_table() -> str:
+    """The C++ table of kinds as the reST table of this module's docstring: kind, rows, what it leaves free."""
+    rows = [(f'``"{k["kind"]}"``', str(k["rows"]), k["free"]) for k in _core._Model._loop_kind_table()]
+    widths = [max(len(r[c]) for r in rows + [("kind", "rows", "free relative motion of frame B in frame A")])
+              for c in range(3)]
+    rule = "  ".join("=" * w for w in widths)
+    line = lambda cells: "  ".join(c.ljust(w) for c, w in zip(cells, widths)).rstrip()  # noqa: E731
+    return "\n".join([rule, line(("kind", "rows", "free relative motion of frame B in frame A")), rule,
+                      *(line(r) for r in rows), rule])
+
+
+__doc__ = __doc__.replace("{kinds}", _kinds_table())
 
 
 def _frame(model, where, frame, name: str):

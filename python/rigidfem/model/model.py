@@ -12,8 +12,7 @@ import numpy as np
 
 from ..base import _checks, display
 import rigidfem._core as _core  # the compiled core, by its absolute name
-from . import force_elements, joints, laws, loops
-from . import parameters
+from . import force_elements, handles, joints, laws, loops, parameters
 from ..base import persistence
 from .motion import constant as _constant
 from .._core import Body, JointSpec, Point, Profile
@@ -198,13 +197,14 @@ class Model(_core._Model):
         return -1 if coordinate is None else self._coordinate_index(body.index, coordinate)
 
     @recorded
-    def prescribe(self, body: Body, motion: Profile, coordinate: str | None = None) -> None:
+    def prescribe(self, body: Body, motion: Profile, coordinate: str | None = None) -> handles.Coordinate:
         """Drive a coordinate of ``body``'s joint by ``motion`` (``rigidfem.motion.*``).
 
         The coordinate leaves the unknowns q; ``System.driving_forces`` reports the
         force (N) or torque (N·m) the drive must exert. ``coordinate`` names it
         ("x", ..., "rx") when the joint has more than one. A coordinate takes one motion:
-        prescribing it again is a ValueError.
+        prescribing it again is a ValueError. Returns the coordinate's handle ("<body>.<axis>", kind "drive"); the
+        drive's numbers are the parameters ``"<body>.<axis>.drive.<path>"``.
         """
         if not isinstance(motion, Profile):
             raise ValueError(f"motion: expected a profile from rigidfem.motion, got {motion!r}")
@@ -213,6 +213,7 @@ class Model(_core._Model):
         name = self._coordinate_name(body.index, k)
         parameters.register(self, parameters.ProfileGroup(f"{name}.drive", "drive", body.index, max(k, 0), motion,
                                                           "the drive's (m or rad, s, rad/s: rigidfem.motion)"))
+        return handles.Coordinate(name, "drive", max(k, 0))
 
     @recorded
     def add_moving_base(self, name: str, motion=None, *, mass: float = 1e-6, inertia=(1e-6, 1e-6, 1e-6),
@@ -251,8 +252,9 @@ class Model(_core._Model):
     @recorded
     def add_generalized_force(
         self, body: Body, force: float | Callable[[float, float, float], float], coordinate: str | None = None
-    ) -> None:
-        """Apply a generalised force (N or N·m) on a joint coordinate of ``body``.
+    ) -> handles.Coordinate:
+        """Apply a generalised force (N or N·m) on a joint coordinate of ``body``; returns the coordinate's handle
+        ("<body>.<axis>", kind "force").
 
         ``force`` is a constant or a Python function ``Q(t, q, qd)`` of that
         coordinate's own value and rate (slow path: called from C++ under the GIL). The
@@ -270,9 +272,11 @@ class Model(_core._Model):
             group = self._parameter_groups.get(self._coordinate_name(body.index, k))
             if group is not None:  # the total constant force on the coordinate
                 parameters.register(self, group.with_values(force=group.values["force"] + value))
+        return handles.Coordinate(self._coordinate_name(body.index, k), "force", max(k, 0))
 
     @recorded
-    def add_maxwell_arm(self, body: Body, stiffness: float, tau: float, coordinate: str | None = None) -> None:
+    def add_maxwell_arm(self, body: Body, stiffness: float, tau: float,
+                        coordinate: str | None = None) -> handles.Coordinate:
         """Add a Maxwell arm — a spring ``stiffness`` k (N/m or N·m/rad) in series with a dashpot k τ
         (``tau``: the relaxation time, s) — on a free joint coordinate of ``body``, in parallel with
         its spring and damper: the standard linear solid (Zener) with one arm, a generalised Maxwell
@@ -282,16 +286,18 @@ class Model(_core._Model):
         Q = −s on the coordinate; it stores s²/(2k) and dissipates s²/(kτ). A mode of the joint's
         stiffness c with one arm has its eigenvalues at the roots of (1 + λτ)(m λ² + c) + k τ λ = 0.
         ``rigidfem.simulate`` integrates s (initial value ``s0``, zero by default) and returns it
-        as ``Result.arm_forces``; ``rigidfem.Material(prony=...)`` puts arms in every sde of a beam.
+        as ``Result.arm_forces``; ``rigidfem.Material(prony=...)`` puts arms in every sde of a beam. Returns the
+        coordinate's handle ("<body>.<axis>", kind "arm").
         """
         k = self._coordinate(body, coordinate)
         stiffness = _checks.scalar(stiffness, "stiffness", positive=True, unit="N/m or N·m/rad (arm stiffness)")
         tau = _checks.scalar(tau, "tau", positive=True, unit="s (relaxation time)")
         self._add_maxwell_arms([body.index], [k], [stiffness], [tau])
+        return handles.Coordinate(self._coordinate_name(body.index, k), "arm", max(k, 0))
 
     @recorded
     def add_force(self, point, force, *, follower: bool = False, scale: Profile | None = None,
-                  name: str | None = None) -> str:
+                  name: str | None = None) -> handles.Load:
         """Apply a point force (N) at ``point`` (a ``Point`` or a ``Body``'s origin).
 
         ``force`` has global components, or body components turning with the body
@@ -300,17 +306,18 @@ class Model(_core._Model):
         ``"<name>.force"`` is its magnitude (``System.parameters``).
         """
         p = self._point(point)
-        return self._load(name, p.body, p.r, _checks.vec3(force, "force"), np.zeros(3), follower, scale)
+        return self._load(name, "force", p.body, p.r, _checks.vec3(force, "force"), np.zeros(3), follower, scale)
 
     @recorded
     def add_torque(self, body: Body, torque, *, follower: bool = False, scale: Profile | None = None,
-                   name: str | None = None) -> str:
+                   name: str | None = None) -> handles.Load:
         """Apply a torque (N·m) on ``body``: global components, or body ones if ``follower``. Returns its
         ``name`` ("load<k>" by default), whose parameter ``"<name>.torque"`` is its magnitude."""
         p = self._point(body)
-        return self._load(name, p.body, np.zeros(3), np.zeros(3), _checks.vec3(torque, "torque"), follower, scale)
+        return self._load(name, "torque", p.body, np.zeros(3), np.zeros(3), _checks.vec3(torque, "torque"), follower,
+                          scale)
 
-    def _load(self, name, body, r, force, torque, follower, scale) -> str:
+    def _load(self, name, kind, body, r, force, torque, follower, scale) -> handles.Load:
         name = f"load{self._nloads}" if name is None else name
         if not isinstance(name, str) or name in self._parameter_groups:
             raise ValueError(f"name: expected a new name (str) for the load, got {name!r}")
@@ -319,7 +326,7 @@ class Model(_core._Model):
         if scale is not None:
             parameters.register(self, parameters.ProfileGroup(f"{name}.scale", "load", -1, self._nloads - 1, scale,
                                                               "the scale's (rigidfem.motion)"))
-        return name
+        return handles.Load(name, kind, self._nloads - 1)
 
     def _point(self, point) -> Point:
         if isinstance(point, Body):
@@ -332,15 +339,15 @@ class Model(_core._Model):
 
     @recorded
     def add_loop_joint(self, kind: str, a, b, *, frame_a=None, frame_b=None, length: float | None = None,
-                       name: str | None = None) -> str:
+                       name: str | None = None) -> handles.Loop:
         """Close a kinematic loop: a joint of ``kind`` between ``a`` and ``b`` (book ch. 2.6).
 
         Parameters
         ----------
         kind : str
-            "revolute", "spherical", "universal", "prismatic", "cylindrical", "fixed" or
-            "distance" (``rigidfem.loops`` tabulates what each leaves free; axes are those of
-            frame A, z for revolute, prismatic and cylindrical joints).
+            One of ``rigidfem.loops.KINDS`` ("revolute", "spherical", "universal", "prismatic",
+            "cylindrical", "fixed", "planar", "distance": ``rigidfem.loops`` tabulates what each leaves
+            free; axes are those of frame A, z for revolute, prismatic, cylindrical and planar joints).
         a, b : Body, Point or ``model.ground``
             The two bodies (rigid bodies or rfes of a beam). A Point places the joint frame at
             that point with the body's axes; a Body at its frame.
@@ -356,18 +363,19 @@ class Model(_core._Model):
         Returns the loop's name. The initial coordinates of a simulation must close every loop:
         ``System.assemble`` finds them from a guess.
         """
-        return loops.add_loop_joint(self, kind, a, b, frame_a=frame_a, frame_b=frame_b, length=length, name=name)
+        name = loops.add_loop_joint(self, kind, a, b, frame_a=frame_a, frame_b=frame_b, length=length, name=name)
+        return handles.Loop(name, kind, self._nloops - 1)
 
     @recorded
-    def add_actuator(self, a, b, length, *, name: str | None = None) -> str:
+    def add_actuator(self, a, b, length, *, name: str | None = None) -> handles.Loop:
         """A linear actuator (hydraulic cylinder under position control) between the points ``a``
         and ``b`` (Point or Body): their distance is held at ``length`` (m), a number or a
         ``rigidfem.motion`` profile l(t). Its force (N, positive pushing the points apart) is the
         loop's reaction, column 0 of ``System.loop_reactions``. Returns its name."""
-        return loops.add_actuator(self, a, b, length, name=name)
+        return handles.Loop(loops.add_actuator(self, a, b, length, name=name), "actuator", self._nloops - 1)
 
     @recorded
-    def add_force_element(self, a, b, law, *, name: str | None = None) -> str:
+    def add_force_element(self, a, b, law, *, name: str | None = None) -> handles.Element:
         """A force element of ``law`` (``rigidfem.laws``: ``SpringDamper``, ``Rope``, ...) between the points ``a``
         and ``b`` (Point, Body or ``model.ground``; rigid bodies or rfes of a beam), acting along the line between
         them with the law's axial force F(t, l, l̇) (N, > 0 pushing the points apart). No constraint: it acts on
@@ -378,7 +386,7 @@ class Model(_core._Model):
 
     @recorded
     def add_spring_damper(self, a, b, *, stiffness: float, length: float, damping: float = 0.0,
-                          name: str | None = None) -> str:
+                          name: str | None = None) -> handles.Element:
         """A linear spring-damper between the points ``a`` and ``b`` (Point, Body or
         ``model.ground``; rigid bodies or rfes of a beam): axial force
         F = −k (l − l₀) − c l̇ (N, > 0 pushing the points apart) with ``stiffness`` k (N/m),
@@ -390,7 +398,7 @@ class Model(_core._Model):
         return force_elements.add_force_element(self, a, b, law, name=name)
 
     @recorded
-    def add_cylinder(self, a, b, force, *, damping: float = 0.0, name: str | None = None) -> str:
+    def add_cylinder(self, a, b, force, *, damping: float = 0.0, name: str | None = None) -> handles.Element:
         """A hydraulic cylinder under force control between the points ``a`` and ``b``: it pushes
         them apart with ``force`` (N; negative pulls) — a number, a ``rigidfem.motion`` profile
         F(t) or a Python function ``force(t, l, ld)`` of time (s), length (m) and its rate (m/s)
@@ -402,7 +410,7 @@ class Model(_core._Model):
         return force_elements.add_force_element(self, a, b, law, name=name)
 
     @recorded
-    def add_rope(self, a, b, *, EA: float, length, DA: float = 0.0, name: str | None = None) -> str:
+    def add_rope(self, a, b, *, EA: float, length, DA: float = 0.0, name: str | None = None) -> handles.Element:
         """A massless rope between the points ``a`` and ``b`` (book ch. 7.1: a hoisting rope): it
         only pulls, with the tension T = (EA (l − l_u) + DA (l̇ − l̇_u))/l_u while positive, 0 when
         slack. ``EA`` (N) is its axial stiffness, ``DA`` (N·s) its axial damping, and ``length`` its unstretched
@@ -413,7 +421,8 @@ class Model(_core._Model):
         return force_elements.add_force_element(self, a, b, law, name=name)
 
     @recorded
-    def add_joint_law(self, body: Body, law, coordinate: str | None = None, *, name: str | None = None) -> str:
+    def add_joint_law(self, body: Body, law, coordinate: str | None = None, *,
+                      name: str | None = None) -> handles.JointLaw:
         """A law of a joint coordinate (``rigidfem.laws``: ``Friction``, ``ForceFunction``) on the coordinate
         ``coordinate`` ("x", ..., "rx"; None: the joint's only one) of ``body``'s joint, adding its generalised
         force Q(t, q, q̇) (N or N·m) to the coordinate's own spring-damping law. Its constants marked as parameters
@@ -436,7 +445,7 @@ class Model(_core._Model):
         group = parameters.LawGroup(str(name), ("coordinate", body.index, max(k, 0), index), law.info, law.values,
                                     rotation=axis.rsplit(".", 1)[1].startswith("r"))
         parameters.register(self, group)
-        return group.prefix
+        return handles.JointLaw(group.prefix, law.kind, index)
 
     @recorded
     def add_beam(self, name: str, parent, length, material, section, elements: int,
