@@ -118,6 +118,7 @@ def test_every_profile_kind_is_the_cpp_table_with_its_numbers_as_parameters():
     table = {k["maker"]: [a["name"] for a in k["arguments"]] for k in _core._profile_kinds()}
     assert parameters.PROFILE_ARGUMENTS == {k: tuple(v) for k, v in table.items()}
     made = [rf.motion.constant(1.0), rf.motion.polynomial([1.0, 2.0]), rf.motion.harmonic(1.0, 2.0),
+            rf.motion.chirp(0.1, 1.0, 5.0, 2.0),
             rf.motion.harmonics([1.0], [2.0]), rf.motion.spin_up(1.0, 2.0), rf.motion.spline([0.0, 1.0], [0.0, 1.0]),
             rf.motion.rest_to_rest(0.0, 1.0, 0.0, 1.0), rf.motion.ramp(1.0, 0.0, 1.0),
             rf.motion.constant(1.0) + rf.motion.harmonic(1.0, 2.0), rf.motion.constant(1.0).shifted(0.5),

@@ -209,3 +209,27 @@ def test_a_beams_root_joint_driven_by_a_law_in_cpp_matches_the_python_drive():
     axis = fast.position(beam.rfes[0].point((1.0, 0.0, 0.0))) - fast.position(beam.rfes[0])
     np.testing.assert_allclose(np.arctan2(axis[20:, 1], axis[20:, 0]), 1.0, atol=1e-14)  # at rest at 1 rad from t = 2 s
     assert fast.driving_forces.shape == (31, 1) and np.abs(fast.driving_forces[25:, 0]).max() > 1e-3  # the beam rings
+
+
+def test_a_chirp_sweeps_its_frequency_with_exact_rates():
+    """rf.motion.chirp (a kind added as its class and row in profiles.cpp and its builder: two files): its rates are
+    the derivatives of its value (central differences), its phase at the end is 2π (f0 + f1) T/2 (the zero crossings
+    count it), it goes on at f1 after T and is zero before t0."""
+    A, f0, f1, T, t0 = 0.2, 1.0, 6.0, 3.0, 0.5
+    p = motion.chirp(A, f0, f1, T, t0=t0)
+    assert p(0.3) == (0.0, 0.0, 0.0)
+    for t in np.linspace(t0 + 0.01, t0 + T + 1.0, 37):
+        h = 1e-6
+        q, qd, qdd = p(t)
+        assert abs(qd - (p(t + h)[0] - p(t - h)[0]) / (2 * h)) < 1e-6 * max(1.0, abs(qd))
+        assert abs(qdd - (p(t + h)[1] - p(t - h)[1]) / (2 * h)) < 1e-5 * max(1.0, abs(qdd))
+    t = np.linspace(t0, t0 + T, 200001)
+    q = np.array([p(x)[0] for x in t])
+    crossings = np.count_nonzero(np.diff(np.signbit(q[1:])))  # each half period once, the start's zero left out
+    assert crossings == int(2 * (f0 + f1) * T / 2)  # φ(T)/π = (f0 + f1) T
+    after = np.array([p(t0 + T + x)[0] for x in (0.0, 0.5 / f1, 1.0 / f1)])
+    assert abs(after[0] - after[2]) < 1e-12 and abs(after[0] + after[1]) < 1e-12  # period 1/f1 after T
+    with pytest.raises(ValueError, match="^f1: expected a frequency >= 0 in Hz"):
+        motion.chirp(A, 1.0, -1.0, T)
+    with pytest.raises(ValueError, match="^duration: expected a positive time in s"):
+        motion.chirp(A, 1.0, 2.0, 0.0)

@@ -71,6 +71,42 @@ class Harmonic final : public Profile {
   double a_, w_, ph_, off_;
 };
 
+/// A linear sweep (chirp) of amplitude A from f0 to f1 (Hz) over T from t0: with τ = t − t0 in [0, T],
+///   q = A sin φ(τ),  φ = 2π (f0 τ + (f1 − f0) τ² / (2T)),  φ̇ = 2π (f0 + (f1 − f0) τ/T),  φ̈ = 2π (f1 − f0)/T,
+/// q̇ = A φ̇ cos φ, q̈ = A (φ̈ cos φ − φ̇² sin φ); zero before t0 (the sweep starts at q = 0 with the rate 2π A f0),
+/// and after t0 + T it goes on at f1 (φ linear). The input of a frequency response or an identification.
+class Chirp final : public Profile {
+ public:
+  Chirp(double a, double f0, double f1, double t0, double T) : a_(a), f0_(f0), f1_(f1), t0_(t0), T_(T) {}
+  MotionState at(double t) const override {
+    const double tau = t - t0_;
+    if (tau < 0.0) return {0.0, 0.0, 0.0};
+    const double k = 2.0 * M_PI, u = std::min(tau, T_);  // the sweep's part, then f1 on
+    const double phi = k * (f0_ * u + 0.5 * (f1_ - f0_) * u * u / T_) + k * f1_ * (tau - u);
+    const double dphi = k * (f0_ + (f1_ - f0_) * u / T_), ddphi = tau < T_ ? k * (f1_ - f0_) / T_ : 0.0;
+    const double s = std::sin(phi), c = std::cos(phi);
+    return {a_ * s, a_ * dphi * c, a_ * (ddphi * c - dphi * dphi * s)};
+  }
+  std::string describe() const override {
+    std::ostringstream o;
+    o << "chirp(amplitude=" << a_ << ", " << f0_ << " -> " << f1_ << " Hz over " << T_ << " s)";
+    return o.str();
+  }
+  ProfileRecipe recipe() const override { return {"chirp_profile", {a_, f0_, f1_, t0_, T_}}; }
+
+ private:
+  double a_, f0_, f1_, t0_, T_;
+};
+
+ProfilePtr chirp_profile(double amplitude, double f0, double f1, double t0, double duration) {
+  require_finite(amplitude, "amplitude");
+  for (const auto& [f, name] : {std::pair<double, const char*>{f0, "f0"}, {f1, "f1"}})
+    if (!(f >= 0.0 && std::isfinite(f))) throw std::invalid_argument(std::string(name) + ": expected a frequency >= 0 in Hz, got " + num(f));
+  require_finite(t0, "t0");
+  require_duration(duration);
+  return std::make_shared<Chirp>(amplitude, f0, f1, t0, duration);
+}
+
 class HarmonicSeries final : public Profile {
  public:
   HarmonicSeries(std::vector<double> a, std::vector<double> w, std::vector<double> ph, double off)
@@ -548,6 +584,11 @@ const std::vector<ProfileKind>& profile_kinds() {
        [](const Arguments& a) {
          return harmonic_series_profile(numbers(a, 0), numbers(a, 1), numbers(a, 2), number(a, 3));
        }},
+      {"chirp_profile",
+       {{"amplitude", P::Number, finite}, {"f0", P::Number, "a frequency >= 0 in Hz"},
+        {"f1", P::Number, "a frequency >= 0 in Hz"}, {"t0", P::Number, finite},
+        {"duration", P::Number, "a positive time in s"}},
+       [](const Arguments& a) { return chirp_profile(number(a, 0), number(a, 1), number(a, 2), number(a, 3), number(a, 4)); }},
       {"spin_up_profile", {{"omega", P::Number, finite}, {"duration", P::Number, "a positive time in s"}},
        [](const Arguments& a) { return spin_up_profile(number(a, 0), number(a, 1)); }},
       {"spline_profile", {{"t", P::Numbers, values}, {"q", P::Numbers, values}},

@@ -60,6 +60,14 @@ def harmonics(amplitudes: Sequence[float], omegas: Sequence[float], phases: Sequ
     return _make("harmonic_series_profile", amplitudes, omegas, phases, offset)
 
 
+def chirp(amplitude: float, f0: float, f1: float, duration: float, t0: float = 0.0) -> _core.Profile:
+    """A linear sweep of ``amplitude`` (m or rad) from ``f0`` to ``f1`` (Hz) over ``duration`` T (s) from ``t0``:
+    q = A sin φ, φ = 2π (f0 τ + (f1 − f0) τ²/(2T)), τ = t − t0, with its exact rates; zero before t0 (it starts at
+    q = 0 with the rate 2π A f0) and going on at f1 after t0 + T. The input of a frequency response or an
+    identification."""
+    return _make("chirp_profile", amplitude, f0, f1, t0, duration)
+
+
 def spin_up(omega: float, duration: float) -> _core.Profile:
     """Kane's spin-up of a hub to the rate ``omega`` (rad/s) over ``duration`` T (s):
     θ = (Ω/T)[t²/2 + (T/2π)²(cos(2πt/T) − 1)] for t < T, θ = Ω(t − T/2) after."""
