@@ -519,9 +519,16 @@ const OptionInfo& option_info(const std::string& name) {
 void check_options(const System& sys, double t0, double t_end, const VecX& q0, const VecX& qd0,
                    const Eigen::Ref<const VecX>& t_eval, const IntegratorOptions& o) {
   const MethodInfo& m = method_info(o.method);
-  if (!std::isfinite(t0) || !std::isfinite(t_end) || !(t_end > t0))
+  if (!std::isfinite(t0)) bad("t0", "a finite start time in s", num(t0));
+  if (!std::isfinite(t_end) || !(t_end > t0))
     throw std::invalid_argument("t_end: expected a finite end time after t0 = " + num(t0) + " s, got " + num(t_end));
   check_vector(q0, sys.nq, "q0", "nq");
+  // beyond 1e15 a double no longer resolves a step of a tenth: a coordinate's steps drown in its rounding
+  for (Eigen::Index k = 0; k < q0.size(); ++k)
+    if (std::abs(q0(k)) > 1e15)
+      bad("q0", "coordinates within ±1e+15 (m, rad), beyond which a double no longer resolves a step of a tenth (its "
+                "spacing is 1/8 at 1e15)",
+          num(q0(k)) + " (" + sys.coordinate_names()[k] + ")");
   check_vector(qd0, sys.nq, "qd0", "nq");
   if (!m.error_estimate && o.adaptive == 1) {
     std::string adaptive;

@@ -316,7 +316,6 @@ void Model::add_load(const Load& load) {
 int Model::add_loop(const Loop& loop) {
   if (loop.body_a < -1 || loop.body_a >= static_cast<int>(bodies_.size())) check_body(loop.body_a, "a");
   if (loop.body_b < -1 || loop.body_b >= static_cast<int>(bodies_.size())) check_body(loop.body_b, "b");
-  if (loop.body_a == loop.body_b) bad("b", "a body other than a (a loop joins two bodies)", "the same body");
   for (const auto& [F, name] : {std::pair<const Mat4*, const char*>{&loop.frame_a, "frame_a"}, {&loop.frame_b, "frame_b"}}) {
     const Mat3 R = F->topLeftCorner<3, 3>();
     if (!F->allFinite() || (R.transpose() * R - Mat3::Identity()).cwiseAbs().maxCoeff() > 1e-9 ||
@@ -325,6 +324,8 @@ int Model::add_loop(const Loop& loop) {
   }
   if (loop.kind == LoopKind::Distance && !loop.drive && !(loop.length > 0.0 && std::isfinite(loop.length)))
     bad("length", "a positive distance in m", num8(loop.length));
+  // each argument first, then how they go together
+  if (loop.body_a == loop.body_b) bad("b", "a body other than a (a loop joins two bodies)", "the same body");
   loops_.push_back(with_unique_name(loop, loops_, "loop", "loop"));
   return static_cast<int>(loops_.size()) - 1;
 }

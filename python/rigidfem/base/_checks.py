@@ -1,8 +1,11 @@
-"""Argument checks shared by the Python layer: clear ValueErrors naming the argument.
+"""The Python layer's one converter: arguments as the types the core takes, ValueErrors naming the argument.
 
 What counts as a real number or an array of them is the C++ bindings' rule (``bindings.hpp``:
 ``real_arg``, ``real_array_arg``, reached as ``_core._real`` and ``_core._real_array``), the one
-conversion layer of the package; these functions add the checks of values (finite, positive, shape).
+conversion rule of the package. ``real`` and ``reals`` convert only: the values of what goes to the core
+are judged there, once (the makers, ``check_options``, the laws' bounds). The other functions also judge
+the values (finite, positive) of what the Python layer alone uses (a sweep's workers, a plot's scale, a
+material before it becomes springs).
 """
 
 from __future__ import annotations
@@ -24,6 +27,20 @@ def _floats(x, name: str, expected: str) -> np.ndarray:
 def _short(x) -> str:
     s = repr(x)
     return s if len(s) <= 200 else s[:197] + "..."
+
+
+def real(x, name: str, expected: str = "a number") -> float:
+    """``x`` as a float by the bindings' rule (not a string, bool, complex number or array); its value is the
+    core's to judge."""
+    return _core._real(x, name, expected)
+
+
+def reals(x, shape: tuple[int, ...], name: str) -> np.ndarray:
+    """``x`` as a float array of exactly ``shape`` (real numbers); its values are the core's to judge."""
+    a = _floats(x, name, f"numbers of shape {shape}")
+    if a.shape != shape:
+        raise ValueError(f"{name}: expected shape {shape}, got {a.shape}")
+    return a
 
 
 def array(x, shape: tuple[int, ...], name: str) -> np.ndarray:

@@ -50,7 +50,7 @@ def _frame(model, where, frame, name: str):
     else:
         if isinstance(where, Point) and np.any(origin != 0.0):
             raise ValueError(f"frame_{name}: give either a Point or a frame on a Body, not both")
-        F = _checks.array(frame, (4, 4), f"frame_{name}")
+        F = _checks.reals(frame, (4, 4), f"frame_{name}")
     return body, F
 
 
@@ -64,7 +64,7 @@ def add_loop_joint(model, kind: str, a, b, *, frame_a=None, frame_b=None, length
     if kind == "distance":
         if length is None:
             raise ValueError("length: expected a positive distance in m for a distance loop, got None")
-        length = _checks.scalar(length, "length", positive=True)
+        length = _checks.real(length, "length", "a positive distance in m")
     elif length is not None:
         raise ValueError(f"length: expected None for a {kind} loop (only distance loops have a length), got {length!r}")
     return _add(model, name, kind, ia, Fa, ib, Fb, length or 0.0, None)
@@ -80,7 +80,7 @@ def add_actuator(model, a, b, length, *, name: str | None = None) -> str:
         parameters.register(model, parameters.ProfileGroup(f"{name}.length", "loop", -1, model._nloops - 1, length,
                                                            "the actuator's (m, s, m/s)"))
         return name
-    return _add(model, name, "distance", ia, Fa, ib, Fb, _checks.scalar(length, "length", positive=True), None,
+    return _add(model, name, "distance", ia, Fa, ib, Fb, _checks.real(length, "length", "a positive distance in m"), None,
                 actuator=True)
 
 

@@ -32,7 +32,7 @@ def _inertia(inertia) -> np.ndarray:
         raise ValueError(
             f"inertia: expected principal moments (3,) or a tensor (3, 3) in kg·m², got shape {np.shape(inertia)}"
         )
-    return _checks.array(a, (3, 3), "inertia")
+    return _checks.reals(a, (3, 3), "inertia")
 
 
 # A moving base's degrees of freedom: ship names and the free joint's coordinates (ZYX angles:
@@ -81,7 +81,7 @@ class Model(_core._Model):
     """
 
     def __init__(self, gravity=(0.0, 0.0, -9.81)):
-        g = np.zeros(3) if gravity is None else _checks.vec3(gravity, "gravity")
+        g = np.zeros(3) if gravity is None else _checks.reals(gravity, (3,), "gravity")
         super().__init__(g)
         self._gravity0, self._calls, self._building = np.array(g, dtype=float), [], False  # the recipe (pickling)
         self._parameter_groups = {}  # prefix -> parameters.Group: the named parameters the builders declared
@@ -97,7 +97,7 @@ class Model(_core._Model):
 
     @recorded
     def _set_gravity(self, g) -> None:
-        _core._Model.gravity.fset(self, _checks.vec3(g, "gravity"))
+        _core._Model.gravity.fset(self, _checks.reals(g, (3,), "gravity"))
 
     def __reduce__(self):
         """Pickled as its recipe (rigidfem.base.persistence): unpickling replays the builder calls."""
@@ -173,8 +173,8 @@ class Model(_core._Model):
         """
         if not isinstance(joint, JointSpec):
             raise ValueError(f"joint: expected a joint from rigidfem.Joint, got {joint!r}")
-        B = np.eye(4) if placement is None else _checks.array(placement, (4, 4), "placement")
-        mass, com, inertia = _checks.scalar(mass, "mass"), _checks.vec3(com, "com"), _inertia(inertia)
+        B = np.eye(4) if placement is None else _checks.reals(placement, (4, 4), "placement")
+        mass, com, inertia = _checks.real(mass, "mass", "a mass in kg"), _checks.reals(com, (3,), "com"), _inertia(inertia)
         body = self._add_body(str(name), self._parent_index(parent), joint, B, mass, com, inertia)
         parameters.register(self, parameters.BodyGroup(body.name, body.index, mass, com, inertia))
         self._declare_coordinates(body, joint)
@@ -290,8 +290,8 @@ class Model(_core._Model):
         coordinate's handle ("<body>.<axis>", kind "arm").
         """
         k = self._coordinate(body, coordinate)
-        stiffness = _checks.scalar(stiffness, "stiffness", positive=True, unit="N/m or N·m/rad (arm stiffness)")
-        tau = _checks.scalar(tau, "tau", positive=True, unit="s (relaxation time)")
+        stiffness = _checks.real(stiffness, "stiffness", "an arm stiffness in N/m or N·m/rad")
+        tau = _checks.real(tau, "tau", "a relaxation time in s")
         self._add_maxwell_arms([body.index], [k], [stiffness], [tau])
         return handles.Coordinate(self._coordinate_name(body.index, k), "arm", max(k, 0))
 
@@ -306,7 +306,8 @@ class Model(_core._Model):
         ``"<name>.force"`` is its magnitude (``System.parameters``).
         """
         p = self._point(point)
-        return self._load(name, "force", p.body, p.r, _checks.vec3(force, "force"), np.zeros(3), follower, scale)
+        return self._load(name, "force", p.body, p.r, _checks.reals(force, (3,), "force"), np.zeros(3), follower,
+                          scale)
 
     @recorded
     def add_torque(self, body: Body, torque, *, follower: bool = False, scale: Profile | None = None,
@@ -314,7 +315,7 @@ class Model(_core._Model):
         """Apply a torque (N·m) on ``body``: global components, or body ones if ``follower``. Returns its
         ``name`` ("load<k>" by default), whose parameter ``"<name>.torque"`` is its magnitude."""
         p = self._point(body)
-        return self._load(name, "torque", p.body, np.zeros(3), np.zeros(3), _checks.vec3(torque, "torque"), follower,
+        return self._load(name, "torque", p.body, np.zeros(3), np.zeros(3), _checks.reals(torque, (3,), "torque"), follower,
                           scale)
 
     def _load(self, name, kind, body, r, force, torque, follower, scale) -> handles.Load:

@@ -175,15 +175,12 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
         got = type(system).__name__ if isinstance(system, _core._Model) else _checks._short(system)
         raise ValueError(f"system: expected a compiled System (call model.compile()), got {got}")
     n = system.nq
-    q0 = np.zeros(n) if q0 is None else _checks.array(q0, (n,), "q0")
-    if n and np.max(np.abs(q0)) > _LARGEST_COORDINATE:
-        raise ValueError(f"q0: expected coordinates within ±{_LARGEST_COORDINATE:g} (m, rad), beyond which a double "
-                         f"no longer resolves a step of a tenth (its spacing is 1/8 at 1e15), got "
-                         f"{q0[np.argmax(np.abs(q0))]:g} ({system.coordinate_names[int(np.argmax(np.abs(q0)))]})")
-    qd0 = np.zeros(n) if qd0 is None else _checks.array(qd0, (n,), "qd0")
-    t0 = _checks.scalar(t0, "t0")
-    t_end = _checks.scalar(t_end, "t_end")  # t_end > t0 and t_eval within [t0, t_end]: _core._check_options
-    t_eval = np.zeros(0) if t_eval is None else _checks.vector(t_eval, "t_eval")
+    # converted here; their values judged by the core (_core._check_options: finite, t_end after t0, t_eval within)
+    q0 = np.zeros(n) if q0 is None else _checks.reals(q0, (n,), "q0")
+    qd0 = np.zeros(n) if qd0 is None else _checks.reals(qd0, (n,), "qd0")
+    t0 = _checks.real(t0, "t0", "a start time in s")
+    t_end = _checks.real(t_end, "t_end", "an end time in s")
+    t_eval = np.zeros(0) if t_eval is None else _checks.reals(t_eval, (np.size(t_eval),), "t_eval")
     if not isinstance(method, str):
         raise ValueError(f"method: expected a method name such as 'dopri5' (see rigidfem.simulate), got {method!r}")
     rtol, atol = _tolerance(rtol, "rtol", n, 1e-6), _tolerance(atol, "atol", n, 1e-9)
@@ -208,15 +205,15 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
     if stop is not None and not callable(getattr(stop, "is_set", None)):
         raise ValueError(f"stop: expected None or a threading.Event (an object with is_set()), got {stop!r}")
     nz = system.nz
-    s0 = np.zeros(nz) if s0 is None else _checks.array(s0, (nz,), "s0")
+    s0 = np.zeros(nz) if s0 is None else _checks.reals(s0, (nz,), "s0")
     if scipy:
         opt.adaptive = -1  # SciPy's solvers are adaptive whatever it says (its type is checked)
     if method == "auto" and adaptive is False:
         raise ValueError("adaptive: expected None or True with method 'auto' (it controls its steps), got False")
     opt.s0 = s0
     opt.set_error_on(outputs)
+    _core._check_options(system, t0, t_end, q0, qd0, t_eval, opt)  # the values, once (the sensitivities': integrate)
     names = sensitivities_.directions(system, sensitivities, opt, t0, t_end)
-    _core._check_options(system, t0, t_end, q0, qd0, t_eval, opt)
     if names and scipy:  # the options are checked first: a bad one is named whatever the method
         raise ValueError(f"method: expected a C++ method that integrates sensitivities (dopri5, rk4, generalized_alpha, "
                          f"...), got {method!r}")
@@ -319,9 +316,6 @@ def _check_closed(system, t0, q0, qd0, tol=1e-8):
                              "system.assemble(q0, qd0, t=t0) finds the nearest ones")
 
 
-#: The largest initial coordinate (m or rad) simulate takes: beyond it the steps of a coordinate drown in its
-#: rounding (scipy: methods then crawled for minutes at q0 = 1e300; the C++ ones returned q frozen at q0).
-_LARGEST_COORDINATE = 1e15
 
 def _reactions_source(own, method: str) -> str:
     """Where ``Result.loop_reactions`` come from, for ``stats["loop_reactions"]``: the method's own
