@@ -132,3 +132,19 @@ def test_every_profile_kind_is_the_cpp_table_with_its_numbers_as_parameters():
     assert rf.motion.LAWS == tuple(_core._point_to_point_laws())
     with pytest.raises(ValueError, match="^law: expected one of 'quintic', 'cycloidal', 'trapezoidal', got 'sine'"):
         rf.motion.ramp(1.0, 0.0, 1.0, law="sine")
+
+
+def test_an_option_the_method_does_not_read_leaves_its_run_unchanged():
+    """The method table says what each method reads: rk4 given first_step or max_step (an adaptive run's) steps at dt
+    as without them (they once set its step: 2 steps instead of 100), but a bad value is still named."""
+    model, _ = rf.samples.pendulum()
+    system = model.compile()
+    plain = rf.simulate(system, 1.0, "rk4", dt=0.01, q0=[0.5])
+    for extra in ({"first_step": 0.05}, {"max_step": 0.003}, {"rho_inf": 0.3}):
+        other = rf.simulate(system, 1.0, "rk4", dt=0.01, q0=[0.5], **extra)
+        assert other.stats["steps"] == plain.stats["steps"] == 100, extra
+        np.testing.assert_array_equal(other.q, plain.q)
+    with pytest.raises(ValueError, match="^first_step: expected a positive finite step in s"):
+        rf.simulate(system, 1.0, "rk4", dt=0.01, first_step=-1.0)
+    with pytest.raises(ValueError, match="^adaptive: the method 'rk4' has no error estimate"):
+        rf.simulate(system, 1.0, "rk4", dt=0.01, adaptive=True)

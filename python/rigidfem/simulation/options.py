@@ -122,12 +122,16 @@ def resolve(options: dict) -> dict:
 
 def compiled(method: str, options: dict) -> _core.IntegratorOptions:
     """The C++ options of ``method`` with ``options`` ({name: value}) set, each converted by the bindings' rule
-    (ValueError naming it); error_on, rtol and atol are left to the caller (they depend on the system)."""
+    (ValueError naming it); error_on, rtol and atol are left to the caller (they depend on the system). An option
+    the method does not read (the method table's) is converted, so that a bad one is named whatever the method,
+    and left at its default: rk4 given ``first_step`` or ``max_step`` steps at dt as without them. ``adaptive`` is a
+    request, always passed on: a method without an error estimate refuses True (``check_options``)."""
     opt = _core.IntegratorOptions()
     opt.method = method
+    reads = _METHODS[method].options if method in _METHODS else ()
     for name, value in options.items():
         if name not in ("error_on", "rtol", "atol"):
-            opt.set(name, value)
+            (opt if name in reads or name == "adaptive" else _core.IntegratorOptions()).set(name, value)
     return opt
 
 
