@@ -166,7 +166,7 @@ def test_t_given_or_not_needed():
 
 # -- simulate ------------------------------------------------------------------------------------
 
-@pytest.mark.parametrize("what, expected", [("model", "got Model"), (None, "got None"), ("system", "got 'system'")])
+@pytest.mark.parametrize("what, expected", [("model", "got a Model"), (None, "got None"), ("system", "got 'system'")])
 def test_simulate_wants_a_compiled_system(what, expected):
     m, _, _ = two_dof()
     arg = m if what == "model" else what

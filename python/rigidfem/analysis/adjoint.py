@@ -105,6 +105,7 @@ def gradient(system, t_end: float, parameters=None, *, outputs, running=None, te
         ``q0``/``qd0`` are the partial derivatives by each coordinate; an initial value named in ``parameters``
         moves along the loops (as ``System.assemble`` would close them).
     """
+    system = _checks.system(system)
 
     if not isinstance(method, str) or method not in METHODS:
         raise ValueError(f"method: expected one of {list(METHODS)} (the methods with an adjoint), got {method!r}")

@@ -188,6 +188,7 @@ def modal_analysis(system, q=None, qd=None, *, t: float = 0.0, sensitivities=Non
     this (q, q̇) come with the modes (``Modes.sensitivity(name)``; symmetric problems: no gyroscopic or
     circulatory terms; ``rigidfem.analysis.analysis_sensitivities``).
     """
+    system = _checks.system(system)
     names = analysis_sensitivities.check_names(system, sensitivities)
     modes = _modal_analysis(system, q, qd, t)
     if names:

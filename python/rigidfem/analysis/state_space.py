@@ -103,6 +103,7 @@ def linearize(system, q, qd=None, *, t: float = 0.0, inputs=(), outputs=None, dt
     argument for bad input (unknown coordinate names list the valid ones; points of another model;
     dt <= 0; shapes).
     """
+    system = _checks.system(system)
     n = system.nq
     t = _checks.scalar(t, "t")
     q = _checks.array(q, (n,), "q")

@@ -121,6 +121,7 @@ def static_equilibrium(system, q0=None, *, t: float = 0.0, load_steps: int = 10,
     equilibrium come with it, K_t dq/dp = ∂f/∂p (``Equilibrium.sensitivity(name)``;
     ``rigidfem.analysis.analysis_sensitivities``).
     """
+    system = _checks.system(system)
     names = analysis_sensitivities.check_names(system, sensitivities)
     eq = _static_equilibrium(system, q0, t, load_steps, tol, max_iterations)
     if names:

@@ -80,6 +80,25 @@ def scalar(x, name: str, *, positive: bool = False, nonnegative: bool = False, u
     return v
 
 
+def system(x, name: str = "system"):
+    """``x`` if it is a compiled System; a ValueError saying what to do otherwise (a Model: compile it)."""
+    if isinstance(x, _core._System):
+        return x
+    got = "a Model" if isinstance(x, _core._Model) else _short(x)
+    raise ValueError(f"{name}: expected a compiled System (call model.compile()), got {got}")
+
+
+def result(x, name: str = "result", needs: str | None = None):
+    """``x`` if it is a Result (``rigidfem.simulate``'s: times, states and the system they are of); ``needs``
+    names what the caller computes from the system, refused for a result loaded without it."""
+    if not all(hasattr(x, a) for a in ("t", "q", "qd", "system", "stats", "sensitivities")):
+        raise ValueError(f"{name}: expected a Result (what rigidfem.simulate returns), got {_short(x)}")
+    if needs is not None and x.system is None:
+        raise ValueError(f"{name}: expected a Result with its System for {needs}, got one loaded without it "
+                         "(rigidfem.load_npz(path, system) gives it)")
+    return x
+
+
 def pose_time(system, t) -> float:
     """The time (s) of a pose of ``system``: ``t``, or 0 when omitted, which only a system without
     prescribed coordinates allows (their drives make the pose depend on t)."""

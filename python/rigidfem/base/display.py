@@ -12,6 +12,8 @@ import re
 
 import numpy as np
 
+from . import _checks
+
 #: Rows shown of a long table (bodies, modes) before "… n more".
 MAX_ROWS = 20
 
@@ -77,6 +79,7 @@ def _beams(body_names) -> list[tuple[str, int]]:
 def system_html(system, title: str = "rigidfem System") -> str:
     """Bodies (parent, joint kind, free and prescribed coordinates), counts of coordinates, beams,
     loops and force elements of a compiled System."""
+    system = _checks.system(system)
     names, parents = system.body_names, system.parent
     free, driven = _by_body(system.coordinate_names), _by_body(system.prescribed_names)
     rows = []
@@ -120,6 +123,7 @@ def _stat(stats: dict, key: str):
 
 def result_html(result) -> str:
     """Method, outputs, steps, rejected steps, rhs evaluations, Newton iterations, wall time."""
+    result = _checks.result(result)
     s, t = result.stats, result.t
     chosen = result.stats.get("method", result.method)
     facts = {"method": result.method + (f" ({chosen})" if chosen != result.method else ""), "outputs": len(t),

@@ -20,6 +20,8 @@ from collections.abc import Mapping
 
 import numpy as np
 
+from . import _checks
+
 #: Suffix of the velocity columns: "<coordinate name>.dot" holds q̇ (m/s or rad/s).
 RATE = ".dot"
 #: Suffix of the error columns: "<output>.error" holds Result.error_estimate's history, once computed.
@@ -38,14 +40,13 @@ def _pandas(what: str):
 def result_columns(result, points=None) -> tuple[list[str], np.ndarray]:
     """(names, values (len(t), ncolumns)) of a Result's table without the time column: q, q̇ and
     the positions (m) of ``points`` (a dict name -> Point or Body)."""
+    result = _checks.result(result)
     if points is None:
         points = {}
     if not isinstance(points, Mapping) or not all(isinstance(k, str) for k in points):
         raise ValueError(f"points: expected None or a dict of column names (str) to Points or Bodies, e.g. "
                          f"{{'tip': beam.tip}}, got {points!r}")
-    if result.system is None:
-        raise ValueError("result: expected a Result with its system; load it with rigidfem.load_npz(path, system)")
-    names = list(result.system.coordinate_names)
+    names = list(_names(result))
     columns = names + [n + RATE for n in names]
     blocks = [result.q, result.qd]
     for key, point in points.items():
@@ -77,15 +78,22 @@ def to_csv(result, path, points=None):
     return path
 
 
+def _names(result) -> list:
+    """The names of a result's coordinates: its own (a loaded result's saved ones) or its system's."""
+    names = getattr(result, "coordinate_names", None)
+    return _checks.result(result, needs="its coordinates' names").system.coordinate_names if names is None else names
+
+
 def to_npz(result, path):
     """NumPy archive with t (s), q, qd (m, rad; per s), arm_forces (N or N·m), the method's own loop
     multipliers (if any), the forward sensitivities (if any: their names and a (P, len t, 2 nq) array),
     coordinate_names, method and stats (JSON)."""
+    result = _checks.result(result)
     own = {} if result.multipliers is None else {"multipliers": result.multipliers}
     if result.sensitivities:
         own["sensitivity_names"] = np.array(list(result.sensitivities), dtype=str)
         own["sensitivities"] = np.stack(list(result.sensitivities.values()))
-    np.savez(path, t=result.t, q=result.q, qd=result.qd, arm_forces=result.arm_forces, coordinate_names=np.array(result.system.coordinate_names,
+    np.savez(path, t=result.t, q=result.q, qd=result.qd, arm_forces=result.arm_forces, coordinate_names=np.array(_names(result),
              dtype=str), method=np.array(result.method), stats=np.array(json.dumps(result.stats)),
              interrupted=np.array(result.interrupted), **own)
     return path
@@ -94,12 +102,14 @@ def to_npz(result, path):
 def read_npz(path, system=None) -> dict:
     """The fields of the Result saved by ``to_npz`` (``rigidfem.load_npz`` builds it), checking
     that ``system`` (if given) has the coordinate names saved."""
+    if system is not None:
+        system = _checks.system(system)
     with np.load(path, allow_pickle=False) as f:
         names = [str(n) for n in f["coordinate_names"]]
         if system is not None and list(system.coordinate_names) != names:
             raise ValueError(f"system: expected a System with the coordinates {names} saved in {path}, got "
                              f"{list(system.coordinate_names)}")
-        return {"t": f["t"], "q": f["q"], "qd": f["qd"], "stats": json.loads(str(f["stats"])),
+        return {"t": f["t"], "q": f["q"], "qd": f["qd"], "coordinate_names": names, "stats": json.loads(str(f["stats"])),
                 "method": str(f["method"]), "interrupted": bool(f["interrupted"]),
                 "arm_forces": f["arm_forces"] if "arm_forces" in f.files else None,
                 "multipliers": f["multipliers"] if "multipliers" in f.files else None,

@@ -303,6 +303,7 @@ class Beam:
     def tip_positions(self, result) -> np.ndarray:
         """Global positions (len(t), 3) in m of the free end over a simulation ``result``: the last
         rfe's origin plus its axis times its current length (L(t)/(2m) for a varying length)."""
+        result = _checks.result(result, needs="tip positions")
         last = self.rfes[-1]
         origin = result.position(last.origin)
         axis = result.position(last.point((1.0, 0.0, 0.0))) - origin
@@ -320,6 +321,7 @@ class Beam:
         Measured against the continuum of a tape retracted at 0.5 m/s from 0.6 m (tests/test_flows.py):
         from its static shape with these rates the tip converges at second order in m (1.4e-6, 3.5e-7,
         8.7e-8 m at m = 8, 16, 32), with zero rates it stays 1.2 % of the deflection off."""
+        system = _checks.system(system)
         n = system.nq
         q = _checks.array(q, (n,), "q")
         t = _checks.scalar(t, "t")
@@ -368,6 +370,7 @@ class Beam:
         """Deformed centre line (m + 2, 3) in the global frame (m): root, sde points, tip, from one
         positions-only kinematics pass. ``t`` (s) is required when the system has prescribed
         coordinates, as for ``System.position``."""
+        system = _checks.system(system)
         points = self._points
         _checks.same_model(points[0], system, "system", "a system compiled from the beam's model")
         t = _checks.pose_time(system, t)

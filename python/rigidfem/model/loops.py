@@ -92,6 +92,7 @@ def _add(model, name, kind, ia, Fa, ib, Fb, length, drive, actuator=False) -> st
 def assemble(system, q, qd=None, *, t: float | None = None, tol: float = 1e-12, max_iterations: int = 50):
     """Coordinates (q, q̇) on the loops' constraint manifold nearest to a guess (see
     ``System.assemble``)."""
+    system = _checks.system(system)
     q = _checks.array(q, (system.nq,), "q")
     qd = np.zeros(system.nq) if qd is None else _checks.array(qd, (system.nq,), "qd")
     t = _checks.scalar(_checks.pose_time(system, t), "t")

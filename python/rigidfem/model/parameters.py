@@ -41,6 +41,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 import rigidfem._core as _core  # the compiled core, by its absolute name
+from ..base import _checks
 
 
 @dataclass(frozen=True)
@@ -237,6 +238,7 @@ def names_argument(names, argument: str, expected: str = "parameter names (Syste
 
 def initial_value(system, name: str):
     """(part, index) of an initial-value parameter "q0[<coordinate>]" or "qd0[<coordinate>]", or None."""
+    system = _checks.system(system)
     for part in ("q0", "qd0"):
         if name.startswith(part + "[") and name.endswith("]"):
             coordinate = name[len(part) + 1:-1]

@@ -171,9 +171,7 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
     o = options_.resolve(options)
     dt, rtol, atol, error_on, first_step = o["dt"], o["rtol"], o["atol"], o["error_on"], o["first_step"]
     adaptive, max_steps, max_step = o["adaptive"], o["max_steps"], o["max_step"]
-    if not isinstance(system, _core._System):
-        got = type(system).__name__ if isinstance(system, _core._Model) else _checks._short(system)
-        raise ValueError(f"system: expected a compiled System (call model.compile()), got {got}")
+    system = _checks.system(system)
     n = system.nq
     # converted here; their values judged by the core (_core._check_options: finite, t_end after t0, t_eval within)
     q0 = np.zeros(n) if q0 is None else _checks.reals(q0, (n,), "q0")

@@ -52,14 +52,19 @@ class Result(Versioned):
     sensitivities: dict = field(default_factory=dict, repr=False)
     #: the function that made it (``rigidfem.simulate``), which its error estimate runs again
     made_by: object = field(default=None, repr=False)
+    #: the names of q's columns (``system.coordinate_names``; the saved ones for a result loaded without its system)
+    coordinate_names: list = field(default=None, repr=False)
 
     def __post_init__(self):
         if self.arm_forces is None:
             self.arm_forces = np.zeros((len(self.t), 0 if self.system is None else self.system.nz))
+        if self.coordinate_names is None and self.system is not None:
+            self.coordinate_names = list(self.system.coordinate_names)
 
     @functools.cached_property
     def _outputs(self):
-        nl = 0 if self.system is None else self.system.nl
+        _checks.result(self, "result", needs="qdd, energies, driving and element forces and loop reactions")
+        nl = self.system.nl
         own = np.zeros((0, nl)) if self.multipliers is None else np.ascontiguousarray(self.multipliers, dtype=float)
         return _core._evaluate_outputs(self.system, self.t, self.q, self.qd, self.arm_forces, own)
 
@@ -138,6 +143,7 @@ class Result(Versioned):
     def position(self, point, frame: Body | None = None) -> np.ndarray:
         """Positions (len(t), 3) in m of a ``Point`` (or a ``Body``'s origin), in the global
         frame or in the frame of the body ``frame``."""
+        _checks.result(self, "result", needs="positions")
         if isinstance(point, Body):
             point = point.origin
         if not isinstance(point, Point):
@@ -157,7 +163,7 @@ class Result(Versioned):
             raise ValueError(f"name: expected one of the sensitivities of this run {list(self.sensitivities)}, "
                              f"got {name!r}")
         S = self.sensitivities[name]
-        n = self.system.nq
+        n = self.q.shape[1]
         return S[:, :n], S[:, n:]
 
     def position_sensitivity(self, point, name: str, frame: Body | None = None) -> np.ndarray:
@@ -166,8 +172,9 @@ class Result(Versioned):
         relative; m per unit of the parameter), plus, for a profile's number, ∂x/∂p at fixed q: a drive's
         number moves its prescribed coordinate, and the point with it (a central difference of x on the
         systems at p ± h)."""
+        _checks.result(self, "result", needs="positions")
         dq, _ = self.sensitivity(name)
-        size = np.max(np.abs(dq), axis=1) / np.maximum(1.0, np.max(np.abs(self.q), axis=1, initial=0.0))
+        size = np.max(np.abs(dq), axis=1, initial=0.0) / np.maximum(1.0, np.max(np.abs(self.q), axis=1, initial=0.0))
         eps = 6e-6 / np.where(size > 0.0, size, 1.0)  # the largest relative change of q: 6e-6
         up, down = (dataclasses.replace(self, q=self.q + sign * eps[:, None] * dq).position(point, frame)
                     for sign in (1.0, -1.0))
@@ -214,7 +221,8 @@ class Result(Versioned):
 def load_npz(path, system=None) -> Result:
     """The Result saved by ``Result.to_npz``. Give the ``system`` it was computed with (its
     coordinate names must match; ValueError otherwise) to use the outputs that need it: positions,
-    energies, ``to_dataframe``."""
+    energies. Without it, ``t``, ``q``, ``qd``, ``stats``, the sensitivities, ``to_npz`` and the table of
+    coordinates (``to_dataframe``, ``to_csv`` without points) work; what needs the system says so (ValueError)."""
     return Result(system, **export.read_npz(path, system))
 
 

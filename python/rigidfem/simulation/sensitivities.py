@@ -31,6 +31,7 @@ from __future__ import annotations
 
 import numpy as np
 
+from ..base import _checks
 from ..model import parameters as parameters_
 
 
@@ -38,6 +39,7 @@ def directions(system, names, options, t0: float, t1: float, argument: str = "se
     """Adds each named direction's systems at p + h (and p − h for a profile's number) and initial sensitivity
     to the C++ ``options`` for a run over [t0, t1] (s); returns the names. ValueError naming what is not a
     parameter or an initial value of the system."""
+    system = _checks.system(system)
     names = parameters_.names_argument(names, argument, "parameter names (System.parameters) or initial "
                                                               "values 'q0[<coordinate>]', 'qd0[<coordinate>]'")
     n = system.nq
@@ -62,5 +64,6 @@ def directions(system, names, options, t0: float, t1: float, argument: str = "se
 
 def split(system, names: list[str], raw: np.ndarray) -> dict[str, np.ndarray]:
     """{name: (len t, 2 nq) [∂q/∂p, ∂q̇/∂p]} of the C++ run's (len t, 2 nq P) rows."""
+    system = _checks.system(system)
     m = 2 * system.nq
     return {name: np.ascontiguousarray(raw[:, m * j:m * (j + 1)]) for j, name in enumerate(names)}

@@ -25,6 +25,7 @@ from ..model import samples
 from .._core import Body, Point
 from ..analysis.modes import modal_analysis
 from ..analysis.statics import static_equilibrium
+from ..base import _checks
 from ..base.persistence import Versioned
 from ..model.materials import Material, Section
 from ..model.model import Model
@@ -43,6 +44,18 @@ class Scene:
     q0: np.ndarray | None = None
     qd0: np.ndarray | None = None
     outputs: int = 51                  #: number of output times (uniform over [0, t_end])
+
+    def __post_init__(self):
+        self.system = _checks.system(self.system, "system")
+        self.t_end = _checks.scalar(self.t_end, "t_end", positive=True, unit="s")
+        if isinstance(self.tip, Body):
+            self.tip = self.tip.origin
+        if not isinstance(self.tip, Point):
+            raise ValueError(f"tip: expected a Point or Body of the system's model, got {_checks._short(self.tip)}")
+        _checks.same_model(self.tip, self.system, "tip")
+        if self.frame is not None and not isinstance(self.frame, Body):
+            raise ValueError(f"frame: expected None or a Body, got {_checks._short(self.frame)}")
+        self.outputs = _checks.integer(self.outputs, "outputs", minimum=2, maximum=10**7)
 
     @property
     def t_eval(self) -> np.ndarray:
@@ -208,8 +221,15 @@ def _observe(scene: Scene, result):
     return result.position(scene.tip, frame=scene.frame)
 
 
+def _scene(scene) -> None:
+    if not isinstance(scene, Scene):
+        raise ValueError(f"scene: expected a rigidfem.study.Scene (e.g. rigidfem.study.scenes.cantilever()), got "
+                         f"{_checks._short(scene)}")
+
+
 def reference(scene: Scene, rtol: float = 1e-10):
     """The scene solved tightly by Dormand–Prince; returns the Result."""
+    _scene(scene)
     return simulate(scene.system, scene.t_end, method="dopri5", rtol=rtol, atol=rtol * 1e-2, t_eval=scene.t_eval,
                     q0=scene.q0, qd0=scene.qd0, max_steps=10**8, stiffness_warning=False)
 
@@ -236,7 +256,9 @@ def work_precision(scene: Scene, methods, repeats: int = 3, ref=None, max_steps:
     """
     from .._core import SimulationError
 
-    ref = reference(scene) if ref is None else ref
+    _scene(scene)
+    ref = reference(scene) if ref is None else _checks.result(ref, "ref", needs="the reference's tip")
+    repeats = _checks.integer(repeats, "repeats", minimum=1)
     tip_ref = _observe(scene, ref)
     rows = []
     for entry in methods:
@@ -292,7 +314,7 @@ def discretisation_error(elements=(5, 10, 20, 40, 80), modes: int = 3) -> Table:
     sol = solve_bvp(bvp, lambda a, b: np.array([a[0], b[1], a[2], a[3]]), s, np.zeros((4, s.size)), tol=1e-10,
                     max_nodes=100000)
     tip_ref = sol.sol(1.0)[2:] * L
-    rows, previous = [], None
+    rows, previous, previous_m = [], None, None
     for m in elements:
         model = Model(gravity=None)
         beam = model.add_beam("b", model.ground, L, Material(E, rho), sec, m, deform=("bend_z",))

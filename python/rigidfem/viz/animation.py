@@ -80,6 +80,7 @@ def animate(result, *, plane: str | None = None, beams=(), segments=(), trails=(
     matplotlib.animation.FuncAnimation
         ``anim.to_jshtml()`` shows it in a notebook, ``save(anim, "movie.gif")`` writes it to a file.
     """
+    result = _checks.result(result, needs="an animation")
     plane = plots._plane(plane)
     t = np.asarray(result.t)
     indices = frame_indices(t, frames, fps)

@@ -102,7 +102,8 @@ def coordinates(result, which=None, *, quantity: str = "q", ax=None):
     """
     if quantity not in QUANTITIES:
         raise ValueError(f"quantity: expected one of {list(QUANTITIES)}, got {quantity!r}")
-    names = result.system.coordinate_names
+    result = _checks.result(result, needs="accelerations" if quantity == "qdd" else None)
+    names = result.coordinate_names
     if not names:
         raise ValueError("result: expected a system with free coordinates, got one with nq = 0")
     k = _select(names, which, "which", "coordinate names", 6)
@@ -120,6 +121,7 @@ def position(result, point, components: str = "xyz", *, frame: Body | None = Non
     ``components``: any of "x", "y", "z" (e.g. "xz"). Lines are labelled "{label} x (m)", ...
     Returns the Axes.
     """
+    result = _checks.result(result, needs="positions")
     if not isinstance(components, str) or not components or any(c not in "xyz" for c in components) \
             or len(set(components)) != len(components):
         raise ValueError(f"components: expected distinct letters from 'xyz' (e.g. 'xz'), got {components!r}")
@@ -132,6 +134,7 @@ def position(result, point, components: str = "xyz", *, frame: Body | None = Non
 def energies(result, which: Sequence[str] = tuple(ENERGIES), *, ax=None):
     """Kinetic, gravity, elastic and total energy (J) of ``result`` against time; ``which``
     chooses among ``"kinetic", "gravity", "elastic", "total"``. Returns the Axes."""
+    result = _checks.result(result, needs="energies")
     k = _select(list(ENERGIES), which, "which", "energies", len(ENERGIES))
     names = [list(ENERGIES)[i] for i in k]
     values = np.column_stack([getattr(result, ENERGIES[n]) for n in names])
@@ -141,6 +144,7 @@ def energies(result, which: Sequence[str] = tuple(ENERGIES), *, ax=None):
 def driving_forces(result, which=None, *, ax=None):
     """Forces (N) and torques (N·m) of the drives of ``result`` against time, by name
     (``system.prescribed_names``) or index; default the first six. Returns the Axes."""
+    result = _checks.result(result, needs="driving forces")
     names = result.system.prescribed_names
     if not names:
         raise ValueError("result: expected a system with prescribed coordinates (drives), got none")
@@ -193,7 +197,7 @@ class Skeleton:
     (Point or Body; on the ground too) joined by straight lines: ropes, cylinders, springs."""
 
     def __init__(self, system, beams=(), segments=()):
-        self.system = system
+        self.system = system = _checks.system(system)
         self.beams = _beams(beams, system)
         hidden = {b.index for beam in self.beams for b in beam.rfes[1:]}
         names, model = system.body_names, getattr(system, "_model_id", 0)
@@ -378,6 +382,7 @@ def shape(system, q, *, t: float | None = None, ax=None, plane: str | None = Non
     aspect around everything drawn into the Axes (several states can share them), axes labelled
     "x (m)", ... Returns the Axes.
     """
+    system = _checks.system(system)
     plane = _plane(plane)
     skeleton = Skeleton(system, beams, segments)
     pose = skeleton.pose(q, t=t, frame_size=frame_size)
@@ -400,6 +405,7 @@ def modes(system, modes, which=(0, 1, 2), *, scale: float | None = None, t: floa
     in ``shape``; ``plane`` and ``beams`` as in ``shape``. ``ax``: a sequence of Axes, one per
     mode (a new figure with one row of them by default). Returns the list of Axes.
     """
+    system = _checks.system(system)
     plane = _plane(plane)
     k = _mode_indices(which, len(modes.omega))
     if ax is None:

@@ -110,13 +110,10 @@ def view(system, result=None, *, trails=(), frames: int | None = None, q=None, t
     height : int
         Height of the picture in pixels.
     """
-    from ..model.model import System
-    from ..simulation.result import Result
 
-    if not isinstance(system, System):
-        raise ValueError(f"system: expected a compiled System, got {_checks._short(system)}")
+    system = _checks.system(system)
     if result is not None:
-        if not isinstance(result, Result) or result.system is not system:
+        if _checks.result(result).system is not system:
             raise ValueError(f"result: expected a Result of this system (rf.simulate(system, ...)), got "
                              f"{_checks._short(result)}")
         if q is not None:
