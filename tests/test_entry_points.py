@@ -165,3 +165,36 @@ def test_a_scene_and_work_precision_name_what_is_wrong(pendulum):
         rf.study.Scene("pendulum", system, -1.0, h["tip"])
     with pytest.raises(ValueError, match=r"^tip: expected a Point or Body"):
         rf.study.Scene("pendulum", system, 1.0, "tip")
+
+
+# -- work bounded before it is allocated --------------------------------------------------------
+
+def test_gradient_bounds_its_steps_and_memory_before_allocating(pendulum):
+    """t_end/dt beyond max_steps is refused at once (it built every step time first: minutes and all
+    the memory); so is a memory that cannot hold the grid and the outputs."""
+    _, h, system = pendulum
+    kw = dict(outputs={"tip": h["tip"]}, terminal=lambda y: y["tip"][0], dt=1e-3)
+    for t_end, max_steps, steps in ((1e300, None, r"1e\+303"), (2000.0, None, r"2e\+06"), (1.0, 999, "1000")):
+        extra = {} if max_steps is None else {"max_steps": max_steps}
+        with pytest.raises(ValueError, match=rf"^t_end, dt: expected at most max_steps = .* got \(t_end - t0\)/dt = "
+                                             rf"{steps} steps"):
+            rf.gradient(system, t_end, ["link.mass"], **kw, **extra)
+    with pytest.raises(ValueError, match=r"^memory: expected at least 320032 bytes \(the grid and the outputs at its "
+                                         r"10001 times\)"):  # 10001 times × (1 + 3 outputs) × 8 bytes
+        rf.gradient(system, 10.0, ["link.mass"], **kw, memory=1000)
+    g = rf.gradient(system, 1.0, ["link.mass"], **kw, max_steps=1000)  # 1000 steps: within the bound
+    assert np.isfinite(g.value)
+
+
+# -- no NaN or inf without a word ---------------------------------------------------------------
+
+def test_resolve_refuses_outputs_that_are_not_finite():
+    """An output function returning NaN or inf made a plan with 'estimated error 0' and a NaN limit."""
+    def build(elements, deform):
+        model, h = rf.samples.cantilever(elements=elements, deform=deform)
+        bad = (lambda system, solution: np.full(3, np.nan)) if elements >= 4 else (lambda s, sol: np.zeros(3))
+        return model, {"tip": h["beam"].tip, "bad": bad, "inf": lambda system, solution: np.array([np.inf])}
+
+    for name in ("bad", "inf"):
+        with pytest.raises(rf.ResolveError, match=rf"^outputs: expected finite values of '{name}', got NaN or inf"):
+            rf.resolve(build, ["tip", name], 1e-3, elements=4)

@@ -103,3 +103,47 @@ def test_a_sweep_answers_ctrl_c_and_keeps_what_it_has(executor):
     ran = [r for r in rows if r["error"] is None]
     assert ran and all(r["interrupted"] and r["reached"] < 1e4 for r in ran)
     assert all(r["error"] == INTERRUPTED for r in rows if r["error"] is not None)
+
+
+def caught(call):
+    """call(), or the KeyboardInterrupt it raised (with its message)."""
+    def run():
+        try:
+            return call()
+        except KeyboardInterrupt as e:
+            return e
+    return run
+
+
+def test_a_dynamic_resolve_answers_ctrl_c_with_keyboard_interrupt():
+    """Ctrl-C in a dynamic rf.resolve's first analysis (Kane's beam over 1,000 s, many seconds): the
+    interrupted run is not taken as a finished level (it was: a broadcast error between runs of other
+    lengths); KeyboardInterrupt names resolve and the analyses made."""
+    def build(elements, deform):
+        model, h = samples.kane_beam(omega=4.0, elements=elements)
+        return model, {"tip": h["beam"].tip}
+
+    def run():
+        with pytest.warns(RuntimeWarning, match="interrupted"):
+            return rf.resolve(build, "tip", 1e-9, t_end=1e3, elements=8, method="dopri5",
+                              stiffness_warning=False)
+
+    outcome, late = interrupted_after(0.5, caught(run))
+    assert isinstance(outcome, KeyboardInterrupt) and late < ANSWER
+    assert str(outcome).startswith("resolve (0 analyses made): interrupted at t = ")
+
+
+def test_an_error_estimate_answers_ctrl_c_with_keyboard_interrupt():
+    """Ctrl-C in the second run of Result.error_estimate: KeyboardInterrupt naming it, not an estimate
+    from a partial run."""
+    model, _ = samples.kane_beam(omega=4.0, elements=8)
+    first = rf.simulate(model.compile(), 100.0, method="dopri5", rtol=1e-7, atol=1e-9, t_eval=[0.0, 100.0],
+                        stiffness_warning=False)
+
+    def run():
+        with pytest.warns(RuntimeWarning, match="interrupted"):
+            return first.error_estimate
+
+    outcome, late = interrupted_after(0.3, caught(run))
+    assert isinstance(outcome, KeyboardInterrupt) and late < ANSWER
+    assert str(outcome).startswith("error_estimate (its second run): interrupted at t = ")

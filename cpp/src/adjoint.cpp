@@ -429,6 +429,16 @@ void Adjoint::forward(double t0, double t_end, const VecX& q0, const VecX& qd0) 
   const System& s = *sys_;
   const int n = s.nq, K = output_size(outputs_);
   if (!(t_end > t0)) bad("t_end", "a time after t0 = " + num(t0) + " s", num(t_end));
+  // the work bounded before anything is allocated: N = ⌈(t_end − t0)/dt⌉ steps, the grid and the outputs
+  // (N + 1)(1 + K) numbers kept whatever the checkpointing
+  const double steps = std::ceil((t_end - t0) / o_.dt);
+  if (!(steps <= static_cast<double>(o_.max_steps)))
+    bad("t_end, dt", "at most max_steps = " + std::to_string(o_.max_steps) + " steps of dt over [t0, t_end]",
+        "(t_end - t0)/dt = " + num(steps) + " steps");
+  if (!((steps + 1.0) * 8.0 * (1.0 + K) <= memory_))
+    bad("memory", "at least " + num((steps + 1.0) * 8.0 * (1.0 + K)) + " bytes (the grid and the outputs at its " +
+                      num(steps + 1.0) + " times)",
+        num(memory_));
   t_ = grid(t0, t_end, o_.dt);
   const long N = static_cast<long>(t_.size()) - 1;
   // every state if they fit, else checkpoints every k = ⌈√N⌉ steps and one segment of k states

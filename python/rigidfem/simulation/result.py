@@ -226,6 +226,16 @@ def load_npz(path, system=None) -> Result:
     return Result(system, **export.read_npz(path, system))
 
 
+def finished(result: Result, what: str) -> Result:
+    """``result`` if Ctrl-C did not stop its run; KeyboardInterrupt naming ``what`` otherwise. For the callers
+    that need a whole run (an error estimate's second run, resolve, a study): a partial result taken as a
+    finished one would be compared with runs of another length."""
+    if result.interrupted:
+        at = f"{result.t[-1]:g}" if len(result.t) else "the start"
+        raise KeyboardInterrupt(f"{what}: interrupted at t = {at} s")
+    return result
+
+
 def _estimate_error(result: Result):
     """Result.error_estimate: the second run (tolerances / TIGHTER, or dt / 2) at the same output times."""
     run = result.run
@@ -244,7 +254,7 @@ def _estimate_error(result: Result):
         kw["max_steps"] = 10 * run["max_steps"]
         order = None
     try:
-        rerun = result.made_by(result.system, **kw)
+        rerun = finished(result.made_by(result.system, **kw), "error_estimate (its second run)")
     except _core.SimulationError as e:
         raise _core.SimulationError(f"error_estimate: the second run failed {e}") from e
     return error_control.estimate(result, rerun, order)

@@ -261,6 +261,7 @@ class _Job:
         """The solution (Result or Equilibrium) and its wall time."""
         from ..analysis.statics import static_equilibrium
         from ..simulation.integration import simulate
+        from ..simulation.result import finished
 
         start = time.perf_counter()
         if self.t_end is None:
@@ -268,7 +269,8 @@ class _Job:
         else:
             kw = dict(dict(rtol=0.0, atol=atol), **self.options)
             kw.update(options)
-            solution = simulate(system, self.t_end, t_eval=self.t_eval, **kw)
+            solution = finished(simulate(system, self.t_end, t_eval=self.t_eval, **kw),
+                                f"resolve ({len(self.runs)} analyses made)")
         return solution, time.perf_counter() - start
 
     def values(self, system, handles, solution) -> list:
@@ -280,6 +282,9 @@ class _Job:
                 out.append(solution.position(point) if self.t_end is not None else system.position(point, 0.0, solution.q))
             else:
                 out.append(np.asarray(h(system, solution), dtype=float))
+            if not np.all(np.isfinite(out[-1])):
+                raise ResolveError(f"outputs: expected finite values of {n!r}, got NaN or inf (from the model of "
+                                   f"nq = {system.nq})", self.runs)
         return out
 
     def outputs(self, m, deform, atol) -> list:
@@ -287,6 +292,8 @@ class _Job:
         try:
             solution, wall = self.solve(system, options, atol)
             values = self.values(system, handles, solution)
+        except ResolveError:
+            raise
         except Exception as e:  # noqa: BLE001 (reported with the runs made)
             raise ResolveError(f"build: the analysis of elements = {m}, deform = {deform} failed: "
                                f"{type(e).__name__}: {e}", self.runs) from e
@@ -297,6 +304,7 @@ class _Job:
     def final(self, m, deform, atol) -> dict:
         system, handles, options = self.model(m, deform)
         solution, wall = self.solve(system, options, atol)
+        values = self.values(system, handles, solution)
         time_error = 0.0
         if self.t_end is not None:
             estimate = solution.error_estimate
@@ -304,8 +312,7 @@ class _Job:
                 h = handles[n]
                 q = (lambda r, h=h: r.position(h)) if isinstance(h, (Point, Body)) else (lambda r, h=h: h(system, r))
                 time_error = max(time_error, float(np.max(estimate.of(q))))
-        self.runs.append({"elements": m, "deform": deform, "nq": system.nq, "wall_time_s": wall,
-                          "values": self.values(system, handles, solution)})
+        self.runs.append({"elements": m, "deform": deform, "nq": system.nq, "wall_time_s": wall, "values": values})
         options = {} if self.t_end is None else {"atol": atol, "rtol": 0.0}
         return {"system": system, "handles": handles, "solution": solution, "cost_s": wall,
                 "time_error": time_error, "options": options}

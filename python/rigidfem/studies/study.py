@@ -30,6 +30,7 @@ from ..base.persistence import Versioned
 from ..model.materials import Material, Section
 from ..model.model import Model
 from ..simulation.integration import simulate
+from ..simulation.result import finished
 
 
 @dataclass
@@ -230,8 +231,9 @@ def _scene(scene) -> None:
 def reference(scene: Scene, rtol: float = 1e-10):
     """The scene solved tightly by Dormand–Prince; returns the Result."""
     _scene(scene)
-    return simulate(scene.system, scene.t_end, method="dopri5", rtol=rtol, atol=rtol * 1e-2, t_eval=scene.t_eval,
-                    q0=scene.q0, qd0=scene.qd0, max_steps=10**8, stiffness_warning=False)
+    return finished(simulate(scene.system, scene.t_end, method="dopri5", rtol=rtol, atol=rtol * 1e-2,
+                             t_eval=scene.t_eval, q0=scene.q0, qd0=scene.qd0, max_steps=10**8, stiffness_warning=False),
+                    "reference")
 
 
 def work_precision(scene: Scene, methods, repeats: int = 3, ref=None, max_steps: int = 10**7) -> Table:
@@ -274,8 +276,8 @@ def work_precision(scene: Scene, methods, repeats: int = 3, ref=None, max_steps:
             try:
                 times = []
                 for k in range(repeats + 1):
-                    r = simulate(scene.system, scene.t_end, method=method, t_eval=scene.t_eval, q0=scene.q0,
-                                 qd0=scene.qd0, **kw)
+                    r = finished(simulate(scene.system, scene.t_end, method=method, t_eval=scene.t_eval,
+                                          q0=scene.q0, qd0=scene.qd0, **kw), f"work_precision ({method})")
                     if k > 0 or repeats == 0:
                         times.append(r.stats["wall_time"])
                 tip_err = np.linalg.norm(_observe(scene, r) - tip_ref, axis=1)
