@@ -3,7 +3,8 @@
 For Kane's spin-up beam with m rfes and F output frames: the time to build the scene (s), the size of
 the exported HTML file (MB), and the time to show one frame (ms: every frame shown once, as playing
 does, in headless Chromium with software WebGL, SwiftShader, 800 × 600; a GPU is faster). Needs
-Debian's ``chromium`` on the PATH.
+Debian's ``chromium`` on the PATH. Then the scene of a long chain against its number of bodies (build
+time per frame and per body and frame: linear).
 """
 
 from __future__ import annotations
@@ -54,7 +55,29 @@ def viewer_scaling(cases=CASES) -> Table:
     return Table(rows, ("m", "bodies", "frames", "build_s", "file_MB", "ms_per_frame"))
 
 
+def body_scaling(elements=(1000, 2000, 10000, 100000), frames: int = 10) -> Table:
+    """The scene of a long chain (a cantilever of m rfes, m + 1 bodies) at ``frames`` frames: the time to
+    build it (s), per frame (ms) and per body and frame (µs): linear in the bodies."""
+    rows = []
+    for m in elements:
+        model, _ = rf.samples.cantilever(elements=m, deform=("bend_z",))
+        system = model.compile()
+        t = np.linspace(0.0, 1.0, frames)
+        q = np.random.default_rng(0).uniform(-1e-4, 1e-4, (frames, system.nq))
+        result = rf.Result(system, t, q, np.zeros_like(q), {}, "none")
+        start = time.perf_counter()
+        viewer = rf.view(system, result)
+        build = time.perf_counter() - start
+        rows.append({"bodies": system.nbodies, "frames": viewer.frames, "build_s": build,
+                     "ms_per_frame": 1e3 * build / viewer.frames,
+                     "us_per_body_frame": 1e6 * build / (viewer.frames * system.nbodies)})
+    return Table(rows, ("bodies", "frames", "build_s", "ms_per_frame", "us_per_body_frame"))
+
+
 def run(output_dir="bench", quick: bool = False) -> dict:
     print(machine(), flush=True)
     return report({"viewer_scaling": ("The 3D viewer: build time, file size, time per frame shown",
-                                      viewer_scaling(QUICK_CASES if quick else CASES))}, output_dir)
+                                      viewer_scaling(QUICK_CASES if quick else CASES)),
+                   "viewer_bodies": ("The 3D viewer's scene against the number of bodies (build only)",
+                                     body_scaling((1000, 2000) if quick else (1000, 2000, 10000, 100000)))},
+                  output_dir)

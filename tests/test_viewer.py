@@ -73,6 +73,80 @@ def test_other_scenes_and_one_state():
     assert "iframe" in v._repr_html_() and "RIGIDFEM" in v.html()
 
 
+def _poses(viewer):
+    import base64
+    d = viewer.data
+    return np.frombuffer(base64.b64decode(d["poses"]), dtype="<f4").reshape(len(d["t"]), len(d["bodies"]), 12)
+
+
+def test_every_documented_beam_shows_and_its_tube_ends_at_its_tip():
+    """A link of varying length (a profile), a tapered section (a function of s), stepped sections and
+    materials (lists): the viewer read the builder's arguments and failed on them (TypeError,
+    AttributeError); it reads the Beam handles and the system. The tube's end, the last rfe's pose times
+    the tip offset, is the beam's tip at every frame (Beam.tip_positions: the point positions in C++)."""
+    steel = rf.Material(2.1e11, 7850.0)
+    m = rf.Model(gravity=(0.0, -9.81, 0.0))
+    hub = m.add_body("hub", m.ground, rf.Joint.revolute("z"), mass=1.0, inertia=(0.1, 0.1, 0.1))
+    beams = [m.add_beam("slide", hub, rf.motion.polynomial([0.5, 0.2]), steel, rf.Section.circle(0.01), 6),
+             m.add_beam("taper", hub, 1.0, steel, lambda s: rf.Section.circle(0.02 - 0.01 * s), 6,
+                        placement=rf.transform((0.0, 0.0, 0.1))),
+             m.add_beam("stepped", hub, 1.0, [steel] * 3, [rf.Section.circle(0.01)] * 3, 3,
+                        placement=rf.transform((0.0, 0.0, 0.2)))]
+    system = m.compile()
+    result = rf.simulate(system, 0.5, t_eval=np.linspace(0.0, 0.5, 11), qd0=np.r_[1.0, np.zeros(system.nq - 1)])
+    viewer = rf.view(system, result)
+    poses = _poses(viewer).astype(float)
+    assert [b["name"] for b in viewer.data["beams"]] == ["slide", "taper", "stepped"]
+    for beam, shown in zip(beams, viewer.data["beams"]):
+        assert shown["bodies"] == [b.index for b in beam.rfes]
+        tips = shown["tips"] if beam.varying else [shown["tip"]] * len(result.t)
+        last = poses[:, shown["bodies"][-1]]
+        ends = np.einsum("kij,kj->ki", last[:, :9].reshape(-1, 3, 3), np.asarray(tips)) + last[:, 9:]
+        np.testing.assert_allclose(ends, beam.tip_positions(result), atol=2e-6)  # float32 poses
+    assert "tips" in viewer.data["beams"][0] and viewer.data["beams"][0]["tips"][-1][0] > viewer.data["beams"][0]["tips"][0][0]
+
+
+def test_a_round_beams_tube_has_its_radius():
+    """The tube's radius is sqrt(2 I_x/m) of the rfes: a round section's radius (here 0.1 m of a 10 m
+    beam, within the bounds the scene's size sets)."""
+    m = rf.Model(gravity=None)
+    m.add_beam("b", m.ground, 10.0, rf.Material(2.1e11, 7850.0), rf.Section.circle(0.2), 5)
+    system = m.compile()
+    assert viewer_radius(system) == pytest.approx(0.1, rel=1e-12)
+
+
+def viewer_radius(system):
+    return rf.view(system).data["beams"][0]["radius"]
+
+
+def test_a_large_system_is_shown_in_linear_time_and_its_frames_are_bounded():
+    """One kinematics pass per frame in C++ for every body's pose (it was a full pass per body: 112 s per
+    frame at 10,000 bodies, benchmarks/viewer.py); frames × bodies within MAX_POSES, the default
+    frames reduced to fit, more asked for refused before anything is computed."""
+    from rigidfem.viz.viewer import MAX_POSES
+
+    model, h = rf.samples.cantilever(elements=4000, deform=("bend_z",))
+    system = model.compile()
+    t = np.linspace(0.0, 1.0, 1001)
+    result = rf.Result(system, t, np.zeros((len(t), system.nq)), np.zeros((len(t), system.nq)), {}, "none")
+    viewer = rf.view(system, result)
+    assert viewer.frames == MAX_POSES // system.nbodies == 499
+    with pytest.raises(ValueError, match=r"^frames: expected an integer in \[1, 499\], got 500"):
+        rf.view(system, result, frames=500)
+    T = system.transform(4000, 0.0, np.zeros(system.nq))
+    np.testing.assert_allclose(_poses(viewer)[-1, 4000, 9:], T[:3, 3], rtol=1e-6)
+
+
+def test_an_animation_bounds_its_frames_before_computing_them():
+    model, h = rf.samples.pendulum()
+    system = model.compile()
+    result = rf.simulate(system, 1.0, method="rk4", dt=0.01, q0=[0.3])
+    with pytest.raises(ValueError, match=r"^fps: expected at most 100,000 frames over the 1 s"):
+        rf.animate(result, fps=1e300)
+    with pytest.raises(ValueError, match=r"^fps: expected at most"):
+        rf.animate(result, fps=1e6)
+
+
 @pytest.mark.parametrize("call, name", [
     (lambda s, r: rf.view("system"), "system"),
     (lambda s, r: rf.view(s, "result"), "result"),

@@ -280,10 +280,12 @@ void bind_integrators(py::module_& m) {
           },
           py::arg("ybar"), "(dJ/dp, dJ/dq0, dJ/dqd0, stats) for ybar = dJ/dy (N + 1, K).");
 
+  // Outputs over a result's times; Ctrl-C stops them (KeyboardInterrupt).
   m.def(
       "_evaluate_outputs",
       [](const System& s, const Eigen::Ref<const VecX>& t, const Eigen::Ref<const RowMatX>& Q,
          const Eigen::Ref<const RowMatX>& QD, const Eigen::Ref<const RowMatX>& S, const Eigen::Ref<const RowMatX>& L) {
+        InterruptScope interrupt(check_signals);
         StateOutputs o = evaluate_outputs(s, t, Q, QD, S, L);
         return py::make_tuple(o.qdd, o.tau, o.kinetic, o.gravity, o.elastic, o.power, o.reactions, o.element_forces);
       },
@@ -291,8 +293,19 @@ void bind_integrators(py::module_& m) {
   m.def(
       "_point_positions",
       [](const System& s, int body, const Vec3& r, int frame, const Eigen::Ref<const VecX>& t,
-         const Eigen::Ref<const RowMatX>& Q) { return point_positions(s, body, r, frame, t, Q); },
+         const Eigen::Ref<const RowMatX>& Q) {
+        InterruptScope interrupt(check_signals);
+        return point_positions(s, body, r, frame, t, Q);
+      },
       py::arg("system"), py::arg("body"), py::arg("r"), py::arg("frame"), py::arg("t"), py::arg("q"));
+  m.def(
+      "_body_poses",
+      [](const System& s, const Eigen::Ref<const VecX>& t, const Eigen::Ref<const RowMatX>& Q) {
+        InterruptScope interrupt(check_signals);
+        return body_poses(s, t, Q);
+      },
+      py::arg("system"), py::arg("t"), py::arg("q"),
+      "(len(t) nbodies, 12): each body's rotation row by row and origin (m) at each (t_k, q_k).");
 }
 
 }  // namespace rigidfem::bindings

@@ -6,6 +6,7 @@
 #include "rigidfem/arms.hpp"
 #include "rigidfem/constraints.hpp"
 #include "rigidfem/dynamics.hpp"
+#include "rigidfem/errors.hpp"
 #include "rigidfem/kinematics.hpp"
 
 namespace rigidfem {
@@ -117,6 +118,7 @@ StateOutputs evaluate_outputs(const System& sys, const Eigen::Ref<const VecX>& t
   Data d(sys);
   VecX s(sys.nz);
   for (Eigen::Index k = 0; k < N; ++k) {
+    interruption_point();
     s = S.row(k).transpose();
     set_arm_forces(sys, d, s);
     set_state(sys, d, t(k), Q.row(k).transpose(), QD.row(k).transpose());
@@ -150,11 +152,30 @@ MatX point_positions(const System& sys, int body, const Vec3& r, int frame, cons
   Data d(sys);
   const VecX zero = VecX::Zero(sys.nq);
   for (Eigen::Index k = 0; k < t.size(); ++k) {
+    if (k % 64 == 0) interruption_point();
     set_state(sys, d, t(k), Q.row(k).transpose(), zero);
     frames(sys, d);
     Vec4 x = d.T[body] * r.homogeneous();
     if (frame >= 0) x = affine_inverse(d.T[frame]) * x;
     P.row(k) = x.head<3>().transpose();
+  }
+  return P;
+}
+
+RowMatX body_poses(const System& sys, const Eigen::Ref<const VecX>& t, const Eigen::Ref<const RowMatX>& Q) {
+  if (Q.rows() != t.size() || Q.cols() != sys.nq) throw std::invalid_argument("q: expected a (len(t), nq) array");
+  RowMatX P(t.size() * sys.nbodies, 12);
+  Data d(sys);
+  const VecX zero = VecX::Zero(sys.nq);
+  for (Eigen::Index k = 0; k < t.size(); ++k) {
+    interruption_point();
+    set_state(sys, d, t(k), Q.row(k).transpose(), zero);
+    frames(sys, d);  // one positions-only pass gives every body's T_i
+    for (int i = 0; i < sys.nbodies; ++i) {
+      const Mat4& T = d.T[i];
+      P.row(k * sys.nbodies + i) << T(0, 0), T(0, 1), T(0, 2), T(1, 0), T(1, 1), T(1, 2), T(2, 0), T(2, 1), T(2, 2),
+          T(0, 3), T(1, 3), T(2, 3);
+    }
   }
   return P;
 }

@@ -60,5 +60,8 @@ StateOutputs evaluate_outputs(const System& sys, const Eigen::Ref<const VecX>& t
 /// the frame of body `frame` (−1: global): one positions-only kinematics pass per sample.
 MatX point_positions(const System& sys, int body, const Vec3& r, int frame, const Eigen::Ref<const VecX>& t,
                      const Eigen::Ref<const RowMatX>& Q);
+/// Every body's pose at (t_k, q_k): rows k·nbodies + i hold T_i's rotation row by row, then its origin
+/// (m); one positions-only kinematics pass per sample (the viewer's frames, O(N n)).
+RowMatX body_poses(const System& sys, const Eigen::Ref<const VecX>& t, const Eigen::Ref<const RowMatX>& Q);
 
 }  // namespace rigidfem

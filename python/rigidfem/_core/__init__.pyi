@@ -737,6 +737,10 @@ def _auto_stiff_method(system: _System, iteration_matrix: str) -> str:
     """
     The implicit method method='auto' hands over to.
     """
+def _body_poses(system: _System, t: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], q: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]", "flags.c_contiguous"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+    """
+    (len(t) nbodies, 12): each body's rotation row by row and origin (m) at each (t_k, q_k).
+    """
 def _check_options(system: _System, t0: typing.SupportsFloat | typing.SupportsIndex, t_end: typing.SupportsFloat | typing.SupportsIndex, q0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], qd0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], t_eval: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], options: IntegratorOptions) -> None:
     """
     integrate's checks of the options alone (ValueError naming the first bad one).

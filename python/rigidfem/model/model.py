@@ -85,6 +85,7 @@ class Model(_core._Model):
         super().__init__(g)
         self._gravity0, self._calls, self._building = np.array(g, dtype=float), [], False  # the recipe (pickling)
         self._parameter_groups = {}  # prefix -> parameters.Group: the named parameters the builders declared
+        self._beams = []  # the Beam handles add_beam returned (the viewer draws them)
 
     @property
     def gravity(self) -> np.ndarray:
@@ -322,7 +323,7 @@ class Model(_core._Model):
         name = f"load{self._nloads}" if name is None else name
         if not isinstance(name, str) or name in self._parameter_groups:
             raise ValueError(f"name: expected a new name (str) for the load, got {name!r}")
-        self._add_load(body, r, force, torque, bool(follower), _scale(scale))
+        self._add_load(body, r, force, torque, _checks.boolean(follower, "follower"), _scale(scale))
         parameters.register(self, parameters.LoadGroup(name, self._nloads - 1, force, torque))
         if scale is not None:
             parameters.register(self, parameters.ProfileGroup(f"{name}.scale", "load", -1, self._nloads - 1, scale,
@@ -499,8 +500,10 @@ class Model(_core._Model):
             Handle with ``tip``, ``point(s)``, ``rfes``, ``centerline(system, q)``, and
             the rfe/sde parameters ``rfe`` and ``sde``.
         """
-        return add_beam(self, name, parent, length, material, section, elements, formulation, deform, linear,
+        beam = add_beam(self, name, parent, length, material, section, elements, formulation, deform, linear,
                         joint, placement, tip_mass, tip_inertia, tip_offset)
+        self._beams.append(beam)
+        return beam
 
     def compile(self, algorithm: str = "recursive") -> System:
         """Freeze the model into an immutable ``System``.
@@ -534,6 +537,7 @@ class System(_core._System):
         self._state = {"rigidfem_state": persistence.STATE_VERSION, "model": persistence.model_state(model),
                        "algorithm": algorithm, "parameters": {}}
         self._parameters = parameters.Parameters(model._parameter_groups)
+        self._beams = tuple(model._beams)  # the model's Beam handles at compile time
 
     @property
     def parameters(self) -> dict:
@@ -552,6 +556,7 @@ class System(_core._System):
         new._model_id = self._model_id
         new._state = {**self._state, "parameters": {**self._state["parameters"], **values}}
         new._parameters = self._parameters.updated(values)
+        new._beams = self._beams
         return new
 
     def __reduce__(self):

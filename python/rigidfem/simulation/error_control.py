@@ -169,8 +169,7 @@ def output_histories(result, error_on) -> list:
     out = []
     for kind, index, r in specs(system, error_on) or [("bodies", -1, None)]:
         if kind == "bodies":
-            out.append(np.hstack([_core._point_positions(system, b, where, -1, result.t, result.q)
-                                  for b in range(system.nbodies) for where in (np.zeros(3), _com(system, b))]))
+            out.append(_bodies(system, result.t, result.q))
         elif kind == "point":
             out.append(_core._point_positions(system, index, r, -1, result.t, result.q))
         elif kind == "coordinate":
@@ -182,8 +181,14 @@ def output_histories(result, error_on) -> list:
     return out
 
 
-def _com(system, body) -> np.ndarray:
-    return np.asarray(system.centres_of_mass[body], dtype=float)
+def _bodies(system, t, q) -> np.ndarray:
+    """(len(t), 6 nbodies): each body's origin and centre of mass, x_i = T_i [c_i; 1] (m, global), from one
+    kinematics pass per output (``_core._body_poses``)."""
+    n, N = system.nbodies, len(t)
+    P = _core._body_poses(system, np.asarray(t, dtype=float), np.ascontiguousarray(q, dtype=float)).reshape(N, n, 12)
+    R, origin = P[:, :, :9].reshape(N, n, 3, 3), P[:, :, 9:]
+    com = np.einsum("knij,nj->kni", R, np.asarray(system.centres_of_mass, dtype=float).reshape(n, 3)) + origin
+    return np.concatenate([origin, com], axis=2).reshape(N, 6 * n)
 
 
 def estimate(result, rerun, fixed_order: int | None) -> ErrorEstimate:

@@ -21,6 +21,8 @@ from .._core import Body, Point
 WRITERS = {".gif": "pillow", ".mp4": "ffmpeg", ".mov": "ffmpeg", ".avi": "ffmpeg", ".mkv": "ffmpeg",
            ".webm": "ffmpeg", ".html": "html"}
 DEFAULT_FRAMES = 100
+#: The most frames an animation draws, and the most points' poses (frames × bodies) it computes.
+MAX_FRAMES, MAX_POSES = 100_000, 2_000_000
 
 
 class Animation(FuncAnimation):
@@ -32,18 +34,27 @@ class Animation(FuncAnimation):
         super().__init__(fig, update, frames=len(indices), interval=interval, blit=False, cache_frame_data=False)
 
 
-def frame_indices(t: np.ndarray, frames: int | None = None, fps: float | None = None) -> np.ndarray:
+def frame_indices(t: np.ndarray, frames: int | None = None, fps: float | None = None, bodies: int = 1) -> np.ndarray:
     """Indices into the output times ``t`` (s) of the frames: ``frames`` evenly spread over the
     outputs (at most len(t); default min(len(t), 100)), or the outputs nearest to the times
-    t0 + k/``fps`` (frames per second of simulated time)."""
+    t0 + k/``fps`` (frames per second of simulated time). At most ``MAX_FRAMES`` frames and
+    ``MAX_POSES`` poses (frames × ``bodies``), bounded before any is computed."""
     if frames is not None and fps is not None:
         raise ValueError(f"fps: expected None when frames is given, got fps={fps!r} and frames={frames!r}")
-    n = len(t)
+    n, most = len(t), max(1, min(MAX_FRAMES, MAX_POSES // max(bodies, 1)))
     if fps is None:
         count = min(n, DEFAULT_FRAMES) if frames is None else min(n, _checks.integer(frames, "frames", minimum=1))
+        if count > most:
+            raise ValueError(f"frames: expected at most {most:,} frames (MAX_FRAMES = {MAX_FRAMES:,}, frames × "
+                             f"{bodies:,} bodies ≤ MAX_POSES = {MAX_POSES:,}), got {count:,}")
         return np.unique(np.round(np.linspace(0, n - 1, count)).astype(int))
     fps = _checks.scalar(fps, "fps", positive=True, unit="frames per s")
-    wanted = t[0] + np.arange(int(np.floor((t[-1] - t[0]) * fps + 1e-9)) + 1) / fps
+    count = np.floor((t[-1] - t[0]) * fps + 1e-9) + 1  # a float: checked before anything is allocated
+    if not count <= most:
+        raise ValueError(f"fps: expected at most {most:,} frames over the {t[-1] - t[0]:g} s of the result "
+                         f"(MAX_FRAMES = {MAX_FRAMES:,}, frames × bodies ≤ MAX_POSES = {MAX_POSES:,}), got fps = "
+                         f"{fps:g}: {count:g} frames")
+    wanted = t[0] + np.arange(int(count)) / fps
     right = np.clip(np.searchsorted(t, wanted), 1, n - 1) if n > 1 else np.zeros(len(wanted), int)
     left = np.maximum(right - 1, 0)
     return np.where(np.abs(t[left] - wanted) <= np.abs(t[right] - wanted), left, right)
@@ -83,7 +94,7 @@ def animate(result, *, plane: str | None = None, beams=(), segments=(), trails=(
     result = _checks.result(result, needs="an animation")
     plane = plots._plane(plane)
     t = np.asarray(result.t)
-    indices = frame_indices(t, frames, fps)
+    indices = frame_indices(t, frames, fps, result.system.nbodies)
     interval = _real_time(t[indices]) if interval is None else _checks.scalar(interval, "interval", positive=True,
                                                                              unit="ms")
     skeleton = plots.Skeleton(result.system, beams, segments)

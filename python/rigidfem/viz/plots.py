@@ -206,20 +206,23 @@ class Skeleton:
         self.fixed: dict[int, np.ndarray] = {}  # row -> global position of joints on the ground
         self.links: list[list[int]] = []   # per body, the rows of its polyline
         self.triads: list[tuple[int, int]] = []  # per triad, the rows of the origin and the x axis' unit point
+        # each a list of all the bodies' (a call builds it): read once, not per body
+        parents, placements, centres = system.parent, system.placements, system.centres_of_mass
         for i, body in enumerate(bodies):
             if i in hidden:
                 continue
-            joint = self._joint(bodies, i)
+            joint = self._joint(bodies, i, parents[i], placements[i])
             origin = self._add(body.origin)
-            self.links.append(joint + [origin, self._add(body.point(system.centres_of_mass[i]))])
+            self.links.append(joint + [origin, self._add(body.point(centres[i]))])
             if not _is_rfe(names[i]):
                 axes = [self._add(body.point(e)) for e in np.eye(3)]  # unit points along x, y, z
                 self.triads.append((origin, axes[0]))
         self.segments = [[self._point(a), self._point(b)] for a, b in _pairs(segments, system)]
 
-    def _joint(self, bodies: list[Body], i: int) -> list[int]:
-        """The rows of body i's parent origin and joint frame (only the joint frame on the ground)."""
-        p, r = self.system.parent[i], np.asarray(self.system.placements[i])[:3, 3]
+    def _joint(self, bodies: list[Body], i: int, p: int, placement) -> list[int]:
+        """The rows of body i's parent p's origin and its joint frame at ``placement`` on p (only the joint
+        frame on the ground)."""
+        r = np.asarray(placement)[:3, 3]
         return [self._fixed(r)] if p < 0 else [self._add(bodies[p].origin), self._add(bodies[p].point(r))]
 
     @property

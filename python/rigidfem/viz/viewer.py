@@ -94,6 +94,10 @@ body {{ margin: 0; font: 13px sans-serif; }}
                 f"{self.frames} frames>")
 
 
+#: The most body poses (frames × bodies) a page holds: 12 float32 each, 96 MB (128 MB as base64).
+MAX_POSES = 2_000_000
+
+
 def view(system, result=None, *, trails=(), frames: int | None = None, q=None, t: float = 0.0,
          height: int = 420, title: str = "rigidfem") -> Viewer:
     """The 3D scene of ``system``: the frames of ``result`` (a ``Result`` of it), or the one state ``q``
@@ -104,7 +108,8 @@ def view(system, result=None, *, trails=(), frames: int | None = None, q=None, t
     trails : sequence of Point or Body
         Points whose paths are drawn from the start up to the frame shown.
     frames : int, optional
-        At most this many frames, spread evenly over the result's outputs (default: every output).
+        At most this many frames, spread evenly over the result's outputs (default: every output, as
+        many as ``MAX_POSES`` body poses allow: frames × bodies ≤ 2,000,000, a page of about 130 MB).
     q, t
         Without a result: the coordinates (m, rad) and the time (s) of the state shown.
     height : int
@@ -124,8 +129,14 @@ def view(system, result=None, *, trails=(), frames: int | None = None, q=None, t
     else:
         q = np.zeros(system.nq) if q is None else _checks.array(q, (system.nq,), "q")
         times, states = np.array([_checks.scalar(t, "t")]), q[None, :]
+    fit = MAX_POSES // max(system.nbodies, 1)  # the frames whose poses the page holds
+    if fit < 1:
+        raise ValueError(f"system: expected at most {MAX_POSES:,} bodies to show, got {system.nbodies:,}")
     if frames is not None:
-        frames = _checks.integer(frames, "frames", minimum=1, maximum=100_000)
+        frames = _checks.integer(frames, "frames", minimum=1, maximum=fit)
+    elif len(times) > fit:
+        frames = fit  # bounded before anything is computed: at most MAX_POSES body poses
+    if frames is not None:
         keep = np.unique(np.round(np.linspace(0, len(times) - 1, min(frames, len(times)))).astype(int))
         times, states = times[keep], states[keep]
     height = _checks.integer(height, "height", minimum=100, maximum=4000)
@@ -137,16 +148,19 @@ def view(system, result=None, *, trails=(), frames: int | None = None, q=None, t
 
 
 def _poses(system, times, states) -> np.ndarray:
-    """(frames, bodies, 12) float32: each body's rotation row by row, then its origin."""
-    out = np.empty((len(times), system.nbodies, 12), dtype=np.float32)
-    pose = _core._System.transform  # the compiled call (the state was checked by simulate or here)
-    for k, (t, q) in enumerate(zip(times, states)):
-        q = np.ascontiguousarray(q, dtype=float)
-        for b in range(system.nbodies):
-            T = pose(system, b, float(t), q)
-            out[k, b, :9] = T[:3, :3].ravel()
-            out[k, b, 9:] = T[:3, 3]
-    return out
+    """(frames, bodies, 12) float32: each body's rotation row by row, then its origin (one kinematics pass
+    per frame in C++, ``_core._body_poses``)."""
+    poses = _core._body_poses(system, np.asarray(times, dtype=float), np.ascontiguousarray(states, dtype=float))
+    return poses.reshape(len(times), system.nbodies, 12).astype(np.float32)
+
+
+def _radius(system, rfes, size: float) -> float:
+    """A beam's tube radius (m): sqrt(2 I_x/m) of its rfes (a round section's radius from the inertia about
+    the beam's axis, whatever the section, tapered or not; the median over the rfes), kept visible at the
+    scene's ``size``."""
+    masses, inertias = system.masses, system.inertias  # each a list of all the bodies': read once
+    r = [np.sqrt(2.0 * inertias[i][0, 0] / masses[i]) for i in rfes if masses[i] > 0.0]
+    return float(np.clip(np.median(r) if r else 0.0, 0.004 * size, 0.02 * size))
 
 
 def _equivalent_box(mass: float, inertia: np.ndarray) -> list[float] | None:
@@ -190,27 +204,27 @@ def _scene(system, times, states, trails, title) -> dict:
     lo, hi = (origins.min(axis=0), origins.max(axis=0)) if len(origins) else (np.zeros(3), np.zeros(3))
     size = float(max(np.linalg.norm(hi - lo), 1e-3))
     beams, in_beam, base = [], set(), set()
+    for beam in getattr(system, "_beams", ()):  # the model's Beam handles: their rfes, tip and length L(t)
+        rfes = [b.index for b in beam.rfes]
+        shown = {"name": beam.name, "bodies": rfes, "radius": _radius(system, rfes, size),
+                 "tip": [float(beam.length - beam.frames[-1]), 0.0, 0.0]}  # on the last rfe, beyond its frame
+        if beam.varying:  # the rfes' frames scale with L(t): the tip at L(t) (1 − s_m/L(0)), frame by frame
+            L = beam.length_at(times)
+            shown["tips"] = [[float(x), 0.0, 0.0] for x in L * (1.0 - beam.frames[-1] / beam.length)]
+        beams.append(shown)
+        in_beam.update(rfes)
     for name, a in _calls(system):
-        if name == "add_beam":
-            rfes = [index[n] for n in names if n.startswith(a["name"] + ".rfe")]
-            rfes.sort(key=lambda i: int(names[i].rsplit("rfe", 1)[1]))
-            along = sum(float(system.placements[i][0, 3]) for i in rfes[1:])
-            sec = a["section"]
-            radius = float(np.clip(np.sqrt(sec.A / np.pi), 0.004 * size, 0.02 * size))
-            beams.append({"name": a["name"], "bodies": rfes, "tip": [float(a["length"]) - along, 0.0, 0.0],
-                          "radius": radius})
-            in_beam.update(rfes)
-        elif name == "add_moving_base":
+        if name == "add_moving_base":
             base.add(index.get(a["name"], -1))
     # the force elements as their laws say, the loops as their kinds do (System._segments)
     segments = [{"kind": kind, "a": [int(ia), [float(x) for x in ra]], "b": [int(ib), [float(x) for x in rb]]}
                 for kind, ia, ra, ib, rb in system._segments]
-    bodies = []
+    bodies, masses, inertias, centres = [], system.masses, system.inertias, system.centres_of_mass
     for i, n in enumerate(names):
-        box = None if i in in_beam else _equivalent_box(float(system.masses[i]), np.asarray(system.inertias[i]))
+        box = None if i in in_beam else _equivalent_box(float(masses[i]), np.asarray(inertias[i]))
         if i in base or (box is not None and max(box) > 2 * size):
             box = [0.08 * size] * 3
-        bodies.append({"name": n, "box": box, "com": [float(x) for x in system.centres_of_mass[i]],
+        bodies.append({"name": n, "box": box, "com": [float(x) for x in centres[i]],
                        "triad": 0.0 if i in in_beam else 0.06 * size, "base": i in base})
     g = np.asarray(system.gravity, dtype=float)
     up = (-g / np.linalg.norm(g)).tolist() if np.linalg.norm(g) > 0 else [0.0, 0.0, 1.0]

@@ -109,7 +109,8 @@
     bodyObjects.forEach((g, i) => { g.matrix.copy(matrix(frame, i, M)); g.matrixWorldNeedsUpdate = true; });
     beams.forEach((b) => {
       b.beam.bodies.forEach((body, j) => point(frame, body, [0, 0, 0], b.pts[j]));
-      point(frame, b.beam.bodies[b.beam.bodies.length - 1], b.beam.tip, b.pts[b.pts.length - 1]);
+      const tip = b.beam.tips ? b.beam.tips[frame] : b.beam.tip;  // a link of varying length: L(t)
+      point(frame, b.beam.bodies[b.beam.bodies.length - 1], tip, b.pts[b.pts.length - 1]);
       const curve = new THREE.CatmullRomCurve3(b.pts);
       b.mesh.geometry.dispose();
       b.mesh.geometry = new THREE.TubeGeometry(curve, 4 * b.pts.length, b.beam.radius, 8, false);
