@@ -172,10 +172,20 @@ class ImplicitRk : public Stepper {
     // η from the last step, raised towards 1 (Hairer's max(η, ε)^0.8): a contraction rate measured long
     // ago, perhaps with another tangent, is trusted less and less, so a second iteration measures it anew.
     eta_ = std::pow(std::max(eta_, std::numeric_limits<double>::epsilon()), 0.8);
+    sensitivities_failed_ = false;
     if (!solve(t, h, tol)) {
-      if (!uses_tangent() || jacobian_fresh_) return false;
-      jacobian_valid_ = false;
-      if (!solve(t, h, tol)) return false;
+      bool solved = false;
+      if (uses_tangent() && !jacobian_fresh_) {
+        jacobian_valid_ = false;
+        solved = solve(t, h, tol);
+      }
+      if (!solved) {
+        // a fixed step cannot be shortened: say which equations failed (adaptive: the step is retried shorter)
+        if (!asked && sensitivities_failed_)
+          step_failure(t, h, "the sensitivities' corrections did not converge with the Newton matrix (with a fresh "
+                             "tangent too); reduce dt");
+        return false;
+      }
     }
     if (!q1_.allFinite() || !v1_.allFinite() || !a1_.allFinite()) step_failure(t, h, "the state became NaN or inf");
     y1_ << q1_, v1_;
@@ -255,7 +265,7 @@ class ImplicitRk : public Stepper {
   /// differences' noise (1e-6 of δA) after a fresh tangent at the stage (`refresh`, once). dA holds the first
   /// iterate on entry; dV, dQ, dl are the stage's on return.
   template <class Correct, class Refresh>
-  void sensitivity_stage(int j, double ti, double gh, const VecX& Q, const VecX& V, const VecX& A, const VecX& lambda,
+  bool sensitivity_stage(int j, double ti, double gh, const VecX& Q, const VecX& V, const VecX& A, const VecX& lambda,
                          const VecX& dqhat, const VecX& dvhat, Eigen::Ref<VecX> dA, VecX& dV, VecX& dQ, VecX& dl,
                          Correct&& correct, Refresh&& refresh) {
     double previous = 0.0, free = 0.0;  // free: the largest correction before the loops' part
@@ -265,8 +275,7 @@ class ImplicitRk : public Stepper {
       interruption_point();
       dV = dvhat + gh * dA;
       dQ = dqhat + gh * dV;
-      if (it == std::max(20, max_it_))
-        step_failure(t_, h_, "the sensitivities' corrections did not converge with the Newton matrix");
+      if (it == std::max(20, max_it_)) return false;  // the step again with a fresh tangent, or a shorter one
       const VecX R = sens_->residual_derivative(j, ti, Q, V, A, lambda, dQ, dV, dA, dl);
       VecX dx(n_), dlambda;
       free = std::max(free, correct(R, dQ, dV, dA, dx, dlambda));
@@ -288,6 +297,7 @@ class ImplicitRk : public Stepper {
     }
     dV = dvhat + gh * dA;
     dQ = dqhat + gh * dV;
+    return true;
   }
 
   /// r_ = M(Q) A − f(Q, V, t) at a stage: inverse dynamics, O(n) for recursive systems.
@@ -414,6 +424,7 @@ class ImplicitRk : public Stepper {
   std::unique_ptr<SensitivityEquations> sens_;  // forward sensitivities, or null
   MatX Sq_, Sv_, Sa_, Sqp_, Svp_, Sap_, Sq1_, Sv1_, Sa1_;  // (nq, P) their q, q̇, q̈: now, at the last step's start, its end
   bool jacobian_valid_ = false, jacobian_fresh_ = false, slow_ = false;
+  bool sensitivities_failed_ = false;  // the last solve's sensitivities did not converge (its state did)
   double eta_ = 1.0;          // Newton's η of the last converged stage
   double t_ = 0.0, h_ = 1.0;  // the last attempted step
 };
@@ -461,14 +472,15 @@ class Esdirk final : public ImplicitRk {
       if (!newton(t + T::c[i] * h, gh, tol, i)) return false;
     }
     q1_ = Q_, v1_ = V_.col(T::s - 1), a1_ = A_.col(T::s - 1), s1_ = S_arm_;
-    if (sens_) stage_sensitivities(t, h);
-    return true;
+    sensitivities_failed_ = sens_ && !stage_sensitivities(t, h);  // as Newton's failure: the step retried
+    return !sensitivities_failed_;
   }
 
   /// The sensitivities' stages (the staggered direct method, sensitivity_stage) after the state's have
   /// converged: δv̂_i = δq̇_n + h Σ_{k<i} a_ik δA_k, δq̂_i = δq_n + h Σ_{k<i} a_ik δV_k; the last stage is the
-  /// step's end.
-  void stage_sensitivities(double t, double h) {
+  /// step's end. False when a stage's corrections do not converge (the step is then retried as after
+  /// Newton's failure: with a fresh tangent, then shorter).
+  bool stage_sensitivities(double t, double h) {
     const double gh = T::gamma * h;
     const int P = sens_->count();
     Sq1_.resize(n_, P), Sv1_.resize(n_, P), Sa1_.resize(n_, P);
@@ -519,11 +531,13 @@ class Esdirk final : public ImplicitRk {
           jacobian_valid_ = false;  // the next step linearises at its own start again
           tangent_here = true;
         };
-        sensitivity_stage(j, ti, gh, Q, Vi, Ai, li, dqhat, dvhat, dA.col(i), dVi, dQi, dl, correct, refresh);
+        if (!sensitivity_stage(j, ti, gh, Q, Vi, Ai, li, dqhat, dvhat, dA.col(i), dVi, dQi, dl, correct, refresh))
+          return false;
         dV.col(i) = dVi;
       }
       Sq1_.col(j) = dQi, Sv1_.col(j) = dV.col(T::s - 1), Sa1_.col(j) = dA.col(T::s - 1);
     }
+    return true;
   }
 
   /// The stage's arm forces S_i = (ŝ_i + γh k V_i)/(1 + γh/τ) into S_arm_ and d_, and (rates) Ṡ_i.
@@ -713,8 +727,8 @@ class Radau5 final : public ImplicitRk, public RadauAccess {
     }
     stage_values(h);
     q1_ = Q_.col(2), v1_ = V_.col(2), a1_ = A_.col(2);
-    if (sens_) stage_sensitivities(t, h);
-    return true;
+    sensitivities_failed_ = sens_ && !stage_sensitivities(t, h);  // as Newton's failure: the step retried
+    return !sensitivities_failed_;
   }
 
   /// The sensitivities' stages (the staggered direct method) after the state's have converged: δA (nq, 3) with
@@ -722,7 +736,9 @@ class Radau5 final : public ImplicitRk, public RadauAccess {
   ///   R_i = K δQ_i + C δV_i + M δA_i − ∂(G_iᵀλ_i)/∂q δQ_i − G_iᵀ δλ_i + ∂r/∂p = 0   (loops: G_i δA_i = D(γ_i − G_i A_i))
   /// by simplified Newton with the step's matrix (solve_stages and, with loops, close_loops_correction), until
   /// the corrections move δQ and δV by less than 1e-9 of them or stall at the differences' noise (1e-6 of δA).
-  void stage_sensitivities(double t, double h) {
+  /// False when they do not converge (the step is then retried as after Newton's failure: with a fresh tangent,
+  /// then shorter).
+  bool stage_sensitivities(double t, double h) {
     const int P = sens_->count(), nl = sys_.nl;
     Sq1_.resize(n_, P), Sv1_.resize(n_, P), Sa1_.resize(n_, P);
     const MatX A = A_, V = V_, Q = Q_, L = L_;  // the converged stages (the loop correction below reuses L_, D_)
@@ -739,8 +755,10 @@ class Radau5 final : public ImplicitRk, public RadauAccess {
         dV.colwise() += VecX(Sv_.col(j));
         dQ.noalias() = h * dV * tab_.a.transpose();
         dQ.colwise() += VecX(Sq_.col(j));
-        if (it == std::max(20, max_it_))
-          step_failure(t, h, "the sensitivities' corrections did not converge with the Newton matrix");
+        if (it == std::max(20, max_it_)) {
+          L_ = L;
+          return false;
+        }
         for (int i = 0; i < 3; ++i) {
           const double ti = t + tab_.c(i) * h;
           R.col(i) = sens_->residual_derivative(j, ti, Q.col(i), V.col(i), A.col(i), nl ? VecX(L.col(i)) : VecX(),
@@ -776,6 +794,7 @@ class Radau5 final : public ImplicitRk, public RadauAccess {
       Sq1_.col(j) = dQ.col(2), Sv1_.col(j) = dV.col(2), Sa1_.col(j) = dA.col(2);
     }
     L_ = L;
+    return true;
   }
 
   /// The multipliers' first iterate, as predict's for A: the last step's stage multipliers continued

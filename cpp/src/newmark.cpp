@@ -85,7 +85,7 @@ class NewmarkFamily final : public NewmarkStepper {
     }
     if (!newton(t, h)) return false;
     if (!s1_.q.allFinite() || !s1_.v.allFinite()) step_failure(t, h, "the state became NaN or inf");
-    if (sens_) step_sensitivities(t, h);
+    if (sens_ && !step_sensitivities(t, h, tol != nullptr)) return false;  // adaptive: the step retried shorter
     if (!tol) return true;
     // Local error estimate of q over the step, h² (β − 1/6)(a_{n+1} − a_n), per unit step: a second-order
     // method propagates the solution it estimates, so the steps' errors add up (coherently, in the phase
@@ -342,8 +342,8 @@ class NewmarkFamily final : public NewmarkStepper {
   ///   G δq_{n+1} + ∂g/∂p = 0,
   /// with δq_{n+1}, δq̇_{n+1} from the method's update. Solved by corrections with the step's own iteration matrix
   /// (exact tangent: one correction to the differences' accuracy; spring matrix: a few) until they are below
-  /// 1e-10 of δq̈.
-  void step_sensitivities(double t, double h) {
+  /// 1e-10 of δq̈. False (adaptive steps) when they do not converge: the step is then retried shorter.
+  bool step_sensitivities(double t, double h, bool adaptive) {
     const int P = sensitivity_count();
     const double bp = beta_ * (1.0 - af_) / (1.0 - am_), gp = gamma_ * (1.0 - af_) / (1.0 - am_);
     NewmarkState& s1 = s1_;
@@ -362,9 +362,11 @@ class NewmarkFamily final : public NewmarkStepper {
         da = ((1.0 - af_) * dqdd + af_ * s_.Sqdd.col(j) - am_ * s_.Sa.col(j)) / (1.0 - am_);
         dq = s_.Sq.col(j) + h * s_.Sv.col(j) + (h * h) * ((0.5 - beta_) * s_.Sa.col(j) + beta_ * da);
         dv = s_.Sv.col(j) + h * ((1.0 - gamma_) * s_.Sa.col(j) + gamma_ * da);
-        if (it == max_it)
+        if (it == max_it) {
+          if (adaptive) return false;  // a shorter step moves the end state off what defeats them (a rope's kink)
           step_failure(t, h, "the sensitivities' corrections did not converge in " + std::to_string(max_it) +
-                                 " iterations with the Newton matrix");
+                                 " iterations with the Newton matrix; reduce dt");
+        }
         const VecX R = sens_->residual_derivative(j, t + h, s1.q, s1.v, s1.qdd, s1.lambda, dq, dv, dqdd, dl);
         const bool spring_matrix = spring_now_;
         spring_now_ = spring;  // the loops' correction solves with the matrix used here
@@ -402,6 +404,7 @@ class NewmarkFamily final : public NewmarkStepper {
       s1.Sv.col(j) = s_.Sv.col(j) + h * ((1.0 - gamma_) * s_.Sa.col(j) + gamma_ * s1.Sa.col(j));
       s1.Slambda.col(j) = dl;
     }
+    return true;
   }
 
   const System& sys_;
