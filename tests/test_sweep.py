@@ -3,6 +3,7 @@ per-case seeds, and parallel results equal to serial ones on threads (one shared
 processes and a two-worker Dask LocalCluster."""
 
 import concurrent.futures
+import os
 import sys
 
 import numpy as np
@@ -44,6 +45,15 @@ def swing(angle):
 
 
 GRID = {"length": [0.5, 1.0, 6.0], "damping": [0.0, 0.2]}
+
+
+def dies_or_returns(k):
+    """Case 2 kills its worker process, case 3 returns what does not pickle, the others k²."""
+    if k == 2:
+        os._exit(3)
+    if k == 3:
+        return {"value": lambda: k}
+    return {"value": k * k}
 
 
 def missing(v):
@@ -101,6 +111,24 @@ def test_processes_equal_serial():
     serial = rf.sweep(pendulum, grid=GRID, executor="serial", as_frame=False)
     processes = rf.sweep(pendulum, grid=GRID, executor="processes", workers=2, as_frame=False)
     same_rows(processes.rows, serial.rows)
+
+
+def test_a_dying_worker_or_a_value_that_does_not_pickle_costs_one_row():
+    """errors="record" in processes: a case that kills its worker (BrokenProcessPool) and one whose
+    value does not pickle each get their error; the other cases of their batches keep their values
+    (every row was lost: the whole sweep raised)."""
+    table = rf.sweep(dies_or_returns, grid={"k": list(range(8))}, executor="processes", workers=2, as_frame=False)
+    rows = {r["k"]: r for r in table.rows}
+    assert [k for k, r in rows.items() if r["error"] is None] == [0, 1, 4, 5, 6, 7]
+    assert all(rows[k]["value"] == k * k for k in (0, 1, 4, 5, 6, 7))
+    assert "worker process died" in rows[2]["error"] and rows[2]["value"] is None
+    assert "return value does not pickle" in rows[3]["error"] and rows[3]["value"] is None
+
+
+def test_a_dataframes_error_is_none_where_the_case_ran():
+    pd = pytest.importorskip("pandas")
+    frame = rf.sweep(pendulum, grid=GRID, executor="serial")
+    assert [e is None for e in frame["error"]] == [True, True, True, True, False, False]
 
 
 def test_processes_and_dask_get_the_cases_in_batches():

@@ -26,7 +26,7 @@ from collections.abc import Callable, Mapping, Sequence
 
 import numpy as np
 
-from ..base import _interrupt
+from ..base import _checks, _interrupt
 from ..base._progress import ProgressBar
 from .study import Table
 
@@ -155,9 +155,32 @@ def _case_in_thread(stop, function, case, seed, record_errors):
         return [run_case(function, case, seed, record_errors)]
 
 
-def run_cases(function, cases: list, seeds: list, record_errors: bool) -> list:
-    """A batch of cases in one worker task: run_case's (value, error, wall time) for each."""
-    return [run_case(function, case, seed, record_errors) for case, seed in zip(cases, seeds)]
+def run_cases(function, cases: list, seeds: list, record_errors: bool, packed: bool = False):
+    """A batch of cases in one worker task: run_case's (value, error, wall time) for each. ``packed`` (a
+    process's task): the outcomes pickled here, where a value that does not pickle is its case's error
+    (recorded) instead of the whole batch's."""
+    outcomes = [run_case(function, case, seed, record_errors) for case, seed in zip(cases, seeds)]
+    if not packed:
+        return outcomes
+    try:
+        return pickle.dumps(outcomes)
+    except Exception:  # noqa: BLE001 (which value does not pickle: each case's own error)
+        if not record_errors:
+            raise
+    kept = []
+    for value, error, wall in outcomes:
+        try:
+            pickle.dumps(value)
+        except Exception as e:  # noqa: BLE001
+            value, error = None, (f"{type(e).__name__}: the function's return value does not pickle (a process "
+                                  f"sends it back by pickle): {e}")
+        kept.append((value, error, wall))
+    return pickle.dumps(kept)
+
+
+def _unpacked(outcomes):
+    """A task's outcomes: pickled by a process (``run_cases(packed=True)``), or as they are."""
+    return pickle.loads(outcomes) if isinstance(outcomes, bytes) else outcomes
 
 
 #: Tasks per worker a process pool or a Dask cluster gets (each a batch of cases): a task costs
@@ -189,8 +212,9 @@ def _submit_all(executor, function, cases, seeds, record_errors, stop, batches) 
         return [executor.submit(_case_in_thread, stop, function, cases[b[0]], seeds[b[0]], record_errors)
                 for b in batches]
     options = {"pure": False} if _is_dask_client(executor) else {}
+    packed = isinstance(executor, concurrent.futures.ProcessPoolExecutor)
     return [executor.submit(run_cases, function, [cases[k] for k in b], [seeds[k] for k in b], record_errors,
-                            **options) for b in batches]
+                            packed, **options) for b in batches]
 
 
 def _as_completed(executor, futures):
@@ -228,18 +252,40 @@ def _outcomes(function, cases, seeds, executor, record_errors, bar, stop) -> lis
         for f in futures:
             f.cancel()
         concurrent.futures.wait([f for f in futures if not _is_dask_client(executor)], timeout=GRACE)
-    outcomes = []
+    outcomes, lost = {}, []
     for f, b in zip(futures, batches):
         if f.done() and not f.cancelled() and f.exception() is None:
-            outcomes += f.result()
+            outcomes.update(zip(b, _unpacked(f.result())))
+        elif stop.is_set():
+            outcomes.update((k, (None, INTERRUPTED, float("nan"))) for k in b)
+        elif not record_errors:
+            raise f.exception()  # errors="raise": the case's own exception
+        elif isinstance(executor, concurrent.futures.ProcessPoolExecutor):
+            lost += b  # a worker died (BrokenProcessPool): which case killed it, each run alone tells
         else:
-            outcomes += [(None, INTERRUPTED if stop.is_set() else _failure(f), float("nan"))] * len(b)
-    return outcomes
+            error = f"{type(f.exception()).__name__}: {f.exception()}"
+            outcomes.update((k, (None, error, float("nan"))) for k in b)
+    outcomes.update(_alone(function, cases, seeds, lost, stop))
+    return [outcomes[k] for k in range(len(cases))]
 
 
-def _failure(future) -> str:
-    """errors="raise": the case's own exception, raised."""
-    raise future.exception()
+def _alone(function, cases, seeds, indices, stop) -> dict:
+    """The cases of batches whose process died, each run again alone in a fresh process: the case that
+    kills its process gets that as its error, the others their results (errors="record")."""
+    out = {}
+    for k in indices:
+        if stop.is_set():
+            out[k] = (None, INTERRUPTED, float("nan"))
+            continue
+        with concurrent.futures.ProcessPoolExecutor(1) as pool:
+            try:
+                out[k] = _unpacked(pool.submit(run_cases, function, [cases[k]], [seeds[k]], True, True).result())[0]
+            except KeyboardInterrupt:
+                stop.set()
+                out[k] = (None, INTERRUPTED, float("nan"))
+            except Exception as e:  # noqa: BLE001 (the process died: this case's failure)
+                out[k] = (None, f"{type(e).__name__}: {e} (the case's worker process died)", float("nan"))
+    return out
 
 
 def _row(case: dict, seed, value, error, wall_time) -> dict:
@@ -276,7 +322,9 @@ def _table(rows: list[dict], as_frame):
     except ImportError:
         raise ValueError("as_frame: expected None or False without pandas installed (pip install pandas), "
                          "got True") from None
-    return pd.DataFrame.from_records(rows, columns=columns)
+    frame = pd.DataFrame.from_records(rows, columns=columns)
+    frame[ERROR] = pd.Series([row[ERROR] for row in rows], index=frame.index, dtype=object)  # None where it ran
+    return frame
 
 
 def sweep(function: Callable, cases: Sequence[Mapping] | None = None, *, grid: Mapping[str, Sequence] | None = None,
@@ -337,7 +385,7 @@ def sweep(function: Callable, cases: Sequence[Mapping] | None = None, *, grid: M
     draw = _takes_seed(function) and not any(SEED in case for case in cases)  # else cases give their own
     seeds = _seeds(seed, len(cases)) if draw else [None] * len(cases)
     pool, owned = _resolve_executor(executor, workers)
-    bar = ProgressBar(len(cases), "cases", "sweep") if progress else None
+    bar = ProgressBar(len(cases), "cases", "sweep") if _checks.boolean(progress, "progress") else None
     stop = threading.Event()
     try:
         outcomes = _outcomes(function, cases, seeds, pool, errors == "record", bar, stop)
