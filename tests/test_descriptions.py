@@ -146,5 +146,10 @@ def test_an_option_the_method_does_not_read_leaves_its_run_unchanged():
         np.testing.assert_array_equal(other.q, plain.q)
     with pytest.raises(ValueError, match="^first_step: expected a positive finite step in s"):
         rf.simulate(system, 1.0, "rk4", dt=0.01, first_step=-1.0)
+    for bad, name in (({"max_step": 0.0}, "max_step"), ({"newton_tol": -1.0}, "newton_tol")):
+        with pytest.raises(ValueError, match=f"^{name}: expected"):  # the options every run checks: whatever the method
+            rf.simulate(system, 1.0, "rk4", dt=0.01, **bad)
+    with pytest.raises(ValueError, match="^dt: expected a positive step in s for the fixed-step method 'rk4'"):
+        rf.simulate(system, 1.0, "rk4", first_step=0.01)  # not its step: rk4 does not read first_step
     with pytest.raises(ValueError, match="^adaptive: the method 'rk4' has no error estimate"):
         rf.simulate(system, 1.0, "rk4", dt=0.01, adaptive=True)

@@ -13,6 +13,7 @@ system or a result is held to the same rule without a new test.
 from __future__ import annotations
 
 import inspect
+import re
 import types
 
 import numpy as np
@@ -198,3 +199,143 @@ def test_resolve_refuses_outputs_that_are_not_finite():
     for name in ("bad", "inf"):
         with pytest.raises(rf.ResolveError, match=rf"^outputs: expected finite values of '{name}', got NaN or inf"):
             rf.resolve(build, ["tip", name], 1e-3, elements=4)
+
+
+def test_linearize_refuses_a_sample_time_whose_hold_overflows(pendulum):
+    """dt = 1e100: e^(A dt) overflows; the matrices were NaN with only numpy's overflow warning."""
+    import warnings
+
+    _, _, system = pendulum
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore", rf.NotAnEquilibriumWarning)
+        with pytest.raises(rf.SimulationError, match=r"zero-order hold at dt = 1e\+100 s\): A has NaN or inf"):
+            rf.linearize(system, [0.1], dt=1e100)
+        ss, continuous = rf.linearize(system, [0.1], dt=0.01), rf.linearize(system, [0.1])
+    import scipy.linalg
+
+    np.testing.assert_allclose(ss.A, scipy.linalg.expm(continuous.A * 0.01), rtol=1e-12)  # the hold: e^(A dt)
+
+
+def test_a_profile_that_overflows_is_a_simulation_error():
+    p = rf.motion.polynomial([0.0] * 10 + [1e300])
+    with pytest.raises(rf.SimulationError, match=r"^at t = 1000000 s: the profile polynomial\(degree 10\) is not "
+                                                 r"finite: \(q, qd, qdd\) = \(inf"):
+        p(1e6)
+    assert p(1.0) == pytest.approx((1e300, 1e301, 9e301), rel=1e-15)
+
+
+def test_a_results_outputs_that_overflow_are_named_in_a_warning():
+    """A base of mass 1e308 driven along x: its driving force overflows. System.driving_forces raises at
+    that state; the result's were inf without a word."""
+    m = rf.Model(gravity=(0.0, 0.0, -9.81))
+    base = m.add_body("base", m.ground, rf.Joint.prismatic("x"), mass=1e308, inertia=(1.0, 1.0, 1.0))
+    m.prescribe(base, rf.motion.polynomial([0.0, 0.0, 1.0]))
+    m.add_body("link", base, rf.Joint.revolute("y"), mass=1.0, inertia=(0.1, 0.1, 0.1), com=(0.0, 0.0, -1.0))
+    system = m.compile()
+    result = rf.simulate(system, 0.1, q0=[0.1], t_eval=[0.0, 0.05, 0.1])
+    with pytest.warns(RuntimeWarning, match=r"^result\.driving_forces: NaN or inf from t = 0 s on \(3 of 3 outputs"):
+        forces = result.driving_forces
+    assert not np.isfinite(forces).any()
+    with pytest.raises(rf.SimulationError, match="driving_forces\\(\\) overflowed"):
+        system.driving_forces(0.0, [0.1], [0.0])
+
+
+# -- the sea: finite spectra, values refused by name ------------------------------------------
+
+def test_jonswap_is_finite_where_it_was_nan_and_equals_the_formula_elsewhere():
+    w = np.array([1e-300, 1e-3, 0.3, 0.5, 0.698, 0.8, 1.5, 3.0])
+    hs, tp, gamma = 3.0, 9.0, 3.3
+    S = rf.sea.jonswap(w, hs, tp, gamma)
+    assert np.all(np.isfinite(S)) and S[0] == 0.0 and S[1] == 0.0  # ω ≪ ω_p: S → 0 (was NaN)
+    wp = 2 * np.pi / tp  # DNV-RP-C205 3.5.5, directly, where it does not underflow
+    sigma = np.where(w[2:] <= wp, 0.07, 0.09)
+    ref = ((1 - 0.287 * np.log(gamma)) * 5 / 16 * hs**2 * wp**4 * w[2:] ** -5 * np.exp(-1.25 * (w[2:] / wp) ** -4)
+           * gamma ** np.exp(-0.5 * ((w[2:] - wp) / (sigma * wp)) ** 2))
+    np.testing.assert_allclose(S[2:], ref, rtol=1e-12)
+    assert np.all(rf.sea.jonswap([0.5, 5.0], 2.0, 1e-300) == 0.0)  # T_p → 0: no energy at these ω (was NaN)
+
+
+@pytest.mark.parametrize("call, name", [
+    (lambda: rf.sea.jonswap(0.5, hs=1e300, tp=8.0), "hs, tp"),
+    (lambda: rf.sea.jonswap(2**1100, 2.0, 8.0), "omega"),
+    (lambda: rf.sea.jonswap("0.5", 2.0, 8.0), "omega"),
+    (lambda: rf.sea.jonswap(0.5 + 1j, 2.0, 8.0), "omega"),
+    (lambda: rf.sea.jonswap_waves(2.0, 8.0, n=2**1100), "n"),
+    (lambda: rf.Section.rectangle(1e300, 1.0), "width"),
+    (lambda: rf.Section.rectangle(1.0, 1e-300), "height"),
+    (lambda: rf.Section.circle(1e300), "d"),
+    (lambda: rf.Section.tube(1e300, 1e299), "d_out"),
+    (lambda: rf.Model().add_beam("b", "ground", 1.0, rf.Material(2e11, 7850.0), rf.Section.circle(0.01), 2,
+                                 deform=3), "deform"),
+])
+def test_overflowing_or_wrong_values_are_value_errors_naming_them(call, name):
+    """They were OverflowError (34, 'Numerical result out of range'), NaN spectra, numbers parsed from
+    strings, imaginary parts dropped, or TypeError from deep inside."""
+    with pytest.raises(ValueError, match=rf"^{re.escape(name)}: expected"):
+        call()
+
+
+def test_raos_pickle():
+    """RAO.table, RAO.oscillator and RAO.constant kept local lambdas: a sweep's processes could not take them."""
+    import pickle
+
+    w = np.linspace(0.0, 3.0, 7)
+    for rao in (rf.sea.RAO.table([0.1, 1.0, 2.0], [1.0, 2.0, 0.5], [0.0, 0.5, 1.0]), rf.sea.RAO.oscillator(8.0, 0.1),
+                rf.sea.RAO.constant(0.7, 0.2)):
+        back = pickle.loads(pickle.dumps(rao))
+        assert np.array_equal(back(w), rao(w)) and repr(back) == repr(rao)
+
+
+# -- wrong input accepted silently --------------------------------------------------------------
+
+@pytest.mark.parametrize("kwargs, name", [
+    ({"rtol": []}, "rtol"), ({"atol": []}, "atol"), ({"progress": "yes"}, "progress"), ({"progress": 1}, "progress"),
+])
+def test_simulate_refuses_what_it_read_by_truthiness_or_replaced_by_defaults(pendulum, kwargs, name):
+    _, _, system = pendulum
+    with pytest.raises(ValueError, match=rf"^{name}: expected"):
+        rf.simulate(system, 0.1, **kwargs)
+
+
+def test_builders_refuse_non_booleans_for_their_switches():
+    """follower="no" made a follower force; linear="no" the linear beam model."""
+    m = rf.Model()
+    body = m.add_body("b", m.ground, rf.Joint.revolute("z"), mass=1.0, inertia=(1.0, 1.0, 1.0))
+    with pytest.raises(ValueError, match=r"^follower: expected True or False, got 'no'"):
+        m.add_force(body, (1.0, 0.0, 0.0), follower="no")
+    with pytest.raises(ValueError, match=r"^follower: expected True or False, got 0"):
+        m.add_torque(body, (1.0, 0.0, 0.0), follower=0)
+    with pytest.raises(ValueError, match=r"^linear: expected True or False, got 'no'"):
+        m.add_beam("beam", body, 1.0, rf.Material(2e11, 7850.0), rf.Section.circle(0.01), 2, linear="no")
+    with pytest.raises(ValueError, match=r"^progress: expected True or False"):
+        rf.sweep(lambda x: x, grid={"x": [1]}, progress="yes")
+
+
+def test_scipy_methods_refuse_a_step_below_the_floor_at_once(pendulum):
+    """max_step = 1e-300, or steps that t no longer resolves (t0 = 1e15 s): the C++ methods refuse at once
+    (16 ε max(1, |t|)); scipy's ran a million steps (minutes) to max_steps."""
+    import time
+
+    _, _, system = pendulum
+    for method in ("dopri5", "scipy:RK45", "scipy:Radau"):
+        start = time.perf_counter()
+        with pytest.raises(rf.SimulationError, match=r"^at t = 0 s: the step size fell below the minimum"):
+            rf.simulate(system, 1.0, method=method, q0=[0.1], max_step=1e-300)
+        assert time.perf_counter() - start < 5.0  # at once, against the minutes of a million scipy steps
+    with pytest.raises(rf.SimulationError, match=r"^at t = 1e\+15 s: "):
+        rf.simulate(system, 1e15 + 100.0, method="scipy:LSODA", t0=1e15, q0=[0.1])
+
+
+def test_position_sensitivity_without_free_coordinates():
+    """nq = 0, a drive's number: numpy's zero-size reduction error before; dx/dc₁ of the arm's end at
+    angle c₁ t is t (−sin, cos, 0)."""
+    m = rf.Model(gravity=(0.0, 0.0, -9.81))
+    arm = m.add_body("arm", m.ground, rf.Joint.revolute("z"), mass=1.0, inertia=(0.1, 0.1, 0.1), com=(0.5, 0, 0))
+    m.prescribe(arm, rf.motion.polynomial([0.0, 0.3]))
+    system = m.compile()
+    assert system.nq == 0
+    name = "arm.rz.drive.coefficients[1]"
+    result = rf.simulate(system, 1.0, method="rk4", dt=0.1, sensitivities=[name])
+    dx = result.position_sensitivity(arm.point((1.0, 0.0, 0.0)), name)
+    t = result.t
+    np.testing.assert_allclose(dx, np.column_stack([-t * np.sin(0.3 * t), t * np.cos(0.3 * t), 0 * t]), atol=1e-8)

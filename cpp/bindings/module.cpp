@@ -156,6 +156,9 @@ void bind_profiles(py::module_& m) {
             const double t = real_arg(time, "t", "a finite time in s");
             if (!std::isfinite(t)) bad("t", "a finite time in s", num(t));
             const MotionState s = p.at(t);
+            if (!(std::isfinite(s.q) && std::isfinite(s.qd) && std::isfinite(s.qdd)))
+              throw SimulationError(t, "the profile " + p.describe() + " is not finite: (q, qd, qdd) = (" + num(s.q) +
+                                           ", " + num(s.qd) + ", " + num(s.qdd) + ") (it overflows at this time)");
             return py::make_tuple(s.q, s.qd, s.qdd);
           },
           py::arg("t"), "(q, qd, qdd) at time t (s).")

@@ -127,8 +127,9 @@ def gradient(system, t_end: float, parameters=None, *, outputs, running=None, te
     for name in ("adaptive", "error_on"):
         if given.get(name) is not None:
             raise ValueError(f"{name}: expected None: the adjoint runs at fixed steps dt, got {given[name]!r}")
-    opt = options_.compiled(method, {**given, "dt": dt, "adaptive": False})
-    _core._check_options(system, t0, t_end, q0, qd0, np.empty(0), opt)
+    given = {**given, "dt": dt, "adaptive": False}
+    opt = options_.compiled(method, given)  # what the method reads; every option given judged:
+    _core._check_options(system, t0, t_end, q0, qd0, np.empty(0), options_.compiled(method, given, every=True))
     if parameters is None:
         parameters = list(system.parameters)
     _probe(system, specs, names, running, terminal, t0, q0)  # a bad objective is named before any run

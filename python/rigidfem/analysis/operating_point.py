@@ -33,11 +33,11 @@ def _frame(t: float, what: str) -> str:
     return f"at t = {t} s: {what}"
 
 
-def _require_finite(t: float, what: str, **matrices) -> None:
+def _require_finite(t: float, what: str, cause: str = "forces, drives or their derivatives overflow at this time "
+                                                    "and configuration", **matrices) -> None:
     for name, a in matrices.items():
         if not np.all(np.isfinite(a)):
-            raise SimulationError(f"{_frame(t, what)}: {name} has NaN or inf entries (forces, drives or "
-                                  "their derivatives overflow at this time and configuration)")
+            raise SimulationError(f"{_frame(t, what)}: {name} has NaN or inf entries ({cause})")
 
 
 def _compiled(t: float, what: str, name: str, function, *args):

@@ -127,8 +127,14 @@ def linearize(system, q, qd=None, *, t: float = 0.0, inputs=(), outputs=None, dt
     _require_finite(t, "linearize", A=A, B=B, C=C)
     _warn_unless_equilibrium(system, q, qd, t, M)  # after the loops' check: q closes them
     D = np.zeros((C.shape[0], B.shape[1]))
-    ss = scipy.signal.StateSpace(A, B, C, D) if dt is None else \
-        scipy.signal.StateSpace(*scipy.signal.cont2discrete((A, B, C, D), dt, method="zoh")[:4], dt=dt)
+    if dt is None:
+        ss = scipy.signal.StateSpace(A, B, C, D)
+    else:
+        with np.errstate(over="ignore", invalid="ignore"):  # e^{A dt} overflowing is said below, by name
+            Ad, Bd, Cd, Dd = scipy.signal.cont2discrete((A, B, C, D), dt, method="zoh")[:4]
+        _require_finite(t, f"linearize (zero-order hold at dt = {dt:g} s)", "e^(A dt) overflows: dt is too long "
+                        "for the model's growing or fastest modes", A=Ad, B=Bd)
+        ss = scipy.signal.StateSpace(Ad, Bd, Cd, Dd, dt=dt)
     ss.state_names, ss.input_names, ss.output_names = states, in_names, out_names
     ss.y0, ss.basis, ss.q, ss.qd, ss.t = y0, N, q, qd, t
     return ss

@@ -137,11 +137,13 @@ def per_coordinate(x, n: int, name: str, *, nonnegative: bool = False) -> list[f
 def integer(x, name: str, *, minimum: int | None = None, maximum: int | None = None) -> int:
     """``x`` as an int (an integral real number by the bindings' rule, not a bool) within [minimum, maximum]."""
     v = _core._real(x, name, "an integer")
+    within = (f" in [{minimum}, {maximum}]" if minimum is not None and maximum is not None else
+              f" >= {minimum}" if minimum is not None else f" <= {maximum}" if maximum is not None else "")
     if not math.isfinite(v) or v != int(v):
-        raise ValueError(f"{name}: expected an integer, got {x!r}")
+        raise ValueError(f"{name}: expected an integer{within}, got {_short(x)}")
     v = int(x) if isinstance(x, (int, np.integer)) else int(v)
     if (minimum is not None and v < minimum) or (maximum is not None and v > maximum):
-        raise ValueError(f"{name}: expected an integer in [{minimum}, {maximum}], got {v}")
+        raise ValueError(f"{name}: expected an integer{within}, got {v}")
     return v
 
 

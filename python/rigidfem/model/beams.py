@@ -408,6 +408,7 @@ def add_beam(
     of varying free length (the equations: ``cpp/include/rigidfem/flows.hpp``): built at L(0), its sde joints get a prescribed
     "x" coordinate first that spreads the rfes over L(t)."""
     flow = None
+    linear = _checks.boolean(linear, "linear")
     if isinstance(length, _core.Profile):
         flow, length = length, _flow_length(length, material, section, deform, formulation, linear, tip_mass)
     L = _checks.scalar(length, "length", positive=True)
@@ -417,7 +418,7 @@ def add_beam(
     if formulation not in ("classical", "modified"):
         raise ValueError(f"formulation: expected 'classical' or 'modified', got {formulation!r}")
     allowed = MODIFIED_DEFORMATIONS if formulation == "modified" else tuple(DEFORMATIONS)
-    deform = allowed if deform is None else ((deform,) if isinstance(deform, str) else tuple(deform))
+    deform = allowed if deform is None else _deform_names(deform)
     for d in deform:
         if d not in allowed:
             raise ValueError(f"deform: expected deformations from {allowed} for the {formulation} formulation, "
@@ -529,6 +530,16 @@ def _add_arms(model, sdes, coordinates, stiffness, prony, E) -> None:
                                 list(E_j / E * c[body, slot]), [tau] * len(body))
 
 
+def _deform_names(deform) -> tuple[str, ...]:
+    """``deform`` as a tuple of deformation names: one name, or a sequence of them."""
+    if isinstance(deform, str):
+        return (deform,)
+    if not isinstance(deform, (list, tuple, np.ndarray)) or not all(isinstance(d, str) for d in deform):
+        raise ValueError(f"deform: expected None, a deformation name or a sequence of them (from "
+                         f"{tuple(DEFORMATIONS)}), got {_checks._short(deform)}")
+    return tuple(deform)
+
+
 def _flow_length(profile, material, section, deform, formulation, linear, tip_mass) -> float:
     """L(0) of a link of varying length, refusing what it does not support (yet)."""
     L0 = profile(0.0)[0]
@@ -540,7 +551,7 @@ def _flow_length(profile, material, section, deform, formulation, linear, tip_ma
     if linear:
         raise ValueError("linear: expected False for a beam of varying length (the linear model is not supported), "
                          "got True")
-    if deform is not None and "axial" in ((deform,) if isinstance(deform, str) else tuple(deform)):
+    if deform is not None and "axial" in _deform_names(deform):
         raise ValueError("deform: expected deformations without 'axial' for a beam of varying length (its sde "
                          "joints' x coordinate spreads the rfes over L(t)), got 'axial'")
     if _checks.scalar(tip_mass, "tip_mass", nonnegative=True) > 0.0:

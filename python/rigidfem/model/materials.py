@@ -116,6 +116,19 @@ def _prony_terms(prony) -> tuple:
                   _checks.scalar(tau, "prony", positive=True, unit="s (relaxation time tau_j)")) for E, tau in terms)
 
 
+#: The sizes (m) a section's dimensions may take: their fourth powers (I, J) finite and positive.
+DIMENSIONS = (1e-50, 1e50)
+
+
+def _dimension(x, name: str) -> float:
+    """A section's dimension (m) within ``DIMENSIONS``, so that A, I and J are finite and positive."""
+    v = _checks.scalar(x, name, positive=True, unit="m")
+    if not DIMENSIONS[0] <= v <= DIMENSIONS[1]:
+        raise ValueError(f"{name}: expected a length in [{DIMENSIONS[0]:g}, {DIMENSIONS[1]:g}] m (its fourth power, "
+                         f"the section's I and J, finite and positive), got {v:g}")
+    return v
+
+
 @dataclass(frozen=True)
 class Section:
     """A beam cross-section in its principal axes y, z (the beam axis is x).
@@ -160,8 +173,7 @@ class Section:
         rectangle with sides a ≥ b: J = (a b³/3) [1 − (192 b/(π⁵ a)) Σ_{n odd} tanh(nπa/2b)/n⁵];
         κ = 5/6.
         """
-        w = _checks.scalar(width, "width", positive=True)
-        h = _checks.scalar(height, "height", positive=True)
+        w, h = _dimension(width, "width"), _dimension(height, "height")
         a, b = max(w, h), min(w, h)
         series = sum(math.tanh(n * math.pi * a / (2 * b)) / n**5 for n in range(1, 200, 2))
         J = a * b**3 / 3 * (1 - 192 * b / (math.pi**5 * a) * series)
@@ -170,15 +182,15 @@ class Section:
     @staticmethod
     def circle(d: float) -> Section:
         """Solid circle of diameter ``d`` (m): I = π d⁴/64, J = π d⁴/32, κ = 9/10."""
-        d = _checks.scalar(d, "d", positive=True)
+        d = _dimension(d, "d")
         I = math.pi * d**4 / 64
         return Section(A=math.pi * d**2 / 4, Iy=I, Iz=I, J=2 * I, kappa_y=0.9, kappa_z=0.9)
 
     @staticmethod
     def tube(d_out: float, d_in: float) -> Section:
         """Circular tube (m): I = π (D⁴ − d⁴)/64, J = 2 I, κ = 1/2 (thin-walled)."""
-        D = _checks.scalar(d_out, "d_out", positive=True)
-        d = _checks.scalar(d_in, "d_in", nonnegative=True)
+        D = _dimension(d_out, "d_out")
+        d = _checks.scalar(d_in, "d_in", nonnegative=True, unit="m")  # below d_out: its d⁴ is finite
         if not d < D:
             raise ValueError(f"d_in: expected less than d_out = {D}, got {d}")
         I = math.pi * (D**4 - d**4) / 64

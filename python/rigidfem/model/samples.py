@@ -8,6 +8,7 @@ the middle, inertia m l²/12 about the transverse axes and a small axial one.
 
 from __future__ import annotations
 
+from ..base import _checks
 from .joints import Joint
 from .materials import Material, Section
 from .model import Model, transform
@@ -50,7 +51,7 @@ def double_pendulum(
     ``tip``.
     """
     (l1, l2), (m1, m2) = lengths, masses
-    joint = Joint.spherical if spatial else (lambda: Joint.revolute("y"))
+    joint = Joint.spherical if _checks.boolean(spatial, "spatial") else (lambda: Joint.revolute("y"))
     model = Model(gravity=(0.0, 0.0, -gravity))
     link1 = model.add_body(
         "link1", model.ground, joint(), mass=m1, com=(0, 0, -l1 / 2), inertia=rod_inertia(m1, l1)

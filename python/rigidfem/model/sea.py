@@ -18,6 +18,7 @@ Conventions (SI; angles in rad):
 
 from __future__ import annotations
 
+import functools
 from collections.abc import Callable
 from dataclasses import dataclass
 
@@ -29,13 +30,12 @@ from .._core import Profile
 from .model import BASE_DOFS
 
 GAMMA_RANGE = (1.0, 7.0)  # peak enhancement factors for which DNV-RP-C205's A_γ holds
+MAX_COMPONENTS = 1_000_000  # the most components of jonswap_waves (n)
 
 
 def _finite(x, name: str) -> np.ndarray:
-    try:
-        a = np.asarray(x, dtype=float)
-    except (TypeError, ValueError):
-        raise ValueError(f"{name}: expected numbers in rad/s, got {x!r}") from None
+    """``x`` as finite real frequencies (rad/s) by the bindings' rule: strings and complex numbers refused."""
+    a = _checks._floats(x, name, "real numbers in rad/s")
     if not np.all(np.isfinite(a)):
         raise ValueError(f"{name}: expected finite values, got NaN or inf")
     return a
@@ -60,13 +60,22 @@ def jonswap(omega, hs: float, tp: float, gamma: float = 3.3) -> np.ndarray:
     """
     w = _finite(omega, "omega")
     hs = _checks.scalar(hs, "hs", positive=True, unit="m")
-    wp = 2.0 * np.pi / _checks.scalar(tp, "tp", positive=True, unit="s")
+    tp = _checks.scalar(tp, "tp", positive=True, unit="s")
     g = _gamma(gamma)
     S = np.zeros_like(w)
     x = w[w > 0.0]
-    sigma = np.where(x <= wp, 0.07, 0.09)
-    pm = 5.0 / 16.0 * hs**2 * wp**4 * x**-5 * np.exp(-1.25 * (x / wp) ** -4)
-    S[w > 0.0] = (1.0 - 0.287 * np.log(g)) * pm * g ** np.exp(-0.5 * ((x - wp) / (sigma * wp)) ** 2)
+    # in logarithms, r = ln(ω/ω_p): ln S = ln(A_γ 5/16 H_s² ω_p⁻¹) − 5 r − (5/4) e^{−4r} + ln γ e^{−½((ω−ω_p)/(σω_p))²},
+    # so that neither a tiny ω (ω⁻⁵ e^{−(ω_p/ω)⁴} → 0) nor an extreme T_p overflows on the way
+    wp = 2.0 * np.pi / tp
+    r = np.log(x) - np.log(wp)
+    sigma = np.where(r <= 0.0, 0.07, 0.09)
+    with np.errstate(over="ignore"):  # e^{−4r} → inf for ω ≪ ω_p: S → 0, exactly the limit
+        log_s = (np.log((1.0 - 0.287 * np.log(g)) * 5.0 / 16.0) + 2.0 * np.log(hs) - np.log(wp) - 5.0 * r
+                 - 1.25 * np.exp(-4.0 * r) + np.log(g) * np.exp(-0.5 * (np.expm1(r) / sigma) ** 2))
+        S[w > 0.0] = np.exp(log_s)
+    if not np.all(np.isfinite(S)):
+        raise ValueError(f"hs, tp: expected a sea state whose spectrum is finite, got S(ω) overflowing for "
+                         f"hs = {hs:g} m, tp = {tp:g} s")
     return S
 
 
@@ -109,14 +118,14 @@ class RAO:
                 raise ValueError(f"{name}: expected {w.size} values (len(omega)), got {values.size}")
         if np.any(amp < 0.0):
             raise ValueError("amplitude: expected non-negative values |H|")
-        return cls(lambda x: np.interp(x, w, amp) * np.exp(1j * np.interp(x, w, arg)), f"table({w.size} points)")
+        return cls(functools.partial(_table, w, amp, arg), f"table({w.size} points)")
 
     @classmethod
     def constant(cls, amplitude: float, phase: float = 0.0) -> RAO:
         """H(ω) = ``amplitude`` e^(i ``phase``) at every ω: the motion is the elevation scaled
         (amplitude 1, phase 0 for heave: a small buoy riding the waves)."""
         H = _checks.scalar(amplitude, "amplitude", nonnegative=True) * np.exp(1j * _checks.scalar(phase, "phase"))
-        return cls(lambda x: np.full(np.shape(x), H), f"constant({H:.6g})")
+        return cls(functools.partial(_constant, H), f"constant({H:.6g})")
 
     @classmethod
     def oscillator(cls, period: float, damping_ratio: float) -> RAO:
@@ -125,8 +134,23 @@ class RAO:
         its hydrostatic stiffness times η, a fair model for wavelengths long against the body)."""
         wn = 2.0 * np.pi / _checks.scalar(period, "period", positive=True, unit="s")
         zeta = _checks.scalar(damping_ratio, "damping_ratio", positive=True)
-        return cls(lambda x: 1.0 / (1.0 - (x / wn) ** 2 + 2j * zeta * x / wn),
+        return cls(functools.partial(_oscillator, wn, zeta),
                    f"oscillator(period={2 * np.pi / wn:.6g} s, damping_ratio={zeta:.6g})")
+
+
+# The RAOs' functions, at module level so that an RAO pickles (a sweep's processes, a saved scene).
+def _table(w, amplitude, phase, x):
+    """|H| and arg H interpolated linearly in ω, held at the ends."""
+    return np.interp(x, w, amplitude) * np.exp(1j * np.interp(x, w, phase))
+
+
+def _constant(H, x):
+    return np.full(np.shape(x), H)
+
+
+def _oscillator(wn, zeta, x):
+    """H = 1/(1 − r² + 2iζr), r = ω/ω_n."""
+    return 1.0 / (1.0 - (x / wn) ** 2 + 2j * zeta * x / wn)
 
 
 def _as_rao(rao, name: str) -> RAO:
@@ -200,8 +224,9 @@ def jonswap_waves(hs: float, tp: float, gamma: float = 3.3, n: int = 200, omega_
     2π/Δω: raise ``n`` for longer simulations.
     """
     wp = 2.0 * np.pi / _checks.scalar(tp, "tp", positive=True, unit="s")
-    if isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer)) or n < 1:
+    if isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer)):
         raise ValueError(f"n: expected a positive number of components, got {n!r}")
+    n = _checks.integer(n, "n", minimum=1, maximum=MAX_COMPONENTS)
     lo, hi = (0.5 * wp, 5.0 * wp) if omega_range is None else _omega_range(omega_range)
     dw = (hi - lo) / n
     w = lo + (np.arange(n) + 0.5) * dw

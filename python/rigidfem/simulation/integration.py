@@ -191,8 +191,9 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
         raise ValueError(f"method: expected one of {list(options_.SCIPY)}, got {method!r}")
     # the C++ options, each converted by the bindings (ValueError naming it); scipy: methods check the C++ ones too
     # (they use only first_step of them), so that a bad option is named whatever the method
-    opt = options_.compiled("dopri5" if scipy else method, o)
-    opt.rtol, opt.atol = rtol, atol
+    opt = options_.compiled("dopri5" if scipy else method, o)  # what the method reads; the others at their defaults
+    judged = options_.compiled("dopri5" if scipy else method, o, every=True)  # every option given: their values
+    opt.rtol, opt.atol = judged.rtol, judged.atol = rtol, atol
     row = options_.method(method)
     fixed = adaptive is False or (not row.adaptive and adaptive is not True)
     if error_on is not None and (scipy or fixed) and not (isinstance(error_on, str) and error_on == "state"):
@@ -204,13 +205,14 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
         raise ValueError(f"stop: expected None or a threading.Event (an object with is_set()), got {stop!r}")
     nz = system.nz
     s0 = np.zeros(nz) if s0 is None else _checks.reals(s0, (nz,), "s0")
-    if scipy:
-        opt.adaptive = -1  # SciPy's solvers are adaptive whatever it says (its type is checked)
     if method == "auto" and adaptive is False:
         raise ValueError("adaptive: expected None or True with method 'auto' (it controls its steps), got False")
-    opt.s0 = s0
-    opt.set_error_on(outputs)
-    _core._check_options(system, t0, t_end, q0, qd0, t_eval, opt)  # the values, once (the sensitivities': integrate)
+    for x in (opt, judged):
+        if scipy:
+            x.adaptive = -1  # SciPy's solvers are adaptive whatever it says (its type is checked)
+        x.s0 = s0
+        x.set_error_on(outputs)
+    _core._check_options(system, t0, t_end, q0, qd0, t_eval, judged)  # the values, once (the sensitivities': integrate)
     names = sensitivities_.directions(system, sensitivities, opt, t0, t_end)
     if names and scipy:  # the options are checked first: a bad one is named whatever the method
         raise ValueError(f"method: expected a C++ method that integrates sensitivities (dopri5, rk4, generalized_alpha, "
@@ -225,7 +227,7 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
         raise ValueError(f"method: expected a C++ method for a system with Maxwell arms ({nz} arm forces as internal "
                          f"variables), got {method!r}; use 'auto', 'esdirk43', 'generalized_alpha' or 'dopri5'")
     max_steps, max_step = opt.get("max_steps"), opt.get("max_step")
-    bar = ProgressBar(t_end - t0, "s", "simulate") if progress else None
+    bar = ProgressBar(t_end - t0, "s", "simulate") if _checks.boolean(progress, "progress") else None
     try:
         if dt is not None and adaptive is None and first_step is None and row.adaptive and not scipy:
             warnings.warn(f"dt: {method!r} is adaptive: dt = {opt.dt:g} s only sets its first step; give "
@@ -345,6 +347,6 @@ def _tolerance(x, name, n, default) -> np.ndarray:
     tol = np.atleast_1d(_checks._floats(x, name, expected))  # real numbers (not complex, not strings)
     if tol.ndim != 1:
         raise ValueError(f"{name}: expected {expected}, got shape {tol.shape}")
-    return np.array([default]) if tol.size == 0 else tol  # the values: _core._check_options
+    return np.array([default]) if tol.size == 0 and n == 0 else tol  # the values: _core._check_options
 
 

@@ -120,18 +120,19 @@ def resolve(options: dict) -> dict:
     return {name: options.get(name, o.default) for name, o in _BY_NAME.items()}
 
 
-def compiled(method: str, options: dict) -> _core.IntegratorOptions:
+def compiled(method: str, options: dict, every: bool = False) -> _core.IntegratorOptions:
     """The C++ options of ``method`` with ``options`` ({name: value}) set, each converted by the bindings' rule
     (ValueError naming it); error_on, rtol and atol are left to the caller (they depend on the system). An option
-    the method does not read (the method table's) is converted, so that a bad one is named whatever the method,
-    and left at its default: rk4 given ``first_step`` or ``max_step`` steps at dt as without them. ``adaptive`` is a
-    request, always passed on: a method without an error estimate refuses True (``check_options``)."""
+    the method does not read (the method table's) is converted and left at its default: rk4 given ``first_step``
+    or ``max_step`` steps at dt as without them. ``every``: all of them set, for ``check_options`` to judge their
+    values (a bad one is named whatever the method). ``adaptive`` is a request, always passed on: a method
+    without an error estimate refuses True (``check_options``)."""
     opt = _core.IntegratorOptions()
     opt.method = method
     reads = _METHODS[method].options if method in _METHODS else ()
     for name, value in options.items():
         if name not in ("error_on", "rtol", "atol"):
-            (opt if name in reads or name == "adaptive" else _core.IntegratorOptions()).set(name, value)
+            (opt if every or name in reads or name == "adaptive" else _core.IntegratorOptions()).set(name, value)
     return opt
 
 

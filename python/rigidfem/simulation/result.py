@@ -5,6 +5,7 @@ from __future__ import annotations
 
 import dataclasses
 import functools
+import warnings
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -16,6 +17,11 @@ from . import options as options_
 from ..model import parameters as parameters_
 from ..base.persistence import Versioned
 from .._core import Body, Point
+
+
+#: The outputs ``_core._evaluate_outputs`` computes, in its order (Result's properties).
+OUTPUTS = ("qdd", "driving_forces", "kinetic_energy", "gravity_energy", "elastic_energy", "dissipated_power",
+           "loop_reactions", "element_forces")
 
 
 @dataclass
@@ -66,7 +72,13 @@ class Result(Versioned):
         _checks.result(self, "result", needs="qdd, energies, driving and element forces and loop reactions")
         nl = self.system.nl
         own = np.zeros((0, nl)) if self.multipliers is None else np.ascontiguousarray(self.multipliers, dtype=float)
-        return _core._evaluate_outputs(self.system, self.t, self.q, self.qd, self.arm_forces, own)
+        outputs = _core._evaluate_outputs(self.system, self.t, self.q, self.qd, self.arm_forces, own)
+        for name, values in zip(OUTPUTS, outputs):  # kept, but not without a word
+            rows = ~np.isfinite(values).reshape(len(self.t), -1).all(axis=1)
+            if rows.any():
+                warnings.warn(f"result.{name}: NaN or inf from t = {self.t[np.argmax(rows)]:g} s on ({rows.sum()} of "
+                              f"{len(self.t)} outputs; they overflow at these states)", RuntimeWarning, stacklevel=4)
+        return outputs
 
     @property
     def qdd(self) -> np.ndarray:

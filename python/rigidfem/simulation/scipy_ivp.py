@@ -72,10 +72,19 @@ def _run_scipy(system, name, t0, t_end, q0, qd0, t_eval, rtol, atol, max_step, m
                 if steps >= max_steps:
                     failure = _failure(solver.t, f"max_steps = {max_steps} reached (scipy {name})")
                     break
+                if min(max_step, t_end - solver.t) < _smallest_step(solver.t):  # the C++ methods' floor
+                    failure = _failure(solver.t, f"the step size fell below the minimum (max_step = {max_step:g} s "
+                                                 f"against {_smallest_step(solver.t):g} s at this time; scipy {name})")
+                    break
                 t_before = solver.t
                 message = solver.step()
                 if solver.status == "failed":
                     failure = _failure(solver.t, f"scipy {name} failed: {message}")
+                    break
+                if solver.status == "running" and solver.t - t_before < _smallest_step(t_before):
+                    failure = _failure(solver.t, f"the step size fell below the minimum: the problem is too stiff or "
+                                                 f"singular for this method (step size {solver.t - t_before:g} s; "
+                                                 f"scipy {name})")
                     break
                 steps += 1
                 dense = solver.dense_output() if len(t_eval) else None
@@ -129,3 +138,8 @@ def _failure(t, cause):
     """(message, time, cause) of a failed run, as _core._integrate reports it."""
     return f"at t = {t:.10g} s: {cause}", float(t), cause
 
+
+def _smallest_step(t: float) -> float:
+    """The smallest step (s) a run takes at time t, as the C++ methods: 16 ε max(1, |t|), below which t + h
+    no longer resolves the step (a step of 1e-300 s, or of less than 3.5 s at t = 1e15 s)."""
+    return 16.0 * np.finfo(float).eps * max(1.0, abs(t))

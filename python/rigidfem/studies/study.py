@@ -30,7 +30,7 @@ from ..base.persistence import Versioned
 from ..model.materials import Material, Section
 from ..model.model import Model
 from ..simulation.integration import simulate
-from ..simulation.result import finished
+from ..simulation.result import finished as _finished
 
 
 @dataclass
@@ -231,7 +231,7 @@ def _scene(scene) -> None:
 def reference(scene: Scene, rtol: float = 1e-10):
     """The scene solved tightly by Dormand–Prince; returns the Result."""
     _scene(scene)
-    return finished(simulate(scene.system, scene.t_end, method="dopri5", rtol=rtol, atol=rtol * 1e-2,
+    return _finished(simulate(scene.system, scene.t_end, method="dopri5", rtol=rtol, atol=rtol * 1e-2,
                              t_eval=scene.t_eval, q0=scene.q0, qd0=scene.qd0, max_steps=10**8, stiffness_warning=False),
                     "reference")
 
@@ -260,7 +260,7 @@ def work_precision(scene: Scene, methods, repeats: int = 3, ref=None, max_steps:
 
     _scene(scene)
     ref = reference(scene) if ref is None else _checks.result(ref, "ref", needs="the reference's tip")
-    repeats = _checks.integer(repeats, "repeats", minimum=1)
+    repeats = _checks.integer(repeats, "repeats", minimum=0)
     tip_ref = _observe(scene, ref)
     rows = []
     for entry in methods:
@@ -276,7 +276,7 @@ def work_precision(scene: Scene, methods, repeats: int = 3, ref=None, max_steps:
             try:
                 times = []
                 for k in range(repeats + 1):
-                    r = finished(simulate(scene.system, scene.t_end, method=method, t_eval=scene.t_eval,
+                    r = _finished(simulate(scene.system, scene.t_end, method=method, t_eval=scene.t_eval,
                                           q0=scene.q0, qd0=scene.qd0, **kw), f"work_precision ({method})")
                     if k > 0 or repeats == 0:
                         times.append(r.stats["wall_time"])
@@ -338,6 +338,7 @@ def discretisation_error(elements=(5, 10, 20, 40, 80), modes: int = 3) -> Table:
 
 def standard_methods(quick: bool = False):
     """The integrators and settings of the benchmark."""
+    quick = _checks.boolean(quick, "quick")
     r = [1e-4, 1e-6, 1e-8] if quick else [1e-3, 1e-4, 1e-5, 1e-6, 1e-7, 1e-8, 1e-9]
     loose = [1e-1, 1e-2] if quick else [1e-1, 3e-2, 1e-2]
     return [("auto", "rtol", loose + r), ("esdirk43", "rtol", loose + r[:-2]), ("radau5", "rtol", loose + r[:-2]),
@@ -358,6 +359,7 @@ def bench(output_dir="bench", quick: bool = False) -> Table:
     import matplotlib.pyplot as plt
 
     out = Path(output_dir)
+    quick = _checks.boolean(quick, "quick")
     m = 6 if quick else 10
     todo = [
         (scenes.cantilever("modified", m), standard_methods(quick) + [
