@@ -339,3 +339,20 @@ def test_position_sensitivity_without_free_coordinates():
     dx = result.position_sensitivity(arm.point((1.0, 0.0, 0.0)), name)
     t = result.t
     np.testing.assert_allclose(dx, np.column_stack([-t * np.sin(0.3 * t), t * np.cos(0.3 * t), 0 * t]), atol=1e-8)
+
+
+def test_simulate_refuses_output_times_whose_states_cannot_fit_before_running(pendulum, monkeypatch):
+    """len(t_eval) states of 2 nq (+ nz + 2 nq per sensitivity) doubles against the machine's memory (here
+    pretended 4 MB): refused before the run rather than failing after it."""
+    from rigidfem.simulation import integration
+
+    _, _, system = pendulum
+    sizes = {"SC_PAGE_SIZE": 4096, "SC_PHYS_PAGES": 1000}
+    monkeypatch.setattr(integration.os, "sysconf", lambda name: sizes[name])
+    t = np.linspace(0.0, 1.0, 300_000)  # 300,000 × 2 doubles = 4.8 MB
+    with pytest.raises(ValueError, match=r"^t_eval: expected at most 256,000 output times \(their states, 2 numbers "
+                                         r"each, within the machine's 0.0041 GB\), got 300,000"):
+        rf.simulate(system, 1.0, t_eval=t)
+    with pytest.raises(ValueError, match=r"^t_eval: expected at most 128,000 output times \(their states, 4 numbers"):
+        rf.simulate(system, 1.0, t_eval=t[:200_000], sensitivities=["link.mass"])
+    assert len(rf.simulate(system, 1.0, t_eval=t[:1000]).t) == 1000

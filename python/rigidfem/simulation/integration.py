@@ -44,6 +44,7 @@ with its own G_i) and projects likewise.
 
 from __future__ import annotations
 
+import os
 import warnings
 
 import numpy as np
@@ -217,6 +218,7 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
     if names and scipy:  # the options are checked first: a bad one is named whatever the method
         raise ValueError(f"method: expected a C++ method that integrates sensitivities (dopri5, rk4, generalized_alpha, "
                          f"...), got {method!r}")
+    _check_output_memory(len(t_eval), 2 * n * (1 + len(names)) + nz)
     _check_closed(system, t0, q0, qd0)
     if system.nl and scipy:
         raise ValueError(f"method: expected a C++ method for a system with loop closures ({system.nl} constraint rows), "
@@ -338,6 +340,20 @@ def _keep_going(bar, stop, t0):
         return (stop is None or not stop.is_set()) and (swept is None or not swept.is_set())
 
     return keep_going
+
+
+def _check_output_memory(outputs: int, numbers: int) -> None:
+    """ValueError naming t_eval when its outputs' states (``numbers`` doubles each: q, q̇, the arms' forces, the
+    sensitivities) would not fit in the machine's memory: refused before the run rather than after it."""
+    try:
+        memory = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (AttributeError, ValueError, OSError):  # no sysconf (Windows): the run finds out itself
+        return
+    need = 8.0 * outputs * numbers
+    if need > memory:
+        raise ValueError(f"t_eval: expected at most {int(memory // (8 * max(numbers, 1))):,} output times (their "
+                         f"states, {numbers} numbers each, within the machine's {memory / 1e9:.3g} GB), got {outputs:,} "
+                         f"({need / 1e9:.3g} GB)")
 
 
 def _tolerance(x, name, n, default) -> np.ndarray:
