@@ -147,3 +147,13 @@ def test_an_error_estimate_answers_ctrl_c_with_keyboard_interrupt():
     outcome, late = interrupted_after(0.3, caught(run))
     assert isinstance(outcome, KeyboardInterrupt) and late < ANSWER
     assert str(outcome).startswith("error_estimate (its second run): interrupted at t = ")
+
+
+def test_a_results_outputs_answer_ctrl_c(beam3000):
+    """The loop over a result's times in C++ (its energies and forces: a forward dynamics per output, 3000
+    outputs of 3000 coordinates: 6.4 s measured) looks at Ctrl-C: KeyboardInterrupt at once."""
+    t = np.linspace(0.0, 1.0, 3000)
+    Q = np.zeros((len(t), beam3000.nq))
+    result = rf.Result(beam3000, t, Q, Q, {}, "none")
+    outcome, late = interrupted_after(0.2, lambda: result.energy)
+    assert outcome is KeyboardInterrupt and late < ANSWER
