@@ -58,9 +58,11 @@ def campaign(args) -> int:
                 print(f"  [{last - start:6.0f} s] {tally.cases} cases, {sum(r['calls'] for r in tally.rows.values())} "
                       f"calls, {len(tally.found)} distinct violations, {runner.restarts} worker restarts", flush=True)
         restarts = runner.restarts
+        package = runner.package
     wall = time.monotonic() - start
-    print(f"\n{tally.cases} cases in {wall:.0f} s ({tally.cases / max(wall, 1e-9):.1f} cases/s), "
-          f"{restarts} worker restarts\n")
+    calls = sum(r["calls"] for r in tally.rows.values())
+    print(f"\n{tally.cases} cases, {calls} calls in {wall:.0f} s ({tally.cases / max(wall, 1e-9):.1f} cases/s), "
+          f"{restarts} worker restarts; the workers imported rigidfem from {package}\n")
     if args.report:
         print(tally.table())
         print()

@@ -44,6 +44,20 @@ import time
 from collections import Counter, defaultdict, deque
 from pathlib import Path
 
+
+def _use_package() -> None:
+    """FUZZ_PACKAGE=/path/to/an/unpacked/wheel: import rigidfem from there, not from the editable install of this
+    tree (whose build may change while a campaign runs). Done on import, so that the parent (which reads the method
+    table), the workers and the processes of a sweep they start all use the same build."""
+    package = os.environ.get("FUZZ_PACKAGE")
+    if package and "rigidfem" not in sys.modules:
+        sys.meta_path[:] = [f for f in sys.meta_path if "editable" not in type(f).__module__.lower()]
+        if package not in sys.path:
+            sys.path.insert(0, package)
+
+
+_use_package()
+
 import rigidfem as rf
 
 HERE = Path(__file__).resolve().parent
@@ -90,7 +104,35 @@ FEATURES = (
     "joint_internals_types",  # add_coupling with a (3, 3) matrix
     "hugeint_vectors",     # q as a list of Python ints beyond int64 (10**30), or numpy bools
     "jacobians_q_size",    # force_jacobians with q of a wrong size (Lagrange systems do not check it)
+    # -- the newer entry points (issue 44's), each on random models and on small samples (Gen.entry_case)
+    "gradient",            # rf.gradient: hostile t_end, dt, memory, max_steps, parameters, outputs, objectives
+    "gradient_initial_names",  # ... parameters naming initial values of unknown coordinates ('q0[nope]')
+    "gradient_complex_objective",  # ... a terminal objective returning a complex number
+    "sensitivities",       # simulate(sensitivities=[...]), Result.sensitivity, Result.position_sensitivity
+    "sensitivity_name_types",  # Result.sensitivity / position_sensitivity given an unhashable name (a list)
+    "parameters",          # System.parameters, System.with_parameters: good, unknown and out-of-range values
+    "parameters_extreme",  # ... values of 1e300 and 1e-300 (finite, in range)
+    "resolve",             # rf.resolve on beam builders: hostile tol, elements, deform, outputs, output functions
+    "resolve_options",     # ... hostile simulate options and load_steps (its own arguments, passed to the runs)
+    "resolve_output_shape",  # ... an output function whose shape changes with the elements (or is empty)
+    "resolve_huge_t_end",  # ... t_end = 1e300 (must be refused at once, not run for max_steps)
+    "view",                # rf.view, Viewer.to_html, rf.animate: hostile frames, fps, q, t, height, trails
+    "view_trail_types",    # ... trails that are not sequences (3, None)
+    "path_types",          # to_html/to_npz/to_csv/load_npz given a path that is not one (None, 3)
+    "sweep",               # rf.sweep: executors, workers, errors, seeds, failing and unpicklable functions
+    "sweep_raise_pickling",  # ... errors='raise' with values that do not pickle or a process that dies
+    "sweep_as_frame_int",  # ... as_frame=1 or 0 (ints for a bool)
+    "sea",                 # rf.sea: jonswap, jonswap_waves, RAOs (table, constant, oscillator) called and pickled
+    "sea_overflow",        # ... amplitudes near the overflow (Waves of 1e300 m, an oscillator of zeta 1e-310)
+    "loaded_results",      # Result.to_npz, rf.load_npz with and without the system, every output of a loaded result
+    "npz_foreign_files",   # ... load_npz of a file that is not a saved Result (junk, another archive)
+    "system_takers",       # every public function taking a system given a Model, None or a string
+    "ground_handles",      # the ground (model.ground, a Body) as an output of rf.gradient
 )
+
+#: The features of the newer entry points' generators (Gen.entry_case draws cases on samples when one is on).
+ENTRY_FEATURES = ("gradient", "sensitivities", "parameters", "resolve", "view", "sweep", "sea", "loaded_results",
+                  "system_takers")
 
 #: Features whose generators hit known contract violations: the suite leaves them out (scripts/fuzz.py
 #: runs everything). Delete an entry once its fix is in, to put the generator back into the suite.
@@ -99,12 +141,56 @@ PENDING = {
     #    Material/Section strings, Point NaN offsets, prescribing twice, foreign handles, force laws
     #    returning non-numbers, statics/modal analysis of nq = 0 and their LinAlgErrors
     # -- found by this fuzzer (issue 10), not fixed yet
+    # -- found by the generators of the newer entry points (2026-11-28), not fixed yet
+    "gradient_initial_names": "rf.gradient(..., ['q0[nope]']) names 'sensitivities', not 'parameters'",
+    "parameters_extreme": "System.with_parameters of 1e300 for a beam's section values or density: ValueError "
+                          "'H: expected a finite pseudo-inertia ...' (H is no argument) for finite values in range",
+    "sensitivity_name_types": "Result.sensitivity / position_sensitivity of an unhashable name: TypeError",
+    "resolve_options": "rf.resolve reports a bad simulate option, load_steps, or a run's SimulationError as "
+                       "ResolveError 'build: the analysis ... failed: ...' (not naming the argument)",
+    "resolve_output_shape": "rf.resolve of an output whose shape changes with the elements: numpy's broadcast "
+                            "ValueError",
+    "resolve_huge_t_end": "rf.resolve(t_end=1e300) runs max_steps (tens of s) before a ResolveError 'build: ...'",
+    "view_trail_types": "rf.view / rf.animate with trails=3 or None: TypeError",
+    "path_types": "Viewer.to_html, Result.to_npz, rf.load_npz given None or 3 for the path: TypeError",
+    "sweep_raise_pickling": "rf.sweep(errors='raise', executor='processes'): a value that does not pickle is a "
+                            "TypeError, a process that dies a BrokenProcessPool",
+    "sweep_as_frame_int": "rf.sweep(as_frame=1 or 0) is taken as a bool (progress=1 is refused)",
+    "sea_overflow": "rf.sea: Waves of 1e300 m give m0 = hs = inf silently; an oscillator RAO of damping ratio "
+                    "1e-310, 1e300 or period 1e-300, 1e300 is refused when called ('rao: ... finite values'); "
+                    "jonswap_waves(hs=1e300, tp=1e-300) names 'amplitude'",
+    "npz_foreign_files": "rf.load_npz of a file that is not a saved Result: KeyError, numpy's pickle message",
+    "ground_handles": "the ground as an output of rf.gradient: 'point, frame: expected bodies of this system'",
+}
+
+#: How the violations of the PENDING groups of the newer entry points look: group -> (kind, function, detail) patterns
+#: (known_issue names the group of a violation that matches)
+PENDING_SIGNS = {
+    "gradient_initial_names": ("wrong_name", r"rf\.gradient", r"sensitivities: expected a free coordinate"),
+    "parameters_extreme": ("rejected_valid|wrong_name", r"with_parameters", r"^ValueError: H: "),
+    "sensitivity_name_types": ("type_error", r"sensitivity$", r"unhashable"),
+    "resolve_options": (r"wrong_name|rejected_valid|accepted_bad", r"rf\.resolve", r"build: the analysis|accepted"),
+    "resolve_output_shape": ("bad_message", r"rf\.resolve", r"operands could not be broadcast|zero-size array"),
+    "resolve_huge_t_end": ("slow|hang", r"rf\.resolve", r""),
+    "view_trail_types": ("type_error", r"rf\.(view|animate)", r"not iterable"),
+    "path_types": ("type_error", r"to_html|to_npz|to_csv|load_npz", r"expected str, bytes or os\.PathLike"),
+    "sweep_raise_pickling": ("type_error|other_exception", r"rf\.sweep", r"pickle|BrokenProcessPool"),
+    "sweep_as_frame_int": ("accepted_bad", r"rf\.sweep", r"as_frame"),
+    "sea_overflow": ("silent_nan|rejected_valid|wrong_result|wrong_name", r"sea|^w\d|^rao|pickle",
+                     r"NaN|rao|amplitude|hs, tp"),
+    "npz_foreign_files": ("other_exception|bad_message", r"rf\.load_npz", r"KeyError|pickled"),
+    "ground_handles": ("wrong_name|rejected_valid", r".", r"point, frame: expected bodies"),
 }
 
 #: Violations that no input group can leave out (they come from what a run does), known and not fixed
 #: yet: (name, kind, called function, pattern of the outcome). The suite tolerates them; delete an
 #: entry once fixed.
 PENDING_OUTCOMES: list = [
+    ("the sensitivities and the adjoint by a number of a piecewise drive (continuity 1): its difference p +- h is "
+     "refused by the pieces' continuity check, 'pieces: expected pieces 0 and 1 to meet ...' (or 'sensitivities: "
+     "expected a parameter whose profile takes values beside ...' from rf.gradient, whose argument is parameters)",
+     "rejected_valid|wrong_name", r"rf\.simulate|rf\.gradient",
+     r"pieces: expected pieces|sensitivities: expected a parameter whose profile takes values beside"),
     # (a scipy: run whose state overflowed ended in ValueError('y: ...') or scipy's own "array must not
     # contain infs or NaNs": fixed, a SimulationError at the last accepted time now)
 ]
@@ -115,15 +201,22 @@ PENDING_OUTCOMES: list = [
 # ------------------------------------------------------------------------------------------------
 
 PRELUDE = '''\
+import os
+import pickle
+import sys
+import tempfile
 import threading
 import numpy as np
+import matplotlib
+matplotlib.use("Agg")
 import rigidfem as rf
 
+sys.path.insert(0, @TESTS@)
+import fuzz_contract as fz  # the sweeps' functions (importable: a process pool pickles them) and LawError
+
 nan, inf = float("nan"), float("inf")
-
-
-class LawError(Exception):
-    """Raised on purpose by a force law or a drive: must reach the caller unchanged."""
+LawError = fz.LawError  # raised on purpose by a force law, a drive, an objective: must reach the caller unchanged
+TMP = fz.scratch()      # files written by the cases (to_html, to_npz, to_csv), deleted at exit
 
 
 def V(n, seed, scale=1.0):
@@ -207,7 +300,253 @@ def _foreign():
 
 foreign_model, fb, fbeam = _foreign()   # another model: its handles are foreign to `model`
 foreign_system = foreign_model.compile()
-'''
+
+
+# -- objectives of rf.gradient: L(t, y) -> (N + 1,), Phi(y) -> float (y: {name: (N + 1, 3) or (N + 1,)})
+def _sq(v):
+    v = np.asarray(v)
+    return np.sum(v * v, axis=-1) if v.ndim == 2 or (v.ndim == 1 and v.shape == (3,)) else v * v
+
+
+def run_sq(t, y):
+    return sum((_sq(v) for v in y.values()), 0.0 * t)
+
+
+def run_abs(t, y):  # not complex-differentiable: central differences
+    return sum((np.abs(np.asarray(v)).sum(axis=-1) if np.ndim(v) == 2 else np.abs(v) for v in y.values()), 0.0 * t)
+
+
+def run_huge(t, y):
+    return 1e300 + run_sq(t, y)
+
+
+def run_nan(t, y):
+    return np.full(len(t), nan)
+
+
+def run_late_nan(t, y):  # finite at the probe (one time), NaN on the run
+    return np.full(len(t), 1.0 if len(t) == 1 else nan)
+
+
+def run_late_inf(t, y):
+    return 1e308 * (1.0 + 1e6 * np.asarray(t))
+
+
+def run_str(t, y):
+    return "abc"
+
+
+def run_none(t, y):
+    return None
+
+
+def run_shape(t, y):
+    return np.zeros(3)
+
+
+def run_late_shape(t, y):
+    return np.zeros(1 if len(t) == 1 else len(t) + 1)
+
+
+def run_raises(t, y):
+    raise LawError("running")
+
+
+def term_sq(y):
+    return sum(float(np.sum(_sq(v))) for v in y.values())
+
+
+def term_sum(y):
+    return sum(np.sum(v) for v in y.values())
+
+
+def term_vec(y):
+    return [1.0, 2.0]
+
+
+def term_none(y):
+    return None
+
+
+def term_nan(y):
+    return nan
+
+
+def term_str(y):
+    return "abc"
+
+
+def term_complex(y):
+    return 1.0 + 1.0j
+
+
+# -- builders of rf.resolve: a soft strip clamped at the origin along x, gravity along -y
+def out_tip_y(beam):
+    def f(system, solution):
+        q = solution.q if hasattr(solution, "t") else solution.q[None, :]
+        t = solution.t if hasattr(solution, "t") else [0.0]
+        return np.array([system.position(beam.tip, tk, qk)[1] for tk, qk in zip(t, q)])
+    return f
+
+
+def out_one(system, solution):
+    return 1.0
+
+
+def out_nan(system, solution):
+    return nan
+
+
+def out_inf(system, solution):
+    return np.array([1.0, inf])
+
+
+def out_str(system, solution):
+    return "abc"
+
+
+def out_nq(system, solution):  # a shape that changes with the elements
+    return np.zeros(system.nq)
+
+
+def out_raises(system, solution):
+    raise LawError("output")
+
+
+def build_strip(elements, deform):
+    model, h = rf.samples.cantilever(elements, material=rf.Material(E=2e7, rho=1000.0),
+                                     section=rf.Section.rectangle(0.02, 0.01), deform=deform, gravity=(0.0, -9.81, 0.0))
+    b = h["beam"]
+    return model, {"tip": b.tip, "mid": b.point(0.5), "root": b.rfes[0], "tip_y": out_tip_y(b), "one": out_one,
+                   "nan": out_nan, "inf": out_inf, "str": out_str, "nq": out_nq, "raises": out_raises}
+
+
+def build_compiled(elements, deform):  # a System instead of a Model, and simulate options
+    model, handles = build_strip(elements, deform)
+    return model.compile(), handles, {"max_steps": 100000}
+
+
+def build_fixed(elements, deform):  # does not pass elements on: its coordinates do not grow
+    return build_strip(2, deform)
+
+
+def build_none(elements, deform):
+    return None
+
+
+def build_raises(elements, deform):
+    raise LawError("build")
+'''.replace("@TESTS@", repr(str(HERE)))
+
+
+class LawError(Exception):
+    """Raised on purpose by a force law, a drive, an objective, a sweep's function: must reach the caller
+    unchanged (the cases' prelude takes this class, so that a sweep's processes pickle it)."""
+
+
+_SCRATCH: list = []
+
+
+def scratch() -> str:
+    """A folder for the files a worker's cases write, deleted when the worker exits."""
+    if not _SCRATCH:
+        import atexit
+        import shutil
+        import tempfile
+
+        _SCRATCH.append(tempfile.mkdtemp(prefix="rigidfem-fuzz-"))
+        atexit.register(shutil.rmtree, _SCRATCH[0], True)
+    return _SCRATCH[0]
+
+
+def junk_file() -> str:
+    """A file that is not a NumPy archive."""
+    path = os.path.join(scratch(), "junk.npz")
+    with open(path, "w") as f:
+        f.write("not an archive")
+    return path
+
+
+def other_npz() -> str:
+    """A NumPy archive that is not a saved Result."""
+    import numpy as np
+
+    path = os.path.join(scratch(), "other.npz")
+    np.savez(path, a=np.arange(3.0))
+    return path
+
+
+# -- the functions of rf.sweep: at module level, so that a process pool pickles them
+
+
+def sweep_square(x):
+    return {"y": x * x}
+
+
+def sweep_seeded(x, seed):
+    import numpy as np
+
+    return {"y": x + float(np.random.default_rng(seed).uniform())}
+
+
+def sweep_raises(x):
+    raise LawError("sweep")
+
+
+def sweep_unpicklable(x):
+    return {"lock": threading.Lock()}
+
+
+def sweep_nan(x):
+    return float("nan")
+
+
+def sweep_kwargs(**kw):
+    return dict(kw)
+
+
+def sweep_dies(x):
+    os._exit(3)  # a process pool's worker that dies (BrokenProcessPool): only drawn with executor='processes'
+
+
+def sweep_simulate(omega):
+    model, h = rf.samples.pendulum()
+    r = rf.simulate(model.compile(), 0.02, method="rk4", dt=1e-3, q0=[omega])
+    return {"tip_x": float(r.position(h["tip"])[-1, 0])}
+
+
+def sweep_rows(table, n: int, failing: str) -> bool:
+    """Whether a sweep's table has its n rows (none lost) and an error in none, all or some of them."""
+    rows = table.to_dict("records") if hasattr(table, "to_dict") else list(table.rows)
+    if len(rows) != n:
+        return False
+    errors = [r.get("error") is not None and r.get("error") == r.get("error") for r in rows]  # None or NaN: no error
+    return {"none": not any(errors), "all": all(errors), "some": True}[failing]
+
+
+# -- RAOs from functions (module level: they pickle)
+
+
+def rao_first_order(w):
+    import numpy as np
+
+    return 1.0 / (1.0 + 1j * np.asarray(w))
+
+
+def rao_string(w):
+    return "abc"
+
+
+def rao_nan(w):
+    import numpy as np
+
+    return np.full(np.shape(w), np.nan) + 0j
+
+
+def rao_shape(w):
+    import numpy as np
+
+    return np.zeros(np.size(w) + 1, dtype=complex)
 
 GOOD_LAWS = ("law_spring",)
 BAD_LAWS = ("law_nan", "law_string", "law_none", "law_vector")
@@ -258,7 +597,12 @@ def _identifiers(step: dict) -> set:
     beam0), except the one it defines."""
     text = step["fn"] + " " + " ".join(a["e"] for a in step.get("args", [])) + " " + \
         " ".join(a["e"] for a in step.get("kw", {}).values())
-    return set(_IDENT.findall(text)) - {step.get("out")}
+    return set(_IDENT.findall(text)) - set(_outs(step))
+
+
+def _outs(step: dict) -> list:
+    """The variables a step binds: its "out", which may name several ("model, h" unpacks a pair)."""
+    return [v.strip() for v in step["out"].split(",")] if step.get("out") else []
 
 
 # ------------------------------------------------------------------------------------------------
@@ -267,15 +611,18 @@ def _identifiers(step: dict) -> set:
 
 #: "name: expected ...", "beta, gamma: expected ...", "inertia of body 'b0': expected ...": the message
 #: starts with the argument's name(s) and a colon.
-VALUE_MESSAGE = re.compile(r"^([A-Za-z_][\w.]*(?:, ?[A-Za-z_][\w.]*)*)(?: of [^:]*)?: \S")
+VALUE_MESSAGE = re.compile(r"^([A-Za-z_][\w.]*(?:\[[^\]]*\])?(?:, ?[A-Za-z_][\w.]*(?:\[[^\]]*\])?)*)(?: of [^:]*)?: \S")
 TIME_IN_MESSAGE = re.compile(r"\bt = [-+]?(?:\d|inf|nan)")
 VECTOR_ROLES = {"q": 1, "qd": 1, "qdd": 1, "q0": 1, "qd0": 1, "y": 2}
 OPTIONAL_ROLES = {"q0", "qd0"}  # None is the default (zeros): simulate's q0, qd0; statics' q0; modal's q, qd
-RUNTIME_ROLES = set(VECTOR_ROLES) | {"t", "topt", "rtol", "atol", "cname"}
+RUNTIME_ROLES = set(VECTOR_ROLES) | {"t", "topt", "rtol", "atol", "cname", "sname", "pvalues", "lsys", "outputs"}
 
 #: Violation kinds (a call's outcome breaking the contract), and the crash/hang of a case.
 VIOLATIONS = ("crash", "hang", "other_exception", "type_error", "accepted_bad", "rejected_valid", "wrong_name",
-              "bad_message", "silent_nan", "bad_input_as_simulation_error")
+              "bad_message", "silent_nan", "bad_input_as_simulation_error", "slow", "wrong_result",
+              "keyboard_interrupt")
+#: numpy's own floating-point warnings ("overflow encountered in square"): they do not name the quantity
+NUMPY_WARNING = re.compile(r"encountered in|Casting complex values")
 
 
 def _finite(value, depth: int = 0) -> bool:
@@ -290,6 +637,8 @@ def _finite(value, depth: int = 0) -> bool:
         return value.dtype.kind not in "fc" or bool(np.all(np.isfinite(value)))
     if isinstance(value, (list, tuple)):
         return all(_finite(v, depth + 1) for v in value)
+    if isinstance(value, dict):
+        return all(_finite(v, depth + 1) for v in value.values())
     fields = getattr(value, "__dataclass_fields__", None)
     if fields:
         if "damping_ratios" in fields and "omega" in fields:  # Modes: ζ = inf is a damped mode of ω = 0
@@ -298,7 +647,70 @@ def _finite(value, depth: int = 0) -> bool:
                 return False
             return all(_finite(getattr(value, f), depth + 1) for f in fields
                        if f not in ("system", "history", "damping_ratios"))
-        return all(_finite(getattr(value, f), depth + 1) for f in fields if f not in ("system", "history"))
+        return all(_finite(getattr(value, f), depth + 1) for f in fields if f not in UNCHECKED_FIELDS)
+    return True
+
+
+#: Fields of the package's dataclasses that are not results: the system, a run's arguments and counts (a model size
+#: of NaN means "the run held the state"), the function that made it, a Plan's runs and handles, a Gradient's stats.
+UNCHECKED_FIELDS = ("system", "history", "stats", "run", "made_by", "estimate", "runs", "handles", "solution",
+                    "simulate_options", "minimum")  # a Parameter's minimum is -inf for a profile's number
+
+
+def _parameter_values(values, system) -> tuple[bool, bool]:
+    """(bad, unsure) of System.with_parameters' ``values``: a dict of names of ``system.parameters`` to real numbers
+    (not bools, strings or complex numbers) that are finite and within each parameter's bounds; unsure when it
+    changes a profile's number (its maker may refuse the profile made with it: a spline's knots out of order)."""
+    import numpy as np
+
+    if not isinstance(values, dict):
+        return True, False
+    try:
+        params = system.parameters
+    except Exception:  # noqa: BLE001 -- not a system: judged by the call
+        return False, True
+    bad, unsure = False, False
+    for name, v in values.items():
+        p = params.get(name) if isinstance(name, str) else None
+        if p is None:
+            return True, False
+        if isinstance(v, (bool, np.bool_)) or not isinstance(v, (int, float, np.integer, np.floating)):
+            return True, False
+        try:
+            x = float(v)
+        except OverflowError:
+            return True, False
+        if not math.isfinite(x) or (x <= p.minimum if p.positive else x < p.minimum):
+            bad = True
+        unsure |= not p.linear
+    return bad, unsure and not bad
+
+
+def _outputs_ok(outputs, system) -> bool:
+    """Whether rf.gradient's ``outputs`` are valid for ``system``: a non-empty dict of str names to Points or Bodies
+    of its model, indices of free coordinates (0 ... nq - 1) or their names."""
+    import numpy as np
+
+    if not isinstance(outputs, dict) or not outputs or system is None:
+        return False
+    own = getattr(system, "_model_id", 0)
+    for name, item in outputs.items():
+        if not isinstance(name, str):
+            return False
+        if isinstance(item, (rf.Point, rf.Body)):
+            body = item.body if isinstance(item, rf.Point) else item.index
+            if (item.model and own and item.model != own) or not -1 <= body < system.nbodies:
+                return False
+            if isinstance(item, rf.Point) and not np.all(np.isfinite(np.asarray(item.r, dtype=float))):
+                return False
+        elif isinstance(item, str):
+            if item not in system.coordinate_names:
+                return False
+        elif isinstance(item, (int, np.integer)) and not isinstance(item, (bool, np.bool_)):
+            if not 0 <= item < system.nq:
+                return False
+        else:
+            return False
     return True
 
 
@@ -353,7 +765,8 @@ def run_case(case: dict, base: dict, progress=None) -> list:
     ns = dict(base)
     SimulationError = ns["rf"].SimulationError
     LawError = ns["LawError"]
-    defined_later = {s["out"] for s in case["steps"] if s.get("out")}
+    defined_later = {v for s in case["steps"] for v in _outs(s)}
+    warned: set = set()    # variables whose outputs a RuntimeWarning has said hold NaN or inf
     flags = case.get("flags", {})
     tainted = False      # a bad input was accepted earlier: NaNs and refusals downstream are its echo
     stage_extreme = False  # the stages' workspace holds an extreme state
@@ -364,6 +777,8 @@ def run_case(case: dict, base: dict, progress=None) -> list:
             progress(k)
         label = step.get("label", step["fn"])
         missing = [v for v in _identifiers(step) & defined_later if v not in ns]
+        if step.get("needs") and any(v not in ns for v in step["needs"]):
+            missing = list(step["needs"])
         if missing:
             records.append([label, "skipped", None, "", 0.0])
             continue
@@ -412,6 +827,18 @@ def run_case(case: dict, base: dict, progress=None) -> list:
                     is_bad = not _tolerance_ok(v, nq)
                 elif role == "cname" and system is not None:
                     is_bad = v not in system.coordinate_names
+                elif role == "sname":  # a name the result's run was asked for
+                    is_bad = not isinstance(v, str) or v not in getattr(ns.get(step.get("res")), "sensitivities", {})
+                elif role == "pvalues":
+                    is_bad, unsure = _parameter_values(v, system)
+                    if unsure:
+                        soft |= {name}
+                elif role == "lsys":  # load_npz's system: None, or one whose coordinates are the saved ones
+                    saved = getattr(ns.get(step.get("res")), "coordinate_names", None)
+                    is_bad = v is not None and not (isinstance(v, rf.System) and saved is not None
+                                                    and list(v.coordinate_names) == list(saved))
+                elif role == "outputs":
+                    is_bad = not _outputs_ok(v, system)
                 else:
                     is_bad = False
                 if is_bad:
@@ -419,14 +846,18 @@ def run_case(case: dict, base: dict, progress=None) -> list:
             if step.get("omit_t") and getattr(system, "np", 0) > 0:
                 bad.add("t")
             bad |= set(step.get("absent_bad", ()))  # left out although required (dt of a fixed step)
-            with warnings.catch_warnings():
-                warnings.simplefilter("ignore")
+            with warnings.catch_warnings(record=True) as caught:
+                warnings.simplefilter("always")
                 value = eval(step["fn"], ns) if step.get("attr") else eval(step["fn"], ns)(*args, **kw)
         except BaseException as e:  # noqa: BLE001 -- every exception is classified
-            if isinstance(e, KeyboardInterrupt):
-                raise
             error = e
         seconds = time.perf_counter() - began
+        owner = step["fn"].split(".")[0]  # res3 of res3.energy: its outputs were computed (and warned about) once
+        if any(issubclass(w.category, RuntimeWarning) and not NUMPY_WARNING.search(str(w.message))
+               for w in (caught if error is None else [])):
+            warned |= {owner, *_outs(step)}
+        if step["fn"].startswith(("rf.plots.", "rf.animate")) and "matplotlib.pyplot" in sys.modules:
+            sys.modules["matplotlib.pyplot"].close("all")
         if step["fn"] == "rf.stages.set_state" and error is None:
             stage_extreme = extreme
         if step["fn"] == "rf.stages.set_state":
@@ -437,15 +868,21 @@ def run_case(case: dict, base: dict, progress=None) -> list:
             bool(flags.get("uncertain"))
         outcome, violation, detail = "returned", None, ""
         if error is None:
-            if step.get("out"):
-                ns[step["out"]] = value
+            outs = _outs(step)
+            if len(outs) == 1:
+                ns[outs[0]] = value
+            elif outs:
+                try:
+                    ns.update(zip(outs, value))
+                except TypeError:
+                    pass
             finite = _finite(value)
             if arity:
                 violation, detail = "accepted_bad", f"a call with {arity} arguments returned"
             elif bad and not ambiguous:
                 violation, detail = "accepted_bad", f"bad {sorted(bad)} accepted"
             elif not finite:
-                if lenient or extreme:
+                if lenient or extreme or owner in warned or set(outs) & warned:
                     outcome = "returned_nonfinite"
                 else:
                     violation, detail = "silent_nan", "NaN/inf returned from finite inputs"
@@ -461,7 +898,7 @@ def run_case(case: dict, base: dict, progress=None) -> list:
                 outcome = "SimulationError"
                 if not TIME_IN_MESSAGE.search(message):
                     violation = "bad_message"
-                elif bad and not ambiguous and not lenient:
+                elif bad and not ambiguous and not lenient and not step.get("late"):
                     violation = "bad_input_as_simulation_error"
             elif isinstance(error, ValueError):
                 outcome = "ValueError"
@@ -469,7 +906,7 @@ def run_case(case: dict, base: dict, progress=None) -> list:
                 if not m:
                     violation = "bad_message"
                 else:
-                    named = {n.strip() for n in m.group(1).split(",")}
+                    named = {re.sub(r"\[.*$", "", n.strip()) for n in m.group(1).split(",")}  # trails[0]: trails
                     if bad and not (named & (bad | soft)) and not lenient:
                         violation, detail = "wrong_name", f"bad {sorted(bad)}; " + detail
                     elif not bad and not (named & (soft | unclosed)) and not arity and not ambiguous and not lenient:
@@ -480,9 +917,25 @@ def run_case(case: dict, base: dict, progress=None) -> list:
                     violation = "type_error"
             elif isinstance(error, LawError) and flags.get("raising_callbacks"):
                 outcome = "LawError"
+            elif isinstance(error, KeyboardInterrupt):  # no Ctrl-C is ever sent to a worker
+                outcome, violation = "other", "keyboard_interrupt"
             else:
                 outcome = "other"
                 violation = "other_exception"
+        if error is not None and step.get("message") and not violation and \
+                not re.search(step["message"], str(error)):
+            violation, detail = "bad_message", f"expected a message matching {step['message']!r}; " + detail
+        if error is None and step.get("expect") and not violation and not tainted and not lenient:
+            try:
+                kept = bool(eval(step["expect"], {**ns, "_": value}))
+                why = ""
+            except Exception as e:  # noqa: BLE001 -- a promise that cannot be checked is not kept
+                kept, why = False, f" ({type(e).__name__}: {str(e)[:200]})"
+            if not kept:
+                violation, detail = "wrong_result", f"returned, but not {step['expect']}{why}"
+        if step.get("quick") and seconds > step["quick"] and not violation:
+            violation, detail = "slow", f"took {seconds:.1f} s, not bounded at once (within {step['quick']:g} s); " + \
+                (detail or "returned")
         if violation and (step["fn"].startswith(("model.", "rf.Model")) or step.get("out")):
             tainted = True  # the model is not what the generator meant: what follows may echo it
         records.append([label, outcome, violation, detail, round(seconds, 4)])
@@ -629,6 +1082,7 @@ class Runner:
         self.events: queue.Queue = queue.Queue()
         self.pool: list[_Worker] = []
         self.restarts = 0
+        self.package = None  # where the workers import rigidfem from (the first worker's answer)
 
     def close(self):
         for w in self.pool:
@@ -676,7 +1130,9 @@ class Runner:
             except queue.Empty:
                 w, msg = None, None
             if w is not None and w in self.pool:
-                if msg.get("ready"):
+                if "package" in msg:
+                    self.package = self.package or msg["package"]
+                elif msg.get("ready"):
                     w.ready = True
                     w.started = time.monotonic()
                 elif "step" in msg:
@@ -761,9 +1217,10 @@ def signature(kind: str, fn: str, detail: str) -> str:
     """What makes two violations the same: the kind, the function called (simulate's methods and
     results' variables merged), the exception type and the start of its message with the numbers
     and reprs taken out."""
-    fn = re.sub(r"^(res|eq|p)\d+\.", r"\1.", fn)
+    fn = re.sub(r"^(res|eq|p|v|an|g|plan|lr|w|rao|sysp|pa)\d+\.", r"\1.", fn)
     fn = re.sub(r"^(beam|b)\d+\.", r"\1.", fn)
     label = re.sub(r"^p\d+$", "profile", fn)
+    label = re.sub(r"^rao\d+$", "rao", label)
     kept = re.match(r"^bad (\[[^\]]*\])(?: accepted|;)", detail)  # which arguments: part of what the bug is
     if kept:
         return f"{kind}|{label}|{kept.group(1)}" + (" accepted" if kind == "accepted_bad" else
@@ -864,6 +1321,10 @@ def known_issue(case: dict, v: dict) -> str | None:
         return PENDING["drive_non_number"]
     if v["label"] == "modal_analysis" and kind == "silent_nan" and "modal" in PENDING:
         return PENDING["modal"]
+    for group, (kinds, fn, pattern) in PENDING_SIGNS.items():
+        if group in PENDING and re.fullmatch(kinds, kind) and re.search(fn, step.get("fn", "")) and \
+                re.search(pattern, detail):
+            return PENDING[group]
     return None
 
 
@@ -878,11 +1339,10 @@ def _closure_without(steps, drop: set) -> list:
     gone: set = set()
     keep = []
     for i, s in enumerate(steps):
-        if i in drop or (_identifiers(s) & gone):
-            if s.get("out"):
-                gone.add(s["out"])
+        if i in drop or (_identifiers(s) & gone) or (set(s.get("needs", ())) & gone):
+            gone.update(_outs(s))
             continue
-        gone.discard(s.get("out"))  # defined again
+        gone.difference_update(_outs(s))  # defined again
         keep.append(s)
     return keep
 
@@ -1019,6 +1479,51 @@ SYSTEM_METHODS = {name: _parameters(name) for name in (
     "kinetic_energy", "gravity_energy", "elastic_energy", "potential_energy", "dissipated_power", "position",
     "velocity", "transform", "loop_constraints", "loop_multipliers", "loop_reactions", "element_states")}
 
+def _system_takers() -> list:
+    """(expression, {"system": its default is None, "order": [(name, required, keyword-only)]}) of every public
+    function and method taking a ``system`` (found as tests/test_entry_points.py finds them): each must refuse a
+    Model, None or a string first, naming ``system`` and saying to compile."""
+    import types
+
+    found, seen = [], set()
+
+    def consider(expr, f):
+        if id(f) in seen:
+            return
+        seen.add(id(f))
+        try:
+            params = inspect.signature(f).parameters
+        except (TypeError, ValueError):
+            return
+        if "system" not in params:
+            return
+        order = [(p.name, p.default is p.empty and p.kind not in (p.VAR_POSITIONAL, p.VAR_KEYWORD),
+                  p.kind == p.KEYWORD_ONLY) for p in params.values() if p.kind not in (p.VAR_POSITIONAL, p.VAR_KEYWORD)]
+        found.append((expr, {"system": params["system"].default is None, "order": order}))
+
+    def members(owner, prefix, names=None):
+        for m in dir(owner) if names is None else names:
+            v = getattr(owner, m, None)
+            if m.startswith("_") or not callable(v) or not getattr(v, "__module__", "").startswith("rigidfem"):
+                continue
+            if f"{prefix}.{m}" in ("rf.Result", "rf.ErrorEstimate", "rf.Plan"):  # containers the package fills
+                continue
+            consider(f"{prefix}.{m}", v)
+            if inspect.isclass(v):
+                for k, f in inspect.getmembers(v, inspect.isfunction):
+                    if not k.startswith("_"):
+                        consider(f"{prefix}.{m}.{k}", f)
+
+    members(rf, "rf", [n for n in rf.__all__ if not isinstance(getattr(rf, n), types.ModuleType)])
+    for n in [*rf.__all__, "loops"]:
+        obj = getattr(rf, n, None)
+        if isinstance(obj, types.ModuleType):
+            members(obj, f"rf.{n}")
+    return sorted(found)
+
+
+SYSTEM_TAKERS = _system_takers()
+
 #: The arguments of rf.motion's profiles, which a ValueError about a bad profile may name.
 PROFILE_NAMES = ("amplitude", "omega", "phase", "offset", "duration", "t", "q", "coefficients", "value", "f", "law",
                  "fraction", "start", "end", "t0", "rate", "pieces", "breaks", "continuity", "delay", "weights")
@@ -1054,6 +1559,26 @@ def fl(x: float) -> str:
 
 def vec(xs) -> str:
     return "(" + ", ".join(fl(x) for x in xs) + ("," if len(xs) == 1 else "") + ")"
+
+
+#: The samples of Gen.entry_case: (expression of (model, handles), points, bodies, nq or None when it depends on the elements,
+#: prescribed coordinates, loops)
+SAMPLES = {
+    "pendulum": ("rf.samples.pendulum()", ("h['tip']", "h['link']", "h['link'].point((0.1, 0.0, -0.2))"),
+                 ("h['link']",), 1, 0, False),
+    "double_pendulum": ("rf.samples.double_pendulum()", ("h['tip']", "h['link1']", "h['link2'].origin"),
+                        ("h['link1']", "h['link2']"), 2, 0, False),
+    "spatial": ("rf.samples.double_pendulum(spatial=True)", ("h['tip']", "h['link2']"), ("h['link1']",), 6, 0,
+                False),
+    "cantilever": (("rf.samples.cantilever(elements=@E, material=rf.Material(E=2e7, rho=1000.0), gravity=(0.0, "
+                    "-9.81, 0.0))"), ("h['beam'].tip", "h['beam'].point(0.5)", "h['beam'].rfes[1]"),
+                   ("h['beam'].rfes[1]",), None, 0, False),
+    "driven": ("rf.samples.pendulum()", ("h['tip']", "h['link']"), ("h['link']",), 0, 1, False),
+    "spring_mass": ("rf.samples.spring_mass(damping=2.0)", ("h['block']", "h['block'].point((0.1, 0.0, 0.0))"),
+                    ("h['block']",), 1, 0, False),
+    "four_bar": ("rf.samples.four_bar()", ("h['crank']", "h['coupler'].point((0.8, 0.0, 0.0))"),
+                 ("h['rocker']",), 3, 0, True),
+}
 
 
 class Gen:
@@ -1852,10 +2377,14 @@ class Gen:
         out = self.new("res")
         # rtol = atol = 0 together: refused by some methods, run by others
         amb = kw.get("rtol", {}).get("e") in ("0.0",) and kw.get("atol", {}).get("e") in ("0.0",)
-        if absent and (kw.get("adaptive", {}).get("e") == "True" or "first_step" in kw):
-            absent = []  # an adaptive Newmark run needs no dt; first_step serves as the step when dt is absent
-        if "first_step" in kw and not kw["first_step"].get("bad") and kw.get("adaptive", {}).get("names") == \
-                ["adaptive", "dt"]:
+        if amb:  # a refusal then names atol (or rtol), whatever else is bad
+            kw["rtol"]["soft"] = kw["atol"]["soft"] = 1
+        # first_step serves as the step when dt is absent, for the methods that read it (rk4's table does not list
+        # it: rk4 given first_step alone has no step, a ValueError naming dt)
+        steps = "first_step" in kw and "first_step" in rf.integrator_options(method)
+        if absent and (kw.get("adaptive", {}).get("e") == "True" or steps):
+            absent = []  # an adaptive Newmark run needs no dt
+        if steps and not kw["first_step"].get("bad") and kw.get("adaptive", {}).get("names") == ["adaptive", "dt"]:
             del kw["adaptive"]["bad"]  # adaptive=False without dt: first_step serves as the step
         self.emit("rf.simulate", args, params, kw, out=out, label=f"simulate:{mlabel}", ambiguous=amb,
                   absent_bad=absent)
@@ -2081,12 +2610,780 @@ class Gen:
 
     def calls(self):
         n = self.choice([3, 6, 10, 15, 25])
+        # the newer entry points on the random model (those that need no model: sea, sweep, now and then)
+        extra = [k for k in ("gradient", "sensitivities", "parameters", "view", "loaded_results", "sea", "sweep",
+                             "system_takers") if self.on(k)]
         for _ in range(n):
             kind = self.choice(["system"] * 8 + ["simulate"] * 3 + ["result"] * 2 + ["analysis", "stages", "misc",
-                                                                                      "misc", "core"])
+                                                                                      "misc", "core"] + extra)
             {"system": self.system_call, "simulate": self.simulate_call, "result": self.result_call,
              "analysis": self.analysis_call, "stages": self.stage_calls, "misc": self.misc_call,
-             "core": self.core_call}[kind]()
+             "core": self.core_call, **self.entry_calls()}[kind]()
+
+    # ------------------------------------------------------------------------------------------------------------
+    # The newer entry points: rf.gradient, forward sensitivities, parameters, rf.resolve, rf.view and rf.animate,
+    # rf.sweep, rf.sea, saved and loaded results, the system argument of every public function. Drawn on the random
+    # model (calls) and on small samples (entry_case), whose cases stay fast.
+    # ------------------------------------------------------------------------------------------------------------
+
+    def entry_calls(self) -> dict:
+        return {"gradient": self.gradient_case_call, "sensitivities": self.sensitivities_call,
+                "parameters": self.parameters_call, "resolve": self.resolve_call, "view": self.view_call,
+                "sweep": self.sweep_call, "sea": self.sea_call, "loaded_results": self.loaded_call,
+                "system_takers": self.system_taker_call}
+
+    def entry_case(self):
+        """A case on a small sample (compiled as ``system``, handles ``h``) calling the newer entry points."""
+        kind = self.choice(list(SAMPLES) + ["pendulum", "double_pendulum", "cantilever", "cantilever"])
+        expr, points, bodies, nq, npres, loops = SAMPLES[kind]
+        expr = expr.replace("@E", str(self.choice([2, 3, 4, 6])))
+        self.emit(expr, out="model, h", label="samples." + kind, attr=True)
+        if kind == "driven":  # every coordinate prescribed: nq = 0
+            self.emit("model.prescribe", [A("h['link']"), A("rf.motion.harmonic(0.3, 2.0)")], ["body", "motion"],
+                      label="prescribe")
+        self.lagrange = self.chance(0.1)
+        self.emit("model.compile", [A("'lagrange'")] if self.lagrange else [],
+                  ["algorithm"] if self.lagrange else [], out="system", label="compile")
+        if loops:
+            self.flags["loops"] = True
+        self.sample_points, self.sample_bodies, self.nq_known, self.n_prescribed = points, bodies, nq, npres
+        calls = self.entry_calls()
+        kinds = [k for k in ENTRY_FEATURES if self.on(k)]
+        for _ in range(self.choice([2, 4, 6, 8, 12])):
+            kind = self.choice(kinds + ["simulate_good"])
+            self.simple_simulate() if kind == "simulate_good" else calls[kind]()
+
+    # -- shared helpers
+    sample_points: tuple = ()
+    sample_bodies: tuple = ()
+    nq_known = None  # the samples' nq (None: depends on the elements, or a random model's)
+
+    def systems(self) -> list:
+        if not hasattr(self, "_systems"):
+            self._systems = ["system"]
+        return self._systems
+
+    def res_info(self) -> dict:
+        """{result variable: {"sys": the system variable it is of (None: loaded without one), "loaded": bool}}"""
+        if not hasattr(self, "_res_info"):
+            self._res_info = {}
+        return self._res_info
+
+    def pick_system(self) -> str:
+        return self.choice(self.systems())
+
+    def good_point(self) -> str:
+        if self.sample_points:
+            return self.choice(self.sample_points)
+        return self.point(good_only=True)[0]
+
+    def any_point(self):
+        """(expression, bad) of a point: mostly the model's, sometimes a foreign or not a point."""
+        if self.chance(0.12):
+            return self.choice(["fb[0]", "'tip'", "None", "3.5", "rf.Point(10**6, (0.0, 0.0, 0.0))"]), True
+        if self.sample_points:
+            return self.good_point(), False
+        e, bad, _ = self.point()
+        return e, bad
+
+    def a_body(self):
+        if self.on("ground_handles") and self.chance(0.05):
+            return "model.ground"
+        if self.sample_bodies:
+            return self.choice(self.sample_bodies)
+        named = [b["var"] for b in self.bodies if b.get("var")]
+        return self.choice(named) if named else None
+
+    def number(self, good, bad, soft=(), names=(), x=()):
+        """A number argument drawn from good values (mostly), soft ones (refused or taken: both fine) and bad ones."""
+        if bad and self.chance(0.12):
+            return A(self.choice(list(bad)), bad=True, names=names)
+        if soft and self.chance(0.1):
+            return A(self.choice(list(soft)), soft=True, names=names)
+        e = self.choice(list(good))
+        return A(e, x=e in x)
+
+    def simple_simulate(self, sysv=None, sensitivities=None) -> str:
+        """A short, ordinary run of the system: its Result for the calls that take one."""
+        sysv = sysv or self.pick_system()
+        method = self.choice(["rk4", "rk4", "dopri5", "generalized_alpha", "radau5", "newmark", "auto", "euler"])
+        t_end = self.choice([0.02, 0.05, 0.1])
+        kw = {"method": A(repr(method)), "max_steps": A("3000")}  # a stiff system's run: a second, not a minute
+        if method in FIXED_STEP:
+            kw["dt"] = A(fl(t_end / self.choice([10, 20, 50])))
+        if self.chance(0.5):
+            kw["q0"] = A(f"V({sysv}.nq, {self.seed()}, 0.3)")
+        if sensitivities:
+            kw["sensitivities"] = A(sensitivities, soft=True, names=("sensitivities", "method"))
+        out = self.new("res")
+        self.emit("rf.simulate", [A(sysv), A(fl(t_end))], ["system", "t_end"], kw, out=out, label=f"simulate:{method}",
+                  sys=sysv)
+        if sysv == "system":
+            self.results.append(out)
+        self.res_info()[out] = {"sys": sysv, "loaded": False}
+        return out
+
+    def a_result(self, loaded=None):
+        """A result variable (made now if there is none): loaded None: any, False: a run's."""
+        options = [r for r, info in self.res_info().items() if loaded is None or info["loaded"] == loaded]
+        return self.choice(options) if options else self.simple_simulate()
+
+    # -- rf.gradient
+    ADJOINT = ("'generalized_alpha'", "'newmark'", "'hht'", "'implicit_spring'", "'radau5'")
+
+    def gradient_case_call(self):
+        sysv = self.pick_system()
+        S = lambda e: e.replace("S.", sysv + ".")
+        quick = False
+        if self.chance(0.12):
+            e = self.choice(["nan", "inf", "-1.0", "0.0", "'0.05'", "None", "2**1100", "1e300", "-1e300"])
+            t_end = A(e, bad=True, names=("t_end", "dt", "max_steps", "t0"))
+            quick = e == "1e300"
+        else:
+            t_end = A(fl(self.choice([0.01, 0.02, 0.05])))
+        kw = {}
+        if self.chance(0.12):
+            e = self.choice(["0.0", "-1e-3", "nan", "inf", "None", "'x'", "1e-300", "2**1100", "1e-320"])
+            kw["dt"] = A(e, bad=True, names=("dt", "t_end", "max_steps"))
+            quick |= e in ("1e-300", "1e-320")
+        else:
+            kw["dt"] = A(fl(self.choice([1e-3, 2e-3, 5e-3, 1e300])))
+        kw["outputs"] = A(self.choice([
+            "{'y': 0}", "{'c': (S.coordinate_names or ['nope'])[0]}", "{'p': @P}", "{'p': @P, 'y': 0}", "{'b': @B}",
+            "{'p': @P, 'q': @Q}"] * 4 + [
+            "{}", "{'y': 'nope'}", "{'y': 10**6}", "{3: 0}", "{'y': fb[0]}", "'x'", "None", "{'y': None}", "{'y': -1}",
+            "{'y': 1.5}", "{'y': True}"]).replace("@P", self.good_point()).replace("@Q", self.good_point()).replace(
+            "@B", self.a_body() or self.good_point()).replace("S.", sysv + "."), role="outputs", names=("outputs",))
+        running = self.choice([None, "run_sq", "run_sq", "run_abs", "run_huge"] +
+                              (["run_nan", "run_late_nan", "run_late_inf", "run_str", "run_none", "run_shape",
+                                "run_late_shape", "3", "run_raises"] if self.chance(0.15) else []))
+        terminal = self.choice([None, None, "term_sq", "term_sum"] +
+                               (["term_vec", "term_none", "term_nan", "term_str"] +
+                                (["term_complex"] if self.on("gradient_complex_objective") else [])
+                                if self.chance(0.12) else []))
+        if running == "run_raises":
+            self.flags["raising_callbacks"] = True
+        if running is not None:
+            kw["running"] = A(running, bad=running not in ("run_sq", "run_abs", "run_huge", "run_raises"),
+                              names=("running",))
+        if terminal is not None:
+            kw["terminal"] = A(terminal, bad=terminal not in ("term_sq", "term_sum"), names=("terminal",))
+        absent = ["running", "terminal"] if running is None and terminal is None else []
+        # an objective that goes bad only on the run's states can only be refused after the run: a run that fails
+        # first is a SimulationError
+        late = running in ("run_late_nan", "run_late_inf", "run_late_shape")
+        if self.chance(0.5):
+            kw["method"] = self.number(self.ADJOINT, ["'rk4'", "'nope'", "None", "3", "'scipy:Radau'"],
+                                       names=("method",))
+        if self.chance(0.3):
+            kw["memory"] = self.number(["1e6", "2.0**28", "1e300"], ["0.0", "-1.0", "nan", "inf", "'x'", "2**1100",
+                                                                     "None", "True"],
+                                       soft=["1e3", "2e3"], names=("memory",))
+        if self.chance(0.2):
+            kw["max_steps"] = self.number(["10**6", "10**5"], ["0", "-1", "2.5", "10**30", "'x'", "True", "None"],
+                                          soft=["3"], names=("max_steps", "t_end", "dt"))
+        if self.chance(0.15):
+            kw["q0"] = self.vector_arg("q0", system=sysv)
+        if self.chance(0.1):
+            kw["qd0"] = self.vector_arg("qd0", system=sysv)
+        if self.chance(0.1):
+            kw["rho_inf"] = self.number(["0.5", "1.0"], ["2.0", "-0.1", "nan"], names=("rho_inf",))
+            if kw.get("method", {}).get("e") not in (None, "'generalized_alpha'", "'implicit_spring'") and \
+                    not kw["method"].get("bad"):
+                kw["rho_inf"] = A(kw["rho_inf"]["e"], soft=True, names=("rho_inf",))  # an option the method ignores
+        if self.chance(0.05):
+            key = self.choice(["adaptive", "error_on"])
+            kw[key] = A({"adaptive": "True", "error_on": "'state'"}[key], bad=True, names=(key,))
+        arity = "keyword" if self.chance(0.03) else None
+        if arity:
+            kw["bogus"] = A("1.0")
+        params = self.choice(["None", "list(S.parameters)[:1]", "list(S.parameters)[:3]", "list(S.parameters)[-2:]",
+                              "['q0[' + c + ']' for c in S.coordinate_names[:2]]",
+                              "['qd0[' + c + ']' for c in S.coordinate_names[-1:]]", "[]"])
+        pa = A(S(params))
+        if self.chance(0.12):
+            bad = ["['nope']", "'x'", "[3]", "list(S.parameters)[:1] * 2 or ['z']", "3"]
+            if self.on("gradient_initial_names"):
+                bad += ["['q0[nope]']", "['qd0[x]']"]
+            pa = A(S(self.choice(bad)), bad=True, names=("parameters",))
+        pa["soft"] = 1  # a system whose parameters' differences fail (a profile that refuses p +- h) names them
+        pa["names"] = list(pa.get("names", [])) + ["parameters"]
+        out = self.new("g")
+        # a system the adjoint does not take yet (Maxwell arms, Lagrange) names system; loops at q0 = 0 name q0
+        self.emit("rf.gradient", [A(sysv, soft=True, names=("system", "q0")), t_end, pa],
+                  ["system", "t_end", "parameters"], kw, out=out, label="gradient", sys=sysv, absent_bad=absent,
+                  arity=arity, quick=3.0 if quick else None, late=late)
+        if self.chance(0.4):
+            self.emit(f"{out}.array", label="Gradient.array")
+
+    # -- forward sensitivities
+    SENSITIVITY_METHODS = ("rk4", "dopri5", "generalized_alpha", "newmark", "hht", "radau5", "esdirk43", "auto",
+                           "euler", "implicit_spring", "bs23")
+
+    def sensitivities_call(self):
+        sysv = self.pick_system()
+        S = lambda e: e.replace("S.", sysv + ".")
+        if self.chance(0.15):
+            names = A(S(self.choice(["['nope']", "'x'", "[3]", "['q0[nope]']", "['qd0[]']",
+                                     "list(S.parameters)[:1] * 2 or ['z']", "3"])), bad=True, names=("sensitivities",))
+        else:  # a system with Maxwell arms refuses them (soft)
+            names = A(S(self.choice(["list(S.parameters)[:1]", "list(S.parameters)[-2:]",
+                                     "['q0[' + c + ']' for c in S.coordinate_names[:1]]",
+                                     "['qd0[' + c + ']' for c in S.coordinate_names[-1:]]",
+                                     "list(S.parameters)[:1] + ['qd0[' + c + ']' for c in S.coordinate_names[:1]]",
+                                     "[]", "None"])), soft=True, names=("sensitivities", "method"))
+        method = self.choice(self.SENSITIVITY_METHODS)
+        kw = {"method": A(repr(method)), "sensitivities": names, "max_steps": A("1000")}
+        if self.chance(0.05):  # refused with sensitivities, taken without (an empty list, None)
+            kw["method"] = A(self.choice(["'scipy:RK45'", "'scipy:Radau'"]), soft=True, names=("method", "sensitivities"))
+        t_end = self.choice([0.02, 0.05])
+        if method in FIXED_STEP:
+            kw["dt"] = A(fl(t_end / self.choice([10, 25])))
+        if self.chance(0.5):
+            kw["q0"] = A(f"V({sysv}.nq, {self.seed()}, 0.3)")
+        out = self.new("res")
+        self.emit("rf.simulate", [A(sysv), A(fl(t_end))], ["system", "t_end"], kw, out=out,
+                  label=f"simulate:{method}", sys=sysv)
+        if sysv == "system":
+            self.results.append(out)
+        self.res_info()[out] = {"sys": sysv, "loaded": False}
+        for _ in range(self.integer(1, 3)):
+            self.sensitivity_calls(out)
+
+    def sensitivity_name(self, res):
+        options = [f"(list({res}.sensitivities) or ['nope'])[0]", f"(list({res}.sensitivities) or ['nope'])[-1]"] * 3 + \
+            ["'nope'", "3", "None", "'q0[x]'"] + (["['x']", "{}"] if self.on("sensitivity_name_types") else [])
+        return A(self.choice(options), role="sname")
+
+    def sensitivity_calls(self, res):
+        if self.chance(0.5):
+            return self.emit(f"{res}.sensitivity", [self.sensitivity_name(res)], ["name"], label="Result.sensitivity",
+                             res=res)
+        p, pbad = self.any_point()
+        kw = {}
+        if self.chance(0.3):
+            body = self.a_body()
+            kw["frame"] = A(body) if body and self.chance(0.8) else A(self.choice(["3", "'x'", "fb[1]"]), bad=True,
+                                                                       names=("frame",))
+        bare = self.res_info().get(res, {}).get("sys", "system") is None
+        self.emit(f"{res}.position_sensitivity", [A(p, bad=pbad, names=ROLE_NAMES["point"]),
+                                                  self.sensitivity_name(res)], ["point", "name"], kw,
+                  label="Result.position_sensitivity", res=res, absent_bad=["result"] if bare else [])
+
+    # -- parameters
+    PARAMETER_VALUES = ("2.0", "0.5", "0.0", "-1.0", "nan", "inf", "1e300", "1e-300", "2**1100", "'1.0'", "True",
+                        "1+0j", "None", "np.float32(2.0)", "np.int64(3)", "[1.0]")
+
+    def parameters_call(self):
+        sysv = self.pick_system()
+        if self.chance(0.25):
+            return self.emit(f"{sysv}.parameters", label="System.parameters", attr=True)
+        extremes = ("1e300", "1e-300")  # finite and in range; with parameters_extreme only
+        x = self.choice([v for v in self.PARAMETER_VALUES if v not in extremes or self.on("parameters_extreme")]) \
+            if self.chance(0.3) else self.choice(["2.0", "0.5", "np.float32(2.0)", "np.int64(3)"] +
+                                                 (list(extremes) if self.on("parameters_extreme") else []))
+        e = self.choice([
+            "{n: p.value * 1.5 for n, p in S.parameters.items()}", "{n: @X for n in list(S.parameters)[:1]}",
+            "{n: @X for n in list(S.parameters)[-2:]}", "{n: @X for n in list(S.parameters)[1:3]}",
+            "{n: p.value * 1.5 for n, p in S.parameters.items()}", "{}", "{'nope': 1.0}", "{3: 1.0}",
+            "{'q0[' + c + ']': 1.0 for c in S.coordinate_names[:1]}", "[('x', 1.0)]", "None", "'x'"])
+        e = e.replace("@X", x).replace("S.", sysv + ".")
+        out = self.new("sysp")
+        self.emit(f"{sysv}.with_parameters", [A(e, role="pvalues", names=("values",))], ["values"], out=out,
+                  label="with_parameters", sys=sysv)
+        self.systems().append(out)
+        if self.chance(0.6):
+            self.simple_simulate(out)
+
+    # -- rf.resolve
+    def resolve_call(self):
+        build = self.choice(["build_strip"] * 6 + ["build_compiled", "build_fixed", "build_none", "build_raises", "3",
+                                                   "None"])
+        args = [A(build, bad=build not in ("build_strip", "build_compiled"), names=("build",))]
+        good = ("'tip'", "['tip', 'mid']", "'one'", "['tip_y']", "'root'", "['tip', 'tip']", "('tip',)")
+        outputs = self.choice(list(good) * 3 + ["'nope'", "[]", "3", "None", "['tip', 3]", "'nan'", "'inf'", "'str'",
+                                                "'raises'"] + (["'nq'"] if self.on("resolve_output_shape") else []))
+        args.append(A(outputs, bad=outputs not in good, names=("outputs", "build")))
+        # any tol may be out of reach within max_elements: "tol: expected a tolerance that a level ... meets"
+        # (tol = 1e-300: atol = tol/20 fails the runs, a SimulationError reported as "build: ...": resolve_options)
+        tol = self.number(["1e-2", "1e-3", "1e-4", "1e300"] + (["1e-300"] if self.on("resolve_options") else []),
+                          ["0.0", "-1.0", "nan", "inf", "'1e-3'", "None", "True", "2**1100"], names=("tol",))
+        if not tol.get("bad"):
+            tol["soft"], tol["names"] = 1, ["tol", "max_elements"]
+        args.append(tol)
+        kw = {}
+        elements = 4
+        if self.chance(0.7):
+            kw["elements"] = self.number(["1", "2", "2", "4"], ["0", "-2", "2.5", "'4'", "None", "True", "10**30",
+                                                                "nan"], names=("elements", "max_elements"))
+            elements = int(kw["elements"]["e"]) if not kw["elements"].get("bad") else 1
+        # three levels at least (fewer: "tol: ... none (fewer than three levels)"); the default, 256, takes minutes
+        kw["max_elements"] = A(str(min(16, max(4, elements * self.choice([4, 8])))))
+        if self.chance(0.06):
+            kw["max_elements"] = A(self.choice(["'x'", "10**30", "0"]), bad=True, names=("max_elements", "elements"))
+        quick = False
+        if self.chance(0.6):
+            kw["t_end"] = self.number(["0.01", "0.02", "0.05"], ["0.0", "-1.0", "nan", "inf", "'x'"],
+                                      names=("t_end",))
+            if self.on("resolve_huge_t_end") and self.chance(0.05):
+                kw["t_end"], quick = A("1e300", soft=True, names=("t_end", "build")), True
+        if self.chance(0.7):
+            kw["deform"] = self.number(["('bend_z',)", "('bend_y', 'bend_z')", "('bend_z', 'torsion')", "()",
+                                        "['bend_z']"], ["'bend_z'", "[3]", "None", "('warp',)"],
+                                       names=("deform", "build"))
+        if "t_end" in kw:
+            if self.chance(0.3):
+                kw["method"] = A(self.choice(["'dopri5'", "'radau5'", "'esdirk43'", "'bs23'"]))
+        elif self.chance(0.3):
+            kw["load_steps"] = A(self.choice(["5", "10"]))
+        if self.on("resolve_options") and self.chance(0.15):  # options of the analysis it runs (simulate's or statics')
+            key, e, bad = self.choice([("method", "'rk4'", True), ("method", "'nope'", True), ("rtol", "-1.0", True),
+                                       ("t_eval", "'x'", True), ("max_steps", "2", False)] if "t_end" in kw else
+                                      [("load_steps", "0", True), ("load_steps", "10**12", True)])
+            kw[key] = A(e, bad=bad, names=(key, "dt"))
+        if build == "build_fixed" and kw.get("deform", {}).get("e") in ("()",):
+            args[0] = A(build, soft=True, names=("build",))  # no deformations: nq = 0 at every level, nothing to tell
+        out = self.new("plan")
+        self.emit("rf.resolve", args, ["build", "outputs", "tol"], kw, out=out, label="resolve",
+                  quick=3.0 if quick else None)
+        if self.chance(0.3):
+            self.emit(f"{out}.report", label="Plan.report")
+
+    # -- rf.view, Viewer.to_html, rf.animate
+    def trails_arg(self):
+        if self.chance(0.12):
+            return A(self.choice(["[fb[0]]", "['x']", "[None]", "'x'"] +
+                                 (["3", "None", "1.5"] if self.on("view_trail_types") else [])), bad=True,
+                     names=("trails",))
+        return A(self.choice(["()", f"[{self.good_point()}]", f"({self.good_point()}, {self.good_point()})"]))
+
+    def view_call(self):
+        if self.chance(0.35):
+            return self.animate_call()
+        sysv = self.pick_system()
+        args, kw = [A(sysv)], {}
+        message = None
+        if self.chance(0.05):
+            wrong = self.choice(["model", "None", "'system'"])
+            args[0] = A(wrong, bad=True, names=("system",))
+            message = r"^system: expected a compiled System \(call model\.compile\(\)\), got (a Model|None|'system')"
+        result = None
+        if self.chance(0.5):
+            result = self.a_result()
+            info = self.res_info()[result]
+            args.append(A(result, bad=info["sys"] != sysv, names=("result",)))
+        if result is None and self.chance(0.4):
+            kw["q"] = self.vector_arg("q0", system=sysv)  # None: the default (zeros)
+        elif result is not None and self.chance(0.05):
+            kw["q"] = A(f"V({sysv}.nq, 1)", bad=True, names=("q",))
+        if self.chance(0.3):
+            kw["t"] = self.number(["0.0", "0.5", "1e300"], ["nan", "inf", "'x'", "None"], names=("t",))
+            if result is not None and kw["t"].get("bad"):
+                kw["t"] = A(kw["t"]["e"], soft=True, names=("t",))  # a result's frames have their own times
+        if self.chance(0.3):
+            kw["trails"] = self.trails_arg()
+        if self.chance(0.3):
+            kw["frames"] = self.number(["1", "5", "100"], ["0", "-1", "2.5", "10**30", "'x'", "nan", "True"],
+                                       soft=["10**6"], names=("frames",))
+        if self.chance(0.2):
+            kw["height"] = self.number(["100", "420", "4000"], ["99", "4001", "2.5", "'x'", "None", "10**30", "True"],
+                                       names=("height",))
+        if self.chance(0.2):
+            kw["title"] = self.number(["'x'", "'<b>t</b>'"], [], soft=["3", "None"], names=("title",))
+        out = self.new("v")
+        self.emit("rf.view", args, ["system", "result"][:len(args)], kw, out=out, label="view", sys=sysv,
+                  message=message)
+        what = self.choice(["to_html", "to_html", "frames", "html", "path"] if self.on("path_types") else
+                           ["to_html", "to_html", "frames", "html"])
+        if what == "to_html":
+            self.emit(f"{out}.to_html", [A(f"os.path.join(TMP, '{out}.html')")], ["path"], label="Viewer.to_html")
+        elif what == "path":
+            self.emit(f"{out}.to_html", [A(self.choice(["None", "3"]), bad=True, names=("path",))], ["path"],
+                      label="Viewer.to_html")
+        elif what == "frames":
+            self.emit(f"{out}.frames", label="Viewer.frames", attr=True)
+        else:
+            self.emit(f"{out}.html", label="Viewer.html")
+
+    def animate_call(self):
+        kw = {}
+        if self.chance(0.08):
+            res = A(self.choice(["None", "'x'", "system"]), bad=True, names=("result",))
+        else:
+            r = self.a_result()
+            res = A(r, bad=self.res_info()[r]["sys"] is None, names=("result",))
+        quick = False
+        if self.chance(0.5):
+            if self.chance(0.5):
+                kw["frames"] = self.number(["1", "3", "20", "10**30"], ["0", "-1", "2.5", "'x'", "nan", "True"],
+                                           names=("frames",))
+            else:
+                kw["fps"] = self.number(["10.0", "100.0", "1e-300", "1000"], ["1e300", "0.0", "-1.0", "nan", "inf",
+                                                                            "'x'", "True", "2**1100", "1e9"],
+                                        names=("fps",))
+                quick = kw["fps"]["e"] in ("1e300", "1e9")
+                if self.chance(0.05):
+                    kw["frames"] = A("5")
+                    kw["fps"] = A(kw["fps"]["e"], bad=True, names=("fps", "frames"))
+        else:
+            kw["frames"] = A(self.choice(["3", "10"]))  # keep the default 100 frames rare: each a kinematics pass
+        if self.chance(0.2):
+            kw["plane"] = self.number(["None", "'xy'", "'xz'", "'yz'"], ["'ab'", "3"], names=("plane",))
+        if self.chance(0.2):
+            kw["trails"] = self.trails_arg()
+        if self.chance(0.1):
+            kw["interval"] = self.number(["40.0", "1.0"], ["0.0", "nan", "-1.0", "'x'"], names=("interval",))
+        if self.chance(0.1):
+            kw["frame_size"] = self.number(["0.1", "1e300"], ["0.0", "nan", "'x'"], names=("frame_size",))
+        self.emit("rf.animate", [res], ["result"], kw, out=self.new("an"), label="animate",
+                  quick=3.0 if quick else None)
+
+    # -- rf.sweep
+    def sweep_call(self):
+        executor = self.choice(["serial", "threads", "threads", "processes"])
+        fn = self.choice(["sweep_square"] * 3 + ["sweep_seeded", "sweep_raises", "sweep_unpicklable", "sweep_nan",
+                                                 "sweep_kwargs", "sweep_simulate"] +
+                         (["sweep_dies"] if executor == "processes" else []))
+        key = "omega" if fn == "sweep_simulate" else "x"
+        n = self.choice([0, 1, 2, 3]) if executor == "processes" else self.choice([0, 1, 2, 3, 5])
+        values = [round(0.1 * (k + 1), 3) for k in range(n)]
+        args, kw, absent = [A(f"fz.{fn}")], {}, []
+        failing = {"sweep_raises": "all", "sweep_dies": "all",
+                   "sweep_unpicklable": "all" if executor == "processes" else "none"}.get(fn, "none")
+        shape = self.choice(["cases", "cases", "grid", "bad"])
+        if shape == "grid" and n:
+            kw["grid"] = A(repr({key: values}))
+        elif shape == "bad":
+            which = self.choice(["[{'zz': 1.0}]", "{'x': [1.0]}", "[3]", "'x'", "grid={'x': []}", "grid={'x': 'ab'}",
+                                 "grid={}", "both", "neither"])
+            if which.startswith("grid="):
+                kw["grid"] = A(which[5:], bad=True, names=("grid",))
+            elif which == "both":
+                args.append(A(repr([{key: v} for v in values])))
+                kw["grid"] = A(repr({key: values or [1.0]}))
+                absent = ["cases", "grid"]
+            elif which == "neither":
+                absent = ["cases", "grid"]
+            elif which == "[{'zz': 1.0}]" and fn == "sweep_kwargs":
+                args.append(A(which))
+                n = 1
+            else:
+                args.append(A(which, bad=True, names=("cases",)))
+        else:
+            args.append(A(repr([{key: v} for v in values])))
+        if self.chance(0.3) or executor != "threads":
+            kw["executor"] = A(repr(executor))
+        if self.chance(0.05):
+            kw["executor"] = A(self.choice(["'nope'", "None", "3"]), bad=True, names=("executor",))
+        if self.chance(0.3):
+            good = ["1", "2"] + (["10**30"] if executor == "threads" and "executor" not in kw else [])
+            kw["workers"] = self.number(good, ["0", "-1", "2.5", "True", "'x'"], names=("workers",))
+        if fn == "sweep_seeded" and self.chance(0.6):
+            kw["seed"] = self.number(["0", "7", "2**70"], ["-1", "2.5", "'x'", "True"], names=("seed",))
+        elif self.chance(0.05) and fn not in ("sweep_seeded", "sweep_kwargs"):  # (**kw takes a seed)
+            kw["seed"] = A("3", bad=True, names=("seed",))  # a seed for a function without a seed parameter
+        if self.chance(0.1):
+            kw["progress"] = self.number(["False", "True"], ["'yes'", "1", "None"], names=("progress",))
+        if self.chance(0.15):
+            kw["as_frame"] = self.number(["None", "False", "True"], ["'x'", "2"] + (["1", "0"] if self.on(
+                "sweep_as_frame_int") else []), names=("as_frame",))
+        errors = self.choice(["'record'", "'record'", "'raise'"])
+        if failing == "all" and errors == "'raise'" and fn != "sweep_raises" and not self.on("sweep_raise_pickling"):
+            errors = "'record'"  # a value that does not pickle, a process that dies: TypeError, BrokenProcessPool
+        if self.chance(0.05):
+            kw["errors"] = A(self.choice(["'ignore'", "None"]), bad=True, names=("errors",))
+        else:
+            kw["errors"] = A(errors)
+        if fn == "sweep_raises" and errors == "'raise'":
+            self.flags["raising_callbacks"] = True
+        expect = None
+        if errors == "'record'" or failing == "none":
+            expect = f"fz.sweep_rows(_, {n}, {failing!r})"
+        if fn == "sweep_nan":  # the function's own NaN in its rows
+            args[0]["x"] = 1
+        self.emit("rf.sweep", args, ["function", "cases"][:len(args)], kw, label=f"sweep:{executor}", expect=expect,
+                  absent_bad=absent)
+
+    # -- rf.sea
+    HOSTILE = ("1e300", "1e-300", "2**1100", "'x'", "1+0j", "nan", "inf", "0.0", "-1.0", "None", "True")
+
+    def sea_arg(self, good, soft=(), names=(), exclude=()):
+        bad = [e for e in self.HOSTILE if e not in good and e not in soft and e not in exclude]
+        return self.number(good, bad, soft=soft, names=names)
+
+    def sea_call(self):
+        kind = self.choice(["jonswap", "waves", "waves", "rao", "rao", "rao", "waves_direct"])
+        hs = lambda: self.sea_arg(["2.0", "0.5", "1e-300", "np.float32(2.0)"],
+                                  soft=["1e300"] if self.on("sea_overflow") else [], names=("hs", "tp"),
+                                  exclude=["1e300"])  # S(w) may overflow: hs, tp refused, or the amplitudes
+        tp = lambda: self.sea_arg(["8.0", "1e300", "1e-300", "np.float32(8.0)"], names=("tp", "hs"))
+        gamma = lambda: self.number(["1.0", "3.3", "7.0"], ["0.5", "8.0", "nan", "'x'", "None", "True", "1e300",
+                                                            "2**1100", "1+0j"], names=("gamma",))
+        if kind == "jonswap":
+            omega = self.number(["np.linspace(0.1, 3.0, 20)", "[0.0, -1.0]", "5.0", "[]", "1e300", "1e-300",
+                                 "[[1.0, 2.0]]"], ["[nan]", "'x'", "1+1j", "[1+0j]", "None", "2**1100", "[2**1100]",
+                                                   "[inf]"], names=("omega",))
+            args = [omega, hs(), tp()] + ([gamma()] if self.chance(0.5) else [])
+            return self.emit("rf.sea.jonswap", args, ["omega", "hs", "tp", "gamma"][:len(args)], label="sea.jonswap")
+        if kind == "waves_direct":
+            if self.on("sea_overflow") and self.chance(0.4):
+                e = ("[1.0, 2.0]", "[1e300, 1e300]", "[0.0, 0.0]")
+            else:
+                e = self.choice([("[1.0]", "[1.0]", "[0.0]"), ("[1.0, 2.0]", "[0.5, 0.1]", "[0.0, 1.0]"),
+                                 ("[1.0]", "[1.0, 2.0]", "[0.0]"), ("[nan]", "[1.0]", "[0.0]"), ("[]", "[]", "[]"),
+                                 ("'x'", "[1.0]", "[0.0]")])
+            bad = e[0] in ("[nan]", "'x'", "[]") or e[1] == "[1.0, 2.0]"
+            out = self.new("w")
+            self.emit("rf.sea.Waves", [A(x, bad=bad, names=("omega", "amplitude", "phase")) for x in e],
+                      ["omega", "amplitude", "phase"], out=out, label="sea.Waves")
+            return self.waves_calls(out)
+        if kind == "waves":
+            kw = {}
+            if self.chance(0.5):
+                kw["gamma"] = gamma()
+            if self.chance(0.6):
+                kw["n"] = self.number(["1", "10", "50", "np.int64(5)"], ["0", "-1", "2.5", "10**30", "True", "'5'",
+                                                                          "None"], names=("n",))
+            else:
+                kw["n"] = A("20")
+            if self.chance(0.4):
+                kw["omega_range"] = self.number(["None", "(0.2, 2.0)", "(1e-300, 2e-300)", "(0.0, 1e300)"],
+                                                ["(2.0, 1.0)", "(-1.0, 1.0)", "(0.0, inf)", "'x'", "(1.0,)",
+                                                 "(nan, 1.0)", "(0.0, 0.0)"], names=("omega_range",))
+            if self.chance(0.4):
+                kw["seed"] = self.number(["0", "5", "np.random.default_rng(1)", "None", "2**1100", "[1, 2]"],
+                                         ["'x'", "-1", "2.5", "1+0j"], names=("seed",))
+            out = self.new("w")
+            self.emit("rf.sea.jonswap_waves", [hs(), tp()], ["hs", "tp"], kw, out=out, label="sea.jonswap_waves")
+            return self.waves_calls(out)
+        out = self.rao_maker()
+        for _ in range(self.integer(1, 3)):
+            self.rao_calls(out)
+
+    def rao_maker(self) -> str:
+        out = self.new("rao")
+        kind = self.choice(["constant", "oscillator", "table", "function"])
+        self._rao_faulty = getattr(self, "_rao_faulty", set())
+        if kind == "constant":
+            args = [self.sea_arg(["1.0", "0.0", "1e300", "1e-300", "np.float32(2.0)"], names=("amplitude",))]
+            if self.chance(0.5):
+                args.append(self.sea_arg(["0.0", "1.0", "-1.0", "1e300", "1e-300"], names=("phase",)))
+            self.emit("rf.sea.RAO.constant", args, ["amplitude", "phase"][:len(args)], out=out,
+                      label="sea.RAO.constant")
+        elif kind == "oscillator":
+            # extreme constants (a period of 1e-300 s, a damping ratio of 1e300 or 1e-310) make H NaN or inf at some
+            # frequencies: with sea_overflow only
+            extreme = ["1e300", "1e-300"] if self.on("sea_overflow") else []
+            zeta = self.sea_arg(["0.1", "2.0"] + extreme, names=("damping_ratio",), exclude=["1e300", "1e-300"])
+            if self.on("sea_overflow") and self.chance(0.2):
+                zeta = A(self.choice(["1e-310", "5e-324"]))  # positive, finite: H = 1/(2i zeta) at resonance overflows
+            period = self.sea_arg(["6.0"] + extreme, names=("period",), exclude=["1e300", "1e-300"])
+            self.emit("rf.sea.RAO.oscillator", [period, zeta], ["period", "damping_ratio"], out=out,
+                      label="sea.RAO.oscillator")
+        elif kind == "table":
+            e, bad, names = self.choice([
+                (("[0.1, 1.0]", "[1.0, 2.0]"), False, ()), (("[0.1]", "[1.0]"), False, ()),
+                (("[0.1, 1e300]", "[1e300, 1e300]"), False, ()), (("[1e-300, 2e-300]", "[1.0, 1.0]"), False, ()),
+                (("[0.1, 1.0]", "[1.0, 2.0]", "[0.0, 1.0]"), False, ()),
+                (("[0.1, 1.0]", "[1.0, 2.0]", "[1e300, -1e300]"), False, ()),
+                (("[1.0, 0.1]", "[1.0, 2.0]"), True, ("omega",)), (("[]", "[]"), True, ("omega",)),
+                (("[0.1, 1.0]", "[1.0]"), True, ("amplitude",)), (("[0.1, 1.0]", "[-1.0, 1.0]"), True, ("amplitude",)),
+                (("'x'", "[1.0]"), True, ("omega",)), (("[0.1, nan]", "[1.0, 1.0]"), True, ("omega",)),
+                (("[0.0, 2**1100]", "[1.0, 1.0]"), True, ("omega",)),
+                (("[0.1, 1.0]", "[1.0, 2.0]", "[0.0]"), True, ("phase",))])
+            self.emit("rf.sea.RAO.table", [A(x, bad=bad, names=names) for x in e],
+                      ["omega", "amplitude", "phase"][:len(e)], out=out, label="sea.RAO.table")
+        else:
+            fn = self.choice(["fz.rao_first_order", "fz.rao_first_order", "fz.rao_string", "fz.rao_nan",
+                              "fz.rao_shape", "3", "None"])
+            self.emit("rf.sea.RAO", [A(fn, bad=fn in ("3", "None"), names=("function",))], ["function"], out=out,
+                      label="sea.RAO")
+            if fn not in ("fz.rao_first_order", "3", "None"):
+                self._rao_faulty.add(out)  # its calls are refused naming the RAO ("rao: expected ... to return")
+        return out
+
+    def rao_calls(self, rao):
+        faulty = rao in getattr(self, "_rao_faulty", ())
+        if self.chance(0.25) and not faulty:
+            w = "np.linspace(0.1, 3.0, 7)"
+            return self.emit("pickle.loads", [A(f"pickle.dumps({rao})")], ["data"], out=self.new("rao"),
+                             label="sea.RAO pickled", expect=f"np.array_equal(_({w}), {rao}({w}))")
+        omega = self.number(["np.linspace(0.1, 3.0, 7)", "1.0", "[1.0]", "1e300", "[]", "2.0 * np.pi / 6.0"],
+                            ["'x'", "[nan]", "2**1100", "1+0j", "None"], names=("omega",))
+        if faulty:
+            omega["soft"], omega["names"] = 1, list(omega.get("names", [])) + ["rao"]
+        self.emit(rao, [omega], ["omega"], label="sea.RAO.__call__")
+
+    def waves_calls(self, w):
+        for _ in range(self.integer(1, 3)):
+            what = self.choice(["hs", "m0", "elevation", "response", "motion", "pickle"])
+            if what in ("hs", "m0"):
+                self.emit(f"{w}.{what}", label=f"sea.Waves.{what}", attr=True)
+            elif what == "pickle":
+                self.emit("pickle.loads", [A(f"pickle.dumps({w})")], ["data"], out=self.new("w"),
+                          label="sea.Waves pickled", expect=f"np.array_equal(_.omega, {w}.omega) and "
+                                                            f"np.array_equal(_.phase, {w}.phase)")
+            elif what == "elevation":
+                p = self.new("p")
+                self.emit(f"{w}.elevation", out=p, label="sea.Waves.elevation")
+                self.emit(p, [self.time_arg(types=False)], ["t"], label="sea.elevation(t)")
+            elif what == "response":
+                if self.chance(0.5):
+                    rao = A(self.rao_maker())
+                else:
+                    rao = self.number(["1.0", "0.0", "1e300"], ["-1.0", "nan", "'x'", "None"], names=("rao",))
+                    if self.on("sea_overflow") and self.chance(0.2):
+                        rao = A("rf.sea.RAO.constant(1e308)")
+                if rao["e"] in getattr(self, "_rao_faulty", ()):
+                    rao["soft"], rao["names"] = 1, ["rao"]
+                p = self.new("p")
+                self.emit(f"{w}.response", [rao], ["rao"], out=p, label="sea.Waves.response")
+                self.emit(p, [self.time_arg(types=False)], ["t"], label="sea.response(t)")
+            else:
+                e = self.choice(["{'heave': 1.0}", "{'roll': 0.03, 'x': rf.sea.RAO.oscillator(6.0, 0.1)}",
+                                 "{'surge': rf.sea.RAO.constant(0.5, 1.0), 'rz': 0.0}", "{'nope': 1.0}", "{3: 1.0}",
+                                 "[]", "None", "{'heave': -1.0}", "{'heave': 'x'}"])
+                self.emit(f"{w}.motion", [A(e, bad=e in ("{'nope': 1.0}", "{3: 1.0}", "[]", "None", "{'heave': -1.0}",
+                                                         "{'heave': 'x'}"), names=("raos",))],
+                          ["raos"], label="sea.Waves.motion")
+
+    # -- saved and loaded results
+    LOADED_OUTPUTS = ("qdd", "energy", "kinetic_energy", "potential_energy", "driving_forces", "element_forces",
+                      "loop_reactions", "dissipated_power")
+
+    def loaded_call(self):
+        loaded = [r for r, info in self.res_info().items() if info["loaded"]]
+        if loaded and self.chance(0.6):
+            return self.loaded_output(self.choice(loaded))
+        res = self.a_result(loaded=False)
+        info = self.res_info()[res]
+        path = self.new("pa")
+        if self.on("path_types") and self.chance(0.05):
+            return self.emit(f"{res}.to_npz", [A(self.choice(["None", "3"]), bad=True, names=("path",))], ["path"],
+                             label="Result.to_npz")
+        self.emit(f"{res}.to_npz", [A(f"os.path.join(TMP, '{res}.npz')")], ["path"], out=path, label="Result.to_npz")
+        same = f"np.array_equal(_.q, {res}.q) and np.array_equal(_.t, {res}.t) and _.coordinate_names == " \
+               f"{res}.coordinate_names and all(np.array_equal(_.sensitivities[k], v) for k, v in " \
+               f"{res}.sensitivities.items())"
+        which = self.choice(["bare", "bare", "none", "own", "own", "other", "wrong", "foreign", "junk", "path"])
+        out = self.new("lr")
+        args, sysv, message = [A(path)], None, None
+        if which == "none":
+            args.append(A("None", role="lsys", names=("system",)))
+        elif which == "own":
+            sysv = info["sys"]
+            args.append(A(sysv, role="lsys", names=("system",)))
+        elif which == "other":
+            sysv = self.pick_system()
+            args.append(A(sysv, role="lsys", names=("system",)))
+        elif which == "foreign":
+            args.append(A("foreign_system", role="lsys", names=("system",)))
+        elif which == "wrong":
+            args.append(A(self.choice(["model", "'system'", "3"]), role="lsys", names=("system",)))
+            message = r"^system: expected a compiled System"
+        elif which == "junk" and self.on("npz_foreign_files"):
+            args = [A(self.choice(["fz.junk_file()", "fz.other_npz()"]), bad=True, names=("path", "file"))]
+            same = None
+        elif which == "path" and self.on("path_types"):
+            args = [A(self.choice(["None", "3"]), bad=True, names=("path", "file"))]
+            same = None
+        self.emit("rf.load_npz", args, ["path", "system"][:len(args)], out=out, label="load_npz", res=res,
+                  expect=same, message=message)
+        self.res_info()[out] = {"sys": sysv, "loaded": True}
+        for _ in range(self.integer(1, 3)):
+            self.loaded_output(out)
+
+    def loaded_output(self, lr):
+        """An output of a loaded result (or of a run's): those that need the system name ``result`` without it."""
+        info = self.res_info()[lr]
+        bare = info["sys"] is None
+        need = ["result"] if bare else []
+        what = self.choice(list(self.LOADED_OUTPUTS) + ["error_estimate", "position", "sensitivity", "dataframe",
+                                                        "csv", "npz", "plot", "plot", "animate", "view"])
+        if what in self.LOADED_OUTPUTS:
+            return self.emit(f"{lr}.{what}", label=f"Result.{what}", attr=True, absent_bad=need)
+        if what == "error_estimate":  # a loaded result has no run to repeat
+            return self.emit(f"{lr}.error_estimate", label="Result.error_estimate", attr=True,
+                             absent_bad=["result"] if info["loaded"] else [], quick=None)
+        if what == "position":
+            p, pbad = self.any_point()
+            return self.emit(f"{lr}.position", [A(p, bad=pbad, names=ROLE_NAMES["point"])], ["point"],
+                             label="Result.position", absent_bad=need)
+        if what == "sensitivity":
+            return self.sensitivity_calls(lr)
+        if what in ("dataframe", "csv"):
+            kw = {}
+            if self.chance(0.4):
+                p, pbad = self.any_point()
+                kw["points"] = A(f"{{'p': {p}}}", bad=pbad, names=("points", *ROLE_NAMES["point"]))
+                if self.chance(0.1):
+                    kw["points"] = A(self.choice(["[1]", "'x'", "{3: None}"]), bad=True, names=("points",))
+                elif what == "csv" and self.chance(0.1):
+                    kw["points"] = A(f"{{'p,q': {self.good_point()}}}", bad=True, names=("points",))
+                if bare:  # positions need the system: refused naming result (or the bad points first)
+                    kw["points"]["bad"] = 1
+                    kw["points"]["names"] = [*kw["points"].get("names", []), "result"]
+            if what == "dataframe":
+                return self.emit(f"{lr}.to_dataframe", [], [], kw, label="Result.to_dataframe")
+            return self.emit(f"{lr}.to_csv", [A(f"os.path.join(TMP, '{lr}.csv')")], ["path"], kw, label="Result.to_csv")
+        if what == "npz":
+            path = self.new("pa")
+            self.emit(f"{lr}.to_npz", [A(f"os.path.join(TMP, '{lr}b.npz')")], ["path"], out=path,
+                      label="Result.to_npz")
+            return self.emit("rf.load_npz", [A(path)], ["path"], label="load_npz",
+                             expect=f"np.array_equal(_.q, {lr}.q) and _.coordinate_names == {lr}.coordinate_names")
+        if what == "plot":
+            fn = self.choice(["coordinates", "coordinates", "position", "energies", "driving_forces"])
+            nq0 = self.nq_known == 0 if self.nq_known is not None else None
+            if fn == "coordinates":
+                kw = {}
+                if self.chance(0.3):
+                    kw["quantity"] = self.number(["'q'", "'qd'", "'qdd'"], ["'x'", "None"], names=("quantity",))
+                if kw.get("quantity", {}).get("e") != "'qdd'":
+                    need = []  # q and qd need no system
+                args = [A(lr, soft=nq0 is None, bad=bool(nq0), names=("result",))]
+                if self.chance(0.3):
+                    args.append(A(self.choice(["0", "-1", "[0]"]) if self.chance(0.8) else self.choice(["'nope'", "99"]),
+                                  soft=True, names=("which",)))
+                return self.emit("rf.plots.coordinates", args, ["result", "which"][:len(args)], kw,
+                                 label="plots.coordinates", absent_bad=need)
+            if fn == "position":
+                p, pbad = self.any_point()
+                return self.emit("rf.plots.position", [A(lr), A(p, bad=pbad, names=ROLE_NAMES["point"])],
+                                 ["result", "point"], label="plots.position", absent_bad=need)
+            if fn == "energies":
+                return self.emit("rf.plots.energies", [A(lr)], ["result"], label="plots.energies", absent_bad=need)
+            drives = self.n_prescribed > 0 if self.sample_points else None
+            return self.emit("rf.plots.driving_forces", [A(lr, soft=drives is None, bad=drives is False,
+                                                           names=("result",))], ["result"],
+                             label="plots.driving_forces", absent_bad=need)
+        if what == "animate":
+            return self.emit("rf.animate", [A(lr, bad=bare, names=("result",))], ["result"],
+                             {"frames": A(self.choice(["1", "3"]))}, label="animate")
+        sysv = info["sys"] or self.pick_system()
+        return self.emit("rf.view", [A(sysv), A(lr, bad=info["sys"] != sysv, names=("result",))], ["system", "result"],
+                         {"frames": A("3")}, label="view")
+
+    # -- the system argument of every public function
+    def system_taker_call(self):
+        fn, params = self.choice(SYSTEM_TAKERS)
+        wrong = self.choice(["model", "'system'"] + (["None"] if not params["system"] else []))
+        args, names, kw = [], [], {}
+        for p, required, keyword in params["order"]:
+            if p == "system":
+                a = A(wrong, bad=True, names=("system",))
+            elif p == "self" or required:
+                a = A("None")
+            else:
+                continue
+            if keyword:
+                kw[p] = a
+            else:
+                args.append(a)
+                names.append(p)
+        said = {"model": "a Model", "'system'": "'system'", "None": "None"}[wrong]
+        self.emit(fn, args, names, kw, label="system:" + fn.split(".")[-1],
+                  message=r"^system: expected a compiled System \(call model\.compile\(\)\), got " + re.escape(said))
 
 
 def strategy(features=None):
@@ -2098,8 +3395,11 @@ def strategy(features=None):
     @st.composite
     def case(draw):
         g = Gen(draw, st, features)
-        g.build_model()
-        g.calls()
+        if any(g.on(f) for f in ENTRY_FEATURES) and g.chance(0.3):
+            g.entry_case()  # a small sample calling the newer entry points
+        else:
+            g.build_model()
+            g.calls()
         return {"steps": g.steps, "flags": g.flags}
 
     return case()
