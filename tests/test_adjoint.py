@@ -364,6 +364,15 @@ def test_bad_input():
         rf.gradient(s, 0.01, ["strip.E"], **{**ok, "terminal": lambda y: [1.0, 2.0]})
     with pytest.raises(ValueError, match="algorithm='recursive'"):
         rf.gradient(strip_lagrange(), 0.01, ["strip.E"], outputs={"p": 0}, running=lambda t, y: y["p"], dt=1e-3)
+    with pytest.raises(ValueError, match=r"^parameters: expected a free coordinate in 'q0\[nope\]'"):
+        rf.gradient(s, 0.01, ["q0[nope]"], **ok)
+    m = rf.Model()
+    rod = m.add_body("rod", m.ground, rf.Joint.revolute("z"), 1.0, (1.0, 1.0, 1.0), com=(0.5, 0.0, 0.0))
+    for ground in (m.ground, m.ground.point((1.0, 0.0, 0.0))):  # the ground's points do not move
+        with pytest.raises(ValueError, match="^outputs: expected points on moving bodies"):
+            rf.gradient(m.compile(), 0.01, [], outputs={"p": rod, "g": ground}, running=running, dt=1e-3)
+        with pytest.raises(ValueError, match="^error_on: expected points on moving bodies"):
+            rf.simulate(m.compile(), 0.01, error_on=[ground])
     loop = samples.four_bar()[0].compile()
     q0 = loop.assemble([0.4, -1.9, 4.6])[0]
     with pytest.raises(ValueError, match="q0: expected initial coordinates that close every loop"):

@@ -2,6 +2,7 @@
 with those values, for every kind of parameter; the listing, pickling and bad input."""
 
 import pickle
+import warnings
 
 import numpy as np
 import pytest
@@ -105,6 +106,24 @@ def test_bad_values():
     with pytest.raises(ValueError, match="values: expected a dict"):
         s.with_parameters([("strip.E", 1.0)])
     s.with_parameters({"cylinder.force": -5.0, "hub.rz.force": -1.0})  # forces take any sign
+
+
+def test_extreme_values_in_range_are_finite_or_refused_by_name():
+    """1e299 and 1e300 m² are finite values in range: the rfes' masses stay finite (their ratio to the built area
+    overflows, their product with the built pseudo-inertias does not: M is linear in A, M(1e300) = 10 M(1e299)
+    − 9 M(A₀)); second moments whose springs E I / l overflow are a ValueError naming them, without NaN or
+    numpy's warnings on the way."""
+    s = build()
+    q = np.full(s.nq, 0.05)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        M0, M299, M300 = (s.with_parameters({"strip.A": a}).mass_matrix(0.0, q) for a in (1e-4, 1e299, 1e300))
+        assert np.isfinite(M300).all()
+        np.testing.assert_allclose(M300, 10.0 * M299 - 9.0 * M0, rtol=0, atol=1e-12 * np.abs(M300).max())
+        for name in ("strip.Iy", "strip.Iz", "strip.J"):
+            with pytest.raises(ValueError, match=f"^values: expected values whose rfes' pseudo-inertias, springs and "
+                                                 f"dampers are finite .*got {name} = 1e\\+300"):
+                s.with_parameters({name: 1e300})
 
 
 def test_profile_numbers_are_parameters():

@@ -246,6 +246,14 @@ def test_bad_input():
     with pytest.raises(ValueError, match="name: expected one of the sensitivities of this run"):
         r.sensitivity("rod.rz.stiffness")
     model = rf.Model()
+    rod = model.add_body("rod", model.ground, rf.Joint.revolute("z", stiffness=1.0), 1.0, (1.0, 1.0, 1.0))
+    r = rf.simulate(model.compile(), 0.01, "rk4", dt=1e-3, sensitivities=["rod.mass"])
+    for name in (["rod.mass"], {}):  # unhashable: no TypeError
+        with pytest.raises(ValueError, match="^name: expected one of the sensitivities of this run"):
+            r.sensitivity(name)
+        with pytest.raises(ValueError, match="^name: expected one of the sensitivities of this run"):
+            r.position_sensitivity(rod.point((1.0, 0.0, 0.0)), name)
+    model = rf.Model()
     b = model.add_body("b", model.ground, rf.Joint.revolute("z", stiffness=1.0), 1.0, (1.0, 1.0, 1.0))
     model.add_maxwell_arm(b, 1.0, 0.1)
     with pytest.raises(ValueError, match="Maxwell arms"):
@@ -427,3 +435,27 @@ def test_sensitivities_through_a_rope_going_slack(method):
                                                      else {}))
     S, _ = rf.simulate(system, 2.0, q0=q0, sensitivities=["q0[load.x]"], **kw).sensitivity("q0[load.x]")
     np.testing.assert_allclose(S, fd, atol=5e-3)
+
+
+def test_a_number_that_cannot_change_alone_is_refused_by_name():
+    """A piece's value of a piecewise drive (continuity 1: the pieces meet at the break) cannot move alone: the
+    sensitivity by it is refused naming sensitivities (parameters for rf.gradient) and the parameter, not the
+    profile maker's argument."""
+    def build(value=0.5, brk=0.2):
+        model = rf.Model(gravity=(0.0, 0.0, -G))
+        drive = rf.motion.piecewise([rf.motion.constant(value), rf.motion.polynomial([value])], [brk])
+        arm = model.add_body("arm", model.ground, rf.Joint.revolute("y"), 1.0, (0.1, 0.1, 0.1), com=(0.0, 0.0, -0.5))
+        model.add_body("tip", arm, rf.Joint.revolute("y", stiffness=5.0), 1.0, (0.1, 0.1, 0.1), com=(0.0, 0.0, -0.5),
+                       placement=rf.transform((0.0, 0.0, -1.0)))
+        model.prescribe(arm, drive)
+        return model.compile()
+
+    s = build()
+    piece = "arm.ry.drive.pieces[0].value"
+    assert piece in s.parameters
+    with pytest.raises(ValueError, match=r"^sensitivities: expected parameters that can change alone, got "
+                                         r"'arm\.ry\.drive\.pieces\[0\]\.value'.*pieces: expected pieces 0 and 1 to meet"):
+        rf.simulate(s, 0.3, "rk4", dt=1e-3, sensitivities=[piece])
+    with pytest.raises(ValueError, match=r"^parameters: expected parameters that can change alone"):
+        rf.gradient(s, 0.3, [piece], outputs={"y": 0}, terminal=lambda y: y["y"], dt=1e-3)
+

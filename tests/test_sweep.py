@@ -178,6 +178,18 @@ def test_errors_raise_propagates_the_first_failure():
         rf.sweep(pendulum, grid=GRID, executor="serial", errors="raise")
 
 
+@pytest.mark.parametrize("k, match", [
+    (3, r"^function: expected return values that pickle with executor='processes' .*case \{'k': 3\}"),
+    (2, r"^function: expected a function that returns, got one whose worker process died running .*'k': 2"),
+])
+def test_errors_raise_names_the_function_whose_value_does_not_pickle_or_whose_process_dies(k, match):
+    """errors='raise' on processes: the function's value that cannot come back, or the worker it ends, is a
+    ValueError naming the function and the case (a pickling TypeError and BrokenProcessPool before)."""
+    with pytest.raises(ValueError, match=match):
+        rf.sweep(dies_or_returns, [{"k": 1}, {"k": k}], executor="processes", workers=1, errors="raise",
+                 as_frame=False)
+
+
 @pytest.mark.parametrize("kwargs, match", [
     (dict(cases=None), "exactly one"),
     (dict(cases=[{"length": 1.0}], grid={"length": [1.0]}), "exactly one"),
@@ -189,6 +201,7 @@ def test_errors_raise_propagates_the_first_failure():
     (dict(grid=GRID, workers=0), "workers"),
     (dict(grid=GRID, errors="ignore"), "errors"),
     (dict(grid=GRID, as_frame="yes"), "as_frame"),
+    (dict(grid=GRID, as_frame=1), "as_frame: expected None, True or False, got 1"),
 ])
 def test_bad_input(kwargs, match):
     with pytest.raises(ValueError, match=match):

@@ -148,17 +148,42 @@ class BeamGroup(Group):
 
     def changes(self, values: dict) -> Changes:
         v = {**self.built, **values}
-        s = {k: v[k] / self.built[k] for k in ("E", "G", "rho", "A", "Iy", "Iz", "J")}
-        H = s["rho"] * (s["A"] * self.H_A + s["Iz"] * self.H_z + s["Iy"] * self.H_y) + self.H_tip
-        factor = np.array([s[self.SPRING[k][0]] * s[self.SPRING[k][1]] if k in self.SPRING else 0.0
-                           for k in self.kinds])
-        c = self.stiffness * factor
-        b = v["damping"] * c
+
+        def scaled(x, k):  # x v_k / v_k₀, divided first (1e300 m⁴ / Iz₀ overflows where x / Iz₀ · 1e300 need not)
+            return _scaled(x, v[k], self.built[k])
+
+        H = scaled(scaled(self.H_A, "A") + scaled(self.H_z, "Iz") + scaled(self.H_y, "Iy"), "rho") + self.H_tip
+        c = self.stiffness.copy()
+        for col, kind in enumerate(self.kinds):
+            modulus, section = self.SPRING.get(kind, (None, None))
+            if modulus is None:
+                c[:, col] = 0.0
+                continue
+            with np.errstate(over="ignore", under="ignore"):  # an overflow is refused below
+                factor = v[modulus] / self.built[modulus] * (v[section] / self.built[section])
+                c[:, col] = c[:, col] * factor if math.isfinite(factor) and factor != 0.0 else \
+                    scaled(scaled(c[:, col], modulus), section)
+        b = _scaled(c, v["damping"])
+        if not (np.isfinite(H).all() and np.isfinite(c).all() and np.isfinite(b).all()):
+            given = ", ".join(f"{self.prefix}.{k} = {values[k]!r}" for k in values if values[k] != self.built[k])
+            raise ValueError(f"values: expected values whose rfes' pseudo-inertias, springs and dampers are finite "
+                             f"(the products of the built ones with the ratios overflow), got {given}")
         out = Changes(bodies=list(zip(self.rfes.tolist(), H)))
         for col, slot in enumerate(self.slots):
             for body, k, d in zip(self.sdes.tolist(), c[:, col].tolist(), b[:, col].tolist()):
                 out.coordinates += [(body, slot, -1, "stiffness", k), (body, slot, -1, "damping", d)]
         return out
+
+
+def _scaled(x: np.ndarray, value: float, built: float = 1.0) -> np.ndarray:
+    """x value / built where x is not zero (exact zeros kept: inf times zero would be NaN): x times the ratio, or,
+    when the ratio overflows or underflows (1e300 m⁴ / Iz₀), x / built times value."""
+    x = np.asarray(x, dtype=float)
+    with np.errstate(over="ignore", invalid="ignore", under="ignore", divide="ignore"):
+        ratio = value / built
+        if math.isfinite(ratio) and (ratio != 0.0 or value == 0.0):
+            return np.where(x != 0.0, ratio * x, 0.0)
+        return np.where(x != 0.0, (x / built) * value, 0.0)
 
 
 class BodyGroup(Group):
@@ -236,14 +261,15 @@ def names_argument(names, argument: str, expected: str = "parameter names (Syste
     return list(names)
 
 
-def initial_value(system, name: str):
-    """(part, index) of an initial-value parameter "q0[<coordinate>]" or "qd0[<coordinate>]", or None."""
+def initial_value(system, name: str, argument: str = "sensitivities"):
+    """(part, index) of an initial-value parameter "q0[<coordinate>]" or "qd0[<coordinate>]", or None;
+    ValueError naming ``argument`` when the coordinate is not one of the system's."""
     system = _checks.system(system)
     for part in ("q0", "qd0"):
         if name.startswith(part + "[") and name.endswith("]"):
             coordinate = name[len(part) + 1:-1]
             if coordinate not in system.coordinate_names:
-                raise ValueError(f"sensitivities: expected a free coordinate in {name!r} "
+                raise ValueError(f"{argument}: expected a free coordinate in {name!r} "
                                  f"({_close(coordinate, system.coordinate_names)}), got {coordinate!r}")
             return part, system.coordinate_names.index(coordinate)
     return None
@@ -330,18 +356,24 @@ class Parameters:
         p = self.values[name]
         return abs(p) if p != 0.0 else 1.0
 
-    def profile_pair(self, base, name: str, t0: float, t1: float) -> tuple:
+    def profile_pair(self, base, name: str, t0: float, t1: float, argument: str = "sensitivities") -> tuple:
         """(system at p + h, system at p − h, h) of a profile's number for the central difference over
         [t0, t1] (s), h from ``profile_step``. Where p sits at the edge of the values its profile takes
         (a ramp's fraction at 0.5), the side beyond is refused: the pair moves inward by h, [p, p − 2h]
-        or [p + 2h, p] (the difference is then first order: the derivative at p ∓ h, its error O(h))."""
-        h = self.profile_step(name, t0, t1)
+        or [p + 2h, p] (the difference is then first order: the derivative at p ∓ h, its error O(h)).
+        ValueError naming ``argument`` for a number that cannot change alone (a piece's value of a piecewise
+        drive whose pieces must meet: only a change of both pieces together keeps them meeting)."""
+        try:
+            h = self.profile_step(name, t0, t1)
+        except ValueError as e:
+            raise ValueError(f"{argument}: expected parameters that can change alone, got {name!r}, whose profile "
+                             f"refuses p ± 1e-6 max(|p|, 1) ({e})") from None
         for low, high in ((-1.0, 1.0), (-2.0, 0.0), (0.0, 2.0)):
             try:
                 return self.shifted(base, name, high * h), self.shifted(base, name, low * h), h
             except ValueError:
                 continue
-        raise ValueError(f"sensitivities: expected a parameter whose profile takes values beside "
+        raise ValueError(f"{argument}: expected a parameter whose profile takes values beside "
                          f"{name} = {self.values[name]:g} (p ± {h:.3g}), got none on either side")
 
     def profile_step(self, name: str, t0: float, t1: float) -> float:

@@ -58,6 +58,8 @@ def _spec(system, item, argument: str = "error_on"):
         item = item.origin
     if isinstance(item, Point):
         same_model(item, system, argument, "points and bodies of the model this system was compiled from")
+        if item.body < 0:
+            raise ValueError(f"{argument}: expected points on moving bodies (the ground's do not move), got {item!r}")
         return ("point", int(item.body), np.asarray(item.r, dtype=float))
     if isinstance(item, (int, np.integer)) and not isinstance(item, bool):
         if not 0 <= item < system.nq:

@@ -171,7 +171,7 @@ class Result(Versioned):
     def sensitivity(self, name: str) -> tuple[np.ndarray, np.ndarray]:
         """(∂q/∂p, ∂q̇/∂p), each (len(t), nq), by the parameter or initial value ``name`` the run was asked
         for (``simulate(sensitivities=...)``; units of q and q̇ per unit of the parameter)."""
-        if name not in self.sensitivities:
+        if not isinstance(name, str) or name not in self.sensitivities:
             raise ValueError(f"name: expected one of the sensitivities of this run {list(self.sensitivities)}, "
                              f"got {name!r}")
         S = self.sensitivities[name]
@@ -193,7 +193,7 @@ class Result(Versioned):
         dx = (up - down) / (2.0 * eps[:, None])  # zero where ∂q/∂p is
         params = self.system._parameters
         if parameters_.initial_value(self.system, name) is None and not params.parameter(name).linear:
-            plus, minus, h = params.profile_pair(self.system, name, self.t[0], self.t[-1])
+            plus, minus, h = params.profile_pair(self.system, name, self.t[0], self.t[-1], "name")
             up, down = (dataclasses.replace(self, system=shifted).position(point, frame) for shifted in (plus, minus))
             dx += (up - down) / (2.0 * h)
         return dx

@@ -45,7 +45,7 @@ def directions(system, names, options, t0: float, t1: float, argument: str = "se
     n = system.nq
     for name in names:
         S0 = np.zeros(2 * n)
-        initial = parameters_.initial_value(system, name)
+        initial = parameters_.initial_value(system, name, argument)
         if initial is not None:
             part, k = initial
             S0[k if part == "q0" else n + k] = 1.0
@@ -57,7 +57,7 @@ def directions(system, names, options, t0: float, t1: float, argument: str = "se
             h = params.step(name)
             options.add_sensitivity(params.shifted(system, name, h), None, h, S0)
             continue
-        plus, minus, h = params.profile_pair(system, name, t0, t1)
+        plus, minus, h = params.profile_pair(system, name, t0, t1, argument)
         options.add_sensitivity(plus, minus, h, S0)
     return names
 

@@ -15,6 +15,7 @@ Results and Modes pickle (``rigidfem.base.persistence``).
 from __future__ import annotations
 
 import concurrent.futures
+from concurrent.futures.process import BrokenProcessPool
 import inspect
 import itertools
 import os
@@ -164,14 +165,17 @@ def run_cases(function, cases: list, seeds: list, record_errors: bool, packed: b
         return outcomes
     try:
         return pickle.dumps(outcomes)
-    except Exception:  # noqa: BLE001 (which value does not pickle: each case's own error)
-        if not record_errors:
-            raise
+    except Exception:  # noqa: BLE001, S110 (which value does not pickle: each case's own error, below)
+        pass
     kept = []
-    for value, error, wall in outcomes:
+    for case, (value, error, wall) in zip(cases, outcomes):
         try:
             pickle.dumps(value)
         except Exception as e:  # noqa: BLE001
+            if not record_errors:
+                raise ValueError(f"function: expected return values that pickle with executor='processes' (a "
+                                 f"process sends them back by pickle), got {type(value).__name__} for the case "
+                                 f"{case!r}: {type(e).__name__}: {e}") from None
             value, error = None, (f"{type(e).__name__}: the function's return value does not pickle (a process "
                                   f"sends it back by pickle): {e}")
         kept.append((value, error, wall))
@@ -258,6 +262,9 @@ def _outcomes(function, cases, seeds, executor, record_errors, bar, stop) -> lis
             outcomes.update(zip(b, _unpacked(f.result())))
         elif stop.is_set():
             outcomes.update((k, (None, INTERRUPTED, float("nan"))) for k in b)
+        elif not record_errors and isinstance(f.exception(), BrokenProcessPool):
+            raise ValueError(f"function: expected a function that returns, got one whose worker process died "
+                             f"running the cases {[cases[k] for k in b]!r}: {f.exception()}") from None
         elif not record_errors:
             raise f.exception()  # errors="raise": the case's own exception
         elif isinstance(executor, concurrent.futures.ProcessPoolExecutor):
@@ -376,7 +383,7 @@ def sweep(function: Callable, cases: Sequence[Mapping] | None = None, *, grid: M
         raise ValueError(f"function: expected a callable function(**parameters), got {function!r}")
     if errors not in ("record", "raise"):
         raise ValueError(f"errors: expected 'record' or 'raise', got {errors!r}")
-    if as_frame not in (None, True, False):
+    if as_frame is not None and not isinstance(as_frame, (bool, np.bool_)):
         raise ValueError(f"as_frame: expected None, True or False, got {as_frame!r}")
     cases = _cases(cases, grid)
     if executor == "processes":
