@@ -26,19 +26,26 @@ A user's builder makes the model at a number of elements and a set of deformatio
 
 The refinement runs integrate at atol = tol/20 so that time errors do not blur the differences.
 Errors: a builder that fails, returns no model, other outputs or a model whose coordinates do not
-grow with the elements is a ``ResolveError`` (a ValueError) naming it; so is a tol that no level up to
-``max_elements`` meets (with the best estimate reached). Either carries ``runs`` (every analysis
-made) and ``best`` (the finest level's plan so far, or None).
+grow with the elements is a ``ResolveError`` (a ValueError) naming it; so is an output whose shape
+changes with the resolution (or is empty), and a tol that no level up to ``max_elements`` meets (with
+the best estimate reached). Each carries ``runs`` (every analysis made) and ``best`` (the finest
+level's plan so far, or None). The options passed on to the runs are judged before any run by the
+checks of ``simulate`` and ``static_equilibrium`` (a ValueError naming the option, as they would),
+and a t_end the runs cannot reach within max_steps is refused at once (``PACE_STEPS``): a
+ResolveError naming t_end. A run that fails numerically is a ``SimulationError`` (with its time
+and cause, and the ``runs`` made before it), as ``simulate`` reports it: not a bad argument.
 """
 
 from __future__ import annotations
 
+import inspect
 import re
 import time
 from dataclasses import dataclass, field
 
 import numpy as np
 
+import rigidfem._core as _core  # the compiled core, by its absolute name
 from .._core import Body, Point
 from ..model.model import Model, System
 
@@ -48,6 +55,12 @@ SPACE, TIME, DROP = 0.5, 0.25, 0.25
 REFINEMENT_TIME = 1.0 / 20.0
 #: The deformations resolve tries to drop by default (the modified formulation's).
 DEFORMATIONS = ("bend_y", "bend_z", "torsion")
+#: The first dynamic analysis runs at most this many steps before its pace is judged: a t_end it cannot reach
+#: within max_steps is refused then (at fixed steps: (t_end − t0)/dt > max_steps, as rf.gradient refuses it;
+#: adaptive: (t_end − t0)/max_step > max_steps, or the pace of those steps needing over ``PACE_MARGIN`` times
+#: max_steps), not after max_steps steps. A run that ends within them is the analysis itself.
+PACE_STEPS = 1000
+PACE_MARGIN = 100.0
 
 
 class ResolveError(ValueError):
@@ -130,8 +143,13 @@ def resolve(build, outputs, tol: float, *, t_end: float | None = None, elements:
         The first level m₀ and the budget (the finest level tried).
     deform : tuple of str
         The deformations to keep or drop (default: bend_y, bend_z, torsion).
+    t_eval : array, optional
+        The output times of a simulation (default: 101 over [0, t_end]).
+    load_steps : int
+        ``static_equilibrium``'s load steps (1 to 100,000), for t_end = None.
     **simulate_options
-        Passed to ``rf.simulate`` (method, ...), for every run.
+        Passed to ``rf.simulate`` (method, rtol, atol, max_steps, ...), for every run; judged before
+        any run as simulate judges them. With t_end = None (statics, no simulation) they are refused.
 
     Returns
     -------
@@ -139,8 +157,20 @@ def resolve(build, outputs, tol: float, *, t_end: float | None = None, elements:
 
     Raises
     ------
+    ValueError
+        A bad argument, naming it: resolve's own (tol, elements, load_steps, ...) and the options of
+        simulate, judged by simulate's and static_equilibrium's checks before any run. An unknown
+        option of simulate is a TypeError, as simulate's.
     ResolveError (a ValueError)
-        Bad arguments, a failing builder, outputs it does not return, or no level within the budget.
+        What resolve finds about its arguments with the builder's models: a failing builder, outputs it
+        does not return or whose shape changes with the elements (or is empty), a t_end the first
+        analysis cannot reach within max_steps (judged in its first ``PACE_STEPS`` steps), no level
+        within the budget. ``runs`` holds the analyses made.
+    SimulationError
+        A run that fails numerically (step size underflow, Newton divergence, max_steps reached
+        before t_end, ...): simulate's or static_equilibrium's error, naming the time and the cause,
+        with the analysis (elements, deform) in its message and the analyses made before it in
+        ``runs``.
     """
     from ..base import _checks
 
@@ -158,6 +188,8 @@ def resolve(build, outputs, tol: float, *, t_end: float | None = None, elements:
     if t_end is not None:
         t_end = _checks.scalar(t_end, "t_end", positive=True)
         t_eval = np.linspace(0.0, t_end, 101) if t_eval is None else _checks.vector(t_eval, "t_eval")
+    load_steps = _checks.integer(load_steps, "load_steps", minimum=1, maximum=_max_load_steps())
+    _judge_options(simulate_options, t_end)
     job = _Job(build, names, tol, t_end, t_eval, load_steps, simulate_options)
 
     # 1. elements: m0, 2 m0, ... with every deformation, until a level is estimated within SPACE · tol
@@ -221,6 +253,8 @@ class _Job:
     def __init__(self, build, names, tol, t_end, t_eval, load_steps, options):
         self.build, self.names, self.tol, self.t_end, self.t_eval = build, names, tol, t_end, t_eval
         self.load_steps, self.options, self.runs, self.nq = load_steps, options, [], {}
+        self.shapes = {}     # output name -> (its shape, the analysis it was first seen in)
+        self.paced = False   # the first dynamic analysis's pace judged (PACE_STEPS)
 
     def model(self, m, deform):
         """(system, handles, options) from the builder, checked."""
@@ -257,23 +291,94 @@ class _Job:
         self.nq[deform] = (m, model.nq)
         return model, handles, options
 
-    def solve(self, system, options, atol):
-        """The solution (Result or Equilibrium) and its wall time."""
+    def solve(self, system, options, atol, where):
+        """The solution (Result or Equilibrium) and its wall time. A bad option of the run is a ValueError
+        naming it (the builder, for one of its own options), a numerical failure a SimulationError naming
+        the analysis; the exceptions of the model's own callbacks reach the caller unchanged."""
         from ..analysis.statics import static_equilibrium
+
+        start = time.perf_counter()
+        try:
+            if self.t_end is None:
+                solution = static_equilibrium(system, load_steps=self.load_steps)
+            else:
+                solution = self._simulate(system, {"rtol": 0.0, "atol": atol, **self.options, **options}, where)
+        except ResolveError:
+            raise
+        except _core.SimulationError as e:
+            raise self._failed(e, where) from e
+        except (ValueError, TypeError) as e:
+            named = _named(str(e))
+            if named & set(options) and not named & set(self.options):  # one of the builder's options
+                raise ResolveError(f"build: expected options of simulate for {where}, got {sorted(named & set(options))} "
+                                   f"refused: {type(e).__name__}: {e}", self.runs) from e
+            raise  # simulate's own message, naming the option of resolve's call (or t_end, t_eval)
+        return solution, time.perf_counter() - start
+
+    def _simulate(self, system, kw, where):
+        """simulate(system, t_end, **kw); the first analysis runs PACE_STEPS steps first and refuses a t_end it
+        cannot reach within max_steps (its run, when it ends within them)."""
+        from ..simulation import options as options_
         from ..simulation.integration import simulate
         from ..simulation.result import finished
 
-        start = time.perf_counter()
-        if self.t_end is None:
-            solution = static_equilibrium(system, load_steps=self.load_steps)
-        else:
-            kw = dict(dict(rtol=0.0, atol=atol), **self.options)
-            kw.update(options)
-            solution = finished(simulate(system, self.t_end, t_eval=self.t_eval, **kw),
-                                f"resolve ({len(self.runs)} analyses made)")
-        return solution, time.perf_counter() - start
+        what = f"resolve ({len(self.runs)} analyses made)"
+        if not self.paced:
+            self.paced = True
+            limit = options_.compiled("auto", {"max_steps": kw.get("max_steps", options_.resolve({})["max_steps"])},
+                                      every=True).get("max_steps")  # converted as simulate converts it
+            if limit > PACE_STEPS:
+                try:
+                    return finished(simulate(system, self.t_end, t_eval=self.t_eval,
+                                             **dict(kw, max_steps=PACE_STEPS, error_estimate=False)), what)
+                except _core.SimulationError as e:
+                    if type(e) is not _core.SimulationError or \
+                            not re.search(rf"\bmax_steps = {PACE_STEPS} reached", str(getattr(e, "cause", ""))):
+                        raise  # the run's own failure, the same as the whole run's
+                    self._judge_pace(e, limit, where)
+        return finished(simulate(system, self.t_end, t_eval=self.t_eval, **kw), what)
 
-    def values(self, system, handles, solution) -> list:
+    def _judge_pace(self, error, limit, where):
+        """ResolveError naming t_end when the first analysis, stopped after PACE_STEPS steps, cannot reach it
+        within max_steps = ``limit``."""
+        run, stats = error.result.run, error.result.stats
+        t0, reached, steps = run["t0"], float(getattr(error, "time", np.nan)), int(stats.get("steps", PACE_STEPS))
+        span = self.t_end - t0
+        if run["fixed"]:
+            need = np.ceil(span / float(run["dt"]))
+            if need > limit:
+                raise ResolveError(f"t_end, dt: expected at most max_steps = {limit:,} steps of dt over [t0, t_end], "
+                                   f"got (t_end - t0)/dt = {need:g} steps (t_end = {self.t_end:g} s, dt = "
+                                   f"{float(run['dt']):g} s)", self.runs)
+            return
+        fewest = span / run["max_step"]  # max_step = inf: 0
+        pace = steps * span / (reached - t0) if reached > t0 else np.inf
+        if fewest > limit or not pace <= PACE_MARGIN * limit:
+            why = (f"its steps of at most max_step = {run['max_step']:g} s need at least {fewest:.3g}" if fewest > limit
+                   else f"the first analysis ({where}) reached t = {reached:.6g} s in {steps:,} steps, a pace that "
+                        f"needs about {pace:.3g} steps to t_end (over {PACE_MARGIN:g} times max_steps)")
+            raise ResolveError(f"t_end: expected an end time the runs reach within max_steps = {limit:,} steps, got "
+                               f"{self.t_end:g} s: {why}; lower t_end or raise max_steps", self.runs)
+
+    def _failed(self, error, where):
+        """The run's SimulationError with the analysis named and the runs made; a subclass (a ForceLawError: a
+        ValueError too) as it is, with them as a note."""
+        context = f"resolve: the analysis of {where} failed"
+        if type(error) is _core.SimulationError:
+            message = str(error)
+            failed = _core.SimulationError(f"{context} {message}" if message.startswith("at t = ")
+                                           else f"{context}: {message}")
+            for name in ("time", "cause", "result"):
+                if hasattr(error, name):
+                    setattr(failed, name, getattr(error, name))
+        else:
+            failed = error
+            if hasattr(failed, "add_note"):
+                failed.add_note(f"({context}; {len(self.runs)} analyses made before it)")
+        failed.runs = self.runs
+        return failed
+
+    def values(self, system, handles, solution, where) -> list:
         out = []
         for n in self.names:
             h = handles[n]
@@ -281,30 +386,40 @@ class _Job:
                 point = h.origin if isinstance(h, Body) else h
                 out.append(solution.position(point) if self.t_end is not None else system.position(point, 0.0, solution.q))
             else:
-                out.append(np.asarray(h(system, solution), dtype=float))
+                try:
+                    out.append(np.asarray(h(system, solution), dtype=float))
+                except Exception as e:  # noqa: BLE001 (the user's function: reported with the runs made)
+                    raise ResolveError(f"outputs: expected {n!r} to return an array of numbers for the solution of "
+                                       f"{where}, got {type(e).__name__}: {e}", self.runs) from e
+            shape = out[-1].shape
+            if out[-1].size == 0:
+                raise ResolveError(f"outputs: expected a non-empty array from {n!r}, got shape {shape} (for {where})",
+                                   self.runs)
+            first = self.shapes.setdefault(n, (shape, where))
+            if first[0] != shape:
+                raise ResolveError(f"outputs: expected the same shape of {n!r} at every resolution, got {shape} for "
+                                   f"{where} and {first[0]} for {first[1]}", self.runs)
             if not np.all(np.isfinite(out[-1])):
                 raise ResolveError(f"outputs: expected finite values of {n!r}, got NaN or inf (from the model of "
                                    f"nq = {system.nq})", self.runs)
         return out
 
-    def outputs(self, m, deform, atol) -> list:
+    def analysis(self, m, deform, atol):
+        """(system, handles, solution, wall time, values) of the model at m and deform."""
+        where = f"elements = {m}, deform = {deform}"
         system, handles, options = self.model(m, deform)
-        try:
-            solution, wall = self.solve(system, options, atol)
-            values = self.values(system, handles, solution)
-        except ResolveError:
-            raise
-        except Exception as e:  # noqa: BLE001 (reported with the runs made)
-            raise ResolveError(f"build: the analysis of elements = {m}, deform = {deform} failed: "
-                               f"{type(e).__name__}: {e}", self.runs) from e
+        solution, wall = self.solve(system, options, atol, where)
+        values = self.values(system, handles, solution, where)
+        return system, handles, solution, wall, values
+
+    def outputs(self, m, deform, atol) -> list:
+        system, _, _, wall, values = self.analysis(m, deform, atol)
         self.runs.append({"elements": m, "deform": deform, "nq": system.nq, "wall_time_s": wall,
                           "values": values})
         return values
 
     def final(self, m, deform, atol) -> dict:
-        system, handles, options = self.model(m, deform)
-        solution, wall = self.solve(system, options, atol)
-        values = self.values(system, handles, solution)
+        system, handles, solution, wall, values = self.analysis(m, deform, atol)
         time_error = 0.0
         if self.t_end is not None:
             estimate = solution.error_estimate
@@ -316,6 +431,41 @@ class _Job:
         options = {} if self.t_end is None else {"atol": atol, "rtol": 0.0}
         return {"system": system, "handles": handles, "solution": solution, "cost_s": wall,
                 "time_error": time_error, "options": options}
+
+
+def _judge_options(options: dict, t_end) -> None:
+    """The options resolve passes to simulate, judged before any run by simulate's own checks (what needs no
+    system: the names, the method, each option's conversion; their values against the system are simulate's
+    at the first run, before it integrates); with t_end = None (statics) none is taken."""
+    from ..base import _checks
+    from ..simulation import options as options_
+    from ..simulation.integration import simulate
+
+    if t_end is None:
+        if options:
+            name = next(iter(options))
+            raise ValueError(f"{name}: expected no options of simulate with t_end = None (a static equilibrium, which "
+                             f"takes load_steps), got {name}={options[name]!r}; give t_end to simulate")
+        return
+    method = options.get("method", "auto")
+    options_.method(method)  # ValueError listing the methods
+    run = {p.name for p in inspect.signature(simulate).parameters.values() if p.kind is p.KEYWORD_ONLY}
+    given = options_.resolve({k: v for k, v in options.items() if k not in run and k != "method"})  # TypeError: unknown
+    options_.compiled("dopri5" if method.startswith("scipy:") else method, given, every=True)  # ValueError naming one
+    if "error_estimate" in options:  # simulate judges it after its run
+        _checks.boolean(options["error_estimate"], "error_estimate")
+
+
+def _named(message: str) -> set:
+    """The arguments a ValueError's message names ("rtol, atol: expected ..." -> {"rtol", "atol"})."""
+    match = re.match(r"([A-Za-z_]\w*(?:, ?[A-Za-z_]\w*)*)(?:\[[^\]]*\])?: ", message)
+    return {n.strip() for n in match.group(1).split(",")} if match else set()
+
+
+def _max_load_steps() -> int:
+    from ..analysis.statics import MAX_LOAD_STEPS
+
+    return MAX_LOAD_STEPS
 
 
 def _difference(a: list, b: list) -> float:
