@@ -235,3 +235,61 @@ setTimeout(() => {
     state = _open(host, "")
     assert state.get("inner") == "150"  # the Python side's frame, shown by the page
     assert state.get("saved") == "300" and state.get("shown") == "300"  # the slider's frame, back in the model
+
+
+# -- trails and paths: TypeError ('not iterable', pathlib's) before, ValueError naming the argument now -------
+
+@pytest.fixture(scope="module")
+def pendulum_run():
+    model, h = rf.samples.pendulum()
+    system = model.compile()
+    return h, system, rf.simulate(system, 0.1, method="rk4", dt=0.01, q0=[0.3])
+
+
+def _no_render(anim):
+    anim._draw_was_started = True  # checked, not rendered: no "deleted without rendering" warning
+    import matplotlib.pyplot as plt
+    plt.close("all")
+    return anim
+
+
+def test_trails_of_one_handle_or_a_sequence_are_taken_alike_by_view_and_animate(pendulum_run):
+    """One Point or Body is one trail in both (view refused it: 'Point' object is not iterable)."""
+    h, system, result = pendulum_run
+    for trails, n in (((), 0), (h["tip"], 1), (h["link"], 1), ([h["tip"], h["link"]], 2)):
+        assert len(rf.view(system, result, trails=trails).data["trails"]) == n
+        anim = _no_render(rf.animate(result, trails=trails, frames=2))
+        assert len([line for line in anim._fig.axes[0].lines if line.get_label().startswith("trail")]) == n
+
+
+@pytest.mark.parametrize("trails, said", [(3, "3"), (None, "None"), (1.5, "1.5"), ("tip", "'tip'"),
+                                          ({"tip": 1}, "{'tip': 1}"), (np.float64(2.0), r"np.float64\(2.0\)")])
+def test_trails_that_are_not_handles_or_sequences_are_named(pendulum_run, trails, said):
+    """TypeError ('int' object is not iterable) before; None is refused as for beams and segments (() is none)."""
+    _, system, result = pendulum_run
+    expected = (r"^trails: expected a Point or Body, or a sequence of Point or Body handles \(\(\) for none\), "
+                rf"got {said}$")
+    with pytest.raises(ValueError, match=expected):
+        rf.view(system, result, trails=trails)
+    with pytest.raises(ValueError, match=expected):
+        rf.animate(result, trails=trails, frames=2)
+
+
+def test_bad_items_and_foreign_handles_in_trails_are_named_alike(pendulum_run):
+    _, system, result = pendulum_run
+    foreign = rf.samples.pendulum()[1]["tip"]
+    for call in (lambda tr: rf.view(system, result, trails=tr), lambda tr: rf.animate(result, trails=tr, frames=2)):
+        with pytest.raises(ValueError, match=r"^trails: expected a sequence of Point or Body handles, got None at "
+                                             r"trails\[0\]"):
+            call([None])
+        with pytest.raises(ValueError, match=r"^trails: expected a sequence of Point or Body handles of the model this "
+                                             r"system was compiled from \(trails\[0\]\), got .* of another model"):
+            call([foreign])
+
+
+@pytest.mark.parametrize("wrong, said", [(None, "None"), (3, "3")])
+def test_to_html_names_a_path_that_is_not_one(pendulum_run, wrong, said, tmp_path):
+    _, system, result = pendulum_run
+    with pytest.raises(ValueError, match=rf"^path: expected a file path \(str or os\.PathLike\), got {said}$"):
+        rf.view(system, result).to_html(wrong)
+    assert rf.view(system, result).to_html(str(tmp_path / "v.html")) == tmp_path / "v.html"

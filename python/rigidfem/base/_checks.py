@@ -152,3 +152,13 @@ def boolean(x, name: str) -> bool:
     if not isinstance(x, (bool, np.bool_)):
         raise ValueError(f"{name}: expected True or False, got {x!r}")
     return bool(x)
+
+
+def path(x, name: str = "path"):
+    """``x`` if it is a file path: a non-empty str or an ``os.PathLike`` (``pathlib.Path``); None, numbers, bytes
+    and open files are refused (a ValueError naming ``name``, where ``open`` would raise a TypeError)."""
+    import os
+
+    if isinstance(x, os.PathLike) or (isinstance(x, str) and x):
+        return x
+    raise ValueError(f"{name}: expected a file path (str or os.PathLike), got {_short(x)}")

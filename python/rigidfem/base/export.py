@@ -99,16 +99,11 @@ def to_npz(result, path):
     return path
 
 
-def read_npz(path, system=None) -> dict:
-    """The fields of the Result saved by ``to_npz`` (``rigidfem.load_npz`` builds it), checking
-    that ``system`` (if given) has the coordinate names saved."""
-    if system is not None:
-        system = _checks.system(system)
-    with np.load(path, allow_pickle=False) as f:
+def read_npz(file) -> dict:
+    """The fields of the Result saved by ``to_npz`` in ``file`` (a path or an open binary file), unchecked:
+    ``rigidfem.base.persistence.read_result`` checks the file and the system for ``rigidfem.load_npz``."""
+    with np.load(file, allow_pickle=False) as f:
         names = [str(n) for n in f["coordinate_names"]]
-        if system is not None and list(system.coordinate_names) != names:
-            raise ValueError(f"system: expected a System with the coordinates {names} saved in {path}, got "
-                             f"{list(system.coordinate_names)}")
         return {"t": f["t"], "q": f["q"], "qd": f["qd"], "coordinate_names": names, "stats": json.loads(str(f["stats"])),
                 "method": str(f["method"]), "interrupted": bool(f["interrupted"]),
                 "arm_forces": f["arm_forces"] if "arm_forces" in f.files else None,

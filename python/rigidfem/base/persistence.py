@@ -12,6 +12,10 @@ Every state carries ``STATE_VERSION``; a state written by a newer rigidfem is re
 error rather than misread. What a recipe cannot hold is a Python function that does not pickle
 (a lambda or a closure given as a force law or drive): pickle raises then and names it. Dask
 pickles with cloudpickle, which also takes those.
+
+A Result saved as a NumPy archive (``Result.to_npz``) is read back by ``read_result``
+(``rigidfem.load_npz``): a file that is not such an archive is a ValueError naming ``path``, a missing
+one stays a FileNotFoundError.
 """
 
 from __future__ import annotations
@@ -19,9 +23,14 @@ from __future__ import annotations
 import copy
 import dataclasses
 import functools
+import os
+import zipfile
+import zlib
+from typing import NoReturn
 
 import numpy as np
 
+from . import _checks, export
 from .._core import JointSpec
 
 #: Format of the pickled states; bumped when a state's layout changes.
@@ -96,3 +105,52 @@ class Versioned:
     def __setstate__(self, state: dict) -> None:
         check_version(state, type(self).__name__)
         self.__dict__.update(state["fields"])
+
+
+#: The first bytes of a zip file, hence of a NumPy .npz archive (np.savez writes zip files).
+ZIP_MAGIC = (b"PK\x03\x04", b"PK\x05\x06")
+
+
+def read_result(path, system=None) -> dict:
+    """The fields of the Result that ``Result.to_npz`` saved at ``path`` (a str or ``os.PathLike``), for
+    ``rigidfem.load_npz``; ``system`` (None: without it) must have the coordinate names saved.
+
+    ValueError naming ``system`` (checked first) or ``path``: not a file path (None, 3), or a file that is
+    not such an archive (another file, another archive, one without the arrays of a Result, or with
+    arrays of inconsistent shapes), the cause in parentheses. A file that does not exist stays a
+    FileNotFoundError, one that cannot be read an OSError (Python's convention for files)."""
+    if system is not None:
+        system = _checks.system(system)
+    path = _checks.path(path)
+    # FileNotFoundError, IsADirectoryError, PermissionError: as they are. The file is read through this handle,
+    # which closes whatever happens (np.load leaves its own open when the zip is corrupt)
+    with open(path, "rb") as file:
+        head = file.read(4)
+        if head not in ZIP_MAGIC:
+            _not_a_result(path, f"not a NumPy .npz archive: it begins with {head!r}")
+        file.seek(0)
+        try:
+            fields = export.read_npz(file)
+        except KeyError as e:  # np.load's "x is not a file in the archive"
+            _not_a_result(path, f"an archive without the arrays of a Result: {e.args[0] if e.args else e}", e)
+        except (ValueError, TypeError, EOFError, zipfile.BadZipFile, zlib.error) as e:
+            _not_a_result(path, f"{type(e).__name__}: {e}", e)
+    names, t, q, qd = fields["coordinate_names"], fields["t"], fields["q"], fields["qd"]
+    for name, a in (("t", t), ("q", q), ("qd", qd)):
+        if not np.issubdtype(a.dtype, np.number):
+            _not_a_result(path, f"its {name} holds {a.dtype}, not numbers")
+    if t.ndim != 1:
+        _not_a_result(path, f"its t has shape {t.shape}, expected one dimension")
+    for name, a in (("q", q), ("qd", qd)):
+        if a.shape != (len(t), len(names)):
+            _not_a_result(path, f"its {name} has shape {a.shape}, expected (len(t), len(coordinate_names)) = "
+                                f"{(len(t), len(names))}")
+    if system is not None and list(system.coordinate_names) != names:
+        raise ValueError(f"system: expected a System with the coordinates {names} saved in {path}, got "
+                         f"{list(system.coordinate_names)}")
+    return fields
+
+
+def _not_a_result(path, cause: str, error: BaseException | None = None) -> NoReturn:
+    cause = cause if len(cause) <= 200 else cause[:197] + "..."
+    raise ValueError(f"path: expected a file written by Result.to_npz, got {os.fspath(path)!r} ({cause})") from error

@@ -15,7 +15,7 @@ import rigidfem._core as _core  # the compiled core, by its absolute name
 from . import error_control
 from . import options as options_
 from ..model import parameters as parameters_
-from ..base.persistence import Versioned
+from ..base.persistence import Versioned, read_result
 from .._core import Body, Point
 
 
@@ -221,21 +221,23 @@ class Result(Versioned):
 
     def to_csv(self, path, points=None):
         """Write the table of ``to_dataframe`` as CSV with a header line ``t,<columns>`` (numpy only;
-        17 significant digits). Returns ``path``."""
-        return export.to_csv(self, path, points)
+        17 significant digits) to ``path`` (a str or ``os.PathLike``). Returns ``path``."""
+        return export.to_csv(self, _checks.path(path), points)
 
     def to_npz(self, path):
         """Save t, q, qd, the forward sensitivities (if any), coordinate_names, method, stats and interrupted in a
-        NumPy archive; ``rigidfem.load_npz(path, system)`` reads it back. Returns ``path``."""
-        return export.to_npz(self, path)
+        NumPy archive at ``path`` (a str or ``os.PathLike``); ``rigidfem.load_npz(path, system)`` reads it back.
+        Returns ``path``."""
+        return export.to_npz(self, _checks.path(path))
 
 
 def load_npz(path, system=None) -> Result:
-    """The Result saved by ``Result.to_npz``. Give the ``system`` it was computed with (its
-    coordinate names must match; ValueError otherwise) to use the outputs that need it: positions,
-    energies. Without it, ``t``, ``q``, ``qd``, ``stats``, the sensitivities, ``to_npz`` and the table of
-    coordinates (``to_dataframe``, ``to_csv`` without points) work; what needs the system says so (ValueError)."""
-    return Result(system, **export.read_npz(path, system))
+    """The Result saved by ``Result.to_npz`` at ``path`` (a str or ``os.PathLike``). Give the ``system`` it was
+    computed with (its coordinate names must match; ValueError otherwise) to use the outputs that need it:
+    positions, energies. Without it, ``t``, ``q``, ``qd``, ``stats``, the sensitivities, ``to_npz`` and the table of
+    coordinates (``to_dataframe``, ``to_csv`` without points) work; what needs the system says so (ValueError).
+    A file that is not such an archive is a ValueError naming ``path``; a missing one a FileNotFoundError."""
+    return Result(system, **read_result(path, system))
 
 
 def finished(result: Result, what: str) -> Result:

@@ -15,7 +15,7 @@ from matplotlib.animation import FuncAnimation, writers
 
 from ..base import _checks
 from . import plots
-from .._core import Body, Point
+from .viewer import _trail_points
 
 #: File extension -> matplotlib movie writer.
 WRITERS = {".gif": "pillow", ".mp4": "ffmpeg", ".mov": "ffmpeg", ".avi": "ffmpeg", ".mkv": "ffmpeg",
@@ -73,8 +73,9 @@ def animate(result, *, plane: str | None = None, beams=(), segments=(), trails=(
         Drawn as their deformed centre lines (``plots.shape``).
     segments : sequence of (a, b) pairs of Point or Body
         Straight lines between points: ropes, cylinders, springs (``plots.shape``).
-    trails : sequence of Point or Body
-        Points whose paths are drawn from the start up to the current frame (e.g. ``[beam.tip]``).
+    trails : Point or Body, or a sequence of them
+        Points (a Body: its origin) whose paths are drawn from the start up to the current frame (e.g.
+        ``[beam.tip]``); () (the default) draws none.
     frames : int, optional
         Number of frames, spread evenly over the outputs (at most len(result.t); default up to 100).
     fps : float, optional
@@ -97,10 +98,11 @@ def animate(result, *, plane: str | None = None, beams=(), segments=(), trails=(
     indices = frame_indices(t, frames, fps, result.system.nbodies)
     interval = _real_time(t[indices]) if interval is None else _checks.scalar(interval, "interval", positive=True,
                                                                              unit="ms")
+    points = _trail_points(trails, result.system)
     skeleton = plots.Skeleton(result.system, beams, segments)
     first = skeleton.pose(result.q[indices[0]], t=t[indices[0]], frame_size=frame_size)
     poses = [skeleton.pose(result.q[i], t=t[i], frame_size=first.frame_size) for i in indices]
-    paths = [result.position(p) for p in _points(trails)]
+    paths = [result.position(p) for p in points]
 
     ax = plots._shape_axes(ax, plane)
     shape = plots.ShapeArtists(ax, plane, [b.name for b in skeleton.beams])
@@ -123,20 +125,12 @@ def _real_time(times: np.ndarray) -> float:
     return 1000.0 * step if step > 0 else 40.0
 
 
-def _points(trails) -> list:
-    items = [trails] if isinstance(trails, (Point, Body)) else list(trails)
-    for p in items:
-        if not isinstance(p, (Point, Body)):
-            raise ValueError(f"trails: expected a sequence of Point or Body handles, got {p!r}")
-    return items
-
-
 def save(anim, path, *, fps: float | None = None, dpi: float | None = None) -> Path:
     """Write the animation ``anim`` to ``path``; the extension chooses the writer (``WRITERS``:
     .gif by pillow, .mp4 and others by ffmpeg, .html). ``fps``: frames per second of the file
     (default from the animation's interval); ``dpi``: resolution. Raises ValueError when the
-    extension is unknown or its writer is not installed. Returns the path."""
-    path = Path(path)
+    extension is unknown or its writer is not installed. Returns the path (a ``pathlib.Path``)."""
+    path = Path(_checks.path(path))
     ext = path.suffix.lower()
     if ext not in WRITERS:
         raise ValueError(f"path: expected a file name ending in one of {list(WRITERS)}, got {str(path)!r}")

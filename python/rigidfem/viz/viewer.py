@@ -73,8 +73,9 @@ body {{ margin: 0; font: 13px sans-serif; }}
 """
 
     def to_html(self, path) -> Path:
-        """Writes the page to ``path`` (a file a browser opens offline); returns the path."""
-        path = Path(path)
+        """Writes the page to ``path`` (a str or ``os.PathLike``: a file a browser opens offline); returns it as a
+        ``pathlib.Path``."""
+        path = Path(_checks.path(path))
         path.write_text(self.html(), encoding="utf-8")
         return path
 
@@ -105,8 +106,9 @@ def view(system, result=None, *, trails=(), frames: int | None = None, q=None, t
 
     Parameters
     ----------
-    trails : sequence of Point or Body
-        Points whose paths are drawn from the start up to the frame shown.
+    trails : Point or Body, or a sequence of them
+        Points (a Body: its origin) whose paths are drawn from the start up to the frame shown; () (the
+        default) draws none.
     frames : int, optional
         At most this many frames, spread evenly over the result's outputs (default: every output, as
         many as ``MAX_POSES`` body poses allow: frames × bodies ≤ 2,000,000, a page of about 130 MB).
@@ -140,11 +142,32 @@ def view(system, result=None, *, trails=(), frames: int | None = None, q=None, t
         keep = np.unique(np.round(np.linspace(0, len(times) - 1, min(frames, len(times)))).astype(int))
         times, states = times[keep], states[keep]
     height = _checks.integer(height, "height", minimum=100, maximum=4000)
-    for k, p in enumerate(trails):
+    points = _trail_points(trails, system)
+    return Viewer(_scene(system, times, states, points, str(title)), height)
+
+
+def _trail_points(trails, system) -> list:
+    """The points of ``trails`` (``view``'s and ``animate``'s) as a list: a Point or Body, or a sequence (any
+    iterable but a string or a mapping) of them, all of the model ``system`` was compiled from; () for none
+    (as for ``beams`` and ``segments``; None is refused: a forgotten value, not a choice)."""
+    if isinstance(trails, (Point, Body)):
+        return [trails]
+    items = None
+    if trails is not None and not isinstance(trails, (str, bytes, dict)):
+        try:
+            items = list(trails)
+        except TypeError:  # not iterable (a number): refused below
+            pass
+    if items is None:
+        raise ValueError(f"trails: expected a Point or Body, or a sequence of Point or Body handles (() for none), "
+                         f"got {_checks._short(trails)}")
+    for k, p in enumerate(items):
         if not isinstance(p, (Point, Body)):
-            raise ValueError(f"trails[{k}]: expected a Point or Body of the system's model, got {_checks._short(p)}")
-        _checks.same_model(p, system, f"trails[{k}]")
-    return Viewer(_scene(system, times, states, list(trails), str(title)), height)
+            raise ValueError(f"trails: expected a sequence of Point or Body handles, got {_checks._short(p)} at "
+                             f"trails[{k}]")
+        _checks.same_model(p, system, "trails", "a sequence of Point or Body handles of the model this system was "
+                                                f"compiled from (trails[{k}])")
+    return items
 
 
 def _poses(system, times, states) -> np.ndarray:
