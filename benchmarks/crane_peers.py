@@ -126,7 +126,7 @@ def base_motion(t: float, coordinate: str) -> tuple:
 # ---------------------------------------------------------------------------------------------
 
 def _model(driven: bool, elements: int):
-    steel = rf.Material(E=210e9, rho=7850.0, nu=0.3, damping=2e-3)
+    steel = rf.Material(E=210e9, rho=7850.0, nu=0.3, retardation=2e-3)
     model = rf.Model(gravity=(0.0, 0.0, -G))
     if driven:
         vessel = model.add_moving_base("vessel", {SHIP_NAMES[c]: base_profile(c) for c in BASE})

@@ -393,7 +393,7 @@ def cantilever(elements: int, gravity=(0.0, 0.0, -9.81), damping: float = 1e-6):
     """The compared chain: ``samples.cantilever`` (steel, 1 m, 20 × 5 mm) in the modified
     formulation with bending about y and z and torsion (nq = 3 · elements), Kelvin–Voigt
     retardation time ``damping`` (s), ``gravity`` in m/s². Returns (model, beam)."""
-    material = Material(**STEEL, damping=damping)
+    material = Material(**STEEL, retardation=damping)
     model, handles = samples.cantilever(elements=elements, material=material, formulation="modified",
                                         deform=DEFORM, gravity=gravity)
     return model, handles["beam"]

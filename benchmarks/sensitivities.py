@@ -31,7 +31,7 @@ from rigidfem.studies.study import Table
 
 from ._common import machine, report
 
-NAMES = ("strip.E", "strip.rho", "strip.damping", "push.force")
+NAMES = ("strip.E", "strip.rho", "strip.retardation", "push.force")
 METHODS = {"generalized_alpha": dict(dt=1e-4), "esdirk43": dict(dt=1e-4, adaptive=False), "rk4": dict()}
 T_END = 0.01
 COLUMNS = ("elements", "nq", "method", "parameters", "cpu_s", "per_parameter")

@@ -16,7 +16,7 @@ G = 9.81
 def strip(elements=6):
     """A clamped-hinged 3D steel strip on a sprung revolute joint, a tip load and a spring-damper to the ground."""
     m = rf.Model(gravity=(0.0, -G, 0.0))
-    b = m.add_beam("strip", m.ground, 1.0, rf.Material(E=2e11, rho=7800.0, G=8e10, damping=1e-4),
+    b = m.add_beam("strip", m.ground, 1.0, rf.Material(E=2e11, rho=7800.0, G=8e10, retardation=1e-4),
                    rf.Section.rectangle(0.02, 0.005), elements, joint=rf.Joint.revolute("z", stiffness=5.0),
                    tip_mass=0.1, deform=("bend_z", "torsion", "bend_y"))
     m.add_force(b.tip, (0.0, -1.0, 0.5), name="push")
@@ -71,7 +71,7 @@ def test_the_adjoint_is_the_derivative_of_the_discrete_run():
     equals the one the forward sensitivities give for the same discrete objective to 1e-8 (both are the exact
     derivative of the discrete solution), and J itself equals the run's."""
     s, beam = strip()
-    names = ["strip.E", "strip.rho", "strip.damping", "strip.Iz", "strip.A", "strip.G", "spring.stiffness",
+    names = ["strip.E", "strip.rho", "strip.retardation", "strip.Iz", "strip.A", "strip.G", "spring.stiffness",
              "spring.damping", "push.force", "strip.rfe0.rz.stiffness", f"q0[{s.coordinate_names[0]}]",
              f"qd0[{s.coordinate_names[2]}]"]
     g = rf.gradient(s, 0.02, names, outputs={"p": beam.tip}, running=running, terminal=terminal, dt=1e-4)
@@ -161,7 +161,7 @@ def test_every_method(method, options, rtol):
     """newmark, hht, implicit_spring, radau5 and Krylov Newton matrices: each adjoint against its own forward
     sensitivities (radau5's stage corrections stop at 1e-9 of them, or at the differences' noise)."""
     s, beam = strip(elements=4)
-    names = ["strip.E", "strip.damping", "push.force", f"q0[{s.coordinate_names[1]}]", f"qd0[{s.coordinate_names[3]}]"]
+    names = ["strip.E", "strip.retardation", "push.force", f"q0[{s.coordinate_names[1]}]", f"qd0[{s.coordinate_names[3]}]"]
     g = rf.gradient(s, 0.01, names, method=method, outputs={"p": beam.tip}, running=running, terminal=terminal,
                     dt=1e-4, **options)
     _, expected = forward_gradient(s, beam.tip, names, 0.01, method=method, dt=1e-4, adaptive=False, **options)

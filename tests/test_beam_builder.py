@@ -120,7 +120,7 @@ def test_uniform_rfe_parameters_closed_form(m):
 
 def test_uniform_sde_parameters_closed_form_and_damping():
     L, m, mu = 2.0, 5, 2.5e-4
-    mat, sec = steel(damping=mu), strip()
+    mat, sec = steel(retardation=mu), strip()
     model, beam = cantilever(L, m, mat, sec)
     d = L / m
     E, G = 2.1e11, 2.1e11 / 2.6
@@ -138,7 +138,7 @@ def test_uniform_sde_parameters_closed_form_and_damping():
 def test_springs_and_dampers_sit_on_the_right_coordinates(rng):
     """V = ½ Σ c_k q_k², dissipated power Σ b_k q̇_k² with c, b from the closed forms."""
     L, m, mu = 2.0, 4, 1e-3
-    mat, sec = steel(damping=mu), strip()
+    mat, sec = steel(retardation=mu), strip()
     model, beam = cantilever(L, m, mat, sec, formulation="classical")
     system = model.compile()
     d = L / m
@@ -172,7 +172,7 @@ def test_rfe_parameters_function_directly():
 
 
 def test_sde_parameters_function_directly():
-    mat, sec = rf.Material(E=7e10, rho=2700, G=2.6e10, damping=0.01), rf.Section.circle(0.03)
+    mat, sec = rf.Material(E=7e10, rho=2700, G=2.6e10, retardation=0.01), rf.Section.circle(0.03)
     s = rf.sde_parameters(mat, sec, 1.0, 1.25)
     d = 0.25
     ref = {"axial": 7e10 * sec.A / d, "shear_y": 0.9 * 2.6e10 * sec.A / d, "shear_z": 0.9 * 2.6e10 * sec.A / d,
@@ -305,7 +305,7 @@ def test_material_shear_modulus():
     assert rf.Material(E=2.0e11, rho=7800).G == pytest.approx(2.0e11 / 2.6, rel=1e-14)  # default nu 0.3
     assert rf.Material(E=2.0e11, rho=7800, nu=0.25, G=7.0e10).G == 7.0e10  # G overrides nu
     assert rf.Material(E=2.0e11, rho=7800, G=7.0e10).G == 7.0e10
-    assert rf.Material(E=2.0e11, rho=7800).damping == 0.0
+    assert rf.Material(E=2.0e11, rho=7800).retardation == 0.0
 
 
 # ----------------------------------------------------------------------------------------
@@ -629,7 +629,7 @@ def test_bad_deform(kw):
     (dict(rho=0.0), "rho"), (dict(rho=-7850.0), "rho"),
     (dict(G=0.0), "G"), (dict(G=-1e9), "G"),
     (dict(nu=0.7), "nu"), (dict(nu=-1.0), "nu"),
-    (dict(damping=-1e-3), "damping"),
+    (dict(retardation=-1e-3), "retardation"),
 ])
 def test_bad_material(kw, name):
     _raises(name, steel, **kw)

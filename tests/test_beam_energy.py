@@ -16,7 +16,7 @@ def released_beam(linear, damping=0.0, m=6):
     problem stiff) by an oblique tip force (PL²/EI_z = 2), then drop the force."""
     def build(with_force):
         model = rf.Model(gravity=None)
-        beam = model.add_beam("b", model.ground, L, rf.Material(E, RHO, nu=0.33, damping=damping), SECTION, m,
+        beam = model.add_beam("b", model.ground, L, rf.Material(E, RHO, nu=0.33, retardation=damping), SECTION, m,
                               deform=("bend_z", "bend_y"), linear=linear)
         if with_force:
             P = 2 * E * SECTION.Iz / L**2

@@ -114,7 +114,7 @@ def test_tapered_beam_against_a_converged_reference():
 
 def test_kelvin_voigt_damping_gives_modal_ratio_mu_omega_over_two():
     mu = 2e-4  # retardation time, s
-    system, _ = cantilever(20, "modified", ("bend_z",), material=rf.Material(E, RHO, nu=0.3, damping=mu))
+    system, _ = cantilever(20, "modified", ("bend_z",), material=rf.Material(E, RHO, nu=0.3, retardation=mu))
     modes = rf.modal_analysis(system)
     undamped = rf.modal_analysis(cantilever(20, "modified", ("bend_z",))[0])
     np.testing.assert_allclose(modes.omega[:6], undamped.omega[:6], rtol=1e-6)

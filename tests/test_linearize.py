@@ -27,7 +27,7 @@ def spinning_beam(force=(0, 0, 0), torque=(0, 0, 0), hub_torque=0.0):
     model = rf.Model()
     hub = model.add_body("hub", model.ground, rf.Joint.revolute("z"), mass=1.0, inertia=(1, 1, 1))
     model.prescribe(hub, rf.motion.spin_up(omega=2.0, duration=1.0))
-    mat = rf.Material(E=2e9, rho=2000.0, nu=0.3, damping=1e-3)
+    mat = rf.Material(E=2e9, rho=2000.0, nu=0.3, retardation=1e-3)
     beam = model.add_beam("beam", hub, 1.0, mat, rf.Section.rectangle(0.03, 0.02), 3,
                           deform=("torsion", "bend_y", "bend_z"))
     payload = model.add_body("payload", beam.rfes[-1], rf.Joint.revolute("y", stiffness=20.0, damping=0.5),
@@ -93,7 +93,7 @@ def test_A_B_C_against_finite_differences_away_from_equilibrium():
 
 
 def damped_beam():
-    mat = rf.Material(E=2.1e11, rho=7850.0, nu=0.3, damping=2e-5)
+    mat = rf.Material(E=2.1e11, rho=7850.0, nu=0.3, retardation=2e-5)
     model, h = rf.samples.cantilever(elements=6, material=mat, deform=("bend_z", "bend_y"))
     return model.compile(), h["beam"]
 

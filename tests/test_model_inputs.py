@@ -42,11 +42,11 @@ def block(mass=2.0, stiffness=50.0):
 
 # --- a) numbers that are not numbers --------------------------------------------------------
 
-MATERIAL = dict(E=2.1e11, rho=7850.0, nu=0.3, damping=1e-4)
+MATERIAL = dict(E=2.1e11, rho=7850.0, nu=0.3, retardation=1e-4)
 SECTION = dict(A=1e-4, Iy=1e-9, Iz=2e-9, J=2.5e-9, kappa_y=0.8, kappa_z=0.8)
 
 
-@pytest.mark.parametrize("field", ["E", "rho", "nu", "G", "damping"])
+@pytest.mark.parametrize("field", ["E", "rho", "nu", "G", "retardation"])
 @pytest.mark.parametrize("value", ["7850", b"1", None, NAN, INF, -INF, True, [1.0], 1 + 2j])
 def test_material_fields_must_be_finite_numbers(field, value):
     if value is None and field in ("nu", "G"):
@@ -55,7 +55,7 @@ def test_material_fields_must_be_finite_numbers(field, value):
         rf.Material(**{**MATERIAL, field: value})
 
 
-@pytest.mark.parametrize("field, value", [("E", 0.0), ("E", -1.0), ("rho", 0.0), ("G", -8e10), ("damping", -1e-3),
+@pytest.mark.parametrize("field, value", [("E", 0.0), ("E", -1.0), ("rho", 0.0), ("G", -8e10), ("retardation", -1e-3),
                                           ("nu", 0.6), ("nu", -1.0)])
 def test_material_fields_must_be_physical(field, value):
     with pytest.raises(ValueError, match=rf"^{field}: expected"):
@@ -64,7 +64,7 @@ def test_material_fields_must_be_physical(field, value):
 
 def test_material_stores_the_numbers_it_checked():
     mat = rf.Material(E=np.float32(2e11), rho=np.int64(7850), nu=fractions.Fraction(1, 4))
-    assert all(type(v) is float for v in (mat.E, mat.rho, mat.nu, mat.G, mat.damping))
+    assert all(type(v) is float for v in (mat.E, mat.rho, mat.nu, mat.G, mat.retardation))
     assert mat.rho == 7850.0 and mat.G == pytest.approx(2e11 / (2 * 1.25), rel=1e-7)
     beam_mass = _uniform_beam_mass(mat)
     assert beam_mass == pytest.approx(7850.0 * 1e-4 * 2.0, rel=1e-12)
@@ -355,7 +355,7 @@ def test_a_bad_force_law_in_a_scipy_run_names_the_time():
 
 def long_beam(m, **kw):
     model = rf.Model(gravity=None)
-    mat, sec = rf.Material(E=2.1e11, rho=7850.0, damping=1e-4), rf.Section.rectangle(0.02, 0.005)
+    mat, sec = rf.Material(E=2.1e11, rho=7850.0, retardation=1e-4), rf.Section.rectangle(0.02, 0.005)
     beam = model.add_beam("b", model.ground, 2.0, mat, sec, m, **kw)
     return model, beam, mat, sec
 

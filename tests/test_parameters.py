@@ -20,7 +20,7 @@ def build(E=2e11, Gm=8e10, rho=7800.0, mu=1e-4, A=1e-4, Iy=2.0e-10, Iz=3.3e-9, J
     hub_ = m.add_body("hub", m.ground, rf.Joint.revolute("z", stiffness=k, damping=c), hub, (0.1, 0.1, 0.2),
                       com=(0.05, 0.0, 0.0))
     m.add_generalized_force(hub_, Q)
-    mat = rf.Material(E=E, rho=rho, G=Gm, damping=mu, prony=prony)
+    mat = rf.Material(E=E, rho=rho, G=Gm, retardation=mu, prony=prony)
     b = m.add_beam("strip", hub_, 1.0, mat, rf.Section(A=A, Iy=Iy, Iz=Iz, J=J), 5, tip_mass=tip,
                    placement=rf.transform((0.1, 0.0, 0.0)))
     m.add_spring_damper(b.point(0.5), m.ground, stiffness=ks, damping=cs, length=0.5, name="spring")
@@ -32,7 +32,7 @@ def build(E=2e11, Gm=8e10, rho=7800.0, mu=1e-4, A=1e-4, Iy=2.0e-10, Iz=3.3e-9, J
 
 
 CHANGES = [  # parameter, new value, keyword of build
-    ("strip.E", 1.3e11, "E"), ("strip.G", 3e10, "Gm"), ("strip.rho", 2700.0, "rho"), ("strip.damping", 3e-3, "mu"),
+    ("strip.E", 1.3e11, "E"), ("strip.G", 3e10, "Gm"), ("strip.rho", 2700.0, "rho"), ("strip.retardation", 3e-3, "mu"),
     ("strip.A", 3e-4, "A"), ("strip.Iy", 5e-10, "Iy"), ("strip.Iz", 1e-9, "Iz"), ("strip.J", 2e-9, "J"),
     ("hub.mass", 0.7, "hub"), ("hub.rz.stiffness", 50.0, "k"), ("hub.rz.damping", 0.0, "c"), ("hub.rz.force", -2.0, "Q"),
     ("spring.stiffness", 1e3, "ks"), ("spring.damping", 4.0, "cs"), ("cylinder.force", -1.5, "F0"),
@@ -80,7 +80,7 @@ def test_viscoelastic_and_varying_beams():
     """A Prony beam's E, G and section values also set its Maxwell arms (k_j = E_j c/E): rho and damping only;
     a beam varying along its length has no single E: no beam parameters."""
     s = build(prony=((1e10, 0.01),))
-    assert {"strip.rho", "strip.damping"} <= set(s.parameters) and not {"strip.E", "strip.A"} & set(s.parameters)
+    assert {"strip.rho", "strip.retardation"} <= set(s.parameters) and not {"strip.E", "strip.A"} & set(s.parameters)
     changed, rebuilt = s.with_parameters({"strip.rho": 2000.0}), build(rho=2000.0, prony=((1e10, 0.01),))
     np.testing.assert_array_equal(changed.arms, rebuilt.arms)
     q = np.full(s.nq, 0.05)

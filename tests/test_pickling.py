@@ -12,7 +12,7 @@ import pytest
 import rigidfem as rf
 from rigidfem.base import persistence
 
-MATERIAL = rf.Material(E=2.1e9, rho=7850.0, damping=1e-3)
+MATERIAL = rf.Material(E=2.1e9, rho=7850.0, retardation=1e-3)
 SECTION = rf.Section.rectangle(0.02, 0.004)
 
 

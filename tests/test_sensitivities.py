@@ -98,7 +98,7 @@ def test_closed_loop_sensitivities_converge(method, run):
 def strip(method_deform=("bend_z", "torsion", "bend_y"), tip=0.1, elements=6):
     """A clamped-hinged steel strip on a sprung revolute joint, a tip load and a spring-damper to the ground."""
     m = rf.Model(gravity=(0.0, -G, 0.0))
-    b = m.add_beam("strip", m.ground, 1.0, rf.Material(E=2e11, rho=7800.0, G=8e10, damping=1e-4),
+    b = m.add_beam("strip", m.ground, 1.0, rf.Material(E=2e11, rho=7800.0, G=8e10, retardation=1e-4),
                    rf.Section.rectangle(0.02, 0.005), elements, joint=rf.Joint.revolute("z", stiffness=5.0),
                    tip_mass=tip, deform=method_deform)
     m.add_force(b.tip, (0.0, -1.0, 0.0), name="push")
@@ -114,7 +114,7 @@ def strip(method_deform=("bend_z", "torsion", "bend_y"), tip=0.1, elements=6):
 def test_beam_sensitivities_converge(method, run):
     """A 3D strip: its material, density, damping and section, a spring-damper and a force."""
     s, beam = strip()
-    names = ["strip.E", "strip.rho", "strip.damping", "strip.Iz", "strip.A", "spring.stiffness", "push.force"]
+    names = ["strip.E", "strip.rho", "strip.retardation", "strip.Iz", "strip.A", "spring.stiffness", "push.force"]
     r = _converges(s, names, method, np.linspace(0, 0.02, 5), steps=(1e-2, 1e-3), floor=1e-5, **run)
     # a point's position: (∂x/∂q) ∂q/∂p against the difference of the runs' tip positions
     p, h = 2e11, 2e7
@@ -267,12 +267,12 @@ def test_modal_sensitivities_of_a_cantilever_are_the_closed_forms():
     """K ∝ E and M ∝ ρ, C = μ K (Kelvin–Voigt): ω ∝ √(E/ρ) and ζ = μ ω/2 mode by mode, so dω/dE = ω/(2E),
     dω/dρ = −ω/(2ρ), dζ/dμ = ω/2 and dζ/dE = μ/2 dω/dE exactly."""
     E, rho, mu = 2.1e11, 7850.0, 1e-4
-    model, _ = samples.cantilever(elements=6, material=rf.Material(E=E, rho=rho, nu=0.3, damping=mu),
+    model, _ = samples.cantilever(elements=6, material=rf.Material(E=E, rho=rho, nu=0.3, retardation=mu),
                                   deform=("bend_z", "bend_y"), section=rf.Section.rectangle(0.02, 0.005))
-    m = rf.modal_analysis(model.compile(), sensitivities=["beam.E", "beam.rho", "beam.damping"])
+    m = rf.modal_analysis(model.compile(), sensitivities=["beam.E", "beam.rho", "beam.retardation"])
     w = m.omega
     for name, dw, dz in [("beam.E", w / (2 * E), mu * w / (4 * E)), ("beam.rho", -w / (2 * rho), -mu * w / (4 * rho)),
-                         ("beam.damping", 0 * w, w / 2)]:
+                         ("beam.retardation", 0 * w, w / 2)]:
         got_w, got_z = m.sensitivity(name)
         np.testing.assert_allclose(got_w, dw, rtol=1e-10, atol=1e-12 * np.max(np.abs(w / (2 * E))))
         np.testing.assert_allclose(got_z, dz, rtol=1e-10, atol=1e-300)

@@ -93,7 +93,7 @@ def nearest_distance(computed, expected):
 
 def test_kelvin_voigt_damps_every_mode_with_zeta_mu_omega_over_2():
     mu = 2e-4  # s
-    system, _ = beam_system(rf.Material(E=70e9, rho=2700.0, nu=0.3, damping=mu))
+    system, _ = beam_system(rf.Material(E=70e9, rho=2700.0, nu=0.3, retardation=mu))
     relaxed, _ = beam_system(rf.Material(E=70e9, rho=2700.0, nu=0.3))
     omega = rf.modal_analysis(relaxed).omega
     lam = np.linalg.eigvals(rf.linearize(system, np.zeros(system.nq)).A)
@@ -145,7 +145,7 @@ def test_zener_material_and_relaxation_fit():
 
 def test_energy_balance_of_a_zener_beam_in_large_amplitude_vibration():
     # A thin strip falling from straight under gravity: the tip swings by a good fraction of L.
-    mat = rf.Material(E=2e9, rho=1200.0, nu=0.35, damping=1e-4, prony=((1e9, 0.02), (0.5e9, 0.2)))
+    mat = rf.Material(E=2e9, rho=1200.0, nu=0.35, retardation=1e-4, prony=((1e9, 0.02), (0.5e9, 0.2)))
     model = rf.Model()
     beam = model.add_beam("b", model.ground, 1.0, mat, rf.Section.rectangle(0.02, 0.002), 8, formulation="modified",
                           deform=("bend_y",))

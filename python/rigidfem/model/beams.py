@@ -229,7 +229,7 @@ def _sde_table(mat: Property, sec: Property, start, end) -> _SdeTable:
         return [1.0 / (E * A), 1.0 / (ky * G * A), 1.0 / (kz * G * A), 1.0 / (G * J), 1.0 / (E * Iy), 1.0 / (E * Iz)]
 
     middle = 0.5 * (np.atleast_1d(np.asarray(start, dtype=float)) + np.atleast_1d(np.asarray(end, dtype=float)))
-    mu = mat.sample(middle, ("damping",))[0]
+    mu = mat.sample(middle, ("retardation",))[0]
     # An overflow (a stiffness of inf, and 0 · inf damping) is refused by add_body, naming the argument.
     with np.errstate(over="ignore", divide="ignore", invalid="ignore"):
         c = (1.0 / _integrate(compliance, start, end, mat.breakpoints + sec.breakpoints)).T

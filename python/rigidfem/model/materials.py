@@ -25,9 +25,10 @@ class Material:
         Poisson's ratio; gives G = E / (2 (1 + nu)). Default 0.3 when G is not given.
     G : float, optional
         Shear modulus, Pa (overrides nu).
-    damping : float
-        Retardation time μ of the Kelvin–Voigt law σ = E (ε + μ ε̇), s. Each sde damper
-        is b_k = μ c_k, so mode n is damped with ζ_n = μ ω_n / 2.
+    retardation : float
+        Retardation time μ of the Kelvin–Voigt law σ = E (ε + μ ε̇), s (default 0: no material
+        damping). Each sde damper is b_k = μ c_k (N·s/m or N·m·s/rad), so mode n is damped with
+        ζ_n = μ ω_n / 2.
     prony : sequence of (E_j, tau_j)
         Maxwell arms (Pa, s) in parallel with the spring E: the relaxation modulus is
         E(t) = E + Σ E_j e^{−t/τ_j}, so ``E`` is the long-term (relaxed) modulus E∞ and
@@ -41,7 +42,7 @@ class Material:
     rho: float
     nu: float | None = None
     G: float | None = None
-    damping: float = 0.0
+    retardation: float = 0.0
     prony: tuple = ()
 
     def __post_init__(self):
@@ -49,7 +50,7 @@ class Material:
         # not stored to fail later).
         E = _checks.scalar(self.E, "E", positive=True, unit="Pa (Young's modulus)")
         rho = _checks.scalar(self.rho, "rho", positive=True, unit="kg/m³ (density)")
-        damping = _checks.scalar(self.damping, "damping", nonnegative=True, unit="s (retardation time)")
+        retardation = _checks.scalar(self.retardation, "retardation", nonnegative=True, unit="s (retardation time)")
         nu = None if self.nu is None else _checks.scalar(self.nu, "nu", unit="(-1, 0.5] (Poisson's ratio)")
         if nu is not None and not -1.0 < nu <= 0.5:
             raise ValueError(f"nu: expected Poisson's ratio in (-1, 0.5], got {nu}")
@@ -58,7 +59,8 @@ class Material:
         else:
             G = E / (2.0 * (1.0 + (0.3 if nu is None else nu)))
         prony = _prony_terms(self.prony)
-        for name, value in (("E", E), ("rho", rho), ("nu", nu), ("G", G), ("damping", damping), ("prony", prony)):
+        for name, value in (("E", E), ("rho", rho), ("nu", nu), ("G", G), ("retardation", retardation),
+                            ("prony", prony)):
             object.__setattr__(self, name, value)
 
     @classmethod

@@ -6,7 +6,7 @@ Every builder declares the constants it was given as parameters named ``"<what>.
 - ``<beam>.E``, ``.G`` (Pa): Young's and shear modulus, the sde springs (E: axial and bending, G: shear
   and torsion); E leaves G as it is.
 - ``<beam>.rho`` (kg/m³): density, the rfes' masses and inertias (a tip mass stays).
-- ``<beam>.damping`` (s): retardation time μ of the Kelvin–Voigt dampers b = μ c.
+- ``<beam>.retardation`` (s): retardation time μ of the Kelvin–Voigt dampers b = μ c.
 - ``<beam>.A``, ``.Iy``, ``.Iz``, ``.J`` (m², m⁴): section values, the springs (EA, κGA, E Iy, E Iz, GJ)
   and the rfes' inertias (A: mass and ∫x² dm; Iy and Iz: rotary inertia).
 - ``<body>.mass`` (kg): a rigid body's mass, its centre of mass and inertia about it kept.
@@ -111,7 +111,7 @@ def _parameter(prefix, name, value, unit, description, positive=False) -> tuple[
 
 
 class BeamGroup(Group):
-    """A uniform beam's E, G, rho, damping and section values (``Model.add_beam``).
+    """A uniform beam's E, G, rho, retardation and section values (``Model.add_beam``).
 
     Its rfes' pseudo-inertias are H = (ρ/ρ₀) [(A/A₀) H_A + (Iz/Iz₀) H_z + (Iy/Iy₀) H_y] + H_tip, the parts
     ∝ ρA (mass, ∫x dm, ∫x² dm), ∝ ρ Iz (∫y² dm) and ∝ ρ Iy (∫z² dm) at the built values; its sde springs
@@ -123,16 +123,16 @@ class BeamGroup(Group):
               "bend_y": ("E", "Iy"), "bend_z": ("E", "Iz")}
 
     def __init__(self, prefix, material, section, viscoelastic, rfes, H, H_tip, sdes, slots, kinds, stiffness):
-        names = ("rho", "damping") if viscoelastic else ("E", "G", "rho", "damping", "A", "Iy", "Iz", "J")
+        names = ("rho", "retardation") if viscoelastic else ("E", "G", "rho", "retardation", "A", "Iy", "Iz", "J")
         info = {"E": ("Pa", "Young's modulus: the axial and bending springs", True),
                 "G": ("Pa", "shear modulus: the shear and torsion springs", True),
                 "rho": ("kg/m³", "density: the rfes' masses and inertias", True),
-                "damping": ("s", "retardation time of the Kelvin-Voigt dampers b = damping * c", False),
+                "retardation": ("s", "retardation time of the Kelvin-Voigt dampers b = retardation * c", False),
                 "A": ("m²", "area: the axial and shear springs, the rfes' masses", True),
                 "Iy": ("m⁴", "second moment about y: the bend_y springs, the rfes' rotary inertia", True),
                 "Iz": ("m⁴", "second moment about z: the bend_z springs, the rfes' rotary inertia", True),
                 "J": ("m⁴", "torsion constant: the torsion springs", True)}
-        built = {"E": material.E, "G": material.G, "rho": material.rho, "damping": material.damping,
+        built = {"E": material.E, "G": material.G, "rho": material.rho, "retardation": material.retardation,
                  "A": section.A, "Iy": section.Iy, "Iz": section.Iz, "J": section.J}
         super().__init__(prefix, dict(_parameter(prefix, k, built[k], *info[k]) for k in names))
         self.built = built
@@ -163,7 +163,7 @@ class BeamGroup(Group):
                 factor = v[modulus] / self.built[modulus] * (v[section] / self.built[section])
                 c[:, col] = c[:, col] * factor if math.isfinite(factor) and factor != 0.0 else \
                     scaled(scaled(c[:, col], modulus), section)
-        b = _scaled(c, v["damping"])
+        b = _scaled(c, v["retardation"])
         if not (np.isfinite(H).all() and np.isfinite(c).all() and np.isfinite(b).all()):
             given = ", ".join(f"{self.prefix}.{k} = {values[k]!r}" for k in values if values[k] != self.built[k])
             raise ValueError(f"values: expected values whose rfes' pseudo-inertias, springs and dampers are finite "
