@@ -3204,7 +3204,7 @@ class Gen:
                 if self.chance(0.5):
                     rao = A(self.rao_maker())
                 else:
-                    rao = self.number(["1.0", "0.0", "1e300"], ["-1.0", "nan", "'x'", "None"], names=("rao",))
+                    rao = self.number(["1.0", "0.0"], ["-1.0", "nan", "'x'", "None"], soft=["1e300"], names=("rao",))
                     if self.on("sea_overflow") and self.chance(0.2):
                         rao = A("rf.sea.RAO.constant(1e308)", soft=True, names=("rao",))  # may overflow a_k |H|
                 if rao["e"] in getattr(self, "_rao_faulty", ()):

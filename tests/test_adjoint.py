@@ -383,3 +383,21 @@ def strip_lagrange():
     m = rf.Model(gravity=(0.0, -G, 0.0))
     m.add_beam("strip", m.ground, 1.0, rf.Material(E=2e11, rho=7800.0), rf.Section.rectangle(0.02, 0.005), 2)
     return m.compile("lagrange")
+
+
+@pytest.mark.parametrize("method", ["generalized_alpha", "newmark", "hht", "implicit_spring"])
+def test_a_step_whose_iterate_overflows_is_a_simulation_error(method):
+    """dt = 1e300 s is a valid step whose Newton predictor overflows: the run fails as Newton does (a
+    SimulationError at the step's time saying to reduce dt), in simulate and in rf.gradient's forward run (a
+    ValueError 'q: expected ... finite values' from deep inside before)."""
+    model = rf.Model(None)
+    body = model.add_body("b", model.ground, rf.Joint.universal(("z", "x")), 2.0, (0.2, 0.3, 0.1))
+    model.add_force(body.origin, (-1e6, 0.0, 3e5))
+    s = model.compile()
+    with pytest.raises(rf.SimulationError, match="reduce dt") as caught:
+        rf.simulate(s, 1e300, method, dt=1e300)
+    assert caught.value.time == 0.0
+    if method != "implicit_spring":  # (rf.gradient's methods: the Newmark family)
+        with pytest.raises(rf.SimulationError, match="reduce dt"):
+            rf.gradient(s, 1e300, ["b.mass"], outputs={"p": body.point((0.0, 1.0, 0.0))},
+                        terminal=lambda y: float(np.sum(y["p"] ** 2)), dt=1e300, method=method)

@@ -479,6 +479,9 @@ void Adjoint::forward(double t0, double t_end, const VecX& q0, const VecX& qd0) 
     interruption_point();
     steps_->step(t_[k], t_[k + 1] - t_[k]);
     StepRecord r = steps_->record(t_[k + 1], t_[k + 1] - t_[k]);
+    if (!r.q.allFinite() || !r.v.allFinite())
+      throw SimulationError(t_[k + 1], "the state became NaN or inf (step dt = " + num(t_[k + 1] - t_[k]) +
+                                           " s); reduce dt");
     outputs_at(k + 1, r.q, r.v);
     if ((k + 1) % interval_ == 0) checkpoints_.push_back(std::move(r));
   }

@@ -183,6 +183,7 @@ class NewmarkFamily final : public NewmarkStepper {
       for (int it = 0; it < max_it_; ++it) {
         interruption_point();
         update(h, s, s1);
+        if (!s1.q.allFinite() || !s1.v.allFinite()) break;  // a step so long that the iterate overflows
         const VecX r = residual(t + h, s1);
         VecX dx = spring_now_ ? spring_correction(h, r, bp, gp) : tangent_correction(t + h, h, r, bp, gp, it == 0);
         if (sys_.nl > 0) close_loops_correction(h * h * bp, s1, dx);

@@ -285,13 +285,15 @@ def _alone(function, cases, seeds, indices, stop) -> dict:
             out[k] = (None, INTERRUPTED, float("nan"))
             continue
         with concurrent.futures.ProcessPoolExecutor(1) as pool:
+            start = time.perf_counter()
             try:
                 out[k] = _unpacked(pool.submit(run_cases, function, [cases[k]], [seeds[k]], True, True).result())[0]
             except KeyboardInterrupt:
                 stop.set()
                 out[k] = (None, INTERRUPTED, float("nan"))
-            except Exception as e:  # noqa: BLE001 (the process died: this case's failure)
-                out[k] = (None, f"{type(e).__name__}: {e} (the case's worker process died)", float("nan"))
+            except Exception as e:  # noqa: BLE001 (the process died: this case's failure, timed until then)
+                out[k] = (None, f"{type(e).__name__}: {e} (the case's worker process died)",
+                          time.perf_counter() - start)
     return out
 
 
