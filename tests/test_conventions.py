@@ -137,3 +137,48 @@ def test_one_bad_option_is_named_before_a_pair_that_is_wrong_only_together():
         rf.simulate(system, 0.01, method="scipy:Radau", dt=0.01, rtol=0.0, atol=0.0, max_steps=0)
     with pytest.raises(ValueError, match="^atol: expected positive values when rtol is zero"):
         rf.simulate(system, 0.01, rtol=0.0, atol=0.0)
+
+
+def _refusals(tree):
+    """(line, message template) of every refusal a module makes: the first argument of ``_checks.refuse`` and
+    of ResolveError, its f-string's fields written {}."""
+    import ast
+
+    def template(node):
+        if isinstance(node, ast.Constant) and isinstance(node.value, str):
+            return node.value
+        if isinstance(node, ast.JoinedStr):
+            return "".join(v.value if isinstance(v, ast.Constant) else "{}" for v in node.values)
+        if isinstance(node, ast.BinOp) and isinstance(node.op, ast.Add):  # "..." + "..."
+            left, right = template(node.left), template(node.right)
+            return None if left is None or right is None else left + right
+        return None
+
+    for node in ast.walk(tree):
+        if isinstance(node, ast.Call) and node.args and (
+                (isinstance(node.func, ast.Attribute) and node.func.attr == "refuse") or
+                (isinstance(node.func, ast.Name) and node.func.id == "ResolveError")):
+            yield node.lineno, template(node.args[0])
+
+
+def test_every_refusal_of_the_python_layer_is_one_form_through_one_function():
+    """The Python layer refuses through ``_checks.refuse`` only (no module raises a ValueError of its own; a
+    ResolveError carries the runs too), and every message has the contract's form, "<argument>: expected ...",
+    as the core's do: checked on the source, so that a new refusal is held to it without a test of its own."""
+    import ast
+
+    argument = r"([A-Za-z_{][\w.{}]*(\[[^\]]*\])?)"  # a name, a field ({name}, frame_{name}), an element (cases[0])
+    form = re.compile(rf"^{argument}(, ?{argument})*: expected ")
+    own, bad, count = [], [], 0
+    for path in sorted((ROOT / "python" / "rigidfem").rglob("*.py")):
+        source = path.read_text()
+        where = path.relative_to(ROOT)
+        if path.name != "_checks.py":
+            own += [f"{where}:{n}" for n, line in enumerate(source.splitlines(), 1) if "raise ValueError(" in line]
+        for line, message in _refusals(ast.parse(source)):
+            count += 1
+            if message is None or not form.match(message):
+                bad.append(f"{where}:{line}: {message!r}")
+    assert not own, f"ValueErrors raised outside _checks.refuse: {own}"
+    assert count > 150, count  # (the scan sees them)
+    assert not bad, "refusals not of the form '<argument>: expected ...':\n" + "\n".join(bad)

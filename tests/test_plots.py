@@ -303,6 +303,6 @@ def test_save_refuses_unknown_extensions_and_missing_writers(pendulum, tmp_path,
     with pytest.raises(ValueError, match=r"path: expected a file name ending in one of \['.gif'"):
         animation.save(anim, tmp_path / "movie.xyz")
     monkeypatch.setattr(animation.writers, "is_available", lambda name: False)
-    with pytest.raises(ValueError, match=r"path: no movie writer for '.mp4' is available \('ffmpeg'"):
+    with pytest.raises(ValueError, match=r"path: expected a format whose movie writer is available, got '.mp4', whose writer 'ffmpeg'"):
         animation.save(anim, tmp_path / "movie.mp4")
     assert not (tmp_path / "movie.mp4").exists()

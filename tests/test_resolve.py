@@ -113,7 +113,7 @@ def test_resolve_bad_input_keeps_the_runs():
             raise RuntimeError("no mesh")
         return build(m, deform)
 
-    with pytest.raises(rf.ResolveError, match=r"build: failed for elements = 8.*RuntimeError: no mesh") as caught:
+    with pytest.raises(rf.ResolveError, match=r"build: expected a function that makes the model, got one that failed for elements = 8.*RuntimeError: no mesh") as caught:
         rf.resolve(failing, "tip", tol=1e-4)
     assert len(caught.value.runs) == 1 and caught.value.runs[0]["elements"] == 4  # nothing lost
 

@@ -108,15 +108,15 @@ def gradient(system, t_end: float, parameters=None, *, outputs, running=None, te
     system = _checks.system(system)
 
     if not isinstance(method, str) or method not in METHODS:
-        raise ValueError(f"method: expected one of {list(METHODS)} (the methods with an adjoint), got {method!r}")
+        raise _checks.refuse(f"method: expected one of {list(METHODS)} (the methods with an adjoint), got {method!r}")
     if dt is None:
-        raise ValueError("dt: expected a fixed step (s) > 0: the adjoint runs at fixed steps, got None")
+        raise _checks.refuse("dt: expected a fixed step (s) > 0: the adjoint runs at fixed steps, got None")
     specs, names = _outputs(system, outputs)
     if running is None and terminal is None:
-        raise ValueError("running: expected a function L(t, y) or a terminal Φ(y) (or both), got neither")
+        raise _checks.refuse("running: expected a function L(t, y) or a terminal Φ(y) (or both), got neither")
     for f, argument in ((running, "running"), (terminal, "terminal")):
         if f is not None and not callable(f):
-            raise ValueError(f"{argument}: expected a function or None, got {f!r}")
+            raise _checks.refuse(f"{argument}: expected a function or None, got {f!r}")
     t0 = _checks.scalar(t0, "t0")
     t_end = _checks.scalar(t_end, "t_end")
     memory = _checks.scalar(memory, "memory", positive=True, unit="bytes")
@@ -126,7 +126,7 @@ def gradient(system, t_end: float, parameters=None, *, outputs, running=None, te
     given = options_.resolve(options) and options  # TypeError naming an unknown option
     for name in ("adaptive", "error_on"):
         if given.get(name) is not None:
-            raise ValueError(f"{name}: expected None: the adjoint runs at fixed steps dt, got {given[name]!r}")
+            raise _checks.refuse(f"{name}: expected None: the adjoint runs at fixed steps dt, got {given[name]!r}")
     given = {**given, "dt": dt, "adaptive": False}
     opt = options_.compiled(method, given)  # what the method reads; every option given judged:
     _core._check_options(system, t0, t_end, q0, qd0, np.empty(0), options_.compiled(method, given, every=True))
@@ -149,15 +149,15 @@ def gradient(system, t_end: float, parameters=None, *, outputs, running=None, te
 def _outputs(system, outputs) -> tuple[list, list]:
     """The C++ specs and names of ``outputs`` (a dict of points, bodies and free coordinates)."""
     if not isinstance(outputs, dict) or not outputs:
-        raise ValueError(f"outputs: expected a dict {{name: Point, Body or coordinate}} with at least one output, "
+        raise _checks.refuse(f"outputs: expected a dict {{name: Point, Body or coordinate}} with at least one output, "
                          f"got {outputs!r}")
     specs = []
     for name, item in outputs.items():
         if not isinstance(name, str):
-            raise ValueError(f"outputs: expected names (str) as keys, got {name!r}")
+            raise _checks.refuse(f"outputs: expected names (str) as keys, got {name!r}")
         kind, index, r = error_control._spec(system, item, "outputs")
         if kind not in ("point", "coordinate"):
-            raise ValueError(f"outputs: expected points, bodies or free coordinates, got the {kind} {item!r}")
+            raise _checks.refuse(f"outputs: expected points, bodies or free coordinates, got the {kind} {item!r}")
         specs.append((kind, index, r))
     return specs, list(outputs)
 
@@ -222,9 +222,9 @@ def _values(x, shape, argument, expected) -> np.ndarray:
     try:
         a = np.asarray(x, dtype=float)
     except (TypeError, ValueError):
-        raise ValueError(f"{argument}: expected {expected} (finite real numbers), got {_checks._short(x)}") from None
+        raise _checks.refuse(f"{argument}: expected {expected} (finite real numbers), got {_checks._short(x)}") from None
     if a.shape != shape or not np.isfinite(a).all():
-        raise ValueError(f"{argument}: expected {expected} (finite real numbers, shape {shape}), got "
+        raise _checks.refuse(f"{argument}: expected {expected} (finite real numbers, shape {shape}), got "
                          f"{_checks._short(x)}")
     return a
 

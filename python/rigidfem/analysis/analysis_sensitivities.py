@@ -30,6 +30,7 @@ from __future__ import annotations
 import numpy as np
 
 from ..model import parameters as parameters_
+from ..base import _checks
 
 
 def _changed(system, name: str, argument: str):
@@ -37,7 +38,7 @@ def _changed(system, name: str, argument: str):
     profile (a motion in time: statics and modes hold the drives at t)."""
     params = system._parameters
     if not params.parameter(name, argument).linear:
-        raise ValueError(f"{argument}: expected a constant's parameter (statics and modes at one t), got the "
+        raise _checks.refuse(f"{argument}: expected a constant's parameter (statics and modes at one t), got the "
                          f"profile's {name!r}")
     h = params.step(name)
     return params.shifted(system, name, h), h
@@ -73,7 +74,7 @@ def modal(system, names: list[str], matrices, undamped) -> dict[str, tuple[np.nd
     Ks, D, G = 0.5 * (K + K.T), 0.5 * (C + C.T), 0.5 * (C - C.T)
     scale = np.sqrt(max(np.max(np.abs(K)), 1e-300) * np.max(np.abs(M)))
     if np.max(np.abs(G)) > 1e-9 * scale or np.max(np.abs(K - K.T)) > 1e-6 * np.max(np.abs(K)):
-        raise ValueError("sensitivities: expected modes without gyroscopic or circulatory terms (the derivatives of "
+        raise _checks.refuse("sensitivities: expected modes without gyroscopic or circulatory terms (the derivatives of "
                          "a spinning or non-conservative system's modes are not implemented), got a skew part in C "
                          "or K")
     w2, Phi = undamped(Ks, 0.5 * (M + M.T))

@@ -56,7 +56,7 @@ class Modes(Versioned):
     def sensitivity(self, name: str) -> tuple[np.ndarray, np.ndarray]:
         """(dω/dp, dζ/dp), each (k,), by the parameter ``name`` (``modal_analysis(sensitivities=...)``)."""
         if name not in self.sensitivities:
-            raise ValueError(f"name: expected one of the sensitivities asked for {list(self.sensitivities)}, got {name!r}")
+            raise _checks.refuse(f"name: expected one of the sensitivities asked for {list(self.sensitivities)}, got {name!r}")
         return self.sensitivities[name]
 
     def _repr_html_(self) -> str:

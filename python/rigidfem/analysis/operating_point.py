@@ -13,6 +13,7 @@ from scipy.linalg import lapack
 from ..base import _interrupt
 import rigidfem._core as _core  # the compiled core, by its absolute name
 from .._core import SimulationError
+from ..base import _checks
 
 # The dense LAPACK routines of the analyses, answering Ctrl-C while they run (_interrupt).
 _eigh = _interrupt.eigh
@@ -206,7 +207,7 @@ def _loop_tangent(system, q: np.ndarray, qd: np.ndarray, t: float, K: np.ndarray
     _require_finite(t, what, **{"loop Jacobian G": G, "g(q)": g, "ġ": gd})
     for name, v in (("q", g), ("qd", gd)):
         if np.max(np.abs(v)) > tol:
-            raise ValueError(
+            raise _checks.refuse(
                 f"{name}: expected {'coordinates' if name == 'q' else 'rates'} that close every loop of "
                 f"{system.loop_names} (max |g{'' if name == 'q' else 'd'}| = {np.max(np.abs(v)):.3g} > {tol:g} in "
                 f"{_worst_loop(system, v)}); rigidfem.static_equilibrium or system.assemble(q, qd, t=t) finds them")

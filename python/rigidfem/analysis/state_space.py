@@ -194,19 +194,19 @@ def _named(specs, what: str) -> list:
     """[(name or None, spec)] of a dict of specs, a sequence of them, or one spec."""
     if isinstance(specs, dict):
         if not all(isinstance(k, str) for k in specs):
-            raise ValueError(f"{what}: expected names (str) as the keys of the dict, got {list(specs)!r}")
+            raise _checks.refuse(f"{what}: expected names (str) as the keys of the dict, got {list(specs)!r}")
         return list(specs.items())
     if isinstance(specs, str) or (isinstance(specs, tuple) and specs and specs[0] in _KINDS):
         return [(None, specs)]  # one spec
     if not isinstance(specs, (list, tuple)):
-        raise ValueError(f"{what}: expected a list or dict of specs, got {specs!r}")
+        raise _checks.refuse(f"{what}: expected a list or dict of specs, got {specs!r}")
     return [(None, s) for s in specs]
 
 
 def _coordinate(system, name: str, what: str) -> int:
     names = system.coordinate_names
     if name not in names:
-        raise ValueError(f"{what}: expected a coordinate name, one of {names}, got {name!r}")
+        raise _checks.refuse(f"{what}: expected a coordinate name, one of {names}, got {name!r}")
     return names.index(name)
 
 
@@ -214,10 +214,10 @@ def _point(system, point, what: str) -> Point:
     if isinstance(point, Body):
         point = point.origin
     if not isinstance(point, Point):
-        raise ValueError(f"{what}: expected a Point or Body of this system's model, got {point!r}")
+        raise _checks.refuse(f"{what}: expected a Point or Body of this system's model, got {point!r}")
     _checks.same_model(point, system, what)
     if not 0 <= point.body < system.nbodies:
-        raise ValueError(f"{what}: expected a Point or Body of this system's model, got {point!r}")
+        raise _checks.refuse(f"{what}: expected a Point or Body of this system's model, got {point!r}")
     return point
 
 
@@ -230,11 +230,11 @@ def _direction(x, what: str) -> tuple[np.ndarray, str]:
     """(d (3,), label) of an axis "x", "y", "z" or a global direction (3,), not zero."""
     if isinstance(x, str):
         if x not in _AXES:
-            raise ValueError(f"{what}: expected 'x', 'y', 'z' or a direction (3,), got {x!r}")
+            raise _checks.refuse(f"{what}: expected 'x', 'y', 'z' or a direction (3,), got {x!r}")
         return np.array(_AXES[x]), x
     d = _checks.vec3(x, what)
     if not np.any(d):
-        raise ValueError(f"{what}: expected a non-zero direction (3,), got {x!r}")
+        raise _checks.refuse(f"{what}: expected a non-zero direction (3,), got {x!r}")
     return d, "(" + ", ".join(f"{v:g}" for v in d) + ")"
 
 
@@ -269,12 +269,12 @@ def _inputs(system, q, t, inputs) -> tuple[list[str], np.ndarray]:
             col, auto = _point_jacobian(system, p, q, t).T @ d, f"force {_label(system, p)}·{label}"
         elif isinstance(spec, tuple) and len(spec) == 3 and spec[0] == "torque":  # Q = J_ωᵀ a
             if not isinstance(spec[1], Body) or spec[1].index < 0:
-                raise ValueError(f"{what}: expected ('torque', body, axis) with a Body of this model, got {spec!r}")
+                raise _checks.refuse(f"{what}: expected ('torque', body, axis) with a Body of this model, got {spec!r}")
             _point(system, spec[1], what)
             a, label = _direction(spec[2], what)
             col, auto = _rotation_jacobian(system, spec[1], q, t).T @ a, f"torque {spec[1].name}·{label}"
         else:
-            raise ValueError(f"{what}: expected a coordinate name, ('force', point, direction) or "
+            raise _checks.refuse(f"{what}: expected a coordinate name, ('force', point, direction) or "
                              f"('torque', body, axis), got {spec!r}")
         names.append(auto if name is None else name)
         columns.append(col)
@@ -306,7 +306,7 @@ def _outputs(system, q, qd, t, outputs):
                 row_q, row_v = d @ _velocity_derivative(system, p, q, qd, t), d @ J
                 value, auto = d @ system.velocity(p, t, q, qd), f"{_label(system, p)}.{label}{RATE}"
         else:
-            raise ValueError(f"{what}: expected a coordinate name, '<name>{RATE}', ('position', point, axis) or "
+            raise _checks.refuse(f"{what}: expected a coordinate name, '<name>{RATE}', ('position', point, axis) or "
                              f"('velocity', point, axis), got {spec!r}")
         names.append(auto if name is None else name)
         Cq.append(row_q)

@@ -65,7 +65,7 @@ class Equilibrium(Versioned):
     def sensitivity(self, name: str) -> np.ndarray:
         """dq/dp (nq,) of the equilibrium by the parameter ``name`` (``static_equilibrium(sensitivities=...)``)."""
         if name not in self.sensitivities:
-            raise ValueError(f"name: expected one of the sensitivities asked for {list(self.sensitivities)}, got {name!r}")
+            raise _checks.refuse(f"name: expected one of the sensitivities asked for {list(self.sensitivities)}, got {name!r}")
         return self.sensitivities[name]
 
 
@@ -90,7 +90,7 @@ MAX_LOAD_STEPS = 100_000
 def _integer_at_least_one(x, name: str) -> int:
     v = _checks.integer(x, name)
     if v < 1:
-        raise ValueError(f"{name}: expected an integer >= 1, got {v}")
+        raise _checks.refuse(f"{name}: expected an integer >= 1, got {v}")
     return v
 def static_equilibrium(system, q0=None, *, t: float = 0.0, load_steps: int = 10, tol: float = 1e-10,
                        max_iterations: int = 50, sensitivities=None) -> Equilibrium:

@@ -5,7 +5,9 @@ What counts as a real number or an array of them is the C++ bindings' rule (``bi
 conversion rule of the package. ``real`` and ``reals`` convert only: the values of what goes to the core
 are judged there, once (the makers, ``check_options``, the laws' bounds). The other functions also judge
 the values (finite, positive) of what the Python layer alone uses (a sweep's workers, a plot's scale, a
-material before it becomes springs).
+material before it becomes springs). Every refusal the Python layer makes is ``raise _checks.refuse(
+"<argument>: expected <what>, got <value>")``, the form the core's refusals have (``errors.hpp``: ``bad``);
+``tests/test_conventions.py`` holds every such message to it, and no module raises a ValueError of its own.
 """
 
 from __future__ import annotations
@@ -16,6 +18,13 @@ import numpy as np
 
 import rigidfem._core as _core  # the compiled core, by its absolute name
 from .._core import Body, Point
+
+
+def refuse(message: str) -> ValueError:
+    """The ValueError of a refusal by the Python layer: ``message`` is "<argument>: expected <what>, got
+    <value>" (or "<a>, <b>: expected ..." for arguments judged together). Raised by the caller (``raise
+    _checks.refuse(...)``, so that its traceback ends where the argument was judged)."""
+    return ValueError(message)
 
 
 def _floats(x, name: str, expected: str) -> np.ndarray:

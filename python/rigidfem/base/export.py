@@ -44,7 +44,7 @@ def result_columns(result, points=None) -> tuple[list[str], np.ndarray]:
     if points is None:
         points = {}
     if not isinstance(points, Mapping) or not all(isinstance(k, str) for k in points):
-        raise ValueError(f"points: expected None or a dict of column names (str) to Points or Bodies, e.g. "
+        raise _checks.refuse(f"points: expected None or a dict of column names (str) to Points or Bodies, e.g. "
                          f"{{'tip': beam.tip}}, got {points!r}")
     names = list(_names(result))
     columns = names + [n + RATE for n in names]
@@ -72,7 +72,7 @@ def to_csv(result, path, points=None):
     columns, values = result_columns(result, points)
     for name in columns:
         if "," in name or '"' in name:
-            raise ValueError(f"points: expected column names without ',' or '\"' for CSV, got {name!r}")
+            raise _checks.refuse(f"points: expected column names without ',' or '\"' for CSV, got {name!r}")
     np.savetxt(path, np.column_stack([result.t, values]), delimiter=",", fmt="%.17g",
                header=",".join(["t", *columns]), comments="")
     return path

@@ -41,7 +41,7 @@ def check_version(state: dict, what: str) -> None:
     """Refuse a state of an unknown (newer) format."""
     version = state.get("rigidfem_state") if isinstance(state, dict) else None
     if version != STATE_VERSION:
-        raise ValueError(f"state: expected a pickled rigidfem {what} of state version {STATE_VERSION}, got version "
+        raise _checks.refuse(f"state: expected a pickled rigidfem {what} of state version {STATE_VERSION}, got version "
                          f"{version!r} (pickled by another rigidfem release?)")
 
 
@@ -146,11 +146,11 @@ def read_result(path, system=None) -> dict:
             _not_a_result(path, f"its {name} has shape {a.shape}, expected (len(t), len(coordinate_names)) = "
                                 f"{(len(t), len(names))}")
     if system is not None and list(system.coordinate_names) != names:
-        raise ValueError(f"system: expected a System with the coordinates {names} saved in {path}, got "
+        raise _checks.refuse(f"system: expected a System with the coordinates {names} saved in {path}, got "
                          f"{list(system.coordinate_names)}")
     return fields
 
 
 def _not_a_result(path, cause: str, error: BaseException | None = None) -> NoReturn:
     cause = cause if len(cause) <= 200 else cause[:197] + "..."
-    raise ValueError(f"path: expected a file written by Result.to_npz, got {os.fspath(path)!r} ({cause})") from error
+    raise _checks.refuse(f"path: expected a file written by Result.to_npz, got {os.fspath(path)!r} ({cause})") from error

@@ -68,13 +68,13 @@ class Property:
             def checked(s):
                 v = value(s)
                 if not isinstance(v, kind):
-                    raise ValueError(f"{name}: expected the function to return a {kind.__name__} at s = {s}, got {v!r}")
+                    raise _checks.refuse(f"{name}: expected the function to return a {kind.__name__} at s = {s}, got {v!r}")
                 return v
 
             return Property(checked)
         if isinstance(value, Sequence) and not isinstance(value, str):
             if len(value) != elements or not all(isinstance(v, kind) for v in value):
-                raise ValueError(f"{name}: expected a {kind.__name__}, a function of s or {elements} of them "
+                raise _checks.refuse(f"{name}: expected a {kind.__name__}, a function of s or {elements} of them "
                                  f"(one per segment), got {len(value)} items")
             d = length / elements
             values = list(value)
@@ -85,7 +85,7 @@ class Property:
 
             return Property(lambda s: values[min(max(int(s // d), 0), elements - 1)],
                             tuple(k * d for k in range(1, elements)), per_segment)
-        raise ValueError(f"{name}: expected a {kind.__name__}, a function of s or a list per segment, got {value!r}")
+        raise _checks.refuse(f"{name}: expected a {kind.__name__}, a function of s or a list per segment, got {value!r}")
 
 
 def _pieces(a: np.ndarray, b: np.ndarray, breakpoints):
@@ -353,7 +353,7 @@ class Beam:
         """The point at arc length ``s`` (m) of the undeformed beam, on the rfe containing it."""
         s = _checks.scalar(s, "s")
         if not 0.0 <= s <= self.length * (1 + 1e-12):
-            raise ValueError(f"s: expected an arc length in [0, {self.length}] m, got {s}")
+            raise _checks.refuse(f"s: expected an arc length in [0, {self.length}] m, got {s}")
         i = min(int(np.floor(s / (self.length / self.elements) + 0.5)), self.elements)
         return self.rfes[i].point((s - self.frames[i], 0.0, 0.0))
 
@@ -413,18 +413,18 @@ def add_beam(
         flow, length = length, _flow_length(length, material, section, deform, formulation, linear, tip_mass)
     L = _checks.scalar(length, "length", positive=True)
     if isinstance(elements, bool) or not isinstance(elements, (int, np.integer)) or not 1 <= elements <= MAX_ELEMENTS:
-        raise ValueError(f"elements: expected an integer number of sdes in [1, {MAX_ELEMENTS}], got {elements!r}")
+        raise _checks.refuse(f"elements: expected an integer number of sdes in [1, {MAX_ELEMENTS}], got {elements!r}")
     m = int(elements)
     if formulation not in ("classical", "modified"):
-        raise ValueError(f"formulation: expected 'classical' or 'modified', got {formulation!r}")
+        raise _checks.refuse(f"formulation: expected 'classical' or 'modified', got {formulation!r}")
     allowed = MODIFIED_DEFORMATIONS if formulation == "modified" else tuple(DEFORMATIONS)
     deform = allowed if deform is None else _deform_names(deform)
     for d in deform:
         if d not in allowed:
-            raise ValueError(f"deform: expected deformations from {allowed} for the {formulation} formulation, "
+            raise _checks.refuse(f"deform: expected deformations from {allowed} for the {formulation} formulation, "
                              f"got {d!r}")
     if len(set(deform)) != len(deform):
-        raise ValueError(f"deform: expected each deformation at most once, got {deform}")
+        raise _checks.refuse(f"deform: expected each deformation at most once, got {deform}")
     prony, mat_E = _prony(material, flow)
     mat = Property.of(material, Material, "material", L, m)
     sec = Property.of(section, Section, "section", L, m)
@@ -439,7 +439,7 @@ def add_beam(
     names = [f"{name}.rfe{k}" for k in range(m + 1)]
     taken = set(model.body_names).intersection(names)
     if taken:
-        raise ValueError(f"name: expected a beam name whose rfe bodies are not in the model yet, got {name!r} "
+        raise _checks.refuse(f"name: expected a beam name whose rfe bodies are not in the model yet, got {name!r} "
                          f"({sorted(taken)[0]} exists)")
     H_beam, H_tip = H.copy(), np.zeros_like(H)  # the parts a density and section set, and what they leave
     if tip_m > 0.0:
@@ -507,13 +507,13 @@ def _prony(material, flow) -> tuple:
     a list or a function of s, has none), and no varying length."""
     if isinstance(material, Material):
         if material.prony and flow is not None:
-            raise ValueError("material: expected a Material without prony terms for a beam of varying length "
+            raise _checks.refuse("material: expected a Material without prony terms for a beam of varying length "
                              "(Maxwell arms on its flowing sdes are not supported), got one with "
                              f"{len(material.prony)}")
         return material.prony, material.E
     pieces = material if isinstance(material, (list, tuple)) else (material(0.0),) if callable(material) else ()
     if any(isinstance(v, Material) and v.prony for v in pieces):
-        raise ValueError("material: expected one Material for a viscoelastic (prony) beam, got a list per segment or a "
+        raise _checks.refuse("material: expected one Material for a viscoelastic (prony) beam, got a list per segment or a "
                          "function of s (varying Maxwell arms are not supported)")
     return (), 1.0
 
@@ -535,7 +535,7 @@ def _deform_names(deform) -> tuple[str, ...]:
     if isinstance(deform, str):
         return (deform,)
     if not isinstance(deform, (list, tuple, np.ndarray)) or not all(isinstance(d, str) for d in deform):
-        raise ValueError(f"deform: expected None, a deformation name or a sequence of them (from "
+        raise _checks.refuse(f"deform: expected None, a deformation name or a sequence of them (from "
                          f"{tuple(DEFORMATIONS)}), got {_checks._short(deform)}")
     return tuple(deform)
 
@@ -544,18 +544,18 @@ def _flow_length(profile, material, section, deform, formulation, linear, tip_ma
     """L(0) of a link of varying length, refusing what it does not support (yet)."""
     L0 = profile(0.0)[0]
     if not (np.isfinite(L0) and L0 > 0.0):
-        raise ValueError(f"length: expected a profile L(t) with a positive length L(0) in m, got L(0) = {L0}")
+        raise _checks.refuse(f"length: expected a profile L(t) with a positive length L(0) in m, got L(0) = {L0}")
     if not isinstance(material, Material) or not isinstance(section, Section):
-        raise ValueError("material, section: expected one Material and one Section for a beam of varying length "
+        raise _checks.refuse("material, section: expected one Material and one Section for a beam of varying length "
                          "(its material flows along it: a uniform beam), got properties varying along it")
     if linear:
-        raise ValueError("linear: expected False for a beam of varying length (the linear model is not supported), "
+        raise _checks.refuse("linear: expected False for a beam of varying length (the linear model is not supported), "
                          "got True")
     if deform is not None and "axial" in _deform_names(deform):
-        raise ValueError("deform: expected deformations without 'axial' for a beam of varying length (its sde "
+        raise _checks.refuse("deform: expected deformations without 'axial' for a beam of varying length (its sde "
                          "joints' x coordinate spreads the rfes over L(t)), got 'axial'")
     if _checks.scalar(tip_mass, "tip_mass", nonnegative=True) > 0.0:
-        raise ValueError(f"tip_mass: expected 0 for a beam of varying length (not supported yet), got {tip_mass}")
+        raise _checks.refuse(f"tip_mass: expected 0 for a beam of varying length (not supported yet), got {tip_mass}")
     return L0
 
 
@@ -565,13 +565,13 @@ def _tip_inertia(tip_inertia) -> np.ndarray:
     try:
         I = np.diag(tip_inertia) if np.shape(tip_inertia) == (3,) else np.asarray(tip_inertia, float)
     except (TypeError, ValueError):
-        raise ValueError(f"tip_inertia: expected (3,) moments or a (3, 3) tensor in kg·m², got {tip_inertia!r}") from None
+        raise _checks.refuse(f"tip_inertia: expected (3,) moments or a (3, 3) tensor in kg·m², got {tip_inertia!r}") from None
     I = _checks.array(I, (3, 3), "tip_inertia")
     if not np.allclose(I, I.T, rtol=1e-12, atol=0.0):
-        raise ValueError("tip_inertia: expected a symmetric tensor, got an asymmetric one")
+        raise _checks.refuse("tip_inertia: expected a symmetric tensor, got an asymmetric one")
     moments = np.linalg.eigvalsh(I)
     if moments[0] < -1e-12 * max(moments[-1], 0.0) or moments[0] + moments[1] < moments[2] * (1 - 1e-9):
-        raise ValueError(f"tip_inertia: expected principal moments >= 0 with I1 + I2 >= I3, got {moments}")
+        raise _checks.refuse(f"tip_inertia: expected principal moments >= 0 with I1 + I2 >= I3, got {moments}")
     return I
 
 

@@ -28,19 +28,20 @@ import numpy as np
 import rigidfem._core as _core  # the compiled core, by its absolute name
 from . import handles, laws, parameters
 from .._core import Body, Point, Profile
+from ..base import _checks
 
 
 def point_of(model, where, name: str):
     """(body index, point in that body's frame, m) of a Point, a Body (its origin) or the ground."""
     if isinstance(where, Body):
         if not model._owns(where):
-            raise ValueError(f"{name}: expected a Body or Point of this model, got {where!r}")
+            raise _checks.refuse(f"{name}: expected a Body or Point of this model, got {where!r}")
         return where.index, np.zeros(3)
     if isinstance(where, Point):
         if not -1 <= where.body < model.nbodies or where.model not in (0, model.id):
-            raise ValueError(f"{name}: expected a Body or Point of this model, got {where!r}")
+            raise _checks.refuse(f"{name}: expected a Body or Point of this model, got {where!r}")
         return where.body, np.asarray(where.r, dtype=float)
-    raise ValueError(f"{name}: expected a Body or Point of this model (or model.ground), got {where!r}")
+    raise _checks.refuse(f"{name}: expected a Body or Point of this model (or model.ground), got {where!r}")
 
 
 def points(model, a, b) -> tuple:
@@ -53,7 +54,7 @@ def add_force_element(model, a, b, law, *, name: str | None = None) -> handles.E
     ``b``; returns its name ("element<k>" when ``name`` is None). Its constants marked as parameters become the
     parameters ``"<name>.<constant>"``, its profile's numbers ``"<name>.<profile name>.<path>"``."""
     if not isinstance(law, laws.Law) or law.info["acts_on"] != "element":
-        raise ValueError(f"law: expected a law of a force element ({', '.join(k for k, i in laws.kinds().items() if i['acts_on'] == 'element')} "
+        raise _checks.refuse(f"law: expected a law of a force element ({', '.join(k for k, i in laws.kinds().items() if i['acts_on'] == 'element')} "
                          f"from rigidfem.laws), got {law!r}")
     ia, ra, ib, rb = points(model, a, b)
     name = model._add_force_element("" if name is None else str(name), ia, ra, ib, rb, law.kind, law.values,

@@ -21,7 +21,7 @@ _ROTATION = {"x": "rx", "y": "ry", "z": "rz"}
 
 def _axis(axis: str) -> str:
     if axis not in _AXES:
-        raise ValueError(f"axis: expected 'x', 'y' or 'z', got {axis!r}")
+        raise _checks.refuse(f"axis: expected 'x', 'y' or 'z', got {axis!r}")
     return axis
 
 
@@ -66,7 +66,7 @@ class Joint:
     def universal(axes: tuple[str, str] = ("z", "y"), **springs) -> JointSpec:
         """Two rotations about two of the joint frame's axes (book order: rz, ry, rx)."""
         if len(axes) != 2 or len(set(axes)) != 2:
-            raise ValueError(f"axes: expected two different axes of 'x', 'y', 'z', got {axes!r}")
+            raise _checks.refuse(f"axes: expected two different axes of 'x', 'y', 'z', got {axes!r}")
         return _make("universal", [_ROTATION[_axis(a)] for a in axes], **springs)
 
     @staticmethod
@@ -79,7 +79,7 @@ class Joint:
         """Two translations in ``plane`` ("xy", "yz" or "zx") and the rotation about its normal."""
         planes = {"xy": ["x", "y", "rz"], "yz": ["y", "z", "rx"], "zx": ["x", "z", "ry"], "xz": ["x", "z", "ry"]}
         if plane not in planes:
-            raise ValueError(f"plane: expected 'xy', 'yz' or 'zx', got {plane!r}")
+            raise _checks.refuse(f"plane: expected 'xy', 'yz' or 'zx', got {plane!r}")
         return _make("planar", planes[plane], **springs)
 
     @staticmethod

@@ -23,6 +23,7 @@ from dataclasses import dataclass
 
 import rigidfem._core as _core  # the compiled core, by its absolute name
 from .._core import Profile
+from ..base import _checks
 
 
 @dataclass(frozen=True)
@@ -63,11 +64,11 @@ class Law:
         if unknown:
             raise TypeError(f"{info['kind']}() got unexpected constants {unknown}; its constants are {names}")
         if profile is not None and (info["profile"] is None or not isinstance(profile, Profile)):
-            raise ValueError(f"profile: expected None{' or a rigidfem.motion profile' if info['profile'] else ''} "
+            raise _checks.refuse(f"profile: expected None{' or a rigidfem.motion profile' if info['profile'] else ''} "
                              f"({info['kind']} {'takes ' + info['profile'] if info['profile'] else 'takes none'}), "
                              f"got {profile!r}")
         if function is not None and (info["function"] is None or not callable(function)):
-            raise ValueError(f"function: expected None{' or a function' if info['function'] else ''} ({info['kind']} "
+            raise _checks.refuse(f"function: expected None{' or a function' if info['function'] else ''} ({info['kind']} "
                              f"{'takes ' + info['function'] if info['function'] else 'takes none'}), got {function!r}")
         values = _core._Model._check_law(info["kind"], constants, profile)
         self.values = dict(zip(names, values))

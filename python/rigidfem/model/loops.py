@@ -49,7 +49,8 @@ def _frame(model, where, frame, name: str):
         F[:3, 3] = origin
     else:
         if isinstance(where, Point) and np.any(origin != 0.0):
-            raise ValueError(f"frame_{name}: give either a Point or a frame on a Body, not both")
+            raise _checks.refuse(f"frame_{name}: expected either a Point or a frame on a Body, not both, got the "
+                                 f"point {where!r} and a frame")
         F = _checks.reals(frame, (4, 4), f"frame_{name}")
     return body, F
 
@@ -58,15 +59,15 @@ def add_loop_joint(model, kind: str, a, b, *, frame_a=None, frame_b=None, length
                    name: str | None = None) -> str:
     """Close a loop between ``a`` and ``b`` (see ``Model.add_loop_joint``); returns its name."""
     if kind not in KINDS:
-        raise ValueError(f"kind: expected one of {', '.join(KINDS)}, got {kind!r}")
+        raise _checks.refuse(f"kind: expected one of {', '.join(KINDS)}, got {kind!r}")
     ia, Fa = _frame(model, a, frame_a, "a")
     ib, Fb = _frame(model, b, frame_b, "b")
     if kind == "distance":
         if length is None:
-            raise ValueError("length: expected a positive distance in m for a distance loop, got None")
+            raise _checks.refuse("length: expected a positive distance in m for a distance loop, got None")
         length = _checks.real(length, "length", "a positive distance in m")
     elif length is not None:
-        raise ValueError(f"length: expected None for a {kind} loop (only distance loops have a length), got {length!r}")
+        raise _checks.refuse(f"length: expected None for a {kind} loop (only distance loops have a length), got {length!r}")
     return _add(model, name, kind, ia, Fa, ib, Fb, length or 0.0, None)
 
 

@@ -53,7 +53,7 @@ class Material:
         retardation = _checks.scalar(self.retardation, "retardation", nonnegative=True, unit="s (retardation time)")
         nu = None if self.nu is None else _checks.scalar(self.nu, "nu", unit="(-1, 0.5] (Poisson's ratio)")
         if nu is not None and not -1.0 < nu <= 0.5:
-            raise ValueError(f"nu: expected Poisson's ratio in (-1, 0.5], got {nu}")
+            raise _checks.refuse(f"nu: expected Poisson's ratio in (-1, 0.5], got {nu}")
         if self.G is not None:
             G = _checks.scalar(self.G, "G", positive=True, unit="Pa (shear modulus)")
         else:
@@ -72,7 +72,7 @@ class Material:
         E0 = _checks.scalar(E0, "E0", positive=True, unit="Pa (instantaneous modulus)")
         E_inf = _checks.scalar(E_inf, "E_inf", positive=True, unit="Pa (long-term modulus)")
         if not E_inf < E0:
-            raise ValueError(f"E_inf: expected a long-term modulus below E0 = {E0} Pa, got {E_inf}")
+            raise _checks.refuse(f"E_inf: expected a long-term modulus below E0 = {E0} Pa, got {E_inf}")
         return cls(E=E_inf, rho=rho, nu=nu, G=G, prony=((E0 - E_inf, tau),))
 
     @classmethod
@@ -86,18 +86,18 @@ class Material:
         t = np.asarray(_checks.vector(t, "t"), dtype=float)
         E_t = np.asarray(_checks.vector(E_t, "E_t"), dtype=float)
         if len(t) != len(E_t) or len(t) < 2 or np.any(t < 0.0) or np.any(E_t <= 0.0):
-            raise ValueError(f"t, E_t: expected as many times >= 0 s as moduli > 0 Pa (at least 2), got {len(t)} "
+            raise _checks.refuse(f"t, E_t: expected as many times >= 0 s as moduli > 0 Pa (at least 2), got {len(t)} "
                              f"times and {len(E_t)} moduli")
         if times is None:
             lo, hi = np.log10(t[t > 0.0].min()), np.log10(t.max())
             times = 10.0 ** np.arange(np.floor(lo), np.ceil(hi) + 1.0)
         times = np.asarray(_checks.vector(times, "times"), dtype=float)
         if np.any(times <= 0.0):
-            raise ValueError(f"times: expected positive relaxation times in s, got {times}")
+            raise _checks.refuse(f"times: expected positive relaxation times in s, got {times}")
         basis = np.column_stack([np.ones_like(t), np.exp(-t[:, None] / times[None, :])]) / E_t[:, None]
         coef, _ = nnls(basis, np.ones_like(t))
         if not coef[0] > 0.0:
-            raise ValueError("E_t: expected relaxation data with a positive long-term modulus, got a fit with E_inf = 0")
+            raise _checks.refuse("E_t: expected relaxation data with a positive long-term modulus, got a fit with E_inf = 0")
         return cls(E=coef[0], rho=rho, nu=nu, prony=tuple((E, tau) for E, tau in zip(coef[1:], times) if E > 0.0))
 
     def relaxation_modulus(self, t):
@@ -111,9 +111,9 @@ def _prony_terms(prony) -> tuple:
     try:
         terms = tuple(tuple(term) for term in prony)
     except TypeError:
-        raise ValueError(f"prony: expected a sequence of (E_j in Pa, tau_j in s) pairs, got {prony!r}") from None
+        raise _checks.refuse(f"prony: expected a sequence of (E_j in Pa, tau_j in s) pairs, got {prony!r}") from None
     if any(len(term) != 2 for term in terms):
-        raise ValueError(f"prony: expected a sequence of (E_j in Pa, tau_j in s) pairs, got {prony!r}")
+        raise _checks.refuse(f"prony: expected a sequence of (E_j in Pa, tau_j in s) pairs, got {prony!r}")
     return tuple((_checks.scalar(E, "prony", positive=True, unit="Pa (arm modulus E_j)"),
                   _checks.scalar(tau, "prony", positive=True, unit="s (relaxation time tau_j)")) for E, tau in terms)
 
@@ -126,7 +126,7 @@ def _dimension(x, name: str) -> float:
     """A section's dimension (m) within ``DIMENSIONS``, so that A, I and J are finite and positive."""
     v = _checks.scalar(x, name, positive=True, unit="m")
     if not DIMENSIONS[0] <= v <= DIMENSIONS[1]:
-        raise ValueError(f"{name}: expected a length in [{DIMENSIONS[0]:g}, {DIMENSIONS[1]:g}] m (its fourth power, "
+        raise _checks.refuse(f"{name}: expected a length in [{DIMENSIONS[0]:g}, {DIMENSIONS[1]:g}] m (its fourth power, "
                          f"the section's I and J, finite and positive), got {v:g}")
     return v
 
@@ -194,6 +194,6 @@ class Section:
         D = _dimension(d_out, "d_out")
         d = _checks.scalar(d_in, "d_in", nonnegative=True, unit="m")  # below d_out: its d⁴ is finite
         if not d < D:
-            raise ValueError(f"d_in: expected less than d_out = {D}, got {d}")
+            raise _checks.refuse(f"d_in: expected less than d_out = {D}, got {d}")
         I = math.pi * (D**4 - d**4) / 64
         return Section(A=math.pi * (D**2 - d**2) / 4, Iy=I, Iz=I, J=2 * I, kappa_y=0.5, kappa_z=0.5)

@@ -25,11 +25,11 @@ def _inertia(inertia) -> np.ndarray:
     try:
         a = np.asarray(inertia, dtype=float)
     except (TypeError, ValueError):
-        raise ValueError(f"inertia: expected principal moments (3,) or a tensor (3, 3) in kg·m², got {inertia!r}") from None
+        raise _checks.refuse(f"inertia: expected principal moments (3,) or a tensor (3, 3) in kg·m², got {inertia!r}") from None
     if a.shape == (3,):
         a = np.diag(a)
     if a.shape != (3, 3):
-        raise ValueError(
+        raise _checks.refuse(
             f"inertia: expected principal moments (3,) or a tensor (3, 3) in kg·m², got shape {np.shape(inertia)}"
         )
     return _checks.reals(a, (3, 3), "inertia")
@@ -46,16 +46,17 @@ def _base_profiles(motion) -> dict[str, Profile]:
     if motion is None:
         motion = {}
     if not isinstance(motion, dict):
-        raise ValueError(f"motion: expected a dict of degrees of freedom to profiles, got {motion!r}")
+        raise _checks.refuse(f"motion: expected a dict of degrees of freedom to profiles, got {motion!r}")
     coordinate_of = {**BASE_DOFS, **{c: c for c in BASE_DOFS.values()}}
     out: dict[str, Profile] = {}
     for dof, value in motion.items():
         if dof not in coordinate_of:
-            raise ValueError(f"motion: expected keys from {list(BASE_DOFS)} or {list(BASE_DOFS.values())}, "
+            raise _checks.refuse(f"motion: expected keys from {list(BASE_DOFS)} or {list(BASE_DOFS.values())}, "
                              f"got {dof!r}")
         c = coordinate_of[dof]
         if c in out:
-            raise ValueError(f"motion: {dof!r} gives coordinate {c!r} a second motion")
+            raise _checks.refuse(f"motion: expected one motion per coordinate, got a second motion of coordinate {c!r} "
+                                 f"from {dof!r}")
         if not isinstance(value, Profile):
             value = _constant(_checks.scalar(value, f"motion[{dof!r}]"))
         out[c] = value
@@ -64,7 +65,7 @@ def _base_profiles(motion) -> dict[str, Profile]:
 
 def _scale(scale):
     if scale is not None and not isinstance(scale, Profile):
-        raise ValueError(f"scale: expected None or a profile from rigidfem.motion, got {scale!r}")
+        raise _checks.refuse(f"scale: expected None or a profile from rigidfem.motion, got {scale!r}")
     return scale
 
 
@@ -112,11 +113,11 @@ class Model(_core._Model):
     def body(self, name: str) -> Body:
         """The handle of the body called ``name``."""
         if not isinstance(name, str):
-            raise ValueError(f"name: expected the name (str) of a body of this model or 'ground', got {name!r}")
+            raise _checks.refuse(f"name: expected the name (str) of a body of this model or 'ground', got {name!r}")
         try:
             index = self._body_index(name)
         except ValueError:
-            raise ValueError(f"name: expected the name of a body of this model or 'ground', got {name!r}") from None
+            raise _checks.refuse(f"name: expected the name of a body of this model or 'ground', got {name!r}") from None
         return Body() if index < 0 else self._handle(index)
 
     def _handle(self, index: int) -> Body:
@@ -134,11 +135,11 @@ class Model(_core._Model):
     def _parent_index(self, parent) -> int:
         if isinstance(parent, Body):
             if not self._owns(parent):
-                raise ValueError(f"parent: expected a body of this model, got {parent!r}")
+                raise _checks.refuse(f"parent: expected a body of this model, got {parent!r}")
             return parent.index
         if isinstance(parent, str):
             return self._body_index(parent)
-        raise ValueError(f"parent: expected a Body handle or a body name, got {parent!r}")
+        raise _checks.refuse(f"parent: expected a Body handle or a body name, got {parent!r}")
 
     @recorded
     def add_body(
@@ -173,7 +174,7 @@ class Model(_core._Model):
             identity by default. The body frame is the joint frame moved by the joint.
         """
         if not isinstance(joint, JointSpec):
-            raise ValueError(f"joint: expected a joint from rigidfem.Joint, got {joint!r}")
+            raise _checks.refuse(f"joint: expected a joint from rigidfem.Joint, got {joint!r}")
         B = np.eye(4) if placement is None else _checks.reals(placement, (4, 4), "placement")
         mass, com, inertia = _checks.real(mass, "mass", "a mass in kg"), _checks.reals(com, (3,), "com"), _inertia(inertia)
         body = self._add_body(str(name), self._parent_index(parent), joint, B, mass, com, inertia)
@@ -192,9 +193,9 @@ class Model(_core._Model):
 
     def _coordinate(self, body: Body, coordinate: str | None) -> int:
         if not isinstance(body, Body) or body.index < 0 or not self._owns(body):
-            raise ValueError(f"body: expected a body of this model, got {body!r}")
+            raise _checks.refuse(f"body: expected a body of this model, got {body!r}")
         if coordinate is not None and not isinstance(coordinate, str):
-            raise ValueError(f"coordinate: expected None or a coordinate name such as 'x' or 'rz', got {coordinate!r}")
+            raise _checks.refuse(f"coordinate: expected None or a coordinate name such as 'x' or 'rz', got {coordinate!r}")
         return -1 if coordinate is None else self._coordinate_index(body.index, coordinate)
 
     @recorded
@@ -208,7 +209,7 @@ class Model(_core._Model):
         drive's numbers are the parameters ``"<body>.<axis>.drive.<path>"``.
         """
         if not isinstance(motion, Profile):
-            raise ValueError(f"motion: expected a profile from rigidfem.motion, got {motion!r}")
+            raise _checks.refuse(f"motion: expected a profile from rigidfem.motion, got {motion!r}")
         k = self._coordinate(body, coordinate)
         self._prescribe(body.index, k, motion)
         name = self._coordinate_name(body.index, k)
@@ -322,7 +323,7 @@ class Model(_core._Model):
     def _load(self, name, kind, body, r, force, torque, follower, scale) -> handles.Load:
         name = f"load{self._nloads}" if name is None else name
         if not isinstance(name, str) or name in self._parameter_groups:
-            raise ValueError(f"name: expected a new name (str) for the load, got {name!r}")
+            raise _checks.refuse(f"name: expected a new name (str) for the load, got {name!r}")
         self._add_load(body, r, force, torque, _checks.boolean(follower, "follower"), _scale(scale))
         parameters.register(self, parameters.LoadGroup(name, self._nloads - 1, force, torque))
         if scale is not None:
@@ -333,10 +334,10 @@ class Model(_core._Model):
     def _point(self, point) -> Point:
         if isinstance(point, Body):
             if not self._owns(point):
-                raise ValueError(f"point: expected a Point or Body of this model, got {point!r}")
+                raise _checks.refuse(f"point: expected a Point or Body of this model, got {point!r}")
             point = point.origin
         if not isinstance(point, Point) or not 0 <= point.body < self.nbodies or point.model not in (0, self.id):
-            raise ValueError(f"point: expected a Point or Body of this model, got {point!r}")
+            raise _checks.refuse(f"point: expected a Point or Body of this model, got {point!r}")
         return point
 
     @recorded
@@ -433,7 +434,7 @@ class Model(_core._Model):
         kind)."""
         if not isinstance(law, laws.Law) or law.info["acts_on"] != "coordinate" or not law.info["addable"]:
             kinds = [k for k, i in laws.kinds().items() if i["acts_on"] == "coordinate" and i["addable"]]
-            raise ValueError(f"law: expected a law of a joint coordinate ({', '.join(kinds)} from rigidfem.laws), "
+            raise _checks.refuse(f"law: expected a law of a joint coordinate ({', '.join(kinds)} from rigidfem.laws), "
                              f"got {law!r}")
         k = self._coordinate(body, coordinate)
         axis = self._coordinate_name(body.index, k)
@@ -442,7 +443,7 @@ class Model(_core._Model):
             while (name := base if n == 1 else f"{base}{n}") in self._parameter_groups:
                 n += 1
         elif not isinstance(name, str) or name in self._parameter_groups:
-            raise ValueError(f"name: expected a name not yet given to a body, coordinate, element or law, got {name!r}")
+            raise _checks.refuse(f"name: expected a name not yet given to a body, coordinate, element or law, got {name!r}")
         index = self._add_coordinate_law(body.index, k, law.kind, law.values, law.function)
         group = parameters.LawGroup(str(name), ("coordinate", body.index, max(k, 0), index), law.info, law.values,
                                     rotation=axis.rsplit(".", 1)[1].startswith("r"))
@@ -531,7 +532,7 @@ class System(_core._System):
 
     def __init__(self, model, algorithm: str = "recursive"):
         if not isinstance(algorithm, str):
-            raise ValueError(f"algorithm: expected 'recursive' or 'lagrange', got {algorithm!r}")
+            raise _checks.refuse(f"algorithm: expected 'recursive' or 'lagrange', got {algorithm!r}")
         super().__init__(model, algorithm)
         self._model_id = model.id  # handles of other models are refused (_checks.same_model)
         self._state = {"rigidfem_state": persistence.STATE_VERSION, "model": persistence.model_state(model),
@@ -596,7 +597,7 @@ class System(_core._System):
         """Index in q of the coordinate called ``name`` (e.g. ``"link1.rz"``)."""
         names = self.coordinate_names
         if name not in names:
-            raise ValueError(f"name: expected one of {names}, got {name!r}")
+            raise _checks.refuse(f"name: expected one of {names}, got {name!r}")
         return names.index(name)
 
     def __repr__(self) -> str:

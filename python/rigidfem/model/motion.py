@@ -127,7 +127,7 @@ def function(f: Callable[[float], tuple[float, float, float]]) -> _core.Profile:
     ValueError (whose message starts with ``f:``) where a System method evaluates the drive, and a
     ``SimulationError`` with ``time`` and ``cause``. Exceptions ``f`` raises propagate."""
     if not callable(f):
-        raise ValueError(f"f: expected a callable f(t) -> (q, qd, qdd), got {f!r}")
+        raise _checks.refuse(f"f: expected a callable f(t) -> (q, qd, qdd), got {f!r}")
     name = getattr(f, "__qualname__", None) or repr(f)
 
     def checked(t):

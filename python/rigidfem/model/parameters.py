@@ -61,13 +61,13 @@ class Parameter:
     def check(self, value, argument: str = "values") -> float:
         """The value as a float, or ValueError naming ``argument``, the parameter and the values it takes."""
         bound = f" > {self.minimum:g}" if self.positive else "" if self.minimum == -math.inf else f" >= {self.minimum:g}"
-        expected = f"{argument}: expected {self.name} to be a finite value{bound} in {self.unit} ({self.description})"
+        expected = f"{self.name} to be a finite value{bound} in {self.unit} ({self.description})"
         try:
             x = _core._real(value, argument, "a number")
         except (TypeError, ValueError):
-            raise ValueError(f"{expected}, got {value!r}") from None
+            raise _checks.refuse(f"{argument}: expected {expected}, got {value!r}") from None
         if not math.isfinite(x) or (x <= self.minimum if self.positive else x < self.minimum):
-            raise ValueError(f"{expected}, got {value!r}")
+            raise _checks.refuse(f"{argument}: expected {expected}, got {value!r}")
         return x
 
 
@@ -166,7 +166,7 @@ class BeamGroup(Group):
         b = _scaled(c, v["retardation"])
         if not (np.isfinite(H).all() and np.isfinite(c).all() and np.isfinite(b).all()):
             given = ", ".join(f"{self.prefix}.{k} = {values[k]!r}" for k in values if values[k] != self.built[k])
-            raise ValueError(f"values: expected values whose rfes' pseudo-inertias, springs and dampers are finite "
+            raise _checks.refuse(f"values: expected values whose rfes' pseudo-inertias, springs and dampers are finite "
                              f"(the products of the built ones with the ratios overflow), got {given}")
         out = Changes(bodies=list(zip(self.rfes.tolist(), H)))
         for col, slot in enumerate(self.slots):
@@ -252,12 +252,12 @@ def names_argument(names, argument: str, expected: str = "parameter names (Syste
     if names is None:
         return []
     if isinstance(names, str) or not isinstance(names, Sequence):
-        raise ValueError(f"{argument}: expected a list of {expected}, got {names!r}")
+        raise _checks.refuse(f"{argument}: expected a list of {expected}, got {names!r}")
     for name in names:
         if not isinstance(name, str):
-            raise ValueError(f"{argument}: expected {expected} (str), got {name!r}")
+            raise _checks.refuse(f"{argument}: expected {expected} (str), got {name!r}")
     if len(set(names)) != len(names):
-        raise ValueError(f"{argument}: expected each name once, got {list(names)}")
+        raise _checks.refuse(f"{argument}: expected each name once, got {list(names)}")
     return list(names)
 
 
@@ -269,7 +269,7 @@ def initial_value(system, name: str, argument: str = "sensitivities"):
         if name.startswith(part + "[") and name.endswith("]"):
             coordinate = name[len(part) + 1:-1]
             if coordinate not in system.coordinate_names:
-                raise ValueError(f"{argument}: expected a free coordinate in {name!r} "
+                raise _checks.refuse(f"{argument}: expected a free coordinate in {name!r} "
                                  f"({_close(coordinate, system.coordinate_names)}), got {coordinate!r}")
             return part, system.coordinate_names.index(coordinate)
     return None
@@ -295,7 +295,7 @@ class Parameters:
         """The parameter called ``name`` at its current value; ValueError naming ``argument`` and the names
         nearest to an unknown one."""
         if not isinstance(name, str) or name not in self.where:
-            raise ValueError(f"{argument}: expected a parameter of this system "
+            raise _checks.refuse(f"{argument}: expected a parameter of this system "
                              f"({_close(str(name), self.where) if isinstance(name, str) else 'System.parameters'}),"
                              f" got {name!r}")
         prefix, short = self.where[name]
@@ -308,7 +308,7 @@ class Parameters:
     def checked(self, values) -> dict[str, float]:
         """{name: float} of a dict of new values, each checked (ValueError naming it)."""
         if not isinstance(values, dict):
-            raise ValueError(f"values: expected a dict of parameter names to values, got {values!r}")
+            raise _checks.refuse(f"values: expected a dict of parameter names to values, got {values!r}")
         return {name: self.parameter(name, "values").check(value) for name, value in values.items()}
 
     def changes(self, values: dict[str, float]) -> Changes:
@@ -366,14 +366,14 @@ class Parameters:
         try:
             h = self.profile_step(name, t0, t1)
         except ValueError as e:
-            raise ValueError(f"{argument}: expected parameters that can change alone, got {name!r}, whose profile "
+            raise _checks.refuse(f"{argument}: expected parameters that can change alone, got {name!r}, whose profile "
                              f"refuses p ± 1e-6 max(|p|, 1) ({e})") from None
         for low, high in ((-1.0, 1.0), (-2.0, 0.0), (0.0, 2.0)):
             try:
                 return self.shifted(base, name, high * h), self.shifted(base, name, low * h), h
             except ValueError:
                 continue
-        raise ValueError(f"{argument}: expected a parameter whose profile takes values beside "
+        raise _checks.refuse(f"{argument}: expected a parameter whose profile takes values beside "
                          f"{name} = {self.values[name]:g} (p ± {h:.3g}), got none on either side")
 
     def profile_step(self, name: str, t0: float, t1: float) -> float:
@@ -491,7 +491,7 @@ class ProfileGroup(Group):
         try:
             profile = remade(self.profile, values)
         except (TypeError, ValueError) as e:
-            raise ValueError(f"values: expected numbers the profile of {self.prefix} takes, got {values} ({e})") from None
+            raise _checks.refuse(f"values: expected numbers the profile of {self.prefix} takes, got {values} ({e})") from None
         return Changes(profiles=[(self.what, self.body, self.index, profile)])
 
     def current_leaves(self) -> dict[str, float]:

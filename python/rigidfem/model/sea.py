@@ -38,14 +38,14 @@ def _finite(x, name: str) -> np.ndarray:
     """``x`` as finite real frequencies (rad/s) by the bindings' rule: strings and complex numbers refused."""
     a = _checks._floats(x, name, "real numbers in rad/s")
     if not np.all(np.isfinite(a)):
-        raise ValueError(f"{name}: expected finite values, got NaN or inf")
+        raise _checks.refuse(f"{name}: expected finite values, got NaN or inf")
     return a
 
 
 def _gamma(gamma) -> float:
     g = _checks.scalar(gamma, "gamma")
     if not GAMMA_RANGE[0] <= g <= GAMMA_RANGE[1]:
-        raise ValueError(f"gamma: expected a peak enhancement factor in [1, 7], got {g}")
+        raise _checks.refuse(f"gamma: expected a peak enhancement factor in [1, 7], got {g}")
     return g
 
 
@@ -64,7 +64,7 @@ def jonswap(omega, hs: float, tp: float, gamma: float = 3.3) -> np.ndarray:
     with np.errstate(over="ignore"):  # ln S < ln(max float), else S = inf: refused below
         S[w > 0.0] = np.exp(_log_jonswap(w[w > 0.0], hs, tp, gamma))
     if not np.all(np.isfinite(S)):
-        raise ValueError(f"hs, tp: expected a sea state whose spectrum is finite, got S(ω) overflowing for "
+        raise _checks.refuse(f"hs, tp: expected a sea state whose spectrum is finite, got S(ω) overflowing for "
                          f"hs = {hs:g} m, tp = {tp:g} s")
     return S
 
@@ -98,7 +98,7 @@ class RAO:
 
     def __init__(self, function: Callable[[np.ndarray], np.ndarray], description: str = "function"):
         if not callable(function):
-            raise ValueError(f"function: expected a callable H(omega) -> complex array, got {function!r}")
+            raise _checks.refuse(f"function: expected a callable H(omega) -> complex array, got {function!r}")
         self._h = function
         self._description = description
         self._overflow = None  # what makes H overflow where its exact value is beyond the floats (the oscillator's)
@@ -108,10 +108,10 @@ class RAO:
         try:
             H = np.asarray(self._h(w), dtype=complex)
         except (TypeError, ValueError) as error:
-            raise ValueError(f"rao: expected {self} to return complex numbers, got {error!r}") from error
+            raise _checks.refuse(f"rao: expected {self} to return complex numbers, got {error!r}") from error
         finite = np.isfinite(H)
         if H.shape != w.shape or not (np.all(finite) or (getattr(self, "_overflow", None) and not np.any(np.isnan(H)))):
-            raise ValueError(f"rao: expected {self} to return finite values of shape {w.shape}, got {H!r}")
+            raise _checks.refuse(f"rao: expected {self} to return finite values of shape {w.shape}, got {H!r}")
         if not np.all(finite):
             warnings.warn(f"{self._overflow}: |H| = inf at ω = {w[~finite][0]:g} rad/s", RuntimeWarning, stacklevel=2)
         return H
@@ -126,14 +126,14 @@ class RAO:
         end values outside the table."""
         w = _checks.vector(omega, "omega", min_length=1)
         if np.any(np.diff(w) <= 0.0):
-            raise ValueError("omega: expected strictly increasing frequencies in rad/s")
+            raise _checks.refuse("omega: expected strictly increasing frequencies in rad/s")
         amp = _checks.vector(amplitude, "amplitude")
         arg = np.zeros_like(w) if phase is None else np.unwrap(_checks.vector(phase, "phase"))
         for values, name in ((amp, "amplitude"), (arg, "phase")):
             if values.size != w.size:
-                raise ValueError(f"{name}: expected {w.size} values (len(omega)), got {values.size}")
+                raise _checks.refuse(f"{name}: expected {w.size} values (len(omega)), got {values.size}")
         if np.any(amp < 0.0):
-            raise ValueError("amplitude: expected non-negative values |H|")
+            raise _checks.refuse("amplitude: expected non-negative values |H|")
         return cls(functools.partial(_table, w, amp, arg), f"table({w.size} points)")
 
     @classmethod
@@ -217,7 +217,7 @@ def _as_rao(rao, name: str) -> RAO:
     try:
         return RAO.constant(rao)
     except ValueError:
-        raise ValueError(f"{name}: expected an RAO or a non-negative gain, got {rao!r}") from None
+        raise _checks.refuse(f"{name}: expected an RAO or a non-negative gain, got {rao!r}") from None
 
 
 @dataclass(frozen=True, eq=False)
@@ -235,7 +235,7 @@ class Waves:
         for name in ("omega", "phase", "amplitude"):
             values = np.array(_checks.vector(getattr(self, name), name))  # a copy, then read-only
             if values.size != a.size:
-                raise ValueError(f"{name}: expected {a.size} values (len(amplitude)), got {values.size}")
+                raise _checks.refuse(f"{name}: expected {a.size} values (len(amplitude)), got {values.size}")
             values.flags.writeable = False
             object.__setattr__(self, name, values)
 
@@ -275,7 +275,7 @@ class Waves:
             amplitude = np.abs(H) * self.amplitude
         if not np.all(np.isfinite(amplitude)):
             k = int(np.argmax(~np.isfinite(amplitude)))
-            raise ValueError(f"rao: expected an RAO whose responses |H(ω_k)| a_k to these waves are finite, got "
+            raise _checks.refuse(f"rao: expected an RAO whose responses |H(ω_k)| a_k to these waves are finite, got "
                              f"|H| = {abs(H[k]):g} at ω = {self.omega[k]:g} rad/s, a_k = {self.amplitude[k]:g} m")
         return motion.harmonics(amplitude, self.omega, self.phase + np.angle(H))
 
@@ -284,11 +284,11 @@ class Waves:
         names "surge", "sway", "heave", "roll", "pitch", "yaw", or "x" ... "rx") to an ``RAO``
         or a constant gain; the result maps them to their responses. Missing ones stay at 0."""
         if not isinstance(raos, dict):
-            raise ValueError(f"raos: expected a dict of degrees of freedom to RAOs, got {raos!r}")
+            raise _checks.refuse(f"raos: expected a dict of degrees of freedom to RAOs, got {raos!r}")
         names = list(BASE_DOFS) + list(BASE_DOFS.values())
         for dof in raos:
             if dof not in names:
-                raise ValueError(f"raos: expected keys from {names}, got {dof!r}")
+                raise _checks.refuse(f"raos: expected keys from {names}, got {dof!r}")
         return {dof: self.response(_as_rao(rao, f"raos[{dof!r}]")) for dof, rao in raos.items()}
 
 
@@ -307,10 +307,10 @@ def jonswap_waves(hs: float, tp: float, gamma: float = 3.3, n: int = 200, omega_
     tp = _checks.scalar(tp, "tp", positive=True, unit="s")
     wp = 2.0 * np.pi / tp
     if isinstance(n, (bool, np.bool_)) or not isinstance(n, (int, np.integer)):
-        raise ValueError(f"n: expected a positive number of components, got {n!r}")
+        raise _checks.refuse(f"n: expected a positive number of components, got {n!r}")
     n = _checks.integer(n, "n", minimum=1, maximum=MAX_COMPONENTS)
     if omega_range is None and not np.isfinite(5.0 * wp):
-        raise ValueError(f"tp: expected a peak period whose default frequencies 0.5 to 5 times 2π/tp are finite "
+        raise _checks.refuse(f"tp: expected a peak period whose default frequencies 0.5 to 5 times 2π/tp are finite "
                          f"(tp >= 1.8e-307 s; or give omega_range), got {tp:g} s")
     lo, hi = (0.5 * wp, 5.0 * wp) if omega_range is None else _omega_range(omega_range)
     dw = (hi - lo) / n
@@ -322,18 +322,18 @@ def jonswap_waves(hs: float, tp: float, gamma: float = 3.3, n: int = 200, omega_
         s, ratio = _scaled_variance(a) if np.all(np.isfinite(a)) else (np.inf, 1.0)
         m0 = s * (s * ratio)
     if not np.isfinite(m0):
-        raise ValueError(f"hs, tp: expected a sea state whose variance m0 ≈ hs²/16 is finite, got m0 overflowing for "
+        raise _checks.refuse(f"hs, tp: expected a sea state whose variance m0 ≈ hs²/16 is finite, got m0 overflowing for "
                          f"hs = {hs:g} m, tp = {tp:g} s")
     if not isinstance(seed, np.random.Generator):
         try:
             seed = np.random.default_rng(seed)
         except (TypeError, ValueError):
-            raise ValueError(f"seed: expected an int or a numpy Generator, got {seed!r}") from None
+            raise _checks.refuse(f"seed: expected an int or a numpy Generator, got {seed!r}") from None
     return Waves(w, a, seed.uniform(0.0, 2.0 * np.pi, n))
 
 
 def _omega_range(omega_range) -> tuple[float, float]:
     r = _checks.array(omega_range, (2,), "omega_range")
     if not 0.0 <= r[0] < r[1]:
-        raise ValueError(f"omega_range: expected (lo, hi) with 0 <= lo < hi in rad/s, got {tuple(r)}")
+        raise _checks.refuse(f"omega_range: expected (lo, hi) with 0 <= lo < hi in rad/s, got {tuple(r)}")
     return float(r[0]), float(r[1])

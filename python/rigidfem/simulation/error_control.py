@@ -29,6 +29,7 @@ import rigidfem._core as _core  # the compiled core, by its absolute name
 from ..base._checks import same_model
 from .._core import Body, Point
 from ..base.persistence import Versioned
+from ..base import _checks
 
 #: The kinds of error_on besides lists of outputs.
 MEASURES = ("bodies", "state")
@@ -45,10 +46,10 @@ def specs(system, error_on) -> list:
     try:
         items = list(items)
     except TypeError:
-        raise ValueError(f"error_on: expected None, 'bodies', 'state' or a list of outputs (points, bodies, "
+        raise _checks.refuse(f"error_on: expected None, 'bodies', 'state' or a list of outputs (points, bodies, "
                          f"coordinate, element or loop names), got {error_on!r}") from None
     if not items:
-        raise ValueError("error_on: expected at least one output, got an empty list")
+        raise _checks.refuse("error_on: expected at least one output, got an empty list")
     return [_spec(system, item) for item in items]
 
 
@@ -59,11 +60,11 @@ def _spec(system, item, argument: str = "error_on"):
     if isinstance(item, Point):
         same_model(item, system, argument, "points and bodies of the model this system was compiled from")
         if item.body < 0:
-            raise ValueError(f"{argument}: expected points on moving bodies (the ground's do not move), got {item!r}")
+            raise _checks.refuse(f"{argument}: expected points on moving bodies (the ground's do not move), got {item!r}")
         return ("point", int(item.body), np.asarray(item.r, dtype=float))
     if isinstance(item, (int, np.integer)) and not isinstance(item, bool):
         if not 0 <= item < system.nq:
-            raise ValueError(f"{argument}: expected coordinate indices 0 ... {system.nq - 1} (nq - 1), got {item}")
+            raise _checks.refuse(f"{argument}: expected coordinate indices 0 ... {system.nq - 1} (nq - 1), got {item}")
         return ("coordinate", int(item), np.zeros(3))
     if isinstance(item, str):
         found = [(kind, names.index(item)) for kind, names in
@@ -72,10 +73,11 @@ def _spec(system, item, argument: str = "error_on"):
         if len(found) == 1:
             return (found[0][0], found[0][1], np.zeros(3))
         if len(found) > 1:
-            raise ValueError(f"{argument}: the name {item!r} is a {' and a '.join(k for k, _ in found)}: ambiguous")
-        raise ValueError(f"{argument}: expected a coordinate ({_few(system.coordinate_names)}), force element "
+            raise _checks.refuse(f"{argument}: expected a name that is one thing, got {item!r}, the name of a "
+                                 f"{' and of a '.join(k for k, _ in found)}: ambiguous")
+        raise _checks.refuse(f"{argument}: expected a coordinate ({_few(system.coordinate_names)}), force element "
                          f"({_few(system.element_names)}) or loop ({_few(system.loop_names)}) name, got {item!r}")
-    raise ValueError(f"{argument}: expected points, bodies, coordinate indices or names of coordinates, force "
+    raise _checks.refuse(f"{argument}: expected points, bodies, coordinate indices or names of coordinates, force "
                      f"elements or loops, got {item!r}")
 
 
@@ -131,11 +133,11 @@ class ErrorEstimate(Versioned):
         """The estimated error of ``quantity(result)`` (a function of a Result returning an array, e.g.
         ``lambda r: r.position(beam.tip)``): factor × |quantity(result) − quantity(second run)|, elementwise."""
         if not callable(quantity):
-            raise ValueError(f"quantity: expected a function of a Result (e.g. lambda r: r.position(tip)), got "
+            raise _checks.refuse(f"quantity: expected a function of a Result (e.g. lambda r: r.position(tip)), got "
                              f"{quantity!r}")
         a, b = np.asarray(quantity(self.result), dtype=float), np.asarray(quantity(self.reference), dtype=float)
         if a.shape != b.shape:
-            raise ValueError(f"quantity: expected the same shape from both runs, got {a.shape} and {b.shape}")
+            raise _checks.refuse(f"quantity: expected the same shape from both runs, got {a.shape} and {b.shape}")
         return self.factor * np.abs(a - b)
 
     def table(self) -> list:

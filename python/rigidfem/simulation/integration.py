@@ -181,15 +181,15 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
     t_end = _checks.real(t_end, "t_end", "an end time in s")
     t_eval = np.zeros(0) if t_eval is None else _checks.reals(t_eval, (np.size(t_eval),), "t_eval")
     if not isinstance(method, str):
-        raise ValueError(f"method: expected a method name such as 'dopri5' (see rigidfem.simulate), got {method!r}")
+        raise _checks.refuse(f"method: expected a method name such as 'dopri5' (see rigidfem.simulate), got {method!r}")
     rtol, atol = _tolerance(rtol, "rtol", n, 1e-6), _tolerance(atol, "atol", n, 1e-9)
     per_component = np.size(rtol) > 1 or np.size(atol) > 1
     if per_component and error_on is not None and not (isinstance(error_on, str) and error_on == "state"):
-        raise ValueError(f"rtol, atol: expected one value each with error_on={error_on!r} (per-component "
+        raise _checks.refuse(f"rtol, atol: expected one value each with error_on={error_on!r} (per-component "
                          f"tolerances hold the state: error_on='state'), got {np.size(rtol)} and {np.size(atol)}")
     scipy = method.startswith("scipy:")
     if scipy and method not in options_.SCIPY:
-        raise ValueError(f"method: expected one of {list(options_.SCIPY)}, got {method!r}")
+        raise _checks.refuse(f"method: expected one of {list(options_.SCIPY)}, got {method!r}")
     # the C++ options, each converted by the bindings (ValueError naming it); scipy: methods check the C++ ones too
     # (they use only first_step of them), so that a bad option is named whatever the method
     opt = options_.compiled("dopri5" if scipy else method, o)  # what the method reads; the others at their defaults
@@ -198,16 +198,16 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
     row = options_.method(method)
     fixed = adaptive is False or (not row.adaptive and adaptive is not True)
     if error_on is not None and (scipy or fixed) and not (isinstance(error_on, str) and error_on == "state"):
-        raise ValueError(f"error_on: expected None or 'state' for {method!r}"
+        raise _checks.refuse(f"error_on: expected None or 'state' for {method!r}"
                          f"{' at fixed steps' if fixed else ''} (it controls no error on outputs), got {error_on!r}")
     state = per_component or scipy or (error_on is None and not _core._measures_outputs(system, opt))
     outputs = [] if state else error_control.specs(system, error_on)
     if stop is not None and not callable(getattr(stop, "is_set", None)):
-        raise ValueError(f"stop: expected None or a threading.Event (an object with is_set()), got {stop!r}")
+        raise _checks.refuse(f"stop: expected None or a threading.Event (an object with is_set()), got {stop!r}")
     nz = system.nz
     s0 = np.zeros(nz) if s0 is None else _checks.reals(s0, (nz,), "s0")
     if method == "auto" and adaptive is False:
-        raise ValueError("adaptive: expected None or True with method 'auto' (it controls its steps), got False")
+        raise _checks.refuse("adaptive: expected None or True with method 'auto' (it controls its steps), got False")
     for x in (opt, judged):
         if scipy:
             x.adaptive = -1  # SciPy's solvers are adaptive whatever it says (its type is checked)
@@ -216,17 +216,17 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
     _core._check_options(system, t0, t_end, q0, qd0, t_eval, judged)  # the values, once (the sensitivities': integrate)
     names = sensitivities_.directions(system, sensitivities, opt, t0, t_end)
     if names and scipy:  # the options are checked first: a bad one is named whatever the method
-        raise ValueError(f"method: expected a C++ method that integrates sensitivities (dopri5, rk4, generalized_alpha, "
+        raise _checks.refuse(f"method: expected a C++ method that integrates sensitivities (dopri5, rk4, generalized_alpha, "
                          f"...), got {method!r}")
     _check_output_memory(len(t_eval), 2 * n * (1 + len(names)) + nz)
     _check_closed(system, t0, q0, qd0)
     if system.nl and scipy:
-        raise ValueError(f"method: expected a C++ method for a system with loop closures ({system.nl} constraint rows), "
+        raise _checks.refuse(f"method: expected a C++ method for a system with loop closures ({system.nl} constraint rows), "
                          f"got {method!r}: SciPy's solvers integrate the constrained accelerations without holding "
                          "g(q) = 0, whose residual drifts (2.5e-4 on a four-bar at rtol = 1e-8); use 'auto', 'radau5', "
                          "'dopri5' or 'generalized_alpha', which close the loops at every output")
     if nz and scipy:
-        raise ValueError(f"method: expected a C++ method for a system with Maxwell arms ({nz} arm forces as internal "
+        raise _checks.refuse(f"method: expected a C++ method for a system with Maxwell arms ({nz} arm forces as internal "
                          f"variables), got {method!r}; use 'auto', 'esdirk43', 'generalized_alpha' or 'dopri5'")
     max_steps, max_step = opt.get("max_steps"), opt.get("max_step")
     bar = ProgressBar(t_end - t0, "s", "simulate") if _checks.boolean(progress, "progress") else None
@@ -313,7 +313,7 @@ def _check_closed(system, t0, q0, qd0, tol=1e-8):
     names = system.loop_names
     for what, v in (("q0", g), ("qd0", gd)):
         if np.max(np.abs(v)) > tol:
-            raise ValueError(f"{what}: expected initial {'coordinates' if what == 'q0' else 'rates'} that close every "
+            raise _checks.refuse(f"{what}: expected initial {'coordinates' if what == 'q0' else 'rates'} that close every "
                              f"loop of {names} (max |g{'' if what == 'q0' else 'd'}| = {np.max(np.abs(v)):.3g} > {tol:g}); "
                              "system.assemble(q0, qd0, t=t0) finds the nearest ones")
 
@@ -351,7 +351,7 @@ def _check_output_memory(outputs: int, numbers: int) -> None:
         return
     need = 8.0 * outputs * numbers
     if need > memory:
-        raise ValueError(f"t_eval: expected at most {int(memory // (8 * max(numbers, 1))):,} output times (their "
+        raise _checks.refuse(f"t_eval: expected at most {int(memory // (8 * max(numbers, 1))):,} output times (their "
                          f"states, {numbers} numbers each, within the machine's {memory / 1e9:.3g} GB), got {outputs:,} "
                          f"({need / 1e9:.3g} GB)")
 
@@ -362,7 +362,7 @@ def _tolerance(x, name, n, default) -> np.ndarray:
     expected = f"a non-negative number or {2 * n} (2 nq) of them"
     tol = np.atleast_1d(_checks._floats(x, name, expected))  # real numbers (not complex, not strings)
     if tol.ndim != 1:
-        raise ValueError(f"{name}: expected {expected}, got shape {tol.shape}")
+        raise _checks.refuse(f"{name}: expected {expected}, got shape {tol.shape}")
     return np.array([default]) if tol.size == 0 and n == 0 else tol  # the values: _core._check_options
 
 

@@ -27,6 +27,7 @@ import textwrap
 from dataclasses import dataclass
 
 import rigidfem._core as _core  # the compiled core, by its absolute name
+from ..base import _checks
 
 #: SciPy's solvers behind ``"scipy:<name>"`` (the Python adapter of ``rigidfem.simulation``) and the options it
 #: reads.
@@ -96,7 +97,7 @@ def methods() -> dict[str, Method]:
 def method(name) -> Method:
     """The method called ``name``; ValueError listing the methods otherwise."""
     if not isinstance(name, str) or name not in _METHODS:
-        raise ValueError(f"method: expected one of {list(METHODS)}, got {name!r}")
+        raise _checks.refuse(f"method: expected one of {list(METHODS)}, got {name!r}")
     return _METHODS[name]
 
 

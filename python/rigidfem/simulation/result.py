@@ -159,9 +159,9 @@ class Result(Versioned):
         if isinstance(point, Body):
             point = point.origin
         if not isinstance(point, Point):
-            raise ValueError(f"point: expected a Point or a Body, got {point!r}")
+            raise _checks.refuse(f"point: expected a Point or a Body, got {point!r}")
         if frame is not None and not isinstance(frame, Body):
-            raise ValueError(f"frame: expected None or a Body, got {frame!r}")
+            raise _checks.refuse(f"frame: expected None or a Body, got {frame!r}")
         _checks.same_model(point, self.system, "point")
         if frame is not None:
             _checks.same_model(frame, self.system, "frame", "None or a Body of the model this system was compiled from")
@@ -172,7 +172,7 @@ class Result(Versioned):
         """(∂q/∂p, ∂q̇/∂p), each (len(t), nq), by the parameter or initial value ``name`` the run was asked
         for (``simulate(sensitivities=...)``; units of q and q̇ per unit of the parameter)."""
         if not isinstance(name, str) or name not in self.sensitivities:
-            raise ValueError(f"name: expected one of the sensitivities of this run {list(self.sensitivities)}, "
+            raise _checks.refuse(f"name: expected one of the sensitivities of this run {list(self.sensitivities)}, "
                              f"got {name!r}")
         S = self.sensitivities[name]
         n = self.q.shape[1]
@@ -254,9 +254,9 @@ def _estimate_error(result: Result):
     """Result.error_estimate: the second run (tolerances / TIGHTER, or dt / 2) at the same output times."""
     run = result.run
     if run is None or result.made_by is None:
-        raise ValueError("result: expected a Result made by rigidfem.simulate (a loaded one has no run to repeat)")
+        raise _checks.refuse("result: expected a Result made by rigidfem.simulate (a loaded one has no run to repeat)")
     if result.interrupted or not len(result.t) or result.t[-1] < run["t_end"]:
-        raise ValueError("result: expected a finished run for its error estimate, got one that stopped at "
+        raise _checks.refuse("result: expected a finished run for its error estimate, got one that stopped at "
                          f"t = {result.t[-1] if len(result.t) else run['t0']:g} s")
     kw = {k: v for k, v in run.items() if k not in ("outputs", "fixed")}
     kw["t_eval"], kw["stiffness_warning"] = result.t, False

@@ -6,6 +6,7 @@ from __future__ import annotations
 import numpy as np
 
 from . import options as options_
+from ..base import _checks
 
 #: SciPy's solvers by name (``"scipy:Radau"`` runs ``Radau``): the adapter's methods, ``rigidfem.options.SCIPY``.
 SCIPY_METHODS = tuple(m[len("scipy:"):] for m in options_.SCIPY)
@@ -31,9 +32,9 @@ def _run_scipy(system, name, t0, t_end, q0, qd0, t_eval, rtol, atol, max_step, m
     import scipy.integrate
 
     if name not in SCIPY_METHODS:
-        raise ValueError(f"method: expected one of {['scipy:' + m for m in SCIPY_METHODS]}, got 'scipy:{name}'")
+        raise _checks.refuse(f"method: expected one of {['scipy:' + m for m in SCIPY_METHODS]}, got 'scipy:{name}'")
     if np.max(rtol) == 0.0 and np.min(atol) == 0.0:
-        raise ValueError("atol: expected positive values when rtol is zero")
+        raise _checks.refuse("atol: expected positive values when rtol is zero")
     n = system.nq
     start = time.perf_counter()
     solver_class = getattr(scipy.integrate, name)

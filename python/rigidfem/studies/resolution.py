@@ -48,6 +48,7 @@ import numpy as np
 import rigidfem._core as _core  # the compiled core, by its absolute name
 from .._core import Body, Point
 from ..model.model import Model, System
+from ..base import _checks
 
 #: Shares of tol: the space (elements), the time integration and the dropped deformations.
 SPACE, TIME, DROP = 0.5, 0.25, 0.25
@@ -172,8 +173,6 @@ def resolve(build, outputs, tol: float, *, t_end: float | None = None, elements:
         with the analysis (elements, deform) in its message and the analyses made before it in
         ``runs``.
     """
-    from ..base import _checks
-
     if not callable(build):
         raise ResolveError(f"build: expected a function build(elements, deform) -> (model, handles), got {build!r}")
     names = [outputs] if isinstance(outputs, str) else list(outputs) if _is_sequence(outputs) else None
@@ -262,7 +261,8 @@ class _Job:
         try:
             made = self.build(m, deform)
         except Exception as e:  # noqa: BLE001 (the user's code: any failure is reported with the runs made)
-            raise ResolveError(f"build: failed for {where}: {type(e).__name__}: {e}", self.runs) from e
+            raise ResolveError(f"build: expected a function that makes the model, got one that failed for {where}: "
+                               f"{type(e).__name__}: {e}", self.runs) from e
         if not isinstance(made, tuple) or len(made) not in (2, 3):
             raise ResolveError(f"build: expected (model, handles) or (model, handles, options) for {where}, "
                                f"got {type(made).__name__}", self.runs)
@@ -437,14 +437,13 @@ def _judge_options(options: dict, t_end) -> None:
     """The options resolve passes to simulate, judged before any run by simulate's own checks (what needs no
     system: the names, the method, each option's conversion; their values against the system are simulate's
     at the first run, before it integrates); with t_end = None (statics) none is taken."""
-    from ..base import _checks
     from ..simulation import options as options_
     from ..simulation.integration import simulate
 
     if t_end is None:
         if options:
             name = next(iter(options))
-            raise ValueError(f"{name}: expected no options of simulate with t_end = None (a static equilibrium, which "
+            raise _checks.refuse(f"{name}: expected no options of simulate with t_end = None (a static equilibrium, which "
                              f"takes load_steps), got {name}={options[name]!r}; give t_end to simulate")
         return
     method = options.get("method", "auto")

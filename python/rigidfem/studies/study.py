@@ -52,10 +52,10 @@ class Scene:
         if isinstance(self.tip, Body):
             self.tip = self.tip.origin
         if not isinstance(self.tip, Point):
-            raise ValueError(f"tip: expected a Point or Body of the system's model, got {_checks._short(self.tip)}")
+            raise _checks.refuse(f"tip: expected a Point or Body of the system's model, got {_checks._short(self.tip)}")
         _checks.same_model(self.tip, self.system, "tip")
         if self.frame is not None and not isinstance(self.frame, Body):
-            raise ValueError(f"frame: expected None or a Body, got {_checks._short(self.frame)}")
+            raise _checks.refuse(f"frame: expected None or a Body, got {_checks._short(self.frame)}")
         self.outputs = _checks.integer(self.outputs, "outputs", minimum=2, maximum=10**7)
 
     @property
@@ -224,7 +224,7 @@ def _observe(scene: Scene, result):
 
 def _scene(scene) -> None:
     if not isinstance(scene, Scene):
-        raise ValueError(f"scene: expected a rigidfem.study.Scene (e.g. rigidfem.study.scenes.cantilever()), got "
+        raise _checks.refuse(f"scene: expected a rigidfem.study.Scene (e.g. rigidfem.study.scenes.cantilever()), got "
                          f"{_checks._short(scene)}")
 
 

@@ -43,27 +43,27 @@ def grid_cases(grid: Mapping[str, Sequence]) -> list[dict]:
     """The Cartesian product of ``grid`` (name -> values) as a list of cases, the last name varying
     fastest: ``grid_cases({"a": [1, 2], "b": [3, 4]})`` gives a=1,b=3; a=1,b=4; a=2,b=3; a=2,b=4."""
     if not isinstance(grid, Mapping) or not grid:
-        raise ValueError(f"grid: expected a non-empty dict of parameter names to sequences of values, got {grid!r}")
+        raise _checks.refuse(f"grid: expected a non-empty dict of parameter names to sequences of values, got {grid!r}")
     names = list(grid)
     values = []
     for name in names:
         v = grid[name]
         if isinstance(v, (str, bytes)) or not isinstance(v, (Sequence, np.ndarray)) or len(v) == 0:
-            raise ValueError(f"grid[{name!r}]: expected a non-empty sequence of values, got {v!r}")
+            raise _checks.refuse(f"grid[{name!r}]: expected a non-empty sequence of values, got {v!r}")
         values.append(list(v))
     return [dict(zip(names, combination)) for combination in itertools.product(*values)]
 
 
 def _cases(cases, grid) -> list[dict]:
     if (cases is None) == (grid is None):
-        raise ValueError("cases, grid: expected exactly one of them (a list of dicts, or a dict of sequences)")
+        raise _checks.refuse("cases, grid: expected exactly one of them (a list of dicts, or a dict of sequences)")
     if grid is not None:
         return grid_cases(grid)
     if isinstance(cases, Mapping) or not isinstance(cases, Sequence) or isinstance(cases, (str, bytes)):
-        raise ValueError(f"cases: expected a list of dicts of parameters, got {cases!r}")
+        raise _checks.refuse(f"cases: expected a list of dicts of parameters, got {cases!r}")
     for k, case in enumerate(cases):
         if not isinstance(case, Mapping) or not all(isinstance(name, str) for name in case):
-            raise ValueError(f"cases[{k}]: expected a dict of parameter names (str) to values, got {case!r}")
+            raise _checks.refuse(f"cases[{k}]: expected a dict of parameter names (str) to values, got {case!r}")
     return [dict(case) for case in cases]
 
 
@@ -71,7 +71,7 @@ def _seeds(seed, n: int) -> list[int]:
     """One independent seed per case from numpy's SeedSequence(seed).spawn(n): the case's stream does
     not depend on the executor nor on the other cases."""
     if seed is not None and (isinstance(seed, bool) or not isinstance(seed, (int, np.integer)) or seed < 0):
-        raise ValueError(f"seed: expected None or a non-negative integer, got {seed!r}")
+        raise _checks.refuse(f"seed: expected None or a non-negative integer, got {seed!r}")
     return [int(child.generate_state(1, np.uint64)[0] >> np.uint64(1))
             for child in np.random.SeedSequence(seed).spawn(n)]
 
@@ -95,10 +95,10 @@ def _check_parameters(function, cases, seed) -> None:
         return
     unknown = sorted({name for case in cases for name in case} - set(parameters))
     if unknown:
-        raise ValueError(f"cases: expected parameters of {getattr(function, '__name__', 'the function')}"
+        raise _checks.refuse(f"cases: expected parameters of {getattr(function, '__name__', 'the function')}"
                          f"({', '.join(parameters)}), got {unknown}")
     if seed is not None and SEED not in parameters:
-        raise ValueError(f"seed: expected None for a function without a 'seed' parameter "
+        raise _checks.refuse(f"seed: expected None for a function without a 'seed' parameter "
                          f"({getattr(function, '__name__', 'the function')}({', '.join(parameters)})), got {seed!r}")
 
 
@@ -121,7 +121,7 @@ def _check_pickles(function) -> None:
     try:
         pickle.dumps(function)
     except (pickle.PicklingError, AttributeError, TypeError) as e:
-        raise ValueError(f"function: expected a function that pickles for executor='processes' (defined at module "
+        raise _checks.refuse(f"function: expected a function that pickles for executor='processes' (defined at module "
                          f"level; lambdas and closures do not), got {function!r} ({e}); threads or a Dask Client "
                          f"(cloudpickle) take it") from None
 
@@ -134,7 +134,7 @@ def _resolve_executor(executor, workers):
     """(executor, whether this call owns it and must shut it down)."""
     if workers is not None and (isinstance(workers, bool) or not isinstance(workers, (int, np.integer))
                                 or workers < 1):
-        raise ValueError(f"workers: expected None or a positive integer, got {workers!r}")
+        raise _checks.refuse(f"workers: expected None or a positive integer, got {workers!r}")
     if executor == "serial":
         return None, False
     if executor == "threads":
@@ -143,9 +143,9 @@ def _resolve_executor(executor, workers):
         return concurrent.futures.ProcessPoolExecutor(workers or os.cpu_count() or 1), True
     if isinstance(executor, concurrent.futures.Executor) or _is_dask_client(executor):
         if workers is not None:
-            raise ValueError("workers: expected None with an executor or a Dask Client (they have their own workers)")
+            raise _checks.refuse("workers: expected None with an executor or a Dask Client (they have their own workers)")
         return executor, False
-    raise ValueError(f"executor: expected 'threads', 'processes', 'serial', a concurrent.futures.Executor or a "
+    raise _checks.refuse(f"executor: expected 'threads', 'processes', 'serial', a concurrent.futures.Executor or a "
                      f"dask.distributed.Client, got {executor!r}")
 
 
@@ -173,7 +173,7 @@ def run_cases(function, cases: list, seeds: list, record_errors: bool, packed: b
             pickle.dumps(value)
         except Exception as e:  # noqa: BLE001
             if not record_errors:
-                raise ValueError(f"function: expected return values that pickle with executor='processes' (a "
+                raise _checks.refuse(f"function: expected return values that pickle with executor='processes' (a "
                                  f"process sends them back by pickle), got {type(value).__name__} for the case "
                                  f"{case!r}: {type(e).__name__}: {e}") from None
             value, error = None, (f"{type(e).__name__}: the function's return value does not pickle (a process "
@@ -263,7 +263,7 @@ def _outcomes(function, cases, seeds, executor, record_errors, bar, stop) -> lis
         elif stop.is_set():
             outcomes.update((k, (None, INTERRUPTED, float("nan"))) for k in b)
         elif not record_errors and isinstance(f.exception(), BrokenProcessPool):
-            raise ValueError(f"function: expected a function that returns, got one whose worker process died "
+            raise _checks.refuse(f"function: expected a function that returns, got one whose worker process died "
                              f"running the cases {[cases[k] for k in b]!r}: {f.exception()}") from None
         elif not record_errors:
             raise f.exception()  # errors="raise": the case's own exception
@@ -329,7 +329,7 @@ def _table(rows: list[dict], as_frame):
     try:
         import pandas as pd
     except ImportError:
-        raise ValueError("as_frame: expected None or False without pandas installed (pip install pandas), "
+        raise _checks.refuse("as_frame: expected None or False without pandas installed (pip install pandas), "
                          "got True") from None
     frame = pd.DataFrame.from_records(rows, columns=columns)
     frame[ERROR] = pd.Series([row[ERROR] for row in rows], index=frame.index, dtype=object)  # None where it ran
@@ -382,11 +382,11 @@ def sweep(function: Callable, cases: Sequence[Mapping] | None = None, *, grid: M
         the case's own time in its worker).
     """
     if not callable(function):
-        raise ValueError(f"function: expected a callable function(**parameters), got {function!r}")
+        raise _checks.refuse(f"function: expected a callable function(**parameters), got {function!r}")
     if errors not in ("record", "raise"):
-        raise ValueError(f"errors: expected 'record' or 'raise', got {errors!r}")
+        raise _checks.refuse(f"errors: expected 'record' or 'raise', got {errors!r}")
     if as_frame is not None and not isinstance(as_frame, (bool, np.bool_)):
-        raise ValueError(f"as_frame: expected None, True or False, got {as_frame!r}")
+        raise _checks.refuse(f"as_frame: expected None, True or False, got {as_frame!r}")
     cases = _cases(cases, grid)
     if executor == "processes":
         _check_pickles(function)

@@ -40,18 +40,18 @@ def frame_indices(t: np.ndarray, frames: int | None = None, fps: float | None = 
     t0 + k/``fps`` (frames per second of simulated time). At most ``MAX_FRAMES`` frames and
     ``MAX_POSES`` poses (frames × ``bodies``), bounded before any is computed."""
     if frames is not None and fps is not None:
-        raise ValueError(f"fps: expected None when frames is given, got fps={fps!r} and frames={frames!r}")
+        raise _checks.refuse(f"fps: expected None when frames is given, got fps={fps!r} and frames={frames!r}")
     n, most = len(t), max(1, min(MAX_FRAMES, MAX_POSES // max(bodies, 1)))
     if fps is None:
         count = min(n, DEFAULT_FRAMES) if frames is None else min(n, _checks.integer(frames, "frames", minimum=1))
         if count > most:
-            raise ValueError(f"frames: expected at most {most:,} frames (MAX_FRAMES = {MAX_FRAMES:,}, frames × "
+            raise _checks.refuse(f"frames: expected at most {most:,} frames (MAX_FRAMES = {MAX_FRAMES:,}, frames × "
                              f"{bodies:,} bodies ≤ MAX_POSES = {MAX_POSES:,}), got {count:,}")
         return np.unique(np.round(np.linspace(0, n - 1, count)).astype(int))
     fps = _checks.scalar(fps, "fps", positive=True, unit="frames per s")
     count = np.floor((t[-1] - t[0]) * fps + 1e-9) + 1  # a float: checked before anything is allocated
     if not count <= most:
-        raise ValueError(f"fps: expected at most {most:,} frames over the {t[-1] - t[0]:g} s of the result "
+        raise _checks.refuse(f"fps: expected at most {most:,} frames over the {t[-1] - t[0]:g} s of the result "
                          f"(MAX_FRAMES = {MAX_FRAMES:,}, frames × bodies ≤ MAX_POSES = {MAX_POSES:,}), got fps = "
                          f"{fps:g}: {count:g} frames")
     wanted = t[0] + np.arange(int(count)) / fps
@@ -133,10 +133,10 @@ def save(anim, path, *, fps: float | None = None, dpi: float | None = None) -> P
     path = Path(_checks.path(path))
     ext = path.suffix.lower()
     if ext not in WRITERS:
-        raise ValueError(f"path: expected a file name ending in one of {list(WRITERS)}, got {str(path)!r}")
+        raise _checks.refuse(f"path: expected a file name ending in one of {list(WRITERS)}, got {str(path)!r}")
     writer = WRITERS[ext]
     if not writers.is_available(writer):
-        raise ValueError(f"path: no movie writer for {ext!r} is available ({writer!r} is not installed); "
-                         f"install it or save as .gif (pillow)")
+        raise _checks.refuse(f"path: expected a format whose movie writer is available, got {ext!r}, whose writer "
+                             f"{writer!r} is not installed; install it or save as .gif (pillow)")
     anim.save(path, writer=writer, fps=fps, dpi=dpi)
     return path

@@ -57,10 +57,10 @@ def _select(names: Sequence[str], which, argument: str, what: str, default: int)
         elif isinstance(item, (int, np.integer)) and not isinstance(item, bool) and -len(names) <= item < len(names):
             out.append(int(item) % len(names))
         else:
-            raise ValueError(f"{argument}: expected {what} from [{listed}] or indices 0..{len(names) - 1}, "
+            raise _checks.refuse(f"{argument}: expected {what} from [{listed}] or indices 0..{len(names) - 1}, "
                              f"got {item!r}")
     if not out:
-        raise ValueError(f"{argument}: expected at least one of {what}, got {which!r}")
+        raise _checks.refuse(f"{argument}: expected at least one of {what}, got {which!r}")
     return out
 
 
@@ -101,11 +101,11 @@ def coordinates(result, which=None, *, quantity: str = "q", ax=None):
     y axis "q (rad)", "q̇ (m/s, rad/s)", ...
     """
     if quantity not in QUANTITIES:
-        raise ValueError(f"quantity: expected one of {list(QUANTITIES)}, got {quantity!r}")
+        raise _checks.refuse(f"quantity: expected one of {list(QUANTITIES)}, got {quantity!r}")
     result = _checks.result(result, needs="accelerations" if quantity == "qdd" else None)
     names = result.coordinate_names
     if not names:
-        raise ValueError("result: expected a system with free coordinates, got one with nq = 0")
+        raise _checks.refuse("result: expected a system with free coordinates, got one with nq = 0")
     k = _select(names, which, "which", "coordinate names", 6)
     symbol, per = QUANTITIES[quantity]
     units = [unit(names[i]) + per for i in k]
@@ -124,7 +124,7 @@ def position(result, point, components: str = "xyz", *, frame: Body | None = Non
     result = _checks.result(result, needs="positions")
     if not isinstance(components, str) or not components or any(c not in "xyz" for c in components) \
             or len(set(components)) != len(components):
-        raise ValueError(f"components: expected distinct letters from 'xyz' (e.g. 'xz'), got {components!r}")
+        raise _checks.refuse(f"components: expected distinct letters from 'xyz' (e.g. 'xz'), got {components!r}")
     X = result.position(point, frame=frame)
     k = ["xyz".index(c) for c in components]
     prefix = f"{label} " if label else ""
@@ -147,7 +147,7 @@ def driving_forces(result, which=None, *, ax=None):
     result = _checks.result(result, needs="driving forces")
     names = result.system.prescribed_names
     if not names:
-        raise ValueError("result: expected a system with prescribed coordinates (drives), got none")
+        raise _checks.refuse("result: expected a system with prescribed coordinates (drives), got none")
     k = _select(names, which, "which", "prescribed coordinate names", 6)
     units = ["N·m" if unit(names[i]) == "rad" else "N" for i in k]
     labels = [f"{names[i]} ({u})" for i, u in zip(k, units)]
@@ -280,7 +280,7 @@ def _beams(beams, system) -> list[Beam]:
     beams = [beams] if isinstance(beams, Beam) else list(beams)
     for beam in beams:
         if not isinstance(beam, Beam):
-            raise ValueError(f"beams: expected Beam handles from Model.add_beam, got {beam!r}")
+            raise _checks.refuse(f"beams: expected Beam handles from Model.add_beam, got {beam!r}")
         _checks.same_model(beam.rfes[0], system, "beams", "beams of the model this system was compiled from")
     return beams
 
@@ -289,7 +289,7 @@ def _pairs(segments, system) -> list[tuple]:
     pairs = list(segments)
     for pair in pairs:
         if not (isinstance(pair, tuple) and len(pair) == 2 and all(isinstance(p, (Point, Body)) for p in pair)):
-            raise ValueError(f"segments: expected pairs (a, b) of Point or Body handles, got {pair!r}")
+            raise _checks.refuse(f"segments: expected pairs (a, b) of Point or Body handles, got {pair!r}")
         for p in pair:
             _checks.same_model(p, system, "segments")
     return pairs
@@ -297,7 +297,7 @@ def _pairs(segments, system) -> list[tuple]:
 
 def _plane(plane):
     if plane is not None and plane not in PLANES:
-        raise ValueError(f"plane: expected None (3D) or one of {list(PLANES)}, got {plane!r}")
+        raise _checks.refuse(f"plane: expected None (3D) or one of {list(PLANES)}, got {plane!r}")
     return plane
 
 
@@ -307,7 +307,7 @@ def _shape_axes(ax, plane):
         ax = _axes(None, "3d" if plane is None else None)
     elif (ax.name == "3d") != (plane is None):
         expected = "3D axes (projection='3d')" if plane is None else "2D axes"
-        raise ValueError(f"ax: expected {expected} for plane={plane!r}, got {ax.name} axes")
+        raise _checks.refuse(f"ax: expected {expected} for plane={plane!r}, got {ax.name} axes")
     for axis, c in zip(("x", "y", "z"), (plane or "xyz")):
         getattr(ax, f"set_{axis}label")(f"{c} (m)")
     return ax
@@ -415,7 +415,7 @@ def modes(system, modes, which=(0, 1, 2), *, scale: float | None = None, t: floa
         fig = _pyplot().figure(figsize=(4 * len(k), 4), layout="constrained")
         ax = [fig.add_subplot(1, len(k), n + 1, projection=None if plane else "3d") for n in range(len(k))]
     elif len(ax) != len(k):
-        raise ValueError(f"ax: expected {len(k)} Axes (one per mode in which), got {len(ax)}")
+        raise _checks.refuse(f"ax: expected {len(k)} Axes (one per mode in which), got {len(ax)}")
     skeleton = Skeleton(system, beams)
     reference = skeleton.pose(modes.q, t=t)
     names = [b.name for b in skeleton.beams]
@@ -435,7 +435,7 @@ def _mode_indices(which, n: int) -> list[int]:
     items = [which] if isinstance(which, (int, np.integer)) else list(which)
     if not items or not all(isinstance(i, (int, np.integer)) and not isinstance(i, bool) and 0 <= i < n
                             for i in items):
-        raise ValueError(f"which: expected mode indices in 0..{n - 1} (0 the lowest frequency), got {which!r}")
+        raise _checks.refuse(f"which: expected mode indices in 0..{n - 1} (0 the lowest frequency), got {which!r}")
     return [int(i) for i in items]
 
 

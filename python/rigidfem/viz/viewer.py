@@ -121,19 +121,19 @@ def view(system, result=None, *, trails=(), frames: int | None = None, q=None, t
     system = _checks.system(system)
     if result is not None:
         if _checks.result(result).system is not system:
-            raise ValueError(f"result: expected a Result of this system (rf.simulate(system, ...)), got "
+            raise _checks.refuse(f"result: expected a Result of this system (rf.simulate(system, ...)), got "
                              f"{_checks._short(result)}")
         if q is not None:
-            raise ValueError("q: expected None with a result (its frames are shown)")
+            raise _checks.refuse("q: expected None with a result (its frames are shown)")
         times, states = np.asarray(result.t), np.asarray(result.q)
         if len(times) == 0:
-            raise ValueError("result: expected at least one output")
+            raise _checks.refuse("result: expected at least one output")
     else:
         q = np.zeros(system.nq) if q is None else _checks.array(q, (system.nq,), "q")
         times, states = np.array([_checks.scalar(t, "t")]), q[None, :]
     fit = MAX_POSES // max(system.nbodies, 1)  # the frames whose poses the page holds
     if fit < 1:
-        raise ValueError(f"system: expected at most {MAX_POSES:,} bodies to show, got {system.nbodies:,}")
+        raise _checks.refuse(f"system: expected at most {MAX_POSES:,} bodies to show, got {system.nbodies:,}")
     if frames is not None:
         frames = _checks.integer(frames, "frames", minimum=1, maximum=fit)
     elif len(times) > fit:
@@ -159,11 +159,11 @@ def _trail_points(trails, system) -> list:
         except TypeError:  # not iterable (a number): refused below
             pass
     if items is None:
-        raise ValueError(f"trails: expected a Point or Body, or a sequence of Point or Body handles (() for none), "
+        raise _checks.refuse(f"trails: expected a Point or Body, or a sequence of Point or Body handles (() for none), "
                          f"got {_checks._short(trails)}")
     for k, p in enumerate(items):
         if not isinstance(p, (Point, Body)):
-            raise ValueError(f"trails: expected a sequence of Point or Body handles, got {_checks._short(p)} at "
+            raise _checks.refuse(f"trails: expected a sequence of Point or Body handles, got {_checks._short(p)} at "
                              f"trails[{k}]")
         _checks.same_model(p, system, "trails", "a sequence of Point or Body handles of the model this system was "
                                                 f"compiled from (trails[{k}])")
