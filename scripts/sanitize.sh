@@ -19,7 +19,8 @@
 #      - LD_PRELOAD: the ASan runtime and libstdc++ (CPython itself is not instrumented);
 #      - ASAN_OPTIONS=detect_leaks=0 (CPython leaks by design at exit), allocator_may_return_null=1
 #        (a runaway allocation throws std::bad_alloc as without ASan instead of ending the process);
-#      - UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1;
+#      - UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1 and the suppressions of scripts/ubsan.supp
+#        (reports inside Eigen that are not ours: each entry says why);
 #      - PYTHONMALLOC=malloc: Python's objects come from the instrumented malloc too;
 #      - FUZZ_MEMORY_LIMIT=-1: the fuzz workers' address-space limit (RLIMIT_AS) would leave ASan
 #        no room for its shadow memory ("ERROR: Failed to mmap");
@@ -95,7 +96,7 @@ PY
 sanitized=(env
   "LD_PRELOAD=$preload${LD_PRELOAD:+ $LD_PRELOAD}"
   "ASAN_OPTIONS=detect_leaks=0:allocator_may_return_null=1:log_path=$reports/asan${ASAN_OPTIONS:+:$ASAN_OPTIONS}"
-  "UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1${UBSAN_OPTIONS:+:$UBSAN_OPTIONS}"
+  "UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1:suppressions=$root/scripts/ubsan.supp${UBSAN_OPTIONS:+:$UBSAN_OPTIONS}"
   "PYTHONMALLOC=malloc"
   "FUZZ_MEMORY_LIMIT=-1"
   "RIGIDFEM_CONTRACT_TIMEOUT=${RIGIDFEM_CONTRACT_TIMEOUT:-120}")
