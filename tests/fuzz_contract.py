@@ -2228,7 +2228,8 @@ class Gen:
     def simulate_call(self):
         method = self.choice(METHODS)
         # (an implicit method on a system of Python drives: 3000 esdirk43 steps of 54 coordinates took 8.3 s)
-        heavy = method.startswith("scipy:") or (bool(self.flags.get("python_drives")) and method in (
+        heavy = method.startswith("scipy:")
+        slow = heavy or (bool(self.flags.get("python_drives")) and method in (
             "esdirk43", "radau5", "auto", "newmark", "hht", "generalized_alpha", "implicit_spring"))
         kw: dict = {}
         absent: list = []
@@ -2273,11 +2274,11 @@ class Gen:
                 kw[key] = self.vector_arg(key)
                 if key == "q0" and kw[key].get("x"):
                     kw[key]["soft"] = 1  # beyond ±1e15 m or rad simulate refuses q0 (a step drowns in rounding)
-        if self.chance(0.7) or heavy:
+        if self.chance(0.7) or slow:
             if self.chance(0.1):
                 kw["max_steps"] = A(self.choice(["0", "-3", "2.5", "'10'", "None", "10**30", "True", "nan"]), bad=True)
             else:
-                kw["max_steps"] = A(str(self.choice([1, 5, 100, 300] if heavy else [1, 5, 100, 1000, 3000])))
+                kw["max_steps"] = A(str(self.choice([1, 5, 100, 300] if slow else [1, 5, 100, 1000, 3000])))
         else:
             kw["max_steps"] = A("3000")
         if self.chance(0.15):

@@ -159,7 +159,9 @@ class BeamGroup(Group):
             if modulus is None:
                 c[:, col] = 0.0
                 continue
-            with np.errstate(over="ignore", under="ignore"):  # an overflow is refused below
+            # the product of the two ratios first, as the springs were built (bit for bit); each ratio in turn
+            # only where that product overflows or underflows (an overflow left is refused below)
+            with np.errstate(over="ignore", under="ignore"):
                 factor = v[modulus] / self.built[modulus] * (v[section] / self.built[section])
                 c[:, col] = c[:, col] * factor if math.isfinite(factor) and factor != 0.0 else \
                     scaled(scaled(c[:, col], modulus), section)

@@ -80,41 +80,45 @@ class Result(Versioned):
                               f"{len(self.t)} outputs; they overflow at these states)", RuntimeWarning, stacklevel=4)
         return outputs
 
+    def _output(self, name: str) -> np.ndarray:
+        """One of the ``OUTPUTS``, by its name."""
+        return self._outputs[OUTPUTS.index(name)]
+
     @property
     def qdd(self) -> np.ndarray:
-        return self._outputs[0]
+        return self._output("qdd")
 
     @property
     def driving_forces(self) -> np.ndarray:
         """Forces/torques of the drives (len(t), np), in ``system.prescribed_names`` order."""
-        return self._outputs[1]
+        return self._output("driving_forces")
 
     @property
     def kinetic_energy(self) -> np.ndarray:
-        return self._outputs[2]
+        return self._output("kinetic_energy")
 
     @property
     def gravity_energy(self) -> np.ndarray:
-        return self._outputs[3]
+        return self._output("gravity_energy")
 
     @property
     def elastic_energy(self) -> np.ndarray:
-        return self._outputs[4]
+        return self._output("elastic_energy")
 
     @property
     def potential_energy(self) -> np.ndarray:
-        return self._outputs[3] + self._outputs[4]
+        return self._output("gravity_energy") + self._output("elastic_energy")
 
     @property
     def energy(self) -> np.ndarray:
         """Kinetic + gravity + elastic energy (J)."""
-        return self._outputs[2] + self._outputs[3] + self._outputs[4]
+        return self._output("kinetic_energy") + self._output("gravity_energy") + self._output("elastic_energy")
 
     @property
     def dissipated_power(self) -> np.ndarray:
         """Power (W) dissipated by the dampers (Σ b q̇², force elements' c l̇², ropes) and the Maxwell
         arms (Σ s²/(k τ)): its integral over t closes the energy balance with ``energy``."""
-        return self._outputs[5]
+        return self._output("dissipated_power")
 
     @property
     def loop_reactions(self) -> np.ndarray:
@@ -132,13 +136,13 @@ class Result(Versioned):
           the projection onto the loops; the explicit methods and SciPy's have none of their own.
 
         ``system.loop_reactions(t, q, qd)`` gives the forward dynamics' at any state."""
-        return self._outputs[6].reshape(len(self.t), len(self.system.loop_names), 6)
+        return self._output("loop_reactions").reshape(len(self.t), len(self.system.loop_names), 6)
 
     @property
     def element_forces(self) -> np.ndarray:
         """Axial forces (len(t), nelements) in N of the force elements (spring-dampers, cylinders, ropes),
         per ``system.element_names``; positive pushing the two points apart (a rope's −T)."""
-        return self._outputs[7]
+        return self._output("element_forces")
 
     @property
     def error_estimate(self):

@@ -1,4 +1,4 @@
-"""The model's resolution chosen for a requested accuracy: ``rf.resolve`` (issue 24, item 4).
+"""The model's resolution chosen for a requested accuracy: ``rf.resolve``.
 
 A user's builder makes the model at a number of elements and a set of deformations::
 
@@ -47,6 +47,7 @@ import numpy as np
 
 import rigidfem._core as _core  # the compiled core, by its absolute name
 from .._core import Body, Point
+from ..analysis.statics import MAX_LOAD_STEPS
 from ..model.model import Model, System
 from ..base import _checks
 
@@ -187,7 +188,7 @@ def resolve(build, outputs, tol: float, *, t_end: float | None = None, elements:
     if t_end is not None:
         t_end = _checks.scalar(t_end, "t_end", positive=True)
         t_eval = np.linspace(0.0, t_end, 101) if t_eval is None else _checks.vector(t_eval, "t_eval")
-    load_steps = _checks.integer(load_steps, "load_steps", minimum=1, maximum=_max_load_steps())
+    load_steps = _checks.integer(load_steps, "load_steps", minimum=1, maximum=MAX_LOAD_STEPS)
     _judge_options(simulate_options, t_end)
     job = _Job(build, names, tol, t_end, t_eval, load_steps, simulate_options)
 
@@ -459,12 +460,6 @@ def _named(message: str) -> set:
     """The arguments a ValueError's message names ("rtol, atol: expected ..." -> {"rtol", "atol"})."""
     match = re.match(r"([A-Za-z_]\w*(?:, ?[A-Za-z_]\w*)*)(?:\[[^\]]*\])?: ", message)
     return {n.strip() for n in match.group(1).split(",")} if match else set()
-
-
-def _max_load_steps() -> int:
-    from ..analysis.statics import MAX_LOAD_STEPS
-
-    return MAX_LOAD_STEPS
 
 
 def _difference(a: list, b: list) -> float:
