@@ -140,7 +140,7 @@ def _model(driven: bool, elements: int):
     tip = np.array(CRANE) + [PIN_X + BOOM * math.cos(LUFF), 0.0, H_COL + BOOM * math.sin(LUFF)]
     payload = model.add_body("payload", model.ground, rf.Joint.custom(["x", "y", "z"]), mass=M_PAY,
                              inertia=(1.0, 1.0, 1.0), placement=rf.transform(tuple(tip - [0.0, 0.0, LU0])))
-    model.add_rope(boom.tip, payload, EA=EA, length=rf.motion.rest_to_rest(LU0, LU1, *WINCH), DA=DA, name="rope")
+    model.add_rope("rope", boom.tip, payload, EA=EA, length=rf.motion.rest_to_rest(LU0, LU1, *WINCH), DA=DA)
     return model.compile(), boom.tip, payload
 
 

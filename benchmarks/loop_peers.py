@@ -205,8 +205,7 @@ def _slider_crank_model(m: int, driven: bool):
                             inertia=(1e-5, 1e-5, 1e-5))
     tip = rod.tip
     loop = Loop("slider pin", slider.index, np.eye(4), tip.body, rf.transform(tuple(tip.r)), (1, 1, 0, 0, 0, 0))
-    model.add_loop_joint("revolute", slider, rod.rfes[-1], frame_a=loop.frame_a, frame_b=loop.frame_b,
-                         name=loop.name)
+    model.add_loop_joint(loop.name, "revolute", slider, rod.rfes[-1], frame_a=loop.frame_a, frame_b=loop.frame_b)
     return model.compile(), rod, loop
 
 
@@ -248,7 +247,7 @@ def bricard(outputs: int = BRICARD_OUTPUTS, t_end: float = BRICARD_END) -> Scene
     # The sixth joint, about x at (0, 0, 1): the end of rod 5 to the ground (z of the loop frames along x).
     along_x = (0.0, math.pi / 2, 0.0)
     loop = Loop("P5", rods[-1].index, rf.transform((0.0, -L, 0.0), along_x), -1, rf.transform((0.0, 0.0, L), along_x))
-    model.add_loop_joint("revolute", rods[-1], model.ground, frame_a=loop.frame_a, frame_b=loop.frame_b, name=loop.name)
+    model.add_loop_joint(loop.name, "revolute", rods[-1], model.ground, frame_a=loop.frame_a, frame_b=loop.frame_b)
     system = model.compile()
     q0 = np.zeros(system.nq)
     scene = Scene("Bricard", system, system, describe(system), (loop,), rods[2].point((0.0, 0.0, L)), q0,

@@ -31,7 +31,7 @@ def roped_beam(elements: int, ropes: int):
                           rf.Section.rectangle(0.02, 0.005), elements, deform=("bend_z", "bend_y", "torsion"))
     for k in range(ropes):
         s = (k + 1) / ropes  # along the beam, the last rope at the tip
-        model.add_actuator(model.ground.point((s, 0.0, 0.5)), beam.point(s), 0.5, name=f"rope{k}")
+        model.add_actuator(f"rope{k}", model.ground.point((s, 0.0, 0.5)), beam.point(s), 0.5)
     system = model.compile()
     q0, _ = system.assemble(np.zeros(system.nq))
     return system, q0

@@ -544,8 +544,8 @@ def stiff_beam(elements: int = 10, t_end: float = 0.2, outputs: int = 41, dampin
     """The ``StiffBeam`` scene with ``elements`` rfes, ``outputs`` uniform output times over
     [0, t_end] (s) and the Kelvin–Voigt retardation time ``damping`` (s)."""
     loaded, beam = cantilever(elements, gravity=None, damping=damping)
-    loaded.add_force(beam.tip, (0.0, 20.0, 1.0))
-    loaded.add_torque(beam.rfes[-1], (0.5, 0.0, 0.0))
+    loaded.add_force("push", beam.tip, (0.0, 20.0, 1.0))
+    loaded.add_torque("twist", beam.rfes[-1], (0.5, 0.0, 0.0))
     q0 = static_equilibrium(loaded.compile(), load_steps=2).q
     model, beam = cantilever(elements, gravity=None, damping=damping)
     system = model.compile()

@@ -84,7 +84,7 @@ def implicit_step_scaling(elements=ELEMENTS, tangent_up_to: int = 200, steps: in
     rows = []
     for m in elements:
         model, hd = samples.cantilever(elements=m, deform=DEFORM)
-        model.add_force(hd["beam"].tip, (0.0, 20.0, 10.0))
+        model.add_force("load0", hd["beam"].tip, (0.0, 20.0, 10.0))
         system = model.compile()
         row = {"m": m, "nq": system.nq}
         runs = [("implicit_spring", {}), ("generalized_alpha", {"iteration_matrix": "tangent"})]
@@ -124,9 +124,9 @@ def large_beam(elements: int, loop: bool = False):
     gravity and a 20 N tip load; with ``loop``, its tip held 0.5 m from the ground point
     (1, 0.5, 0) m by a distance loop (one constraint row)."""
     model, hd = samples.cantilever(elements=elements, deform=("bend_z",), gravity=(0.0, -9.81, 0.0))
-    model.add_force(hd["beam"].tip, (0.0, 20.0, 0.0))
+    model.add_force("load0", hd["beam"].tip, (0.0, 20.0, 0.0))
     if loop:
-        model.add_loop_joint("distance", hd["beam"].tip, model.ground.point((1.0, 0.5, 0.0)), length=0.5)
+        model.add_loop_joint("loop0", "distance", hd["beam"].tip, model.ground.point((1.0, 0.5, 0.0)), length=0.5)
     return model.compile()
 
 

@@ -48,7 +48,7 @@ def strip(elements: int):
     beam = model.add_beam("strip", model.ground, 1.0, rf.Material(E=2.1e11, rho=7850.0),
                           rf.Section.rectangle(0.02, 0.005), elements, deform=("bend_z", "bend_y"),
                           joint=rf.Joint.revolute("z", stiffness=50.0))
-    model.add_force(beam.tip, (0.0, -5.0, 2.0), name="push")
+    model.add_force("push", beam.tip, (0.0, -5.0, 2.0))
     return model.compile(), beam
 
 
@@ -60,7 +60,7 @@ def driven_strip(elements: int):
     model.prescribe(hub, rf.motion.spline(knots, 0.1 * np.sin(100.0 * knots)))
     beam = model.add_beam("strip", hub, 1.0, rf.Material(E=2.1e11, rho=7850.0), rf.Section.rectangle(0.02, 0.005),
                           elements, deform=("bend_z", "bend_y"))
-    model.add_force(beam.tip, (0.0, -5.0, 2.0), name="push")
+    model.add_force("push", beam.tip, (0.0, -5.0, 2.0))
     return model.compile(), beam
 
 

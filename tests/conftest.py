@@ -113,8 +113,7 @@ def luffed_boom():
     m = rf.Model(gravity=(0.0, -9.81, 0.0))
     boom = m.add_body("boom", m.ground, rf.Joint.revolute("z", stiffness=3.0, damping=0.5), 5.0,
                       (1e-4, 5.0 * 4 / 12, 5.0 * 4 / 12), com=(1.0, 0.0, 0.0))
-    m.add_actuator(m.ground.point((0.5, 0, 0)), boom.point((1.0, 0, 0)), rf.motion.polynomial([0.9, 0.3]),
-                   name="cylinder")
+    m.add_actuator("cylinder", m.ground.point((0.5, 0, 0)), boom.point((1.0, 0, 0)), rf.motion.polynomial([0.9, 0.3]))
     s = m.compile()
     q0, qd0 = s.assemble([np.arccos(1.25 - 0.81)], [0.0])
     return s, boom, q0, qd0
@@ -140,5 +139,5 @@ def slider_four_bar(profile):
                         placement=rf.transform((0.7, 0, 0)))
     m.prescribe(slider, profile)
     rocker = m.add_body("rocker", slider, rf.Joint.revolute("z"), **rod(0.6))
-    m.add_loop_joint("revolute", coupler.point((0.8, 0, 0)), rocker.point((0.6, 0, 0)), name="C")
+    m.add_loop_joint("C", "revolute", coupler.point((0.8, 0, 0)), rocker.point((0.6, 0, 0)))
     return m.compile(), coupler

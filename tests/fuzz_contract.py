@@ -1558,6 +1558,7 @@ class Gen:
         self.profiles: list[str] = []
         self.nbodies = 0
         self.body_names = 0  # names b0, b1, ... drawn so far: one per add_body, added or not (never reused)
+        self.other_names = 0  # names of loads, loops, elements and laws (n0, n1, ...), likewise never reused
         self.n_prescribed = 0
         self.results: list[str] = []
         self.counter = 0
@@ -1708,6 +1709,17 @@ class Gen:
                           label="JointSpec.setattr", ambiguous=True)
         self.flags["joint_internals"] = True  # the model may hold anything: NaNs downstream are its echo
         return var, coords
+
+    def fresh_name(self):
+        """The first argument of a builder other than add_body: a new name (n0, n1, ...), or now and then a
+        bad one (a number, an empty str, a body's name)."""
+        if self.chance(0.03):
+            taken = [repr(b["name"]) for b in self.bodies]
+            e = self.choice(["3", "''", "None"] + taken[:1])
+            return A(e, bad=True, soft=e in taken, names=("name",))  # a body's name: refused if the body was added
+        name = f"n{self.other_names}"
+        self.other_names += 1
+        return A(repr(name))
 
     def add_body(self):
         # a fresh name even after a call that was meant to fail: one that succeeded after all (a soft or
@@ -1991,15 +2003,15 @@ class Gen:
             joint = self.choice(["'revolute'", "'spherical'", "'universal'", "'prismatic'", "'cylindrical'", "'fixed'",
                                  "'distance'"] + (["'hinge'", "None"] if self.chance(0.1) else []))
             kw = {"length": A(fl(self.choice([0.5, 1.0, 2.0])))} if joint == "'distance'" else {}
-            self.emit("model.add_loop_joint", [A(joint, bad=joint in ("'hinge'", "None")),
+            self.emit("model.add_loop_joint", [self.fresh_name(), A(joint, bad=joint in ("'hinge'", "None")),
                                                A(a, bad=bad_a, names=ROLE_NAMES["point"]), A(b)],
-                      ["kind", "a", "b"], kw, label="add_loop_joint", ambiguous=not bad)
+                      ["name", "kind", "a", "b"], kw, label="add_loop_joint", ambiguous=not bad)
             self.flags["loops"] = True
         elif kind == "actuator":
             length = self.choice(["1.0", "0.5", "rf.motion.polynomial([1.0, 0.1])", "-1.0", "nan"])
-            self.emit("model.add_actuator", [A(a, bad=bad_a, names=ROLE_NAMES["point"]), A(b),
+            self.emit("model.add_actuator", [self.fresh_name(), A(a, bad=bad_a, names=ROLE_NAMES["point"]), A(b),
                                              A(length, bad=length in ("-1.0", "nan"))],
-                      ["a", "b", "length"], label="add_actuator", ambiguous=not bad)
+                      ["name", "a", "b", "length"], label="add_actuator", ambiguous=not bad)
             self.flags["loops"] = True
         else:
             kw = {"stiffness": A(fl(self.choice([10.0, 1e4, 1e8]))), "length": A(fl(self.choice([0.0, 0.5, 1.0])))}
@@ -2012,8 +2024,8 @@ class Gen:
                 kw["EA"] = kw.pop("stiffness")
                 if "damping" in kw:
                     kw["DA"] = kw.pop("damping")
-            self.emit(fn, [A(a, bad=bad_a, names=ROLE_NAMES["point"]), A(b)], ["a", "b"], kw, label=fn.split(".")[1],
-                      ambiguous=not bad)
+            self.emit(fn, [self.fresh_name(), A(a, bad=bad_a, names=ROLE_NAMES["point"]), A(b)], ["name", "a", "b"], kw,
+                      label=fn.split(".")[1], ambiguous=not bad)
 
     def add_load(self):
         kind = self.choice(["force", "force", "torque", "generalized"])
@@ -2043,9 +2055,9 @@ class Gen:
             if self.chance(0.03):
                 kw["scale"] = A(self.choice(["2.0", "'x'"]), bad=True)
                 fbad = True
-            self.emit(f"model.add_{kind}", [A(p, bad=pbad, soft=pamb, names=("point", "body", "r")),
+            self.emit(f"model.add_{kind}", [self.fresh_name(), A(p, bad=pbad, soft=pamb, names=("point", "body", "r")),
                                             A(fe, bad=fbad, names=("force", "torque", "scale"))],
-                      ("point" if kind == "force" else "body", kind), kw, label=f"add_{kind}")
+                      ("name", "point" if kind == "force" else "body", kind), kw, label=f"add_{kind}")
             return
         b = self.body_with_coords()
         if b is None:
@@ -2063,8 +2075,8 @@ class Gen:
                 values[key] = self.choice(["-1.0", "nan", "inf", "'x'", "None"] + (["0.0"] if key in ("stribeck", "smoothing")
                                                                                  else []))
             law = "rf.laws.Friction(" + ", ".join(f"{k}={v}" for k, v in values.items()) + ")"
-            self.emit("model.add_joint_law", [A(self.handle(b)), A(law, bad=bad, names=tuple(values))], ("body", "law"),
-                      kw, label="add_joint_law")
+            self.emit("model.add_joint_law", [self.fresh_name(), A(self.handle(b)), A(law, bad=bad, names=tuple(values))],
+                      ("name", "body", "law"), kw, label="add_joint_law")
             return
         law_taken = (b["index"], c) in self.laws
         if self.chance(0.4):

@@ -19,8 +19,8 @@ def strip(elements=6):
     b = m.add_beam("strip", m.ground, 1.0, rf.Material(E=2e11, rho=7800.0, G=8e10, retardation=1e-4),
                    rf.Section.rectangle(0.02, 0.005), elements, joint=rf.Joint.revolute("z", stiffness=5.0),
                    tip_mass=0.1, deform=("bend_z", "torsion", "bend_y"))
-    m.add_force(b.tip, (0.0, -1.0, 0.5), name="push")
-    m.add_spring_damper(b.tip, m.ground, stiffness=10.0, damping=0.5, length=0.5, name="spring")
+    m.add_force("push", b.tip, (0.0, -1.0, 0.5))
+    m.add_spring_damper("spring", b.tip, m.ground, stiffness=10.0, damping=0.5, length=0.5)
     return m.compile(), b
 
 
@@ -30,8 +30,7 @@ def boom_and_rope():
     boom = m.add_body("boom", m.ground, rf.Joint.revolute("z"), 10.0, (1.0, 1.0, 1.0), com=(1.0, 0.0, 0.0))
     m.prescribe(boom, rf.motion.harmonic(0.3, 1.5))
     load = m.add_body("load", boom, rf.Joint.free(), 5.0, (0.1, 0.1, 0.1), placement=rf.transform((2.0, 0, 0)))
-    m.add_rope(boom.point((2.0, 0.0, 0.0)), load, EA=1e6, DA=1e3, length=rf.motion.ramp(-0.2, 0.0, 0.5, start=1.0),
-               name="rope")
+    m.add_rope("rope", boom.point((2.0, 0.0, 0.0)), load, EA=1e6, DA=1e3, length=rf.motion.ramp(-0.2, 0.0, 0.5, start=1.0))
     return m.compile(), load.origin, [0.0, 0.0, -1.0 - 5 * G / 1e6, 0.0, 0.0, 0.0]
 
 
@@ -141,7 +140,7 @@ def test_reverse_mode_by_the_prescribed_motion():
     model.prescribe(hub, rf.motion.polynomial([0.3, 0.7, 0.4]))
     beam = model.add_beam("beam", hub, 1.0, rf.Material(E=7e10, rho=2700.0), rf.Section.rectangle(0.02, 0.01), 3,
                           deform=("bend_z", "bend_y"))
-    model.add_force(beam.tip, (0.0, 1.0, 0.5), follower=True)
+    model.add_force("load0", beam.tip, (0.0, 1.0, 0.5), follower=True)
     s = model.compile()
     rng = np.random.default_rng(5)
     q, qd, qdd, mu = rng.normal(0, 0.1, (4, s.nq))
@@ -231,7 +230,7 @@ def test_a_link_of_varying_length():
     tape = model.add_beam("tape", hub, rf.motion.polynomial([0.5, 0.8, -0.3]), rf.Material(E=2.1e9, rho=7850.0),
                           rf.Section.rectangle(0.02, 0.004), 4, deform=("bend_y", "bend_z"),
                           joint=rf.Joint.revolute("y", stiffness=30.0), placement=rf.transform((0.1, 0.0, 0.0)))
-    model.add_force(tape.tip, (0.0, 0.3, 0.0), name="push")
+    model.add_force("push", tape.tip, (0.0, 0.3, 0.0))
     s = model.compile()
     names = ["hub.rz.drive.amplitude", "tape.E", "tape.rho", "tape.A", "tape.Iy", "tape.rfe0.ry.stiffness",
              "push.force"] + [f"tape.length.coefficients[{k}]" for k in range(3)]
@@ -292,7 +291,7 @@ def test_radau5_krylov_on_a_long_chain():
     model.prescribe(hub, rf.motion.harmonic(0.1, 100.0))
     beam = model.add_beam("strip", hub, 1.0, rf.Material(E=2.1e11, rho=7850.0), rf.Section.rectangle(0.02, 0.005), 40,
                           deform=("bend_z", "bend_y"))
-    model.add_force(beam.tip, (0.0, -5.0, 2.0), name="push")
+    model.add_force("push", beam.tip, (0.0, -5.0, 2.0))
     s = model.compile()
     run = dict(method="radau5", outputs={"p": beam.tip}, running=running, terminal=terminal, dt=1e-4)
     names = ["strip.E", "push.force", "hub.rz.drive.omega"]
@@ -392,7 +391,7 @@ def test_a_step_whose_iterate_overflows_is_a_simulation_error(method):
     ValueError 'q: expected ... finite values' from deep inside before)."""
     model = rf.Model(None)
     body = model.add_body("b", model.ground, rf.Joint.universal(("z", "x")), 2.0, (0.2, 0.3, 0.1))
-    model.add_force(body.origin, (-1e6, 0.0, 3e5))
+    model.add_force("load0", body.origin, (-1e6, 0.0, 3e5))
     s = model.compile()
     with pytest.raises(rf.SimulationError, match="reduce dt") as caught:
         rf.simulate(s, 1e300, method, dt=1e300)

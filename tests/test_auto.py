@@ -142,7 +142,7 @@ def four_bar(crank_spring: dict, guess):
     coupler = model.add_body("coupler", crank, rf.Joint.revolute("z"), **rod(0.8), placement=rf.transform((0.3, 0, 0)))
     rocker = model.add_body("rocker", model.ground, rf.Joint.revolute("z"), **rod(0.6),
                             placement=rf.transform((0.7, 0, 0)))
-    model.add_loop_joint("revolute", coupler.point((0.8, 0, 0)), rocker.point((0.6, 0, 0)))
+    model.add_loop_joint("loop0", "revolute", coupler.point((0.8, 0, 0)), rocker.point((0.6, 0, 0)))
     system = model.compile()
     return system, system.assemble(guess)[0]
 

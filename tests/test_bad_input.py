@@ -264,7 +264,7 @@ def test_prescribe_needs_a_body_of_the_model():
 def test_add_force_bad_force(force):
     m, h = samples.pendulum()
     with pytest.raises(ValueError, match=r"^force\b"):
-        m.add_force(h["tip"], force)
+        m.add_force("push", h["tip"], force)
 
 
 def test_add_force_point_of_another_model():
@@ -272,9 +272,9 @@ def test_add_force_point_of_another_model():
     other = bigger_model_body()
     for point in (other, other.point((0.0, 0.0, 1.0)), m.ground, rf.Point(-7, np.zeros(3))):
         with pytest.raises(ValueError, match=r"^point\b"):
-            m.add_force(point, (1.0, 0.0, 0.0))
+            m.add_force("push", point, (1.0, 0.0, 0.0))
     with pytest.raises(ValueError, match=r"^point\b"):
-        m.add_force((0.0, 0.0, 1.0), (1.0, 0.0, 0.0))  # a position is not a Point
+        m.add_force("push", (0.0, 0.0, 1.0), (1.0, 0.0, 0.0))  # a position is not a Point
 
 
 # --- the interpreter survives --------------------------------------------------------------

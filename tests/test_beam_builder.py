@@ -528,7 +528,7 @@ SQ = dict(width=0.02, height=0.02)
 
 def tip_under_load(F, L=2.0, m=8, steps=1, **kw):
     model, beam = cantilever(L, m, steel(), rf.Section.rectangle(**SQ), **kw)
-    model.add_force(beam.tip, (0.0, F, 0.0))
+    model.add_force("load0", beam.tip, (0.0, F, 0.0))
     system = model.compile()
     eq = rf.static_equilibrium(system, load_steps=steps)
     assert eq.converged

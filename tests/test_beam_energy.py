@@ -20,7 +20,7 @@ def released_beam(linear, damping=0.0, m=6):
                               deform=("bend_z", "bend_y"), linear=linear)
         if with_force:
             P = 2 * E * SECTION.Iz / L**2
-            model.add_force(beam.tip, (0.0, P, 0.3 * P), follower=False)
+            model.add_force("load0", beam.tip, (0.0, P, 0.3 * P), follower=False)
         return model.compile(), beam
 
     loaded, _ = build(True)

@@ -36,7 +36,7 @@ def pendulum(prescribed: bool = False):
     a = m.add_body("a", m.ground, rf.Joint.revolute("x"), mass=1.0, inertia=(0.1, 0.1, 0.02), com=(0, 0, -0.5))
     b = m.add_body("b", a, rf.Joint.revolute("y"), mass=0.5, inertia=(0.05, 0.05, 0.01), com=(0.1, 0, -0.4),
                    placement=rf.transform((0, 0, -1.0)))
-    m.add_spring_damper(b.point((0, 0, -0.8)), m.ground.point((0.3, 0.2, 0.0)), stiffness=50.0, length=1.5,
+    m.add_spring_damper("element0", b.point((0, 0, -0.8)), m.ground.point((0.3, 0.2, 0.0)), stiffness=50.0, length=1.5,
                         damping=0.3)
     if prescribed:
         m.prescribe(b, rf.motion.polynomial([0.1, 0.5]))
@@ -182,3 +182,27 @@ def test_every_refusal_of_the_python_layer_is_one_form_through_one_function():
     assert not own, f"ValueErrors raised outside _checks.refuse: {own}"
     assert count > 150, count  # (the scan sees them)
     assert not bad, "refusals not of the form '<argument>: expected ...':\n" + "\n".join(bad)
+
+
+def test_every_builder_takes_the_name_of_what_it_adds_first():
+    """Every Model builder that adds something named (``add_*`` returning a handle with ``.name``, but not the
+    coordinate's own laws, which the coordinate names) takes ``name`` first, required, and refuses a number, None,
+    "" and a name given already, naming ``name``."""
+    named = [n for n in dir(rf.Model) if n.startswith("add_") and n not in ("add_generalized_force", "add_maxwell_arm")]
+    assert len(named) == 12, named  # bodies, beams and bases; loads, loops, actuators, elements, laws
+    for n in named:
+        first = list(inspect.signature(getattr(rf.Model, n)).parameters.values())[1]
+        assert (first.name, first.default, first.kind) == ("name", inspect.Parameter.empty,
+                                                          inspect.Parameter.POSITIONAL_OR_KEYWORD), n
+    model = rf.Model()
+    body = model.add_body("b", model.ground, rf.Joint.revolute("z"), 1.0, (1, 1, 1))
+    model.add_force("push", body, (1.0, 0.0, 0.0))
+    calls = {"add_body": lambda nm: model.add_body(nm, model.ground, rf.Joint.revolute("z"), 1.0, (1, 1, 1)),
+             "add_force": lambda nm: model.add_force(nm, body, (1.0, 0.0, 0.0)),
+             "add_torque": lambda nm: model.add_torque(nm, body, (1.0, 0.0, 0.0)),
+             "add_rope": lambda nm: model.add_rope(nm, model.ground, body.point((1, 0, 0)), EA=1e3, length=1.0),
+             "add_joint_law": lambda nm: model.add_joint_law(nm, body, rf.laws.Friction())}
+    for n, call in calls.items():
+        for bad in (3, None, "", "push"):
+            with pytest.raises(ValueError, match="^name: expected"):
+                call(bad)

@@ -93,11 +93,11 @@ def sprung_beams(gravity=(0.0, -9.81, 0.0), flowing=True):
                           placement=rf.transform((0.1, 0.0, 0.0)))
     arm = model.add_beam("arm", model.ground, 1.0, rf.Material(E=2e9, rho=2700.0), rf.Section.rectangle(0.02, 0.01), 3,
                          joint=rf.Joint.spherical(), placement=rf.transform((0.0, 1.0, 0.0)))
-    model.add_spring_damper(tape.tip, arm.tip, stiffness=50.0, damping=2.0, length=0.3)
-    model.add_rope(arm.point(0.5), model.ground, EA=1e4, DA=10.0, length=0.5)
-    model.add_force(arm.tip, (0.0, 1.0, 2.0), follower=True)
-    model.add_force(tape.tip, (1.0, 0.0, -2.0))
-    model.add_torque(arm.rfes[1], (0.3, 0.0, 0.1), follower=True)
+    model.add_spring_damper("element0", tape.tip, arm.tip, stiffness=50.0, damping=2.0, length=0.3)
+    model.add_rope("element1", arm.point(0.5), model.ground, EA=1e4, DA=10.0, length=0.5)
+    model.add_force("load0", arm.tip, (0.0, 1.0, 2.0), follower=True)
+    model.add_force("load1", tape.tip, (1.0, 0.0, -2.0))
+    model.add_torque("load2", arm.rfes[1], (0.3, 0.0, 0.1), follower=True)
     return model
 
 
@@ -188,8 +188,8 @@ def stiff_beam(elements=12, algorithm="recursive"):
     def build(load):
         model, h = rf.samples.cantilever(elements=elements, deform=("torsion", "bend_y", "bend_z"))
         if load:
-            model.add_force(h["beam"].tip, (0.0, 20.0, 10.0))
-            model.add_torque(h["beam"].tip, (1.0, 0.0, 0.0))
+            model.add_force("load0", h["beam"].tip, (0.0, 20.0, 10.0))
+            model.add_torque("load1", h["beam"].tip, (1.0, 0.0, 0.0))
         return model, h
     loaded, _ = build(True)
     q0 = rf.static_equilibrium(loaded.compile(), load_steps=2).q

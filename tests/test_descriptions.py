@@ -92,7 +92,7 @@ def test_every_law_kind_is_the_cpp_description_and_what_parameters_and_viewer_re
     body = model.add_body("b", model.ground, rf.Joint.prismatic("x"), mass=1.0, inertia=(1, 1, 1))
     elements = [k for k, info in kinds.items() if info["acts_on"] == "element"]
     for k, kind in enumerate(elements):
-        model.add_force_element(model.ground.point((0.0, 1.0 + k, 0.0)), body, getattr(rf.laws, kind)(), name=kind)
+        model.add_force_element(kind, model.ground.point((0.0, 1.0 + k, 0.0)), body, getattr(rf.laws, kind)())
     system = model.compile()
     for k, kind in enumerate(elements):
         info = kinds[kind]

@@ -52,7 +52,7 @@ def test_loops_and_force_elements_are_counted():
     a = model.add_body("a", model.ground, rf.Joint.revolute("z"), mass=1.0, inertia=(1, 1, 1))
     b = model.add_body("b", model.ground, rf.Joint.revolute("z"), mass=1.0, inertia=(1, 1, 1),
                        placement=rf.transform((1.0, 0, 0)))
-    model.add_spring_damper(a.point((0.5, 0, 0)), b.point((0.5, 0, 0)), stiffness=10.0, length=1.0)
+    model.add_spring_damper("element0", a.point((0.5, 0, 0)), b.point((0.5, 0, 0)), stiffness=10.0, length=1.0)
     page = model.compile()._repr_html_()
     assert "force elements: 1" in page and "loops: 0" in page
 

@@ -63,3 +63,19 @@ def test_the_options_table_is_the_one_of_rigidfem_options(site):
     for o in options.OPTIONS:
         assert f" {o.name} " in page, o.name
     assert "rho_inf" in text(site / "api" / "rigidfem.simulate.html")
+
+
+def test_the_examples_in_the_modules_docstrings_print_what_they_say():
+    """Every ``>>>`` example of the package's docstrings runs and prints what it shows (doctest)."""
+    import doctest
+    import importlib
+    import pkgutil
+
+    failed, tried = 0, 0
+    for info in pkgutil.walk_packages(rf.__path__, "rigidfem."):
+        if info.name.startswith("rigidfem._core"):
+            continue
+        module = importlib.import_module(info.name)
+        result = doctest.testmod(module, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE, verbose=False)
+        failed, tried = failed + result.failed, tried + result.attempted
+    assert tried > 0 and failed == 0, f"{failed} of {tried} examples failed"

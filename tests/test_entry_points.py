@@ -302,9 +302,9 @@ def test_builders_refuse_non_booleans_for_their_switches():
     m = rf.Model()
     body = m.add_body("b", m.ground, rf.Joint.revolute("z"), mass=1.0, inertia=(1.0, 1.0, 1.0))
     with pytest.raises(ValueError, match=r"^follower: expected True or False, got 'no'"):
-        m.add_force(body, (1.0, 0.0, 0.0), follower="no")
+        m.add_force("push", body, (1.0, 0.0, 0.0), follower="no")
     with pytest.raises(ValueError, match=r"^follower: expected True or False, got 0"):
-        m.add_torque(body, (1.0, 0.0, 0.0), follower=0)
+        m.add_torque("twist", body, (1.0, 0.0, 0.0), follower=0)
     with pytest.raises(ValueError, match=r"^linear: expected True or False, got 'no'"):
         m.add_beam("beam", body, 1.0, rf.Material(2e11, 7850.0), rf.Section.circle(0.01), 2, linear="no")
     with pytest.raises(ValueError, match=r"^progress: expected True or False"):

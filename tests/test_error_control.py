@@ -104,7 +104,7 @@ def test_error_on_element_forces_and_loop_reactions():
     measured on the element's force and on the loop's reaction, each compared with the state run."""
     model = rf.Model(gravity=(0.0, -9.81, 0.0))
     bob = model.add_body("bob", model.ground, rf.Joint.planar(), mass=1.0, inertia=(0.01, 0.01, 0.01))
-    spring = model.add_spring_damper(model.ground, bob, stiffness=400.0, length=1.0, damping=0.5)
+    spring = model.add_spring_damper("element0", model.ground, bob, stiffness=400.0, length=1.0, damping=0.5)
     system = model.compile()
     q0 = np.array([0.2, -1.1, 0.0])
     t = np.linspace(0, 1, 51)

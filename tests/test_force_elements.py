@@ -16,8 +16,7 @@ def spring_pendulum(algorithm, m=1.3, L=0.8, Izz=0.05, k=40.0, c=0.7, l0=0.5, P=
     spring-damper to the ground point P."""
     model = rf.Model(gravity=(0.0, -g, 0.0))
     arm = model.add_body("arm", model.ground, rf.Joint.revolute("z"), m, (0.03, 0.03, Izz), com=(L, 0.0, 0.0))
-    model.add_spring_damper(model.ground.point(P), arm.point((L, 0.0, 0.0)), stiffness=k, length=l0, damping=c,
-                            name="spring")
+    model.add_spring_damper("spring", model.ground.point(P), arm.point((L, 0.0, 0.0)), stiffness=k, length=l0, damping=c)
     return model.compile(algorithm)
 
 
@@ -54,16 +53,16 @@ def chain_with_elements(algorithm, law=False):
                        placement=rf.transform(translation=(0.2, 0.0, 0.3)))
     d = model.add_body("d", b, rf.Joint.revolute("x"), 0.9, (0.03, 0.02, 0.05), com=(0.0, 0.2, 0.0),
                        placement=rf.transform(translation=(0.6, 0.0, 0.0)))
-    model.add_spring_damper(c.point((0.1, 0.2, 0.0)), d.point((0.0, 0.3, 0.1)), stiffness=120.0, length=0.4,
+    model.add_spring_damper("element0", c.point((0.1, 0.2, 0.0)), d.point((0.0, 0.3, 0.1)), stiffness=120.0, length=0.4,
                             damping=3.0)
-    model.add_spring_damper(model.ground.point((0.5, 0.5, 1.0)), b.point((0.2, 0.0, 0.0)), stiffness=60.0,
+    model.add_spring_damper("element1", model.ground.point((0.5, 0.5, 1.0)), b.point((0.2, 0.0, 0.0)), stiffness=60.0,
                             length=0.9, damping=1.0)
-    model.add_spring_damper(a.point((0.3, 0.0, 0.1)), d.point((0.1, 0.1, 0.0)), stiffness=30.0, length=0.5)
+    model.add_spring_damper("element2", a.point((0.3, 0.0, 0.1)), d.point((0.1, 0.1, 0.0)), stiffness=30.0, length=0.5)
     if law:
-        model.add_cylinder(model.ground.point((-0.3, 0.2, 0.0)), c.point((0.0, 0.1, 0.0)),
+        model.add_cylinder("element3", model.ground.point((-0.3, 0.2, 0.0)), c.point((0.0, 0.1, 0.0)),
                            lambda t, l, ld: 5.0 * np.sin(3.0 * l) - 0.4 * ld * abs(ld) + 2.0 * t, damping=0.5)
     else:
-        model.add_cylinder(model.ground.point((-0.3, 0.2, 0.0)), c.point((0.0, 0.1, 0.0)),
+        model.add_cylinder("element3", model.ground.point((-0.3, 0.2, 0.0)), c.point((0.0, 0.1, 0.0)),
                            rf.motion.harmonic(4.0, 2.0), damping=0.5)
     return model.compile(algorithm)
 
@@ -95,9 +94,9 @@ def test_energy_balance_with_springs_and_dampers(algorithm):
     a = model.add_body("a", model.ground, rf.Joint.spherical(), 2.0, (0.1, 0.2, 0.15), com=(0.4, 0.0, 0.0))
     b = model.add_body("b", a, rf.Joint.universal(("y", "z")), 1.5, (0.05, 0.08, 0.07), com=(0.3, 0.1, 0.0),
                        placement=rf.transform(translation=(0.8, 0.0, 0.0)))
-    model.add_spring_damper(model.ground.point((0.5, 0.5, 1.0)), b.point((0.2, 0.0, 0.0)), stiffness=60.0,
+    model.add_spring_damper("element0", model.ground.point((0.5, 0.5, 1.0)), b.point((0.2, 0.0, 0.0)), stiffness=60.0,
                             length=0.9, damping=0.8)
-    model.add_spring_damper(model.ground.point((0.0, -0.4, 0.2)), a.point((0.3, 0.0, 0.1)), stiffness=200.0,
+    model.add_spring_damper("element1", model.ground.point((0.0, -0.4, 0.2)), a.point((0.3, 0.0, 0.1)), stiffness=200.0,
                             length=0.3)
     s = model.compile(algorithm)
     q0 = np.array([0.2, -0.3, 0.1, 0.4, -0.2])
@@ -121,7 +120,7 @@ def test_lateral_stiffness_of_a_pretensioned_spring():
     for algorithm in ENGINES:
         model = rf.Model(gravity=(0.0, 0.0, 0.0))
         slider = model.add_body("slider", model.ground, rf.Joint.prismatic("y"), m, (1.0, 1.0, 1.0))
-        model.add_spring_damper(model.ground.point((-L, 0.0, 0.0)), slider, stiffness=k, length=l0, damping=5.0)
+        model.add_spring_damper("element0", model.ground.point((-L, 0.0, 0.0)), slider, stiffness=k, length=l0, damping=5.0)
         modes = rf.modal_analysis(model.compile(algorithm), np.zeros(1))
         assert modes.omega[0] == pytest.approx(np.sqrt(k * (L - l0) / (L * m)), rel=1e-10)
         assert modes.damping_ratios[0] == 0.0  # the damper acts along x only
@@ -134,7 +133,7 @@ def test_cylinder_holds_a_boom_in_static_equilibrium(algorithm):
     m, xc, a, b, F = 50.0, 1.2, 0.6, 0.9, 600.0
     model = rf.Model(gravity=(0.0, -9.81, 0.0))
     boom = model.add_body("boom", model.ground, rf.Joint.revolute("z"), m, (3.0, 3.0, 5.0), com=(xc, 0.0, 0.0))
-    model.add_cylinder(model.ground.point((a, -0.5, 0.0)), boom.point((b, 0.0, 0.0)), F, name="lift")
+    model.add_cylinder("lift", model.ground.point((a, -0.5, 0.0)), boom.point((b, 0.0, 0.0)), F)
     s = model.compile(algorithm)
     eq = rf.static_equilibrium(s, [0.8])
     th = eq.q[0]
@@ -162,9 +161,9 @@ def test_python_law_equals_the_built_in_spring_damper():
         arm = model.add_body("arm", model.ground, rf.Joint.revolute("z"), 1.3, (0.03, 0.03, 0.05), com=(0.8, 0, 0))
         ends = model.ground.point((0.3, 0.6, 0.0)), arm.point((0.8, 0.0, 0.0))
         if python:
-            model.add_cylinder(*ends, lambda t, l, ld: -k * (l - l0) - c * ld)
+            model.add_cylinder("element0", *ends, lambda t, l, ld: -k * (l - l0) - c * ld)
         else:
-            model.add_spring_damper(*ends, stiffness=k, length=l0, damping=c)
+            model.add_spring_damper("element0", *ends, stiffness=k, length=l0, damping=c)
         return model.compile(), ends
 
     (built_in, ends), (slow, _) = build(False), build(True)
@@ -188,8 +187,8 @@ def test_cylinder_in_a_closed_chain_with_implicit_methods():
                              placement=rf.transform(translation=(0.4, 0.0, 0.0)))
     rocker = model.add_body("rocker", model.ground, rf.Joint.revolute("z"), 1.0, (0.03, 0.03, 0.05),
                             com=(0.35, 0.0, 0.0), placement=rf.transform(translation=(1.0, 0.0, 0.0)))
-    model.add_loop_joint("revolute", coupler.point((1.0, 0.0, 0.0)), rocker.point((0.7, 0.0, 0.0)))
-    model.add_cylinder(model.ground.point((0.5, -0.4, 0.0)), coupler.point((0.5, 0.0, 0.0)),
+    model.add_loop_joint("loop0", "revolute", coupler.point((1.0, 0.0, 0.0)), rocker.point((0.7, 0.0, 0.0)))
+    model.add_cylinder("element0", model.ground.point((0.5, -0.4, 0.0)), coupler.point((0.5, 0.0, 0.0)),
                        rf.motion.polynomial([0.0, 60.0]), damping=2.0)
     s = model.compile()
     q0, qd0 = s.assemble([1.2, -0.9, 1.9])
@@ -204,19 +203,21 @@ def test_cylinder_in_a_closed_chain_with_implicit_methods():
 @pytest.mark.parametrize(
     "kwargs, argument",
     [
-        (dict(stiffness=-1.0, length=1.0), "stiffness"),
-        (dict(stiffness=1.0, length=float("nan")), "length"),
-        (dict(stiffness=1.0, length=1.0, damping="x"), "damping"),
-        (dict(stiffness=1.0, length=1.0, name="twice"), "name"),
+        (dict(name="spring", stiffness=-1.0, length=1.0), "stiffness"),
+        (dict(name="spring", stiffness=1.0, length=float("nan")), "length"),
+        (dict(name="spring", stiffness=1.0, length=1.0, damping="x"), "damping"),
+        (dict(name="twice", stiffness=1.0, length=1.0), "name"),
+        (dict(name=3, stiffness=1.0, length=1.0), "name"),
+        (dict(name="", stiffness=1.0, length=1.0), "name"),
+        (dict(name="b", stiffness=1.0, length=1.0), "name"),
     ],
 )
 def test_bad_spring_damper_input(kwargs, argument):
     model = rf.Model()
     body = model.add_body("b", model.ground, rf.Joint.revolute("z"), 1.0, (1, 1, 1))
-    model.add_spring_damper(model.ground.point((1, 0, 0)), body.point((0, 1, 0)), stiffness=1.0, length=1.0,
-                            name="twice")
+    model.add_spring_damper("twice", model.ground.point((1, 0, 0)), body.point((0, 1, 0)), stiffness=1.0, length=1.0)
     with pytest.raises(ValueError, match=f"^{argument}: expected"):
-        model.add_spring_damper(model.ground.point((1, 0, 0)), body.point((0, 1, 0)), **kwargs)
+        model.add_spring_damper(a=model.ground.point((1, 0, 0)), b=body.point((0, 1, 0)), **kwargs)
 
 
 def test_bad_cylinder_input_and_failures():
@@ -224,22 +225,22 @@ def test_bad_cylinder_input_and_failures():
     body = model.add_body("b", model.ground, rf.Joint.revolute("z"), 1.0, (1, 1, 1))
     stranger = other.add_body("s", other.ground, rf.Joint.revolute("z"), 1.0, (1, 1, 1))
     with pytest.raises(ValueError, match="^force: expected a finite number in N, a rigidfem.motion profile"):
-        model.add_cylinder(model.ground, body.point((1, 0, 0)), "strong")
+        model.add_cylinder("cylinder", model.ground, body.point((1, 0, 0)), "strong")
     with pytest.raises(ValueError, match="^b: expected a Body or Point of this model"):
-        model.add_cylinder(model.ground, stranger, 1.0)
+        model.add_cylinder("cylinder", model.ground, stranger, 1.0)
     with pytest.raises(ValueError, match="^b: expected a body other than a"):
-        model.add_cylinder(body, body.point((1, 0, 0)), 1.0)
+        model.add_cylinder("cylinder", body, body.point((1, 0, 0)), 1.0)
     with pytest.raises(ValueError, match="^a: expected a Body or Point"):
-        model.add_cylinder("ground", body, 1.0)
+        model.add_cylinder("cylinder", "ground", body, 1.0)
     # the points meet: no line of action, a SimulationError naming the element and the time
-    model.add_cylinder(model.ground, body, 1.0, name="degenerate")
+    model.add_cylinder("degenerate", model.ground, body, 1.0)
     s = model.compile()
     with pytest.raises(rf.SimulationError, match="force element 'degenerate' coincide"):
         s.forward_dynamics(0.25, [0.0], [0.0])
     # a law that returns no number: a ForceLawError naming the law, the element and the state
     model = rf.Model()
     body = model.add_body("b", model.ground, rf.Joint.revolute("z"), 1.0, (1, 1, 1))
-    model.add_cylinder(model.ground.point((1, 1, 0)), body.point((1, 0, 0)), lambda t, l, ld: None, name="bad")
+    model.add_cylinder("bad", model.ground.point((1, 1, 0)), body.point((1, 0, 0)), lambda t, l, ld: None)
     s = model.compile()
     with pytest.raises(rf.ForceLawError, match="force element 'bad'.*got None at t = 0 s, l = 1, ld = 0"):
         s.forward_dynamics(0.0, [0.0], [0.0])
@@ -254,7 +255,7 @@ def _drop_on_buffer(law, m=2.0, v0=1.5, gap=0.3):
     buffer from the ground: the buffer touches at z = l0."""
     model = rf.Model(gravity=None)
     block = model.add_body("block", model.ground, rf.Joint.prismatic("z"), mass=m, inertia=(0.1, 0.1, 0.1))
-    model.add_force_element(model.ground, block, law, name="stop")
+    model.add_force_element("stop", model.ground, block, law)
     return model.compile(), law.values["length"] + gap
 
 
@@ -300,7 +301,7 @@ def test_a_buffers_derivatives_are_exact_and_its_constants_are_parameters():
     model = rf.Model(gravity=(0.0, 0.0, -9.81))
     arm = model.add_body("arm", model.ground, rf.Joint.revolute("y"), mass=1.0, inertia=(0.1, 0.1, 0.1),
                          com=(1.0, 0.0, 0.0))
-    model.add_force_element(model.ground.point((1.0, 0.0, -1.0)), arm.point((1.0, 0.0, 0.0)), law, name="stop")
+    model.add_force_element("stop", model.ground.point((1.0, 0.0, -1.0)), arm.point((1.0, 0.0, 0.0)), law)
     s = model.compile()
     for q, qd in (([0.3], [0.5]), ([0.2], [-0.4]), ([-0.3], [0.1])):  # pushing, leaving, not touching
         Kq, Kqd = s.force_jacobians(0.0, np.array(q), np.array(qd))

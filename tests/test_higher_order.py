@@ -45,7 +45,7 @@ def _stiff_chain(k_stiff=1e8):
     body = model.ground
     for i, k in enumerate((100.0, k_stiff, 50.0)):
         body = model.add_body(f"m{i}", body, rf.Joint.prismatic("x", stiffness=k), mass=1.0, inertia=(1e-3,) * 3)
-    model.add_force(body, (1.0, 0.0, 0.0), scale=rf.motion.harmonic(1.0, 2.0))
+    model.add_force("load0", body, (1.0, 0.0, 0.0), scale=rf.motion.harmonic(1.0, 2.0))
     return model.compile()
 
 

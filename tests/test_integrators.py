@@ -86,7 +86,7 @@ def stiff_beam(m=50):
     (ω_max/ω_1)² > 1e6), released from rest at its small static deflection under 2 N at the tip."""
     model, h = rf.samples.cantilever(elements=m, formulation="classical", deform=("axial", "shear_y", "bend_z"))
     loaded, hl = rf.samples.cantilever(elements=m, formulation="classical", deform=("axial", "shear_y", "bend_z"))
-    loaded.add_force(hl["beam"].tip, (0.0, 2.0, 0.0))
+    loaded.add_force("load0", hl["beam"].tip, (0.0, 2.0, 0.0))
     q0 = rf.static_equilibrium(loaded.compile(), load_steps=1).q
     return model.compile(), h["beam"], q0
 
@@ -226,7 +226,7 @@ def test_fine_discretisation_runs_and_converges():
     tips = {}
     for m in (100, 200):
         loaded, hl = rf.samples.cantilever(elements=m)
-        loaded.add_force(hl["beam"].tip, (0.0, 5.0, 0.0))
+        loaded.add_force("load0", hl["beam"].tip, (0.0, 5.0, 0.0))
         q0 = rf.static_equilibrium(loaded.compile(), load_steps=1).q
         model, h = rf.samples.cantilever(elements=m)
         system = model.compile()

@@ -18,7 +18,7 @@ def block(law=None, push=0.0, mass=1.0):
     b = model.add_body("block", model.ground, rf.Joint.prismatic("x"), mass=mass, inertia=(0.1, 0.1, 0.1))
     if push:
         model.add_generalized_force(b, push)
-    name = model.add_joint_law(b, law) if law is not None else None
+    name = model.add_joint_law("block.x.friction", b, law) if law is not None else None
     return model, b, name
 
 
@@ -67,7 +67,7 @@ def test_a_pendulum_with_joint_friction_loses_what_the_friction_dissipates():
     model = rf.Model(gravity=(0.0, -9.81, 0.0))
     arm = model.add_body("arm", model.ground, rf.Joint.revolute("z"), mass=1.2, inertia=(0.01, 0.1, 0.1),
                          com=(0.5, 0.0, 0.0))
-    name = model.add_joint_law(arm, rf.laws.Friction(breakaway=0.4, coulomb=0.3, stribeck=0.2, viscous=0.05,
+    name = model.add_joint_law("arm.rz.friction", arm, rf.laws.Friction(breakaway=0.4, coulomb=0.3, stribeck=0.2, viscous=0.05,
                                                      smoothing=0.05))
     assert name == "arm.rz.friction"
     s = model.compile()
@@ -91,7 +91,7 @@ def test_the_laws_derivatives_are_exact(algorithm):
                                                      smoothing=0.4)),
                             (last, rf.laws.ForceFunction(function=lambda t, q, qd: np.sin(q) * qd - 0.3 * qd ** 3))):
         body, axis = coordinate.rsplit(".", 1)
-        model.add_joint_law(model.body(body), law, coordinate=axis)
+        model.add_joint_law(f"{coordinate}.{law.kind.lower()}", model.body(body), law, coordinate=axis)
     s = model.compile(algorithm)
     for _ in range(3):
         t, q, qd = 0.2, rng.uniform(-0.5, 0.5, s.nq), rng.uniform(-1.0, 1.0, s.nq)
@@ -105,9 +105,9 @@ def test_friction_constants_are_named_parameters_in_the_coordinates_units():
     model = rf.Model(gravity=(0.0, -9.81, 0.0))
     arm = model.add_body("arm", model.ground, rf.Joint.revolute("z"), mass=1.0, inertia=(0.01, 0.1, 0.1),
                          com=(0.5, 0.0, 0.0))
-    model.add_joint_law(arm, rf.laws.Friction(breakaway=0.4, coulomb=0.3), name="hinge")
+    model.add_joint_law("hinge", arm, rf.laws.Friction(breakaway=0.4, coulomb=0.3))
     slider = model.add_body("slider", arm, rf.Joint.prismatic("x"), mass=0.5, inertia=(0.01, 0.01, 0.01))
-    model.add_joint_law(slider, rf.laws.Friction(coulomb=2.0, viscous=0.1))
+    model.add_joint_law("slider.x.friction", slider, rf.laws.Friction(coulomb=2.0, viscous=0.1))
     p = model.compile().parameters
     assert (p["hinge.breakaway"].value, p["hinge.breakaway"].unit) == (0.4, "N m")
     assert (p["hinge.viscous"].unit, p["slider.x.friction.coulomb"].unit) == ("N m s/rad", "N")
@@ -121,8 +121,8 @@ def test_sensitivities_and_the_adjoint_by_a_friction_constant_match_differences_
     model = rf.Model(gravity=(0.0, -9.81, 0.0))
     arm = model.add_body("arm", model.ground, rf.Joint.revolute("z"), mass=1.0, inertia=(0.01, 0.1, 0.1),
                          com=(0.5, 0.0, 0.0))
-    model.add_joint_law(arm, rf.laws.Friction(breakaway=0.4, coulomb=0.3, stribeck=0.3, viscous=0.05,
-                                              smoothing=0.1), name="hinge")
+    model.add_joint_law("hinge", arm, rf.laws.Friction(breakaway=0.4, coulomb=0.3, stribeck=0.3, viscous=0.05,
+                                              smoothing=0.1))
     s = model.compile()
     names = ["hinge.coulomb", "hinge.viscous", "hinge.breakaway"]
     run = dict(method="generalized_alpha", dt=1e-3, q0=[0.4], newton_tol=1e-14)
@@ -165,13 +165,13 @@ def test_bad_joint_law_input():
     with pytest.raises(TypeError, match=r"unexpected constants \['mu'\]"):
         rf.laws.Friction(mu=0.3)
     with pytest.raises(ValueError, match="^law: expected a law of a joint coordinate"):
-        model.add_joint_law(b, rf.laws.Rope(EA=1.0))
+        model.add_joint_law("law", b, rf.laws.Rope(EA=1.0))
     with pytest.raises(ValueError, match="^law: expected a law of a joint coordinate"):
-        model.add_joint_law(b, rf.laws.SpringDamping())
+        model.add_joint_law("law", b, rf.laws.SpringDamping())
     with pytest.raises(ValueError, match="^function: expected None"):
         rf.laws.Friction(function=lambda t, q, qd: 0.0)
-    model.add_joint_law(b, rf.laws.Friction(coulomb=1.0), name="f")
+    model.add_joint_law("f", b, rf.laws.Friction(coulomb=1.0))
     with pytest.raises(ValueError, match="^name: expected a name not yet given"):
-        model.add_joint_law(b, rf.laws.Friction(coulomb=1.0), name="f")
+        model.add_joint_law("f", b, rf.laws.Friction(coulomb=1.0))
     with pytest.raises(ValueError, match="^body: expected a body of this model"):
-        model.add_joint_law(model.ground, rf.laws.Friction())
+        model.add_joint_law("law", model.ground, rf.laws.Friction())

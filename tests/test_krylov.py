@@ -19,9 +19,9 @@ def large_beam(m, loop=False):
     """A planar steel cantilever (1 m, bending only) under gravity and a 20 N tip load; with loop,
     its tip held 0.5 m from a ground point by a distance loop."""
     model, hd = samples.cantilever(elements=m, deform=("bend_z",), gravity=(0.0, -9.81, 0.0))
-    model.add_force(hd["beam"].tip, (0.0, 20.0, 0.0))
+    model.add_force("load0", hd["beam"].tip, (0.0, 20.0, 0.0))
     if loop:
-        model.add_loop_joint("distance", hd["beam"].tip, model.ground.point((1.0, 0.5, 0.0)), length=0.5)
+        model.add_loop_joint("loop0", "distance", hd["beam"].tip, model.ground.point((1.0, 0.5, 0.0)), length=0.5)
     return model.compile(), hd["beam"].tip
 
 

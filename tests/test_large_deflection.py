@@ -105,7 +105,7 @@ def tip_rotation(system, beam, q):
 def rfem_tip_force(m, k, follower):
     """Tip (x/L, y/L, θ) of the RFEM cantilever under P = k EI/L² along y (global or tip axes)."""
     model, beam = cantilever(m)
-    model.add_force(beam.tip, (0.0, k * EI / L**2, 0.0), follower=follower)
+    model.add_force("load0", beam.tip, (0.0, k * EI / L**2, 0.0), follower=follower)
     system = model.compile()
     eq = rf.static_equilibrium(system, load_steps=10, tol=1e-12)
     assert eq.converged
@@ -151,7 +151,7 @@ def test_elastica_reference_matches_bisshopp_drucker():
 @pytest.mark.parametrize("m", MS)
 def test_tip_moment_two_pi_rolls_a_full_circle(m):
     model, beam = cantilever(m)
-    model.add_torque(beam.rfes[-1], (0.0, 0.0, 2 * np.pi * EI / L))
+    model.add_torque("load0", beam.rfes[-1], (0.0, 0.0, 2 * np.pi * EI / L))
     system = model.compile()
     eq = rf.static_equilibrium(system, load_steps=8, tol=1e-12)
     # Each sde turns by M Δ/EI = 2π/m: the sdes are the vertices of a closed regular m-gon and the
@@ -175,7 +175,7 @@ def test_tip_moment_pi_bends_a_half_circle():
     errors = []
     for m in MS:
         model, beam = cantilever(m)
-        model.add_torque(beam.rfes[-1], (0.0, 0.0, np.pi * EI / L))
+        model.add_torque("load0", beam.rfes[-1], (0.0, 0.0, np.pi * EI / L))
         system = model.compile()
         eq = rf.static_equilibrium(system, load_steps=4, tol=1e-12)
         tip = system.position(beam.tip, 0.0, eq.q) / L
@@ -241,7 +241,7 @@ def test_gravity_sag_matches_euler_bernoulli(plane):
 def test_static_equilibrium_reports_convergence():
     model, beam = cantilever(20)
     P = 10.0 * EI / L**2
-    model.add_force(beam.tip, (0.0, P, 0.0))
+    model.add_force("load0", beam.tip, (0.0, P, 0.0))
     system = model.compile()
     eq = rf.static_equilibrium(system, load_steps=10, tol=1e-12)
     assert eq.converged is True
@@ -254,7 +254,7 @@ def test_static_equilibrium_reports_convergence():
 
 def test_static_equilibrium_too_few_iterations_raises():
     model, beam = cantilever(20)
-    model.add_force(beam.tip, (0.0, 10.0 * EI / L**2, 0.0))
+    model.add_force("load0", beam.tip, (0.0, 10.0 * EI / L**2, 0.0))
     system = model.compile()
     with pytest.raises(rf.SimulationError) as err:
         rf.static_equilibrium(system, load_steps=1, max_iterations=2)

@@ -33,8 +33,8 @@ def spinning_beam(force=(0, 0, 0), torque=(0, 0, 0), hub_torque=0.0):
     payload = model.add_body("payload", beam.rfes[-1], rf.Joint.revolute("y", stiffness=20.0, damping=0.5),
                              mass=0.5, inertia=(0.01, 0.02, 0.01), com=(0.1, 0, 0),
                              placement=rf.transform((1.0 / 6, 0, 0)))
-    model.add_force(beam.tip, force)
-    model.add_torque(beam.rfes[-1], torque)
+    model.add_force("load0", beam.tip, force)
+    model.add_torque("load1", beam.rfes[-1], torque)
     model.add_generalized_force(payload, hub_torque)
     return model.compile(), beam, payload
 
@@ -132,7 +132,7 @@ def chain(force=0.0):
     b = model.add_body("b", a, joint, mass=0.7, com=(0, 0, -0.4), inertia=(0.04, 0.04, 1e-3),
                        placement=rf.transform((0, 0, -1.0)))
     tip = b.point((0, 0, -0.8))
-    model.add_force(tip, (force, 0.0, 0.0))
+    model.add_force("load0", tip, (force, 0.0, 0.0))
     return model.compile(), tip
 
 

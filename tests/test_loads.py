@@ -34,7 +34,7 @@ def test_point_force_generalized_force_is_its_virtual_work(follower, rng):
     model, (a, b, c) = chain()
     point = c.point((0.1, -0.2, 0.3))
     F = np.array([1.0, -2.0, 3.0])
-    model.add_force(point, F, follower=follower)
+    model.add_force("load0", point, F, follower=follower)
     system = model.compile()
     for _ in range(3):
         q = rng.uniform(-1, 1, system.nq)
@@ -48,7 +48,7 @@ def test_point_force_generalized_force_is_its_virtual_work(follower, rng):
 def test_torque_generalized_force_is_its_virtual_work(rng):
     model, (a, b, c) = chain()
     tau = np.array([0.5, -1.0, 2.0])
-    model.add_torque(b, tau)
+    model.add_torque("load0", b, tau)
     system = model.compile()
     q = rng.uniform(-1, 1, system.nq)
     # δθ_i from δR Rᵀ = S(δθ): columns of the rotation Jacobian of body b.
@@ -92,7 +92,7 @@ def test_velocity_of_a_point_is_the_derivative_of_its_position(rng):
 
 def test_scaled_load_follows_its_profile():
     model, (a, b, c) = chain()
-    model.add_force(b.origin, (0.0, 0.0, 1.0), scale=rf.motion.polynomial([0.0, 2.0]))  # F(t) = 2t e_z
+    model.add_force("load0", b.origin, (0.0, 0.0, 1.0), scale=rf.motion.polynomial([0.0, 2.0]))  # F(t) = 2t e_z
     system = model.compile()
     q = np.full(system.nq, 0.1)
     Q1 = system.generalized_forces(1.0, q, np.zeros(system.nq))

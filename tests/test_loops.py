@@ -30,7 +30,7 @@ def four_bar(crank_drive=None, algorithm="recursive", kind="revolute"):
     crank = m.add_body("crank", m.ground, rf.Joint.revolute("z"), **rod(A))
     coupler = m.add_body("coupler", crank, rf.Joint.revolute("z"), **rod(B), placement=rf.transform((A, 0, 0)))
     rocker = m.add_body("rocker", m.ground, rf.Joint.revolute("z"), **rod(C), placement=rf.transform((D, 0, 0)))
-    m.add_loop_joint(kind, coupler.point((B, 0, 0)), rocker.point((C, 0, 0)), name="C")
+    m.add_loop_joint("C", kind, coupler.point((B, 0, 0)), rocker.point((C, 0, 0)))
     if crank_drive is not None:
         m.prescribe(crank, crank_drive)
     return m.compile(algorithm)
@@ -100,7 +100,7 @@ def test_the_recursive_loop_equations_are_the_lagrange_ones(kind):
         c = m.add_body("c", m.ground, rf.Joint.free(), mass=0.7, inertia=(0.02, 0.03, 0.04), com=(0.1, 0.2, 0.0),
                        placement=rf.transform((1.0, 0.2, 0.1)))
         m.prescribe(b, rf.motion.polynomial([0.2, 1.5, -2.0]))
-        m.add_loop_joint(kind, b.point((0.5, 0.1, 0.0)), c.point((0.2, -0.1, 0.05)),
+        m.add_loop_joint("loop0", kind, b.point((0.5, 0.1, 0.0)), c.point((0.2, -0.1, 0.05)),
                          **(dict(length=0.7) if kind == "distance" else {}))
         return m.compile(algorithm)
 
@@ -174,7 +174,7 @@ def test_redundant_loop_gives_the_tree_motion_and_newton_euler_reactions():
     ref = rf.simulate(tree, 1.5, q0=[theta0], rtol=1e-11, atol=1e-12, t_eval=t)
     for joint in (rf.Joint.free(), rf.Joint.planar("xy")):
         mod, body = model(joint)
-        mod.add_loop_joint("revolute", mod.ground, body, name="pin")
+        mod.add_loop_joint("pin", "revolute", mod.ground, body)
         s = mod.compile()
         guess = np.zeros(s.nq)
         guess[s.coordinate_index("rod.rz")] = theta0
@@ -198,7 +198,7 @@ def test_actuator_luffs_a_boom_along_the_triangle():
     cylinder's power −F l̇ (F pushing positive) against dE/dt."""
     mod = rf.Model(gravity=(0, -G0, 0))
     boom = mod.add_body("boom", mod.ground, rf.Joint.revolute("z"), **rod(2.0, 5.0))
-    name = mod.add_actuator(mod.ground.point((0.5, 0, 0)), boom.point((1.0, 0, 0)), rf.motion.polynomial([0.9, 0.3]), name="cylinder")
+    name = mod.add_actuator("cylinder", mod.ground.point((0.5, 0, 0)), boom.point((1.0, 0, 0)), rf.motion.polynomial([0.9, 0.3]))
     s = mod.compile()
     assert s.loop_names == [name] and s.loop_kinds == ["distance"]
     t = np.linspace(0, 1, 101)
@@ -221,17 +221,17 @@ def test_bad_loops_are_value_errors_and_unreachable_ones_simulation_errors():
     mod = rf.Model()
     a = mod.add_body("a", mod.ground, rf.Joint.revolute("z"), **rod(1.0))
     with pytest.raises(ValueError, match="^kind: expected one of"):
-        mod.add_loop_joint("hinge", mod.ground, a)
+        mod.add_loop_joint("pin", "hinge", mod.ground, a)
     with pytest.raises(ValueError, match="^b: expected a body other than a"):
-        mod.add_loop_joint("spherical", a, a.point((1, 0, 0)))
+        mod.add_loop_joint("pin", "spherical", a, a.point((1, 0, 0)))
     with pytest.raises(ValueError, match="^length: expected a positive distance"):
-        mod.add_loop_joint("distance", mod.ground, a)
+        mod.add_loop_joint("pin", "distance", mod.ground, a)
     with pytest.raises(ValueError, match="^frame_a: expected a rigid transformation"):
-        mod.add_loop_joint("revolute", mod.ground, a, frame_a=2 * np.eye(4))
-    mod.add_loop_joint("distance", mod.ground.point((0.0, 3.0, 0.0)), a.point((1, 0, 0)), length=0.5, name="rope")
+        mod.add_loop_joint("pin", "revolute", mod.ground, a, frame_a=2 * np.eye(4))
+    mod.add_loop_joint("rope", "distance", mod.ground.point((0.0, 3.0, 0.0)), a.point((1, 0, 0)), length=0.5)
     with pytest.raises(ValueError, match="^name: expected a name not used by another loop, got 'rope'"):
-        mod.add_loop_joint("spherical", mod.ground, a, name="rope")
-    assert mod.add_loop_joint("distance", mod.ground, a.point((1, 0, 0)), length=1.0) == "loop1"  # the default
+        mod.add_loop_joint("rope", "spherical", mod.ground, a)
+    assert mod.add_loop_joint("loop1", "distance", mod.ground, a.point((1, 0, 0)), length=1.0) == "loop1"  # the default
     s = mod.compile()
     with pytest.raises(ValueError, match=r"^q0: expected initial coordinates that close every loop of \['rope', 'loop1'\]"):
         rf.simulate(s, 1.0, q0=[0.0])
@@ -240,7 +240,7 @@ def test_bad_loops_are_value_errors_and_unreachable_ones_simulation_errors():
     # A rope on the pivot, which no coordinate moves: G = 0, nothing to assemble with.
     mod2 = rf.Model()
     b = mod2.add_body("b", mod2.ground, rf.Joint.revolute("z"), **rod(1.0))
-    mod2.add_actuator(mod2.ground.point((0.0, 0.6, 0.0)), b.origin, 0.5, name="stuck")
+    mod2.add_actuator("stuck", mod2.ground.point((0.0, 0.6, 0.0)), b.origin, 0.5)
     with pytest.raises(rf.SimulationError, match="loop 'stuck' \\(distance, residual 0.1\\)"):
         mod2.compile().assemble([0.3])
 
@@ -253,8 +253,8 @@ def test_a_planar_loop_joint_keeps_a_free_body_in_its_plane():
     g, vx, wz, P = 9.81, 0.4, 2.0, 3.0
     model = rf.Model(gravity=(0.0, -g, 0.0))
     body = model.add_body("puck", model.ground, rf.Joint.free(), mass=2.0, inertia=(0.1, 0.2, 0.3))
-    loop = model.add_loop_joint("planar", model.ground, body, name="table")
-    model.add_force(body.origin, (0.0, 0.0, P))
+    loop = model.add_loop_joint("table", "planar", model.ground, body)
+    model.add_force("load0", body.origin, (0.0, 0.0, P))
     s = model.compile()
     assert (s.nl, loop.kind) == (3, "planar")
     names = s.coordinate_names

@@ -41,7 +41,7 @@ def four_bar(algorithm="recursive", spring=True, gravity=True, damping=0.0):
     crank = m.add_body("crank", m.ground, joint, **rod(A))
     coupler = m.add_body("coupler", crank, rf.Joint.revolute("z"), **rod(B), placement=rf.transform((A, 0, 0)))
     rocker = m.add_body("rocker", m.ground, rf.Joint.revolute("z"), **rod(C), placement=rf.transform((D, 0, 0)))
-    m.add_loop_joint("revolute", coupler.point((B, 0, 0)), rocker.point((C, 0, 0)), name="C")
+    m.add_loop_joint("C", "revolute", coupler.point((B, 0, 0)), rocker.point((C, 0, 0)))
     return m.compile(algorithm)
 
 
@@ -136,8 +136,8 @@ def parallelogram(algorithm):
                     **rod(L_PAR), placement=rf.transform((i * W_PAR, 0, 0))) for i in range(3)]
     c = m.add_body("coupler", r[0], rf.Joint.revolute("z"), **rod(2 * W_PAR, M_COUPLER),
                    placement=rf.transform((L_PAR, 0, 0)))
-    m.add_loop_joint("revolute", c.point((W_PAR, 0, 0)), r[1].point((L_PAR, 0, 0)), name="middle")
-    m.add_loop_joint("revolute", c.point((2 * W_PAR, 0, 0)), r[2].point((L_PAR, 0, 0)), name="end")
+    m.add_loop_joint("middle", "revolute", c.point((W_PAR, 0, 0)), r[1].point((L_PAR, 0, 0)))
+    m.add_loop_joint("end", "revolute", c.point((2 * W_PAR, 0, 0)), r[2].point((L_PAR, 0, 0)))
     return m.compile(algorithm)
 
 
@@ -178,9 +178,9 @@ def pendulum(joint, algorithm, loop):
     (``loop`` False), or on ``joint`` closed to the ground by a revolute loop."""
     mod = rf.Model(gravity=(0, -G0, 0))
     body = mod.add_body("rod", mod.ground, joint, **rod(L_ROD, M_ROD))
-    mod.add_force(body.point((L_ROD, 0, 0)), (F_TIP, 0.0, 0.0))
+    mod.add_force("load0", body.point((L_ROD, 0, 0)), (F_TIP, 0.0, 0.0))
     if loop:
-        mod.add_loop_joint("revolute", mod.ground, body, name="pin")
+        mod.add_loop_joint("pin", "revolute", mod.ground, body)
     return mod.compile(algorithm)
 
 
@@ -226,7 +226,7 @@ def test_boom_held_by_an_actuator_is_a_structure_without_modes(algorithm, driven
     mod = rf.Model(gravity=(0, -G0, 0))
     boom = mod.add_body("boom", mod.ground, rf.Joint.revolute("z"), **rod(2.0, m_))
     length, t = (rf.motion.polynomial([0.6, 0.6]), 0.5) if driven else (l, 0.0)
-    mod.add_actuator(mod.ground.point((0.5, 0, 0)), boom.point((1.0, 0, 0)), length, name="cylinder")
+    mod.add_actuator("cylinder", mod.ground.point((0.5, 0, 0)), boom.point((1.0, 0, 0)), length)
     s = mod.compile(algorithm)
     theta = np.arccos(1.25 - l * l)
     eq = rf.static_equilibrium(s, q0=[1.0], t=t)
@@ -247,7 +247,7 @@ def test_boom_held_by_an_actuator_is_a_structure_without_modes(algorithm, driven
 def test_a_loop_that_cannot_be_closed_is_a_simulation_error_naming_it():
     mod = rf.Model()
     a = mod.add_body("a", mod.ground, rf.Joint.revolute("z"), **rod(1.0))
-    mod.add_loop_joint("distance", mod.ground.point((0.0, 3.0, 0.0)), a.point((1, 0, 0)), length=0.5, name="rope")
+    mod.add_loop_joint("rope", "distance", mod.ground.point((0.0, 3.0, 0.0)), a.point((1, 0, 0)), length=0.5)
     with pytest.raises(rf.SimulationError, match=r"loop 'rope' \(distance, residual.*static_equilibrium"):
         rf.static_equilibrium(mod.compile(), q0=[0.0])
 

@@ -179,8 +179,8 @@ def test_handles_of_another_model_are_refused_by_results_and_beams():
 
 def test_handles_of_another_model_are_refused_by_the_model():
     ma, a, mb, b = twins()
-    for call in (lambda: ma.add_force(b, (1.0, 0.0, 0.0)),
-                 lambda: ma.add_force(b.point((1.0, 0.0, 0.0)), (1.0, 0.0, 0.0))):
+    for call in (lambda: ma.add_force("push", b, (1.0, 0.0, 0.0)),
+                 lambda: ma.add_force("push", b.point((1.0, 0.0, 0.0)), (1.0, 0.0, 0.0))):
         with pytest.raises(ValueError, match=r"^point: expected a Point or Body of this model"):
             call()
     with pytest.raises(ValueError, match=r"^parent: expected a body of this model"):
@@ -191,7 +191,7 @@ def test_handles_of_another_model_are_refused_by_the_model():
         ma.add_generalized_force(b, 1.0)
     assert ma.compile().np == 0 and ma.nbodies == 1
     # a handle made by hand (no model id) still names a body by index and name
-    ma.add_force(rf.Body(0, "arm"), (1.0, 0.0, 0.0))
+    ma.add_force("load0", rf.Body(0, "arm"), (1.0, 0.0, 0.0))
     with pytest.raises(ValueError, match=r"^parent: expected a body of this model"):
         ma.add_body("more", rf.Body(0, "other name"), rf.Joint.revolute("z"), mass=1.0, inertia=(1, 1, 1))
     assert ma.body("arm").model == ma.id != mb.id
@@ -442,15 +442,15 @@ def test_every_builder_returns_a_handle_with_its_name():
     base = m.add_moving_base("deck", {"heave": rf.motion.harmonic(0.1, 1.0)})
     made = {
         "add_body": a, "add_beam": beam, "add_moving_base": base,
-        "add_spring_damper": m.add_spring_damper(m.ground.point((0, 1, 0)), b, stiffness=10.0, length=1.0, name="k"),
-        "add_cylinder": m.add_cylinder(m.ground.point((0, 2, 0)), b, 5.0),
-        "add_rope": m.add_rope(base, beam.tip, EA=1e5, length=2.0),
-        "add_force_element": m.add_force_element(m.ground.point((0, 3, 0)), b, rf.laws.Buffer(stiffness=1.0)),
-        "add_force": m.add_force(beam.tip, (0.0, -1.0, 0.0), name="push"),
-        "add_torque": m.add_torque(a, (0.0, 0.0, 1.0)),
-        "add_loop_joint": m.add_loop_joint("distance", m.ground.point((2, 0, 0)), b, length=1.5),
-        "add_actuator": m.add_actuator(m.ground.point((3, 0, 0)), b, 2.5, name="ram"),
-        "add_joint_law": m.add_joint_law(a, rf.laws.Friction(coulomb=0.1)),
+        "add_spring_damper": m.add_spring_damper("k", m.ground.point((0, 1, 0)), b, stiffness=10.0, length=1.0),
+        "add_cylinder": m.add_cylinder("element1", m.ground.point((0, 2, 0)), b, 5.0),
+        "add_rope": m.add_rope("element2", base, beam.tip, EA=1e5, length=2.0),
+        "add_force_element": m.add_force_element("element3", m.ground.point((0, 3, 0)), b, rf.laws.Buffer(stiffness=1.0)),
+        "add_force": m.add_force("push", beam.tip, (0.0, -1.0, 0.0)),
+        "add_torque": m.add_torque("load1", a, (0.0, 0.0, 1.0)),
+        "add_loop_joint": m.add_loop_joint("loop0", "distance", m.ground.point((2, 0, 0)), b, length=1.5),
+        "add_actuator": m.add_actuator("ram", m.ground.point((3, 0, 0)), b, 2.5),
+        "add_joint_law": m.add_joint_law("a.rz.friction", a, rf.laws.Friction(coulomb=0.1)),
         "add_generalized_force": m.add_generalized_force(a, 0.5),
         "add_maxwell_arm": m.add_maxwell_arm(b, 10.0, 0.1),
         "prescribe": m.prescribe(beam.rfes[1], rf.motion.constant(0.0)),

@@ -23,11 +23,11 @@ def build(E=2e11, Gm=8e10, rho=7800.0, mu=1e-4, A=1e-4, Iy=2.0e-10, Iz=3.3e-9, J
     mat = rf.Material(E=E, rho=rho, G=Gm, retardation=mu, prony=prony)
     b = m.add_beam("strip", hub_, 1.0, mat, rf.Section(A=A, Iy=Iy, Iz=Iz, J=J), 5, tip_mass=tip,
                    placement=rf.transform((0.1, 0.0, 0.0)))
-    m.add_spring_damper(b.point(0.5), m.ground, stiffness=ks, damping=cs, length=0.5, name="spring")
-    m.add_cylinder(b.tip, m.ground, F0, name="cylinder")
-    m.add_rope(b.tip, m.ground, EA=EA, DA=DA, length=0.9, name="rope")
-    m.add_force(b.tip, (0.0, -force, 0.0), name="push")
-    m.add_torque(b.rfes[2], (0.0, 0.0, torque), name="twist")
+    m.add_spring_damper("spring", b.point(0.5), m.ground, stiffness=ks, damping=cs, length=0.5)
+    m.add_cylinder("cylinder", b.tip, m.ground, F0)
+    m.add_rope("rope", b.tip, m.ground, EA=EA, DA=DA, length=0.9)
+    m.add_force("push", b.tip, (0.0, -force, 0.0))
+    m.add_torque("twist", b.rfes[2], (0.0, 0.0, torque))
     return m.compile()
 
 
@@ -134,9 +134,9 @@ def test_profile_numbers_are_parameters():
         boom = m.add_body("boom", m.ground, rf.Joint.revolute("z"), 10.0, (1.0, 1.0, 1.0), com=(1.0, 0.0, 0.0))
         m.prescribe(boom, rf.motion.harmonic(0.3, omega) + rf.motion.polynomial([0.0, 0.1]))
         load = m.add_body("load", boom, rf.Joint.free(), 5.0, (0.1, 0.1, 0.1), placement=rf.transform((2.0, 0, -1.0)))
-        m.add_rope(boom.point((2.0, 0.0, 0.0)), load, EA=1e5, length=rf.motion.polynomial([0.9, rate]), name="rope")
-        m.add_cylinder(load, m.ground, rf.motion.harmonic(amplitude, 3.0), name="jack")
-        m.add_force(load, (0.0, 1.0, 0.0), scale=rf.motion.polynomial([scale]), name="gust")
+        m.add_rope("rope", boom.point((2.0, 0.0, 0.0)), load, EA=1e5, length=rf.motion.polynomial([0.9, rate]))
+        m.add_cylinder("jack", load, m.ground, rf.motion.harmonic(amplitude, 3.0))
+        m.add_force("gust", load, (0.0, 1.0, 0.0), scale=rf.motion.polynomial([scale]))
         return m.compile()
 
     s = crane()

@@ -69,7 +69,7 @@ def test_peers_match_a_tree_with_translations_and_rest_values():
 
 def test_a_hidden_load_is_caught():
     model, beam = peers.cantilever(3)
-    model.add_force(beam.tip, (0.0, 0.0, 5.0))  # not visible on a System, so not in the peers' chains
+    model.add_force("push", beam.tip, (0.0, 0.0, 5.0))  # not visible on a System, so not in the peers' chains
     with pytest.raises(AssertionError, match="disagree"):
         peers.check_mujoco(model.compile())
 

@@ -50,13 +50,13 @@ def everything():
                             placement=rf.transform((0.0, 0.8, 0.0)))
     model.add_generalized_force(rocker, pin_friction)
     model.add_generalized_force(slider, 1.5)
-    model.add_force(arm.tip, (0.0, 0.0, -2.0), scale=rf.motion.spin_up(1.0, 2.0))
-    model.add_torque(rocker, (0.1, 0.0, 0.0), follower=True, scale=rf.motion.spline([0, 1, 2, 3], [0, 1, 0.5, 0]))
-    model.add_spring_damper(rocker.point((0.0, 0.6, 0.0)), base.point((0.0, 0.9, 0.3)), stiffness=50.0, length=0.3,
+    model.add_force("load0", arm.tip, (0.0, 0.0, -2.0), scale=rf.motion.spin_up(1.0, 2.0))
+    model.add_torque("load1", rocker, (0.1, 0.0, 0.0), follower=True, scale=rf.motion.spline([0, 1, 2, 3], [0, 1, 0.5, 0]))
+    model.add_spring_damper("element0", rocker.point((0.0, 0.6, 0.0)), base.point((0.0, 0.9, 0.3)), stiffness=50.0, length=0.3,
                             damping=1.0)
-    model.add_cylinder(base.point((0.2, 0.0, -0.3)), rocker.point((0.0, 0.5, 0.0)), cylinder_law, damping=2.0)
-    model.add_rope(base.point((0.0, -0.3, 0.6)), pendulum.point((0.0, 0.0, -0.4)), EA=5e3, length=0.75)
-    model.add_loop_joint("distance", slider.origin, base.point((0.4, 0.8, 0.3)), length=0.5, name="tie")
+    model.add_cylinder("element1", base.point((0.2, 0.0, -0.3)), rocker.point((0.0, 0.5, 0.0)), cylinder_law, damping=2.0)
+    model.add_rope("element2", base.point((0.0, -0.3, 0.6)), pendulum.point((0.0, 0.0, -0.4)), EA=5e3, length=0.75)
+    model.add_loop_joint("tie", "distance", slider.origin, base.point((0.4, 0.8, 0.3)), length=0.5)
     model.gravity = (0.0, 0.0, -9.81)
     return model, tape, arm
 
@@ -84,7 +84,7 @@ def test_model_and_system_round_trip_bit_for_bit():
     q = rng.uniform(-0.3, 0.3, system.nq)
     copied = pickle.loads(pickle.dumps(system))
     assert np.array_equal(copied.position(arm.tip, 0.5, q), system.position(arm.tip, 0.5, q))
-    copy_model.add_spring_damper(tape.rfes[-1].origin, arm.tip, stiffness=1.0, length=0.1)
+    copy_model.add_spring_damper("element3", tape.rfes[-1].origin, arm.tip, stiffness=1.0, length=0.1)
 
 
 def test_joint_spec_changed_after_use_is_not_recorded():

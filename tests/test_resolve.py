@@ -30,7 +30,7 @@ def test_resolve_meets_the_elastica(k, tol):
     def build(m, deform):
         model = rf.Model(gravity=None)
         beam = model.add_beam("b", model.ground, 1.0, STEEL, sec, m, deform=deform)
-        model.add_force(beam.tip, (0.0, k * STEEL.E * sec.Iz, 0.0))
+        model.add_force("load0", beam.tip, (0.0, k * STEEL.E * sec.Iz, 0.0))
         return model, {"tip": beam.tip}
 
     plan = rf.resolve(build, "tip", tol=tol, elements=2)
@@ -58,7 +58,7 @@ def test_resolve_keeps_torsion_only_where_it_matters():
             model = rf.Model(gravity=None)
             beam = model.add_beam("b", model.ground, 1.0, STEEL, sec, m, deform=deform)
             tip = beam.rfes[-1].point((1.0 / (2 * m), offset, 0.0)) if offset else beam.tip
-            model.add_force(tip, (0.0, 0.0, 20.0))
+            model.add_force("load0", tip, (0.0, 0.0, 20.0))
             return model, {"tip": beam.rfes[-1].point((1.0 / (2 * m), 0.01, 0.0))}  # a point beside the axis
         return build
 

@@ -13,7 +13,7 @@ def four_bar(arm: bool = False):
     """rf.samples.four_bar with a spring-damper from the ground to the coupler and, optionally, a Maxwell arm
     on the crank's joint: (model, system, q0 closing the loop, crank)."""
     model, h = rf.samples.four_bar()
-    model.add_spring_damper(model.ground, h["coupler"], stiffness=10.0, length=0.5)
+    model.add_spring_damper("element0", model.ground, h["coupler"], stiffness=10.0, length=0.5)
     if arm:
         model.add_maxwell_arm(h["crank"], stiffness=50.0, tau=0.1)
     system = model.compile()
@@ -113,7 +113,7 @@ def test_the_jacobian_of_a_closed_chain_is_that_of_its_constrained_rhs(algorithm
     from scipy.integrate import solve_ivp
 
     model, h = rf.samples.double_pendulum(spatial=True)
-    model.add_actuator(model.ground.point((1.0, 0.0, 0.0)), h["tip"], rf.motion.polynomial([1.5, 0.1]))
+    model.add_actuator("loop0", model.ground.point((1.0, 0.0, 0.0)), h["tip"], rf.motion.polynomial([1.5, 0.1]))
     system = model.compile(algorithm)
     q, qd = system.assemble(0.2 * np.ones(6), 0.1 * np.ones(6))
     y = np.r_[q, qd]

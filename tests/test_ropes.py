@@ -14,7 +14,7 @@ def hoist(length=LU, damping=0.0, EA=EA):
     """A payload on a vertical slide (prismatic z) hanging from a rope fixed at the origin."""
     model = rf.Model(gravity=(0.0, 0.0, -G))
     load = model.add_body("load", model.ground, rf.Joint.prismatic("z"), MASS, (1.0, 1.0, 1.0))
-    model.add_rope(model.ground, load, EA=EA, length=length, DA=damping, name="rope")
+    model.add_rope("rope", model.ground, load, EA=EA, length=length, DA=damping)
     return load, model.compile()
 
 
@@ -23,7 +23,7 @@ def test_static_stretch_and_frequency(algorithm):
     """z = −l_u (1 + m g/EA) and ω² = EA/(l_u m) on the taut rope; T = m g."""
     model = rf.Model(gravity=(0.0, 0.0, -G))
     load = model.add_body("load", model.ground, rf.Joint.prismatic("z"), MASS, (1.0, 1.0, 1.0))
-    model.add_rope(model.ground, load, EA=EA, length=LU, DA=3e4)
+    model.add_rope("element0", model.ground, load, EA=EA, length=LU, DA=3e4)
     s = model.compile(algorithm)
     eq = rf.static_equilibrium(s, [-LU * 1.01])
     assert eq.q[0] == pytest.approx(-LU * (1 + MASS * G / EA), rel=1e-13)
@@ -82,14 +82,14 @@ def test_bad_rope_input():
     model = rf.Model()
     load = model.add_body("load", model.ground, rf.Joint.prismatic("z"), 1.0, (1.0, 1.0, 1.0))
     with pytest.raises(ValueError, match="^EA: expected a positive number in N"):
-        model.add_rope(model.ground, load, EA=0.0, length=1.0)
+        model.add_rope("rope", model.ground, load, EA=0.0, length=1.0)
     with pytest.raises(ValueError, match="^length: expected a positive number in m"):
-        model.add_rope(model.ground, load, EA=1e6, length=-1.0)
+        model.add_rope("rope", model.ground, load, EA=1e6, length=-1.0)
     with pytest.raises(ValueError, match="^length: expected a profile l_u"):
-        model.add_rope(model.ground, load, EA=1e6, length=rf.motion.polynomial([0.0, 1.0]))
+        model.add_rope("rope", model.ground, load, EA=1e6, length=rf.motion.polynomial([0.0, 1.0]))
     with pytest.raises(ValueError, match="^DA: expected a non-negative number in N s"):
-        model.add_rope(model.ground, load, EA=1e6, length=1.0, DA=-1.0)
-    model.add_rope(model.ground, load, EA=1e6, length=rf.motion.polynomial([1.0, -1.0]), name="reeled")
+        model.add_rope("rope", model.ground, load, EA=1e6, length=1.0, DA=-1.0)
+    model.add_rope("reeled", model.ground, load, EA=1e6, length=rf.motion.polynomial([1.0, -1.0]))
     s = model.compile()
     with pytest.raises(rf.SimulationError, match="unstretched length of rope 'reeled' is l_u = -0.5 m"):
         s.forward_dynamics(1.5, [-1.0], [0.0])

@@ -101,8 +101,8 @@ def strip(method_deform=("bend_z", "torsion", "bend_y"), tip=0.1, elements=6):
     b = m.add_beam("strip", m.ground, 1.0, rf.Material(E=2e11, rho=7800.0, G=8e10, retardation=1e-4),
                    rf.Section.rectangle(0.02, 0.005), elements, joint=rf.Joint.revolute("z", stiffness=5.0),
                    tip_mass=tip, deform=method_deform)
-    m.add_force(b.tip, (0.0, -1.0, 0.0), name="push")
-    m.add_spring_damper(b.tip, m.ground, stiffness=10.0, damping=0.5, length=0.5, name="spring")
+    m.add_force("push", b.tip, (0.0, -1.0, 0.0))
+    m.add_spring_damper("spring", b.tip, m.ground, stiffness=10.0, damping=0.5, length=0.5)
     return m.compile(), b
 
 
@@ -142,7 +142,7 @@ def test_rope_across_slack_phases():
     rope stays taut they agree to the differences' own 1e-8."""
     model = rf.Model(gravity=(0.0, 0.0, -G))
     load = model.add_body("load", model.ground, rf.Joint.prismatic("z"), 500.0, (1.0, 1.0, 1.0))
-    model.add_rope(model.ground, load, EA=2e6, length=10.0, DA=1e3, name="rope")
+    model.add_rope("rope", model.ground, load, EA=2e6, length=10.0, DA=1e3)
     s = model.compile()
     t = np.linspace(0, 1.5, 7)
     errors = []
@@ -344,8 +344,7 @@ def test_profile_numbers_converge():
     boom = m.add_body("boom", m.ground, rf.Joint.revolute("z"), 10.0, (1.0, 1.0, 1.0), com=(1.0, 0.0, 0.0))
     m.prescribe(boom, rf.motion.harmonic(0.3, 1.5))
     load = m.add_body("load", boom, rf.Joint.free(), 5.0, (0.1, 0.1, 0.1), placement=rf.transform((2.0, 0, 0)))
-    m.add_rope(boom.point((2.0, 0.0, 0.0)), load, EA=1e6, DA=1e3, length=rf.motion.ramp(-0.2, 0.0, 0.5, start=1.0),
-               name="rope")  # hoisting from rest, smoothly: the rope stays taut
+    m.add_rope("rope", boom.point((2.0, 0.0, 0.0)), load, EA=1e6, DA=1e3, length=rf.motion.ramp(-0.2, 0.0, 0.5, start=1.0))  # hoisting from rest, smoothly: the rope stays taut
     s = m.compile()
     r = _converges(s, ["rope.length.rate", "rope.length.duration", "rope.EA"], "generalized_alpha",
                    np.linspace(0, 1.0, 5), steps=(1e-2, 1e-3), floor=2e-6, dt=1e-3, newton_tol=1e-14,
@@ -423,7 +422,7 @@ def test_sensitivities_through_a_rope_going_slack(method):
     central differences of two runs."""
     m = rf.Model(gravity=(0.0, 0.0, -9.81))
     load = m.add_body("load", m.ground, rf.Joint.custom(["x", "y", "z"]), mass=10.0, inertia=(0.1, 0.1, 0.1))
-    m.add_rope(m.ground.point((0.0, 0.0, 0.0)), load, EA=1e5, length=rf.motion.polynomial([0.9, 0.3]))
+    m.add_rope("element0", m.ground.point((0.0, 0.0, 0.0)), load, EA=1e5, length=rf.motion.polynomial([0.9, 0.3]))
     system = m.compile()
     q0 = np.array([0.0, 0.0, -1.0])
     kw = dict(method="radau5", rtol=1e-10, atol=1e-12, t_eval=np.linspace(0.0, 2.0, 21))

@@ -234,7 +234,7 @@ def slider_crank(m, formulation="modified"):
                          elements=m, formulation=formulation, deform=("bend_z",), joint=rf.Joint.revolute("z"),
                          placement=rf.transform((R, 0, 0)))
     slider = model.add_body("slider", model.ground, rf.Joint.prismatic("x"), mass=M_SLIDER, inertia=(1e-5, 1e-5, 1e-5))
-    model.add_loop_joint("revolute", slider, rod.tip, name="slider pin")  # reaction: on the rod, in global axes
+    model.add_loop_joint("slider pin", "revolute", slider, rod.tip)  # reaction: on the rod, in global axes
     return model.compile(), rod, slider
 
 

@@ -181,7 +181,7 @@ def test_one_table_of_loop_kinds():
         m = rf.Model(gravity=None)
         a = m.add_body("a", m.ground, rf.Joint.free(), mass=1.0, inertia=(1, 1, 1))
         if kind == "distance":
-            m.add_loop_joint(kind, m.ground, a.point((1.0, 0, 0)), length=1.0)
+            m.add_loop_joint("loop0", kind, m.ground, a.point((1.0, 0, 0)), length=1.0)
         else:
-            m.add_loop_joint(kind, m.ground, a)
+            m.add_loop_joint("loop0", kind, m.ground, a)
         assert m.compile().nl == rows, kind

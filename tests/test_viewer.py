@@ -64,8 +64,8 @@ def test_other_scenes_and_one_state():
                        com=(0.15, 0, 0))
     rocker = m.add_body("rocker", m.ground, rf.Joint.revolute("z"), mass=1.0, inertia=(1e-3, 0.03, 0.03),
                         com=(0.3, 0, 0), placement=rf.transform((0.7, 0, 0)))
-    m.add_spring_damper(crank.point((0.3, 0, 0)), rocker.point((0.6, 0, 0)), stiffness=100.0, length=0.5)
-    m.add_loop_joint("distance", crank.point((0.3, 0, 0)), rocker.point((0.6, 0, 0)), length=0.55)
+    m.add_spring_damper("element0", crank.point((0.3, 0, 0)), rocker.point((0.6, 0, 0)), stiffness=100.0, length=0.5)
+    m.add_loop_joint("loop0", "distance", crank.point((0.3, 0, 0)), rocker.point((0.6, 0, 0)), length=0.55)
     s = m.compile()
     v = rf.view(s, q=np.zeros(s.nq))
     assert v.frames == 1 and [seg["kind"] for seg in v.data["segments"]] == ["spring", "loop"]

@@ -370,10 +370,9 @@ void bind_model(py::module_& m) {
           [](Model& model, const std::string& name, int a, const Vec3& point_a, int b, const Vec3& point_b,
              const std::string& kind, const py::dict& values, ProfilePtr profile, const py::object& function) {
             const ElementLawKind& k = element_kind(kind);
-            const std::string label = name.empty() ? "element" + std::to_string(model.force_elements().size()) : name;
             const AxialFunction f = function.is_none()
                                         ? AxialFunction()
-                                        : python_law(function, "force element '" + label + "'", "l", "ld", "N");
+                                        : python_law(function, "force element '" + name + "'", "l", "ld", "N");
             const ForceElement e{name, a, b, point_a, point_b,
                                  k.make(law_values(k.info(), values), std::move(profile), f)};
             return model.force_elements()[model.add_force_element(e)].name;

@@ -16,11 +16,10 @@ namespace {
 
 std::string num8(double x) { return num(x, 8); }
 
-// `item` named "<prefix><index>" if its name is empty; std::invalid_argument naming `name` if another
-// of `items` has its name already.
+// `item`, or std::invalid_argument naming `name` if its name is empty or another of `items` has it already.
 template <class T>
-T with_unique_name(T item, const std::vector<T>& items, const char* prefix, const char* what) {
-  if (item.name.empty()) item.name = prefix + std::to_string(items.size());
+const T& with_unique_name(const T& item, const std::vector<T>& items, const char* what) {
+  if (item.name.empty()) bad("name", std::string("a non-empty name of the ") + what, "''");
   for (const T& other : items)
     if (other.name == item.name)
       bad("name", std::string("a name not used by another ") + what, "'" + item.name + "'");
@@ -326,7 +325,7 @@ int Model::add_loop(const Loop& loop) {
     bad("length", "a positive distance in m", num8(loop.length));
   // each argument first, then how they go together
   if (loop.body_a == loop.body_b) bad("b", "a body other than a (a loop joins two bodies)", "the same body");
-  loops_.push_back(with_unique_name(loop, loops_, "loop", "loop"));
+  loops_.push_back(with_unique_name(loop, loops_, "loop"));
   return static_cast<int>(loops_.size()) - 1;
 }
 
@@ -339,7 +338,7 @@ int Model::add_force_element(const ForceElement& element) {
   require_finite(element.point_b, "b");
   if (!element.law) bad("law", "the law of a force element's kind", "none");
   element.law->validate();
-  elements_.push_back(with_unique_name(element, elements_, "element", "force element"));
+  elements_.push_back(with_unique_name(element, elements_, "force element"));
   return static_cast<int>(elements_.size()) - 1;
 }
 

@@ -171,3 +171,11 @@ def path(x, name: str = "path"):
     if isinstance(x, os.PathLike) or (isinstance(x, str) and x):
         return x
     raise ValueError(f"{name}: expected a file path (str or os.PathLike), got {_short(x)}")
+
+
+def name(x, what: str = "name") -> str:
+    """``x`` as the name of what a builder adds: a non-empty str (numbers, None and handles are refused, not
+    converted). Whether it is new is judged where the names are kept."""
+    if isinstance(x, str) and x:
+        return x
+    raise ValueError(f"{what}: expected a non-empty str, got {_short(x)}")

@@ -407,7 +407,7 @@ def add_beam(
     couplings make it O(m²). A ``length`` given as a ``rigidfem.motion`` profile L(t) makes a link
     of varying free length (the equations: ``cpp/include/rigidfem/flows.hpp``): built at L(0), its sde joints get a prescribed
     "x" coordinate first that spreads the rfes over L(t)."""
-    flow = None
+    flow, name = None, model._new_name(name)
     linear = _checks.boolean(linear, "linear")
     if isinstance(length, _core.Profile):
         flow, length = length, _flow_length(length, material, section, deform, formulation, linear, tip_mass)

@@ -49,15 +49,15 @@ def points(model, a, b) -> tuple:
     return (*point_of(model, a, "a"), *point_of(model, b, "b"))
 
 
-def add_force_element(model, a, b, law, *, name: str | None = None) -> handles.Element:
-    """The element of ``law`` (a ``rigidfem.laws`` law of a force element) added to ``model`` between ``a`` and
-    ``b``; returns its name ("element<k>" when ``name`` is None). Its constants marked as parameters become the
+def add_force_element(model, name: str, a, b, law) -> handles.Element:
+    """The element ``name`` of ``law`` (a ``rigidfem.laws`` law of a force element) added to ``model`` between ``a``
+    and ``b``; returns its handle. Its constants marked as parameters become the
     parameters ``"<name>.<constant>"``, its profile's numbers ``"<name>.<profile name>.<path>"``."""
     if not isinstance(law, laws.Law) or law.info["acts_on"] != "element":
         raise _checks.refuse(f"law: expected a law of a force element ({', '.join(k for k, i in laws.kinds().items() if i['acts_on'] == 'element')} "
                          f"from rigidfem.laws), got {law!r}")
     ia, ra, ib, rb = points(model, a, b)
-    name = model._add_force_element("" if name is None else str(name), ia, ra, ib, rb, law.kind, law.values,
+    name = model._add_force_element(name, ia, ra, ib, rb, law.kind, law.values,
                                     law.profile, law.function)
     k = model._nelements - 1
     info = law.info

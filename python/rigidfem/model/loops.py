@@ -55,9 +55,9 @@ def _frame(model, where, frame, name: str):
     return body, F
 
 
-def add_loop_joint(model, kind: str, a, b, *, frame_a=None, frame_b=None, length: float | None = None,
-                   name: str | None = None) -> str:
-    """Close a loop between ``a`` and ``b`` (see ``Model.add_loop_joint``); returns its name."""
+def add_loop_joint(model, name: str, kind: str, a, b, *, frame_a=None, frame_b=None,
+                   length: float | None = None) -> str:
+    """Close a loop ``name`` between ``a`` and ``b`` (see ``Model.add_loop_joint``); returns its name."""
     if kind not in KINDS:
         raise _checks.refuse(f"kind: expected one of {', '.join(KINDS)}, got {kind!r}")
     ia, Fa = _frame(model, a, frame_a, "a")
@@ -71,8 +71,8 @@ def add_loop_joint(model, kind: str, a, b, *, frame_a=None, frame_b=None, length
     return _add(model, name, kind, ia, Fa, ib, Fb, length or 0.0, None)
 
 
-def add_actuator(model, a, b, length, *, name: str | None = None) -> str:
-    """A linear actuator between points ``a`` and ``b`` with prescribed length (see
+def add_actuator(model, name: str, a, b, length) -> str:
+    """A linear actuator ``name`` between points ``a`` and ``b`` with prescribed length (see
     ``Model.add_actuator``); returns its name."""
     ia, Fa = _frame(model, a, None, "a")
     ib, Fb = _frame(model, b, None, "b")
@@ -86,8 +86,8 @@ def add_actuator(model, a, b, length, *, name: str | None = None) -> str:
 
 
 def _add(model, name, kind, ia, Fa, ib, Fb, length, drive, actuator=False) -> str:
-    """The loop added (its name: ``name``, or "loop<k>" when None)."""
-    return model._add_loop("" if name is None else str(name), kind, ia, Fa, ib, Fb, length, drive, actuator)
+    """The loop ``name`` added; returns its name."""
+    return model._add_loop(name, kind, ia, Fa, ib, Fb, length, drive, actuator)
 
 
 def assemble(system, q, qd=None, *, t: float | None = None, tol: float = 1e-12, max_iterations: int = 50):

@@ -173,11 +173,12 @@ class Model(_core._Model):
             Pose of the joint frame in the parent's frame (``rigidfem.transform``);
             identity by default. The body frame is the joint frame moved by the joint.
         """
+        name = self._new_name(name)
         if not isinstance(joint, JointSpec):
             raise _checks.refuse(f"joint: expected a joint from rigidfem.Joint, got {joint!r}")
         B = np.eye(4) if placement is None else _checks.reals(placement, (4, 4), "placement")
         mass, com, inertia = _checks.real(mass, "mass", "a mass in kg"), _checks.reals(com, (3,), "com"), _inertia(inertia)
-        body = self._add_body(str(name), self._parent_index(parent), joint, B, mass, com, inertia)
+        body = self._add_body(name, self._parent_index(parent), joint, B, mass, com, inertia)
         parameters.register(self, parameters.BodyGroup(body.name, body.index, mass, com, inertia))
         self._declare_coordinates(body, joint)
         return body
@@ -298,38 +299,51 @@ class Model(_core._Model):
         return handles.Coordinate(self._coordinate_name(body.index, k), "arm", max(k, 0))
 
     @recorded
-    def add_force(self, point, force, *, follower: bool = False, scale: Profile | None = None,
-                  name: str | None = None) -> handles.Load:
+    def add_force(self, name: str, point, force, *, follower: bool = False,
+                  scale: Profile | None = None) -> handles.Load:
         """Apply a point force (N) at ``point`` (a ``Point`` or a ``Body``'s origin).
 
         ``force`` has global components, or body components turning with the body
         when ``follower=True``. ``scale`` (a ``rigidfem.motion`` profile) multiplies
-        it by its value q(t). Returns its ``name`` ("load<k>" by default), whose parameter
-        ``"<name>.force"`` is its magnitude (``System.parameters``).
+        it by its value q(t). ``name`` (new among the model's names) names its parameter
+        ``"<name>.force"``, its magnitude (``System.parameters``). Returns its handle.
         """
+        name = self._new_name(name)
         p = self._point(point)
         return self._load(name, "force", p.body, p.r, _checks.reals(force, (3,), "force"), np.zeros(3), follower,
                           scale)
 
     @recorded
-    def add_torque(self, body: Body, torque, *, follower: bool = False, scale: Profile | None = None,
-                   name: str | None = None) -> handles.Load:
-        """Apply a torque (N·m) on ``body``: global components, or body ones if ``follower``. Returns its
-        ``name`` ("load<k>" by default), whose parameter ``"<name>.torque"`` is its magnitude."""
+    def add_torque(self, name: str, body: Body, torque, *, follower: bool = False,
+                   scale: Profile | None = None) -> handles.Load:
+        """Apply a torque (N·m) on ``body``: global components, or body ones if ``follower``. ``name`` names its
+        parameter ``"<name>.torque"``, its magnitude. Returns its handle."""
+        name = self._new_name(name)
         p = self._point(body)
         return self._load(name, "torque", p.body, np.zeros(3), np.zeros(3), _checks.reals(torque, (3,), "torque"), follower,
                           scale)
 
     def _load(self, name, kind, body, r, force, torque, follower, scale) -> handles.Load:
-        name = f"load{self._nloads}" if name is None else name
-        if not isinstance(name, str) or name in self._parameter_groups:
-            raise _checks.refuse(f"name: expected a new name (str) for the load, got {name!r}")
         self._add_load(body, r, force, torque, _checks.boolean(follower, "follower"), _scale(scale))
         parameters.register(self, parameters.LoadGroup(name, self._nloads - 1, force, torque))
         if scale is not None:
             parameters.register(self, parameters.ProfileGroup(f"{name}.scale", "load", -1, self._nloads - 1, scale,
                                                               "the scale's (rigidfem.motion)"))
         return handles.Load(name, kind, self._nloads - 1)
+
+    def _new_name(self, name) -> str:
+        """``name`` if it is a non-empty str not yet given to a body (an rfe included), coordinate, load, element
+        or law (the names of the bodies and of the parameters' groups); whether a loop's or an element's name is new
+        among its kind is judged by the core."""
+        name = _checks.name(name)
+        try:
+            taken = name in self._parameter_groups or self._body_index(name) >= -1  # -1: "ground"
+        except ValueError:  # not a body's name
+            taken = False
+        if taken:
+            raise _checks.refuse(f"name: expected a name not yet given to a body, coordinate, load, element or law, "
+                                 f"got {name!r}")
+        return name
 
     def _point(self, point) -> Point:
         if isinstance(point, Body):
@@ -341,12 +355,14 @@ class Model(_core._Model):
         return point
 
     @recorded
-    def add_loop_joint(self, kind: str, a, b, *, frame_a=None, frame_b=None, length: float | None = None,
-                       name: str | None = None) -> handles.Loop:
+    def add_loop_joint(self, name: str, kind: str, a, b, *, frame_a=None, frame_b=None,
+                       length: float | None = None) -> handles.Loop:
         """Close a kinematic loop: a joint of ``kind`` between ``a`` and ``b`` (book ch. 2.6).
 
         Parameters
         ----------
+        name : str
+            Names its reaction in ``System.loop_names`` (new among the loops' names).
         kind : str
             One of ``rigidfem.loops.KINDS`` ("revolute", "spherical", "universal", "prismatic",
             "cylindrical", "fixed", "planar", "distance": ``rigidfem.loops`` tabulates what each leaves
@@ -360,92 +376,87 @@ class Model(_core._Model):
             ``length`` apart).
         length : float
             m, distance loops only.
-        name : str, optional
-            Names its reaction in ``System.loop_names``; "loop<k>" by default.
 
-        Returns the loop's name. The initial coordinates of a simulation must close every loop:
+        Returns the loop's handle. The initial coordinates of a simulation must close every loop:
         ``System.assemble`` finds them from a guess.
         """
-        name = loops.add_loop_joint(self, kind, a, b, frame_a=frame_a, frame_b=frame_b, length=length, name=name)
+        name = loops.add_loop_joint(self, self._new_name(name), kind, a, b, frame_a=frame_a, frame_b=frame_b,
+                                    length=length)
         return handles.Loop(name, kind, self._nloops - 1)
 
     @recorded
-    def add_actuator(self, a, b, length, *, name: str | None = None) -> handles.Loop:
+    def add_actuator(self, name: str, a, b, length) -> handles.Loop:
         """A linear actuator (hydraulic cylinder under position control) between the points ``a``
         and ``b`` (Point or Body): their distance is held at ``length`` (m), a number or a
         ``rigidfem.motion`` profile l(t). Its force (N, positive pushing the points apart) is the
-        loop's reaction, column 0 of ``System.loop_reactions``. Returns its name."""
-        return handles.Loop(loops.add_actuator(self, a, b, length, name=name), "actuator", self._nloops - 1)
+        loop's reaction, column 0 of ``System.loop_reactions``; ``name`` names it in ``System.loop_names``. Returns its
+        handle."""
+        return handles.Loop(loops.add_actuator(self, self._new_name(name), a, b, length), "actuator", self._nloops - 1)
 
     @recorded
-    def add_force_element(self, a, b, law, *, name: str | None = None) -> handles.Element:
+    def add_force_element(self, name: str, a, b, law) -> handles.Element:
         """A force element of ``law`` (``rigidfem.laws``: ``SpringDamper``, ``Rope``, ...) between the points ``a``
         and ``b`` (Point, Body or ``model.ground``; rigid bodies or rfes of a beam), acting along the line between
         them with the law's axial force F(t, l, l̇) (N, > 0 pushing the points apart). No constraint: it acts on
         trees and closed chains alike (``rigidfem.model.force_elements``). Its constants marked as parameters become
-        ``"<name>.<constant>"`` (``System.parameters``). Returns its name ("element<k>" by default), which
-        ``System.element_names`` lists."""
-        return force_elements.add_force_element(self, a, b, law, name=name)
+        ``"<name>.<constant>"`` (``System.parameters``); ``System.element_names`` lists ``name``. Returns its handle."""
+        return force_elements.add_force_element(self, self._new_name(name), a, b, law)
 
     @recorded
-    def add_spring_damper(self, a, b, *, stiffness: float, length: float, damping: float = 0.0,
-                          name: str | None = None) -> handles.Element:
+    def add_spring_damper(self, name: str, a, b, *, stiffness: float, length: float,
+                          damping: float = 0.0) -> handles.Element:
         """A linear spring-damper between the points ``a`` and ``b`` (Point, Body or
         ``model.ground``; rigid bodies or rfes of a beam): axial force
         F = −k (l − l₀) − c l̇ (N, > 0 pushing the points apart) with ``stiffness`` k (N/m),
-        rest ``length`` l₀ (m) and ``damping`` c (N·s/m): ``add_force_element(a, b,
-        rf.laws.SpringDamper(stiffness=k, length=l₀, damping=c))``. Returns its name ("element<k>" by
-        default), which ``System.element_names`` lists."""
+        rest ``length`` l₀ (m) and ``damping`` c (N·s/m): ``add_force_element(name, a, b,
+        rf.laws.SpringDamper(stiffness=k, length=l₀, damping=c))``. ``System.element_names`` lists ``name``. Returns
+        its handle."""
+        name = self._new_name(name)
         force_elements.points(self, a, b)  # named before the law's constants
         law = laws.SpringDamper(stiffness=stiffness, length=length, damping=damping)
-        return force_elements.add_force_element(self, a, b, law, name=name)
+        return force_elements.add_force_element(self, name, a, b, law)
 
     @recorded
-    def add_cylinder(self, a, b, force, *, damping: float = 0.0, name: str | None = None) -> handles.Element:
+    def add_cylinder(self, name: str, a, b, force, *, damping: float = 0.0) -> handles.Element:
         """A hydraulic cylinder under force control between the points ``a`` and ``b``: it pushes
         them apart with ``force`` (N; negative pulls) — a number, a ``rigidfem.motion`` profile
         F(t) or a Python function ``force(t, l, ld)`` of time (s), length (m) and its rate (m/s)
         (the slow path: called under the GIL at every evaluation) — less its ``damping`` c l̇
         (N·s/m): a ``rf.laws.SpringDamper`` without a spring. Position control is ``add_actuator``. Returns its
-        name ("element<k>" by default); ``System.element_states`` and ``Result.element_forces`` give its force."""
+        handle; ``System.element_states`` and ``Result.element_forces`` give its force."""
+        name = self._new_name(name)
         force_elements.points(self, a, b)  # named before the law's constants
         law = laws.SpringDamper(damping=damping, **force_elements.cylinder_force(force))
-        return force_elements.add_force_element(self, a, b, law, name=name)
+        return force_elements.add_force_element(self, name, a, b, law)
 
     @recorded
-    def add_rope(self, a, b, *, EA: float, length, DA: float = 0.0, name: str | None = None) -> handles.Element:
+    def add_rope(self, name: str, a, b, *, EA: float, length, DA: float = 0.0) -> handles.Element:
         """A massless rope between the points ``a`` and ``b`` (book ch. 7.1: a hoisting rope): it
         only pulls, with the tension T = (EA (l − l_u) + DA (l̇ − l̇_u))/l_u while positive, 0 when
         slack. ``EA`` (N) is its axial stiffness, ``DA`` (N·s) its axial damping, and ``length`` its unstretched
         length l_u (m): a number or a ``rigidfem.motion`` profile l_u(t) paid out by a winch
-        (``rf.laws.Rope``). Returns its name; ``System.element_states`` gives its force F = −T (N)."""
+        (``rf.laws.Rope``). Returns its handle; ``System.element_states`` gives its force F = −T (N)."""
+        name = self._new_name(name)
         force_elements.points(self, a, b)  # named before the law's constants
         law = laws.Rope(EA=EA, DA=DA, **force_elements.unstretched(length))
-        return force_elements.add_force_element(self, a, b, law, name=name)
+        return force_elements.add_force_element(self, name, a, b, law)
 
     @recorded
-    def add_joint_law(self, body: Body, law, coordinate: str | None = None, *,
-                      name: str | None = None) -> handles.JointLaw:
+    def add_joint_law(self, name: str, body: Body, law, coordinate: str | None = None) -> handles.JointLaw:
         """A law of a joint coordinate (``rigidfem.laws``: ``Friction``, ``ForceFunction``) on the coordinate
         ``coordinate`` ("x", ..., "rx"; None: the joint's only one) of ``body``'s joint, adding its generalised
         force Q(t, q, q̇) (N or N·m) to the coordinate's own spring-damping law. Its constants marked as parameters
         become ``"<name>.<constant>"`` (``System.parameters``, in the coordinate's units: N or N·m for a rotation's
-        forces). Returns its name ("<body>.<axis>.<kind>" in lower case by default, "...2" for a second one of a
-        kind)."""
+        forces). Returns its handle."""
+        name = self._new_name(name)
         if not isinstance(law, laws.Law) or law.info["acts_on"] != "coordinate" or not law.info["addable"]:
             kinds = [k for k, i in laws.kinds().items() if i["acts_on"] == "coordinate" and i["addable"]]
             raise _checks.refuse(f"law: expected a law of a joint coordinate ({', '.join(kinds)} from rigidfem.laws), "
                              f"got {law!r}")
         k = self._coordinate(body, coordinate)
         axis = self._coordinate_name(body.index, k)
-        if name is None:
-            base, n = f"{axis}.{law.kind.lower()}", 1
-            while (name := base if n == 1 else f"{base}{n}") in self._parameter_groups:
-                n += 1
-        elif not isinstance(name, str) or name in self._parameter_groups:
-            raise _checks.refuse(f"name: expected a name not yet given to a body, coordinate, element or law, got {name!r}")
         index = self._add_coordinate_law(body.index, k, law.kind, law.values, law.function)
-        group = parameters.LawGroup(str(name), ("coordinate", body.index, max(k, 0), index), law.info, law.values,
+        group = parameters.LawGroup(name, ("coordinate", body.index, max(k, 0), index), law.info, law.values,
                                     rotation=axis.rsplit(".", 1)[1].startswith("r"))
         parameters.register(self, group)
         return handles.JointLaw(group.prefix, law.kind, index)

@@ -102,7 +102,7 @@ def four_bar(crank_spring: dict | None = None):
     crank = model.add_body("crank", model.ground, Joint.revolute("z", **(crank_spring or {})), **rod(0.3))
     coupler = model.add_body("coupler", crank, Joint.revolute("z"), **rod(0.8), placement=transform((0.3, 0, 0)))
     rocker = model.add_body("rocker", model.ground, Joint.revolute("z"), **rod(0.6), placement=transform((0.7, 0, 0)))
-    loop = model.add_loop_joint("revolute", coupler.point((0.8, 0, 0)), rocker.point((0.6, 0, 0)), name="C")
+    loop = model.add_loop_joint("C", "revolute", coupler.point((0.8, 0, 0)), rocker.point((0.6, 0, 0)))
     return model, {"crank": crank, "coupler": coupler, "rocker": rocker, "loop": loop}
 
 
@@ -129,8 +129,7 @@ def double_four_bar(rocker: float = 0.5, span: float = 1.0, rocker_mass: float =
         c = model.add_body(f"c{i + 1}", rockers[i], Joint.revolute("z"), **rod(span, coupler_mass),
                            placement=transform((rocker, 0, 0)))
         couplers.append(c)
-        loops.append(model.add_loop_joint("revolute", c.point((span, 0, 0)), rockers[i + 1].point((rocker, 0, 0)),
-                                          name=name))
+        loops.append(model.add_loop_joint(name, "revolute", c.point((span, 0, 0)), rockers[i + 1].point((rocker, 0, 0))))
     return model, {"rockers": rockers, "couplers": couplers, "loops": loops}
 
 
@@ -212,7 +211,8 @@ def random_tree(seed: int, nbodies: int = 6):
                 if rng.random() < 0.5 else polynomial(list(rng.uniform(-0.3, 0.3, 3)))
             model.prescribe(body, drive, coordinate=c)
         if rng.random() < 0.5:
-            model.add_force(body.point(rng.uniform(-1, 1, 3)), rng.normal(0, 3, 3), follower=bool(rng.random() < 0.5))
+            model.add_force(f"{body.name}_force", body.point(rng.uniform(-1, 1, 3)), rng.normal(0, 3, 3),
+                            follower=bool(rng.random() < 0.5))
         if rng.random() < 0.3:
-            model.add_torque(body, rng.normal(0, 2, 3), follower=bool(rng.random() < 0.5))
+            model.add_torque(f"{body.name}_torque", body, rng.normal(0, 2, 3), follower=bool(rng.random() < 0.5))
     return model, {"bodies": bodies}, rng

@@ -11,9 +11,11 @@ Conventions (SI; angles in rad):
   arg H is in rad, positive when the motion leads the elevation. RAOs are those of one wave
   heading: the sea state is long-crested.
 
->>> waves = rf.sea.jonswap_waves(hs=2.0, tp=8.0, n=200, seed=1)
->>> deck = model.add_moving_base("deck", waves.motion({"heave": rf.sea.RAO.oscillator(6.0, 0.1),
-...                                                      "roll": np.radians(2.0)}))
+For example (``model`` a ``rigidfem.Model``)::
+
+    waves = rf.sea.jonswap_waves(hs=2.0, tp=8.0, n=200, seed=1)
+    deck = model.add_moving_base("deck", waves.motion({"heave": rf.sea.RAO.oscillator(6.0, 0.1),
+                                                         "roll": np.radians(2.0)}))
 """
 
 from __future__ import annotations

@@ -1,10 +1,12 @@
 """Speed against error (book ch. 5.3): work–precision studies of models and integrators,
 and the discretisation error against the number of rigid finite elements.
 
->>> scene = study.scenes.kane(omega=6.0, elements=10)
->>> table = study.work_precision(scene, [("dopri5", "rtol", [1e-4, 1e-6, 1e-8]),
-...                                      ("generalized_alpha", "dt", [0.01, 0.005])])
->>> print(table); table.to_csv("wp.csv"); table.plot()
+For example (a study of several minutes)::
+
+    scene = study.scenes.kane(omega=6.0, elements=10)
+    table = study.work_precision(scene, [("dopri5", "rtol", [1e-4, 1e-6, 1e-8]),
+                                         ("generalized_alpha", "dt", [0.01, 0.005])])
+    print(table); table.to_csv("wp.csv"); table.plot()
 
 Errors are measured against a reference solved much more tightly (Dormand–Prince at
 rtol = 1e-12 by default) at the same output times: the tip position (m) at the final time
@@ -72,7 +74,7 @@ class scenes:
         rest at its static deflection under a 20 N tip load; classical adds axial and shear."""
         deform = ("bend_z",) if formulation == "modified" else ("axial", "shear_y", "bend_z")
         loaded, hl = samples.cantilever(elements=elements, formulation=formulation, deform=deform)
-        loaded.add_force(hl["beam"].tip, (0.0, 20.0, 0.0))
+        loaded.add_force("load0", hl["beam"].tip, (0.0, 20.0, 0.0))
         q0 = static_equilibrium(loaded.compile(), load_steps=2).q
         model, h = samples.cantilever(elements=elements, formulation=formulation, deform=deform)
         T1 = 2 * np.pi / 105.0  # first period of this cantilever (s)
@@ -86,8 +88,8 @@ class scenes:
         270 times the first frequency (105 rad/s), and the torque excites the torsion modes."""
         deform = ("torsion", "bend_y", "bend_z")
         loaded, hl = samples.cantilever(elements=elements, deform=deform)
-        loaded.add_force(hl["beam"].tip, (0.0, 20.0, 10.0))
-        loaded.add_torque(hl["beam"].tip, (1.0, 0.0, 0.0))
+        loaded.add_force("load0", hl["beam"].tip, (0.0, 20.0, 10.0))
+        loaded.add_torque("load1", hl["beam"].tip, (1.0, 0.0, 0.0))
         q0 = static_equilibrium(loaded.compile(), load_steps=2).q
         model, h = samples.cantilever(elements=elements, deform=deform)
         T1 = 2 * np.pi / 105.0
@@ -111,7 +113,7 @@ class scenes:
             beam = model.add_beam("beam", model.ground, 1.0, Material(E=7e10, rho=2700.0),
                                   Section.rectangle(0.001, 0.02), elements, deform=("bend_z",))
             if force:
-                model.add_force(beam.tip, (0.0, 1.0, 0.0), follower=False)
+                model.add_force("load0", beam.tip, (0.0, 1.0, 0.0), follower=False)
             return model, beam
 
         loaded, _ = build(True)
@@ -321,7 +323,7 @@ def discretisation_error(elements=(5, 10, 20, 40, 80), modes: int = 3) -> Table:
         model = Model(gravity=None)
         beam = model.add_beam("b", model.ground, L, Material(E, rho), sec, m, deform=("bend_z",))
         w = modal_analysis(model.compile()).omega[:modes]
-        model.add_force(beam.tip, (0.0, k * E * sec.Iz / L**2, 0.0))
+        model.add_force("load0", beam.tip, (0.0, k * E * sec.Iz / L**2, 0.0))
         system = model.compile()
         tip = system.position(beam.tip, 0.0, static_equilibrium(system, load_steps=5).q)[:2]
         errors = np.r_[np.abs(w / w_ref - 1), np.linalg.norm(tip - tip_ref) / L]

@@ -7,12 +7,14 @@ joints as a marker and a line between their two frames, and the paths of chosen 
 play/pause, the playback speed and the time are below the picture; the mouse turns (left), pans
 (right) and zooms (wheel).
 
->>> import rigidfem as rf
->>> model, h = rf.samples.kane_beam(omega=6.0, duration=15.0, elements=8)
->>> system = model.compile()
->>> result = rf.simulate(system, 20.0, t_eval=[0.05 * k for k in range(401)])
->>> viewer = rf.view(system, result, trails=[h["beam"].tip])
->>> path = viewer.to_html("kane.html")          # a self-contained page, 1.15 MB (10 bodies)
+For example::
+
+    import rigidfem as rf
+    model, h = rf.samples.kane_beam(omega=6.0, duration=15.0, elements=8)
+    system = model.compile()
+    result = rf.simulate(system, 20.0, t_eval=[0.05 * k for k in range(401)])
+    viewer = rf.view(system, result, trails=[h["beam"].tip])
+    path = viewer.to_html("kane.html")          # a self-contained page, 1.15 MB (10 bodies)
 
 The file holds every frame's pose of every body as float32: 48 bytes × frames × bodies before base64
 (4/3), plus 0.9 MB of three.js; a 20 s Kane run (m = 20, 401 frames, 22 bodies) is about 1.5 MB.
