@@ -1,4 +1,4 @@
-"""``python -m benchmarks {scaling,peers,scale,loops,implicit_step,sweep,kane_peers,loop_peers,sweep_peers,strip_peers,crane_peers,size_peers,orders,tolerance,accuracy,viewer,sensitivities} [--quick] [--output DIR]``, from the root of a checkout."""
+"""``python -m benchmarks {scaling,peers,scale,loops,implicit_step,sweep,kane_peers,loop_peers,sweep_peers,strip_peers,crane_peers,size_peers,orders,tolerance,accuracy,viewer,sensitivities,contact} [--quick] [--output DIR]``, from the root of a checkout."""
 
 from __future__ import annotations
 
@@ -25,6 +25,7 @@ COMMANDS = {
     "accuracy": "the default asked for a tip error against the best of every method: strips, tapes, the bench's scenes",
     "viewer": "the 3D viewer: build time, HTML size and time per frame in headless Chromium (needs chromium)",
     "sensitivities": "forward sensitivities: cost per parameter against the run, strips of m = 20, 80, 320",
+    "contact": "contact at scale: a strip of m rfes on the ground, a capsule per rfe: forward dynamics and Jacobians",
 }
 
 

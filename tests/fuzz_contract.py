@@ -71,6 +71,7 @@ CORPUS = HERE / "fuzz_corpus"
 
 FEATURES = (
     "loops_and_elements",  # loop joints, actuators, spring-dampers and ropes between random points
+    "contacts",            # shapes on bodies, beams and the ground, and contacts between them (rf.shapes, rf.laws.Contact)
     "material_strings",    # Material/Section with numbers given as strings
     "point_nan",           # Body.point with a NaN/inf offset
     "prescribe_twice",     # prescribing a coordinate that is already prescribed
@@ -1721,6 +1722,56 @@ class Gen:
         self.other_names += 1
         return A(repr(name))
 
+    def shape(self):
+        """(handle variable, is a half-space, is a box) of a new shape on a body, a beam or the ground, or None when
+        its add_shape was meant to fail (a bad radius, normal, box or body)."""
+        bad = self.chance(0.1)
+        on_beam = self.beams and self.chance(0.25)
+        var = self.new("sh")
+        if on_beam:
+            bm = self.choice(self.beams)
+            radius = self.choice(["None", "0.01", "0.2"] + (["-1.0", "'r'"] if bad else []))
+            self.emit("model.add_shape", [self.fresh_name(), A(bm["var"]), A(f"rf.shapes.Capsules({radius})",
+                                                                            bad=radius in ("-1.0", "'r'"),
+                                                                            names=("radius",))],
+                      ["name", "body", "shape"], out=None if radius in ("-1.0", "'r'") else var, label="add_shape")
+            return None if radius in ("-1.0", "'r'") else (var, False, False)
+        body = "model.ground" if not self.bodies or self.chance(0.3) else self.handle(self.choice(self.bodies))
+        kind = self.choice(["sphere", "capsule", "box", "half_space"] if body != "model.ground" else
+                           ["half_space", "half_space", "sphere", "box"])
+        r = self.choice(["0.05", "0.5", "2.0"]) if not bad else self.choice(["0.0", "-0.1", "nan", "inf"])
+        expr = {"sphere": f"rf.shapes.Sphere({r}, {vec(self.vec3())})",
+                "capsule": f"rf.shapes.Capsule({r}, {vec(self.vec3())}, {vec(self.vec3())})",
+                "box": ("rf.shapes.Box((0.1, 0.2, 0.3), " + vec(self.vec3()) + ")") if not bad else
+                       self.choice(["rf.shapes.Box((0.1, -0.2, 0.3))", "rf.shapes.Box((0.1, 0.1, 0.1), rotation=np.ones((3, 3)))"]),
+                "half_space": (f"rf.shapes.HalfSpace({self.choice(['(0.0, 0.0, 1.0)', '(0.0, 1.0, 0.0)', '(0.6, 0.0, 0.8)'])}, "
+                               f"{vec(self.vec3())})") if not bad else "rf.shapes.HalfSpace((0.0, 0.0, 2.0))"}[kind]
+        self.emit("model.add_shape", [self.fresh_name(), A(body), A(expr, bad=bad,
+                                                                       names=("radius", "half_extents", "rotation", "normal"))],
+                  ["name", "body", "shape"], out=None if bad else var, label="add_shape")
+        return None if bad else (var, kind == "half_space", kind == "box")
+
+    def add_contact(self):
+        """Shapes (some on a beam's rfes, some on the ground) and one contact between two groups, with a law whose
+        constants are sometimes out of their bounds; pairs the core refuses (a box against a sphere, two half-spaces,
+        shapes on one body) are named by it."""
+        shapes = [s for s in (self.shape() for _ in range(self.choice([1, 2, 3, 4]))) if s is not None]
+        if len(shapes) < 2:
+            return
+        k = self.choice(range(1, len(shapes)))
+        a, b = shapes[:k], shapes[k:]
+        values = {"stiffness": self.choice(["1e3", "1e6", "1e9"]), "exponent": self.choice(["1.0", "1.5"]),
+                  "restitution": self.choice(["0.3", "0.9", "1.0"]), "mu_k": self.choice(["0.0", "0.5"]),
+                  "mu_s": self.choice(["0.0", "0.8"]), "smoothing": self.choice(["1e-4", "0.01"])}
+        bad = self.chance(0.1)
+        if bad:
+            key = self.choice(list(values))
+            values[key] = self.choice(["-1.0", "nan", "inf", "'x'", "0.0" if key in ("stiffness", "restitution", "smoothing") else "-2.0"])
+        law = "rf.laws.Contact(" + ", ".join(f"{k}={v}" for k, v in values.items()) + ")"
+        group = lambda g: g[0][0] if len(g) == 1 else "[" + ", ".join(v for v, _, _ in g) + "]"  # noqa: E731
+        self.emit("model.add_contact", [self.fresh_name(), A(group(a)), A(group(b)), A(law, bad=bad, names=tuple(values))],
+                  ["name", "a", "b", "law"], label="add_contact", ambiguous=True)
+
     def add_body(self):
         # a fresh name even after a call that was meant to fail: one that succeeded after all (a soft or
         # ambiguous case) must not make the next body's name a duplicate
@@ -2125,6 +2176,8 @@ class Gen:
         if self.on("loops_and_elements"):
             for _ in range(self.choice([0, 0, 1, 1, 2])):
                 self.add_loop_or_element()
+        if self.on("contacts") and self.chance(0.4):
+            self.add_contact()
         if self.on("model_body_lookup") and self.chance(0.05):
             self.emit("model.body", [A(self.choice(["'nope'", "3", "None"]), bad=True)], ["name"], label="Model.body")
         algorithm = self.choice(["recursive", "recursive", "lagrange", None, "bad"])

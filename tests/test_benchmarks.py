@@ -281,3 +281,12 @@ def test_viewer_benchmark_quick(tmp_path, capsys):
     assert (row["m"], row["bodies"], row["frames"]) == (20, 22, 101)
     assert 0.9 < row["file_MB"] < 5 and (tmp_path / "viewer_scaling.csv").exists()
     assert "ms_per_frame" in capsys.readouterr().out
+
+
+def test_contact_benchmark_quick():
+    """The contact benchmark's table: every capsule of the strip on the ground touches it by its two ends."""
+    from benchmarks import contact
+
+    table = contact.contact_cost((10,))
+    row = table.rows[0]
+    assert row["overlaps"] == 2 * 11 and row["fd_us_with"] > 0 and row["jac_ms_with"] > 0

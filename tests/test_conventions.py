@@ -189,7 +189,7 @@ def test_every_builder_takes_the_name_of_what_it_adds_first():
     coordinate's own laws, which the coordinate names) takes ``name`` first, required, and refuses a number, None,
     "" and a name given already, naming ``name``."""
     named = [n for n in dir(rf.Model) if n.startswith("add_") and n not in ("add_generalized_force", "add_maxwell_arm")]
-    assert len(named) == 12, named  # bodies, beams and bases; loads, loops, actuators, elements, laws
+    assert len(named) == 14, named  # bodies, beams and bases; loads, loops, actuators, elements, laws; shapes, contacts
     for n in named:
         first = list(inspect.signature(getattr(rf.Model, n)).parameters.values())[1]
         assert (first.name, first.default, first.kind) == ("name", inspect.Parameter.empty,

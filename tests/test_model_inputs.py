@@ -454,7 +454,10 @@ def test_every_builder_returns_a_handle_with_its_name():
         "add_generalized_force": m.add_generalized_force(a, 0.5),
         "add_maxwell_arm": m.add_maxwell_arm(b, 10.0, 0.1),
         "prescribe": m.prescribe(beam.rfes[1], rf.motion.constant(0.0)),
+        "add_shape": m.add_shape("ball", b, rf.shapes.Sphere(0.1)),
     }
+    made["add_contact"] = m.add_contact("touch", made["add_shape"], m.add_shape("floor", m.ground, rf.shapes.HalfSpace()),
+                                        rf.laws.Contact())
     builders = {n for n, f in inspect.getmembers(rf.Model, inspect.isfunction) if n.startswith("add_") or n == "prescribe"}
     assert builders == set(made), builders ^ set(made)
     for builder, handle in made.items():

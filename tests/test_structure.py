@@ -117,11 +117,11 @@ def test_public_classes_and_functions_have_docstrings():
 CPP = PACKAGE.parents[1] / "cpp"
 LAYERS = [
     {"errors", "transforms", "profiles", "laws"},
-    {"joint_motion", "loops", "force_elements", "coordinate_laws", "flows"},
+    {"joint_motion", "loops", "force_elements", "coordinate_laws", "flows", "contact"},
     {"model"},
     {"system", "parameters"},                  # a compiled system, and its copies with other constants
     {"arms"},                                  # internal variables of the state (system level)
-    {"kinematics", "constraints"},
+    {"kinematics", "constraints", "contact_forces"},
     {"lagrange", "recursive", "derivatives"},  # the formulations
     {"dynamics"},                              # the only place that chooses one
     {"error_measure", "sensitivities"},        # the outputs an error is measured on; the sensitivity equations

@@ -293,3 +293,30 @@ def test_to_html_names_a_path_that_is_not_one(pendulum_run, wrong, said, tmp_pat
     with pytest.raises(ValueError, match=rf"^path: expected a file path \(str or os\.PathLike\), got {said}$"):
         rf.view(system, result).to_html(wrong)
     assert rf.view(system, result).to_html(str(tmp_path / "v.html")) == tmp_path / "v.html"
+
+
+def test_the_shapes_of_contacts_are_drawn_in_their_bodies_frames(tmp_path):
+    """Every shape goes into the scene with its body and geometry (a body with shapes is drawn by them, not by its
+    inertia's box), and the page draws them without an error."""
+    model = rf.Model()
+    arm = model.add_body("arm", model.ground, rf.Joint.revolute("y"), 1.0, (0.01, 0.05, 0.05), com=(0.3, 0.0, 0.0),
+                         placement=rf.transform((0.0, 0.0, 0.6)))
+    ball = model.add_body("ball", model.ground, rf.Joint.free(), 0.5, (0.002, 0.002, 0.002),
+                          placement=rf.transform((0.3, 0.3, 0.5)))
+    other = model.add_body("other", model.ground, rf.Joint.revolute("z"), 1.0, (0.1, 0.1, 0.1))
+    shapes = [model.add_shape("rod", arm, rf.shapes.Capsule(0.05, (0.0, 0.0, 0.0), (0.6, 0.0, 0.0))),
+              model.add_shape("shell", ball, rf.shapes.Sphere(0.08)),
+              model.add_shape("brick", other, rf.shapes.Box((0.1, 0.06, 0.04), rotation=rf.euler_zyx(0.3, 0.0, 0.0)))]
+    floor = model.add_shape("floor", model.ground, rf.shapes.HalfSpace())
+    model.add_contact("on floor", shapes, floor, rf.laws.Contact(stiffness=1e5, restitution=0.6, mu_s=0.5, mu_k=0.4))
+    s = model.compile()
+    r = rf.simulate(s, 0.5, t_eval=np.linspace(0.0, 0.5, 11))
+    viewer = rf.view(s, r)
+    drawn = viewer.data["shapes"]
+    assert [(d["kind"], d["body"]) for d in drawn] == [("capsule", 0), ("sphere", 1), ("box", 2), ("half_space", -1)]
+    assert drawn[0]["b"] == [0.6, 0.0, 0.0] and drawn[1]["radius"] == 0.08
+    np.testing.assert_allclose(np.reshape(drawn[2]["rotation"], (3, 3)), rf.euler_zyx(0.3, 0.0, 0.0))
+    assert all(b["box"] is None for b in viewer.data["bodies"])
+    state = _open(viewer.to_html(tmp_path / "contact.html"), "slide=10&probe=1")
+    assert "error" not in state, state.get("error")
+    assert state.get("ready") == "1" and int(state["ink"]) > 500

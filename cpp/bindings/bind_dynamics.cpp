@@ -254,6 +254,44 @@ void bind_dynamics(py::module_& m) {
             return out;
           },
           "(how it is drawn, body a, point on a (m), body b, point on b) of every force element and loop.")
+      .def_property_readonly(
+          "_shapes",
+          [](const System& s) {
+            // what the viewer draws of each shape, in its body's frame
+            py::list out;
+            for (const Shape& shape : s.shapes)
+              out.append(py::make_tuple(shape_kind_name(shape.kind), shape.body, shape.a, shape.b, shape.n, shape.h,
+                                        shape.R, shape.radius));
+            return out;
+          },
+          "(kind, body, a, b, normal, half_extents, rotation, radius) of every shape (contact.hpp).")
+      .def_property_readonly(
+          "contact_names",
+          [](const System& s) {
+            std::vector<std::string> names;
+            for (const Contact& C : s.contacts) names.push_back(C.name);
+            return names;
+          },
+          "Names of the contacts (Model.add_contact).")
+      .def(
+          "contact_states",
+          [](const System& s, Time t, Coordinates q, Rates qd) {
+            Workspace d(s);
+            set_state(s, *d, t, q, qd);
+            kinematics(s, *d);
+            py::list out;
+            for_each_contact_force(s, *d, false, [&](const ContactForce& c) {
+              out.append(py::dict(py::arg("contact") = s.contacts[c.contact].name, py::arg("a") = c.body_a,
+                                  py::arg("b") = c.body_b, py::arg("point") = c.x, py::arg("normal") = c.n,
+                                  py::arg("gap") = c.gap, py::arg("gap_rate") = c.gap_rate,
+                                  py::arg("normal_force") = c.Fn, py::arg("force") = c.f, py::arg("slip") = c.vt));
+            });
+            return out;
+          },
+          py::arg("t"), py::arg("q"), py::arg("qd"),
+          "Every overlap of two shapes of a contact at (t, q, qd), each a dict: contact (its name), a and b (the\n"
+          "bodies' indices, -1 the ground), point (the contact point, m), normal (from a to b), gap (m, < 0: the\n"
+          "penetration), gap_rate (m/s), normal_force (N), force (on b, N; -force on a), slip (m/s).")
       .def(
           "element_states",
           [](const System& s, Time t, Coordinates q, Rates qd) {

@@ -382,6 +382,39 @@ void bind_model(py::module_& m) {
           "Adds a force element of the law `kind` (its constants' values by name, the rest their defaults), with its\n"
           "profile and Python function where the kind takes them; returns its name.")
       .def(
+          "_add_shape",
+          [](Model& model, const std::string& name, int body, const std::string& kind, const Vec3& a, const Vec3& b,
+             const Vec3& normal, const Vec3& half_extents, const Mat3& rotation, double radius) {
+            Shape shape{name, body, ShapeKind::Sphere, a, b, normal, half_extents, rotation, radius};
+            const ShapeKind kinds[] = {ShapeKind::Sphere, ShapeKind::Capsule, ShapeKind::Box, ShapeKind::HalfSpace};
+            bool known = false;
+            for (const ShapeKind k : kinds)
+              if (kind == shape_kind_name(k)) shape.kind = k, known = true;
+            if (!known) bad("kind", "'sphere', 'capsule', 'box' or 'half_space'", "'" + kind + "'");
+            return model.add_shape(shape);
+          },
+          py::arg("name"), py::arg("body"), py::arg("kind"), py::arg("a"), py::arg("b"), py::arg("normal"),
+          py::arg("half_extents"), py::arg("rotation"), py::arg("radius"),
+          "Adds a shape fixed on `body` (-1: the ground; rigidfem/contact.hpp); returns its index.")
+      .def(
+          "_add_contact",
+          [](Model& model, const std::string& name, const std::vector<int>& a, const std::vector<int>& b,
+             const std::string& kind, const py::dict& values) {
+            const ContactLawKind& k = kind_called(contact_law_kinds(), kind, "a contact law");
+            return model.add_contact({name, a, b, k.make(law_values(k.info(), values))});
+          },
+          py::arg("name"), py::arg("a"), py::arg("b"), py::arg("kind"), py::arg("values"),
+          "Adds a contact of the law `kind` between the shapes `a` and `b` (indices); returns its index.")
+      .def_property_readonly("_shape_table", [](const Model& model) {
+            py::list shapes;
+            for (const Shape& s : model.shapes())
+              shapes.append(py::dict(py::arg("name") = s.name, py::arg("body") = s.body,
+                                     py::arg("kind") = shape_kind_name(s.kind), py::arg("a") = s.a, py::arg("b") = s.b,
+                                     py::arg("normal") = s.n, py::arg("half_extents") = s.h,
+                                     py::arg("rotation") = s.R, py::arg("radius") = s.radius));
+            return shapes;
+          }, "The shapes, each a dict: name, body, kind, a, b, normal, half_extents, rotation, radius.")
+      .def(
           "_add_coordinate_law",
           [](Model& model, int body, int coordinate, const std::string& kind, const py::dict& values,
              const py::object& function) {
@@ -409,9 +442,10 @@ void bind_model(py::module_& m) {
             kinds.append(law_kind(SpringDamping::description(), false));
             for (const ElementLawKind& k : element_law_kinds()) kinds.append(law_kind(k.info(), true));
             for (const CoordinateLawKind& k : coordinate_law_kinds()) kinds.append(law_kind(k.info(), true));
+            for (const ContactLawKind& k : contact_law_kinds()) kinds.append(law_kind(k.info(), true));
             return kinds;
           },
-          "Every kind of law, each a dict: kind, acts_on ('element' or 'coordinate'), doc, constants (name, unit,\n"
+          "Every kind of law, each a dict: kind, acts_on ('element', 'coordinate' or 'contact'), doc, constants (name, unit,\n"
           "rotation_unit, default, lower, positive, doc, parameter), profile, profile_name, profile_units, function,\n"
           "addable (False: every coordinate's own spring-damping law).")
       .def_static(
@@ -420,6 +454,8 @@ void bind_model(py::module_& m) {
             std::shared_ptr<const Law> law;
             for (const ElementLawKind& k : element_law_kinds())
               if (kind == k.info().kind) law = k.make(law_values(k.info(), values), std::move(profile), {});
+            for (const ContactLawKind& k : contact_law_kinds())
+              if (kind == k.info().kind) law = k.make(law_values(k.info(), values));
             if (!law) {
               const CoordinateLawKind& k = coordinate_kind(kind);
               law = k.make(law_values(k.info(), values), {});

@@ -60,6 +60,29 @@ void element_tangent(const Data& d, const ForceElement& E, const ElementState& s
   }
 }
 
+// A contact's force f on body b (−f on a) at the contact point x_c, along the tangent: its wrench on b about the
+// origin changes by J ε (contact_jacobian, ε = (W_a, δv_a, W_b, δv_b)), of which loads_tangent, moving the loads'
+// points with their bodies, took −δx_b × f on b and δx_a × f on a (δx_k = W_v + W_ω × x_c): the rest here.
+void contact_tangent(const ContactForce& c, const Eigen::Matrix<double, 6, 24>& J, Tangent& w) {
+  Eigen::Matrix<double, 24, 1> eps = Eigen::Matrix<double, 24, 1>::Zero();
+  const bool moves_a = c.body_a >= 0 && w.inside[c.body_a], moves_b = c.body_b >= 0 && w.inside[c.body_b];
+  if (!moves_a && !moves_b) return;
+  if (moves_a) eps << w.W[c.body_a], w.v[c.body_a], Vec6::Zero(), Vec6::Zero();
+  if (moves_b) eps.tail<12>() << w.W[c.body_b], w.v[c.body_b];
+  const Vec6 dwrench = J * eps;
+  const auto moved = [&](bool moves, int k) {
+    return moves ? Vec3(w.W[k].tail<3>() + w.W[k].head<3>().cross(c.x)) : Vec3::Zero();
+  };
+  if (c.body_b >= 0) {
+    w.f[c.body_b] -= dwrench;
+    w.f[c.body_b].head<3>() += moved(moves_b, c.body_b).cross(c.f);
+  }
+  if (c.body_a >= 0) {
+    w.f[c.body_a] += dwrench;
+    w.f[c.body_a].head<3>() -= moved(moves_a, c.body_a).cross(c.f);
+  }
+}
+
 // The change of the loads of the flowing material on one rfe (flow_loads) along the tangent (the
 // motion of their points under fixed forces is the geometric term of BodyLoad): its axis turns with the
 // rfe's twist, δe = W_ω × e, and its angular velocity changes by δω;
@@ -76,21 +99,6 @@ void flow_tangent(const FlowTerm& f, Tangent& w) {
   w.f[f.body].head<3>() -= f.xc.cross(dF_c) + f.origin.cross(dF_turn);
   w.f[f.body].tail<3>() -= dF_c + dF_turn;
 }
-
-// The loads, element states and flowing rfes' terms at the state of d (after the RNEA): what the tangents of
-// the loads' and elements' forces start from.
-struct LoadTerms {
-  std::vector<BodyLoad> loads;
-  std::vector<ElementState> elements;
-  std::vector<FlowTerm> flows;
-  LoadTerms(const System& sys, const Data& d) {
-    for_each_body_load(sys, d, true, [&](int body, const AppliedLoad& a, bool follower) {
-      loads.push_back({body, follower, a});
-    });
-    for (const ForceElement& E : sys.elements) elements.push_back(element_state(d, E, true));
-    for_each_flow_term(sys, d, true, [&](const FlowTerm& f) { flows.push_back(f); });
-  }
-};
 
 // The loads' change along the tangent: a follower load turns with its body's twist W, δf = W ×* f; a fixed
 // one keeps its force while its point moves by δx = W_v + W_ω × x: the moment δx × F.
@@ -110,6 +118,35 @@ void loads_tangent(const std::vector<BodyLoad>& loads, Tangent& w) {
   }
 }
 
+// The loads, element states and flowing rfes' terms at the state of d (after the RNEA): what the tangents of
+// the loads' and elements' forces start from.
+struct LoadTerms {
+  std::vector<BodyLoad> loads;
+  std::vector<ElementState> elements;
+  std::vector<FlowTerm> flows;
+  std::vector<ContactForce> contacts;
+  std::vector<Eigen::Matrix<double, 6, 24>> contact_J;
+  LoadTerms(const System& sys, const Data& d) {
+    for_each_body_load(sys, d, true, [&](int body, const AppliedLoad& a, bool follower) {
+      loads.push_back({body, follower, a});
+    });
+    for (const ForceElement& E : sys.elements) elements.push_back(element_state(d, E, true));
+    for_each_flow_term(sys, d, true, [&](const FlowTerm& f) { flows.push_back(f); });
+    if (!sys.contacts.empty())
+      for_each_contact_force(sys, d, true, [&](const ContactForce& c) {
+        contacts.push_back(c);
+        contact_J.push_back(contact_jacobian(sys, c));
+      });
+  }
+  // The tangents of the loads, the elements' and the contacts' forces and the flowing material's loads.
+  void tangent(const Data& d, const System& sys, Tangent& w) const {
+    loads_tangent(loads, w);
+    for (std::size_t k = 0; k < elements.size(); ++k) element_tangent(d, sys.elements[k], elements[k], w);
+    for (std::size_t k = 0; k < contacts.size(); ++k) contact_tangent(contacts[k], contact_J[k], w);
+    for (const FlowTerm& f : flows) flow_tangent(f, w);
+  }
+};
+
 // Column ∂r/∂q_j (position) or ∂r/∂q̇_j (rate) for the coordinate j with use uj on body bj,
 // into col (nq). Only the bodies carried by q_j (bj and its subtree) have tangents:
 //   position: the later axes turn, δs_u = s_j ×m s_u, and so do inertias and follower loads;
@@ -117,9 +154,8 @@ void loads_tangent(const std::vector<BodyLoad>& loads, Tangent& w) {
 // Then δc = Σ (δv ×m s_u + v ×m δs_u) q̇_u, δv = Σ δs_u q̇_u, δa_p = δa_λ + δc + Σ δs_u q̈_u,
 // δf_p = δI a + I δa + δv ×* I v + v ×* (δI v + I δv) − δf_ext, summed over subtrees, and
 // δr_i = δs_iᵀ f̄_b + s_iᵀ δf̄_b.
-void tangent_column(const System& sys, const Data& d, const std::vector<BodyLoad>& loads,
-                    const std::vector<ElementState>& elements, const std::vector<FlowTerm>& flows, int uj, int bj,
-                    bool position, Tangent& w, Eigen::Ref<VecX> col) {
+void tangent_column(const System& sys, const Data& d, const LoadTerms& terms, int uj, int bj, bool position, Tangent& w,
+                    Eigen::Ref<VecX> col) {
   const Vec6& s = d.axes[uj];
   auto turned = [&](int p, int u) { return position && w.inside[p] && (p != bj || u > uj); };
   for (int p = 0; p < sys.nbodies; ++p) {
@@ -154,9 +190,7 @@ void tangent_column(const System& sys, const Data& d, const std::vector<BodyLoad
     w.f[p] = I * da + crossf(dv, I * d.v[p]) + crossf(d.v[p], I * dv);
     if (position) w.f[p] += turned_inertia_times(s, I, d.a[p]) + crossf(d.v[p], turned_inertia_times(s, I, d.v[p]));
   }
-  loads_tangent(loads, w);
-  for (std::size_t k = 0; k < elements.size(); ++k) element_tangent(d, sys.elements[k], elements[k], w);
-  for (const FlowTerm& f : flows) flow_tangent(f, w);
+  terms.tangent(d, sys, w);
   accumulate_subtrees(sys, w.f);
   for (int k = 0; k < sys.nq; ++k) {
     const int b = sys.coords[sys.free_coords[k]].body, u = sys.q_use[k];
@@ -196,9 +230,7 @@ VecX rnea_directional_derivative(const System& sys, Data& d, const VecX& dq, con
     w.f[p] = I * da + crossf(dv, I * d.v[p]) + crossf(d.v[p], I * dv) + turned_inertia_times(W, I, d.a[p]) +
              crossf(d.v[p], turned_inertia_times(W, I, d.v[p]));
   }
-  loads_tangent(terms.loads, w);
-  for (std::size_t k = 0; k < terms.elements.size(); ++k) element_tangent(d, sys.elements[k], terms.elements[k], w);
-  for (const FlowTerm& f : terms.flows) flow_tangent(f, w);
+  terms.tangent(d, sys, w);
   accumulate_subtrees(sys, w.f);
   VecX out(sys.nq);
   for (int k = 0; k < sys.nq; ++k) {
@@ -275,6 +307,17 @@ ResidualVjp rnea_vector_jacobian_product(const System& sys, Data& d, const VecX&
     point_adjoint(E.body_b, st.xb, dd_bar, ddd_bar);
     point_adjoint(E.body_a, st.xa, -dd_bar, -ddd_bar);
   }
+  for (std::size_t k = 0; k < terms.contacts.size(); ++k) {
+    // contact_tangent transposed: ε̄ = Jᵀ (h_a − h_b), and the moved points' moments, x_c × f on b and a
+    const ContactForce& c = terms.contacts[k];
+    const Vec6 ha = c.body_a >= 0 ? H[c.body_a] : Vec6::Zero(), hb = c.body_b >= 0 ? H[c.body_b] : Vec6::Zero();
+    Eigen::Matrix<double, 24, 1> eps_bar = terms.contact_J[k].transpose() * (ha - hb);
+    const Vec3 gb = c.f.cross(hb.head<3>()), ga = c.f.cross(ha.head<3>());
+    eps_bar.segment<3>(15) += gb, eps_bar.segment<3>(12) += c.x.cross(gb);
+    eps_bar.segment<3>(3) -= ga, eps_bar.segment<3>(0) -= c.x.cross(ga);
+    if (c.body_a >= 0) Wb[c.body_a] += eps_bar.segment<6>(0), vb[c.body_a] += eps_bar.segment<6>(6);
+    if (c.body_b >= 0) Wb[c.body_b] += eps_bar.segment<6>(12), vb[c.body_b] += eps_bar.segment<6>(18);
+  }
   for (const FlowTerm& f : terms.flows) {
     // flow_tangent transposed: with F̄ = x × h_ω − h_v the adjoints of δF_C (x = x_C) and δF_turn (x = origin),
     //   ē = −m (2α F̄_C × ω + β F̄_C) − ρA α² F̄_turn,  ē_prev = ρA α² F̄_turn,  δω̄ = −2mα e × F̄_C,
@@ -338,14 +381,13 @@ std::pair<MatX, MatX> rnea_derivatives(const System& sys, Data& d) {
   // The loads (their geometric term) and the states of the elements and flowing rfes whose forces
   // change with the state.
   const LoadTerms terms(sys, d);
-  const auto& [loads, elements, flows] = terms;
   MatX dq(sys.nq, sys.nq), dqd(sys.nq, sys.nq);
   Tangent w(sys);
   for (int j = 0; j < sys.nq; ++j) {
     const int i = sys.free_coords[j], b = sys.coords[i].body, u = sys.q_use[j];
     interruption_point();
-    tangent_column(sys, d, loads, elements, flows, u, b, true, w, dq.col(j));
-    tangent_column(sys, d, loads, elements, flows, u, b, false, w, dqd.col(j));
+    tangent_column(sys, d, terms, u, b, true, w, dq.col(j));
+    tangent_column(sys, d, terms, u, b, false, w, dqd.col(j));
     // −∂Q_j/∂(q_j, q̇_j) of the coordinate's own spring-damping law and its further laws.
     const Coordinate& c = sys.coords[i];
     const auto [k_own, c_own] = c.spring.derivatives(d.spring_scale(i));

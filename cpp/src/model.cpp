@@ -342,6 +342,56 @@ int Model::add_force_element(const ForceElement& element) {
   return static_cast<int>(elements_.size()) - 1;
 }
 
+int Model::add_shape(const Shape& shape) {
+  if (shape.body != -1) check_body(shape.body, "body");  // −1: the ground
+  require_finite(shape.a, "a");
+  require_finite(shape.b, "b");
+  switch (shape.kind) {
+    case ShapeKind::Sphere:
+    case ShapeKind::Capsule:
+      if (!(shape.radius > 0.0) || !std::isfinite(shape.radius)) bad("radius", "a positive radius in m", num8(shape.radius));
+      break;
+    case ShapeKind::Box:
+      if (!((shape.h.array() > 0.0).all() && shape.h.allFinite()))
+        bad("half_extents", "three positive half-extents in m", num8(shape.h.minCoeff()));
+      if (!(shape.R.allFinite() && (shape.R.transpose() * shape.R - Mat3::Identity()).norm() < 1e-9 && shape.R.determinant() > 0.0))
+        bad("rotation", "a rotation matrix (orthonormal, determinant 1)", "another matrix");
+      break;
+    case ShapeKind::HalfSpace:
+      if (!(std::abs(shape.n.norm() - 1.0) < 1e-12)) bad("normal", "a unit normal", num8(shape.n.norm()));
+      break;
+  }
+  if (shape.name.empty()) bad("name", "a non-empty name of the shape", "''");
+  for (const Shape& other : shapes_)
+    if (other.name == shape.name) bad("name", "a name not used by another shape", "'" + shape.name + "'");
+  shapes_.push_back(shape);
+  return static_cast<int>(shapes_.size()) - 1;
+}
+
+int Model::add_contact(const Contact& contact) {
+  const int n = static_cast<int>(shapes_.size());
+  bool any = false;
+  for (const auto& [group, argument] : {std::pair{&contact.shapes_a, "a"}, std::pair{&contact.shapes_b, "b"}}) {
+    if (group->empty()) bad(argument, "one shape or more", "none");
+    for (const int k : *group)
+      if (k < 0 || k >= n) bad(argument, "shapes of this model (index 0.." + std::to_string(n - 1) + ")", std::to_string(k));
+  }
+  for (const int ia : contact.shapes_a)
+    for (const int ib : contact.shapes_b) {
+      const Shape &A = shapes_[ia], &B = shapes_[ib];
+      const bool plane_a = A.kind == ShapeKind::HalfSpace, plane_b = B.kind == ShapeKind::HalfSpace;
+      if (plane_a && plane_b) bad("b", "shapes that can touch those of a (two half-spaces never do)", "'" + B.name + "'");
+      if ((A.kind == ShapeKind::Box && !plane_b) || (B.kind == ShapeKind::Box && !plane_a))
+        bad("b", "a half-space against a box (a box touches half-spaces only)", "'" + A.name + "' and '" + B.name + "'");
+      any = any || A.body != B.body;
+    }
+  if (!any) bad("b", "shapes on other bodies than a's (shapes on one body never touch)", "the same body");
+  if (!contact.law) bad("law", "a contact law", "none");
+  contact.law->validate();
+  contacts_.push_back(with_unique_name(contact, contacts_, "contact"));
+  return static_cast<int>(contacts_.size()) - 1;
+}
+
 void Model::add_flow(Flow flow) {
   if (!flow.length) bad("length", "a rigidfem.motion profile L(t) in m", "None");
   const double L0 = flow.length->at(0.0).q;

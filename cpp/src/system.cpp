@@ -18,6 +18,8 @@ std::shared_ptr<const System> Model::compile(Algorithm algorithm) const {
   s.loops = loops_;
   s.flows = flows_;
   s.elements = elements_;
+  s.shapes = shapes_;
+  s.contacts = contacts_;
   s.loop_row.push_back(0);
   for (const Loop& L : loops_) s.loop_row.push_back(s.loop_row.back() + loop_rows(L.kind));
   s.nl = s.loop_row.back();

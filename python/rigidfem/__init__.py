@@ -32,7 +32,7 @@ from ._core import (
     skew,
 )
 from .base import display, export  # notebook displays; tables, CSV and NumPy archives
-from .model import laws, loops, motion, parameters, samples, sea, stages
+from .model import laws, loops, motion, parameters, samples, sea, shapes, stages
 from .model.beams import Beam, rfe_parameters, sde_parameters
 from .model.frames import transform
 from .model.joints import Joint
@@ -54,7 +54,7 @@ from .studies.sweep import sweep
 
 # The public modules keep their short paths: `import rigidfem.motion`, `from rigidfem.laws import Rope`, and the
 # documentation's pages (rigidfem.animation, lazy, is reached as rf.animation).
-for _module in (display, export, laws, loops, motion, parameters, samples, sea, stages, options, sensitivities, plots,
+for _module in (display, export, laws, loops, motion, parameters, samples, sea, shapes, stages, options, sensitivities, plots,
                 study):
     sys.modules.setdefault(f"{__name__}.{_module.__name__.rsplit('.', 1)[1]}", _module)
 del _module
@@ -123,6 +123,7 @@ __all__ = [
     "sde_parameters",
     "samples",
     "sea",
+    "shapes",
     "sensitivities",
     "simulate",
     "skew",

@@ -10,6 +10,7 @@
 #include <utility>
 #include <vector>
 
+#include "rigidfem/contact_forces.hpp"
 #include "rigidfem/system.hpp"
 
 namespace rigidfem {
@@ -83,7 +84,8 @@ std::pair<AppliedLoad, AppliedLoad> flow_loads(const FlowTerm& f);
 
 /// visit(body, load, follower) for every load on a body at the current state, the one list both
 /// formulations and the tangents read: the model's loads, the force elements' two point forces
-/// (none on the ground) and the loads of the flowing material. Velocities as in element_state.
+/// (none on the ground), the contacts' forces f on body b and −f on body a at their contact points
+/// (contact_forces.hpp) and the loads of the flowing material. Velocities as in element_state.
 template <class Visit>
 void for_each_body_load(const System& sys, const Data& d, bool spatial, Visit&& visit) {
   for (const Load& L : sys.loads) visit(L.body, applied_load(d, L), L.follower);
@@ -92,6 +94,11 @@ void for_each_body_load(const System& sys, const Data& d, bool spatial, Visit&& 
     if (E.body_b >= 0) visit(E.body_b, on_b, false);
     if (E.body_a >= 0) visit(E.body_a, on_a, false);
   }
+  if (!sys.contacts.empty())
+    for_each_contact_force(sys, d, spatial, [&visit](const ContactForce& c) {
+      if (c.body_b >= 0) visit(c.body_b, AppliedLoad{c.x, c.f, Vec3::Zero()}, false);
+      if (c.body_a >= 0) visit(c.body_a, AppliedLoad{c.x, -c.f, Vec3::Zero()}, false);
+    });
   for_each_flow_term(sys, d, spatial, [&](const FlowTerm& f) {
     const auto [coriolis, turn] = flow_loads(f);
     visit(f.body, coriolis, false);

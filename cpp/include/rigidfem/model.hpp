@@ -9,6 +9,7 @@
 #include <unordered_map>
 #include <vector>
 
+#include "rigidfem/contact.hpp"
 #include "rigidfem/coordinate_laws.hpp"
 #include "rigidfem/errors.hpp"
 #include "rigidfem/flows.hpp"
@@ -153,16 +154,22 @@ class Model {
   /// Adds a Maxwell arm (stiffness k > 0, relaxation time τ > 0) on one joint coordinate.
   void add_maxwell_arm(int body, int coordinate, const MaxwellArm& arm);
   void add_load(const Load& load);
-  /// Closes a loop (loops.hpp); returns its index. Checks the bodies, frames, length and name
-  /// (an empty name becomes "loop<index>").
+  /// Closes a loop (loops.hpp); returns its index. Checks the bodies, frames, length and name (non-empty, new
+  /// among the loops').
   int add_loop(const Loop& loop);
   /// Makes the beam of rfes flow.first .. flow.first + flow.elements a link of varying free length
   /// L(t) (flows.hpp): checks the chain and the length, sets L₀ = L(0) and prescribes the first
   /// ("x") coordinate of every sde joint with its growth κ_k (L(t) − L₀).
   void add_flow(Flow flow);
   /// Adds a force element between two bodies (force_elements.hpp); returns its index. Checks the
-  /// bodies, points and parameters (an empty name becomes "element<index>").
+  /// bodies, points, parameters and name (non-empty, new among the elements').
   int add_force_element(const ForceElement& element);
+  /// Adds a shape fixed on a body (contact.hpp); returns its index. Checks the body, the geometry and the name.
+  int add_shape(const Shape& shape);
+  /// Adds a contact between two groups of shapes (contact.hpp); returns its index. Checks the shapes, their pairs
+  /// (a box touches half-spaces only, two half-spaces never touch, at least one pair on two bodies), the law and
+  /// the name.
+  int add_contact(const Contact& contact);
   void set_gravity(const Vec3& g);
 
   const Vec3& gravity() const { return gravity_; }
@@ -170,6 +177,8 @@ class Model {
   const std::vector<Loop>& loops() const { return loops_; }
   const std::vector<Flow>& flows() const { return flows_; }
   const std::vector<ForceElement>& force_elements() const { return elements_; }
+  const std::vector<Shape>& shapes() const { return shapes_; }
+  const std::vector<Contact>& contacts() const { return contacts_; }
   const std::vector<Load>& loads() const { return loads_; }
   /// Unique among the Models of this process (never 0): the `model` of the handles it makes.
   std::uint64_t id() const { return id_; }
@@ -198,6 +207,8 @@ class Model {
   std::vector<Loop> loops_;
   std::vector<Flow> flows_;
   std::vector<ForceElement> elements_;
+  std::vector<Shape> shapes_;
+  std::vector<Contact> contacts_;
 };
 
 }  // namespace rigidfem

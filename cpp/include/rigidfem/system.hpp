@@ -82,6 +82,8 @@ class System : public std::enable_shared_from_this<System> {
   int nl = 0;                           ///< constraint rows (multipliers λ)
   std::vector<Flow> flows;              // links of varying length (flows.hpp)
   std::vector<ForceElement> elements;   // force elements between two bodies (force_elements.hpp)
+  std::vector<Shape> shapes;            // shapes fixed on bodies, and the contacts between them (contact.hpp)
+  std::vector<Contact> contacts;
   std::vector<Arm> arms;                // (nz) Maxwell arms, in coordinate order (arms.hpp)
   int nz = 0;                           ///< internal variables: the arms' forces s
 

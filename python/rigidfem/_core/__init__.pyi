@@ -179,7 +179,7 @@ class _Model:
     @staticmethod
     def _law_kinds() -> list:
         """
-        Every kind of law, each a dict: kind, acts_on ('element' or 'coordinate'), doc, constants (name, unit,
+        Every kind of law, each a dict: kind, acts_on ('element', 'coordinate' or 'contact'), doc, constants (name, unit,
         rotation_unit, default, lower, positive, doc, parameter), profile, profile_name, profile_units, function,
         addable (False: every coordinate's own spring-damping law).
         """
@@ -202,6 +202,10 @@ class _Model:
         """
     def _add_body(self, name: str, parent: typing.SupportsInt | typing.SupportsIndex, joint: JointSpec, placement: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[4, 4]"], mass: typing.SupportsFloat | typing.SupportsIndex, com: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], inertia: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 3]"]) -> Body:
         ...
+    def _add_contact(self, name: str, a: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], b: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], kind: str, values: dict) -> int:
+        """
+        Adds a contact of the law `kind` between the shapes `a` and `b` (indices); returns its index.
+        """
     def _add_coordinate_law(self, body: typing.SupportsInt | typing.SupportsIndex, coordinate: typing.SupportsInt | typing.SupportsIndex, kind: str, values: dict, function: typing.Any) -> int:
         """
         Adds a law of `kind` on a joint coordinate (-1: the joint's only one); returns its index among the
@@ -223,6 +227,10 @@ class _Model:
     def _add_maxwell_arms(self, bodies: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], coordinates: collections.abc.Sequence[typing.SupportsInt | typing.SupportsIndex], stiffness: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex], tau: collections.abc.Sequence[typing.SupportsFloat | typing.SupportsIndex]) -> None:
         """
         Adds Maxwell arms (k in N/m or N·m/rad, tau in s) on joint coordinates (-1: the joint's only one).
+        """
+    def _add_shape(self, name: str, body: typing.SupportsInt | typing.SupportsIndex, kind: str, a: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], b: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], normal: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], half_extents: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 1]"], rotation: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[3, 3]"], radius: typing.SupportsFloat | typing.SupportsIndex) -> int:
+        """
+        Adds a shape fixed on `body` (-1: the ground; rigidfem/contact.hpp); returns its index.
         """
     def _adopt_id(self, id: typing.SupportsInt | typing.SupportsIndex) -> None:
         """
@@ -260,6 +268,11 @@ class _Model:
     @property
     def _nloops(self) -> int:
         ...
+    @property
+    def _shape_table(self) -> list:
+        """
+        The shapes, each a dict: name, body, kind, a, b, normal, half_extents, rotation, radius.
+        """
     @property
     def body_names(self) -> list[str]:
         ...
@@ -383,6 +396,12 @@ class _System:
         (dqdd/dq, dqdd/dqd), each (nq, nq): -A^-1 (dr/dq, dr/dqd) at the forward-dynamics qdd; with loop
         closures, of the constrained qdd (multipliers and constraint Jacobian varying too), by central differences.
         """
+    def contact_states(self, t: float, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> list:
+        """
+        Every overlap of two shapes of a contact at (t, q, qd), each a dict: contact (its name), a and b (the
+        bodies' indices, -1 the ground), point (the contact point, m), normal (from a to b), gap (m, < 0: the
+        penetration), gap_rate (m/s), normal_force (N), force (on b, N; -force on a), slip (m/s).
+        """
     def dissipated_power(self, t: float, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> float:
         """
         Power dissipated by the joint dampers, sum b qd^2, and by the force elements' dampers,
@@ -488,6 +507,11 @@ class _System:
         (how it is drawn, body a, point on a (m), body b, point on b) of every force element and loop.
         """
     @property
+    def _shapes(self) -> list:
+        """
+        (kind, body, a, b, normal, half_extents, rotation, radius) of every shape (contact.hpp).
+        """
+    @property
     def algorithm(self) -> str:
         """
         'recursive' (O(n): RNEA, CRBA, ABA) or 'lagrange' (the book's formulation; always for linear joints).
@@ -504,6 +528,11 @@ class _System:
     def centres_of_mass(self) -> list[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"]]:
         """
         Centre of mass of every body in its own frame (m).
+        """
+    @property
+    def contact_names(self) -> list[str]:
+        """
+        Names of the contacts (Model.add_contact).
         """
     @property
     def coordinate_names(self) -> list[str]:

@@ -54,3 +54,22 @@ class Coordinate(Handle):
     """A joint coordinate that a builder gave something ("<body>.<axis>"): a drive (``Model.prescribe``, kind "drive"),
     a constant or a Python generalised force (``add_generalized_force``: "force"), a Maxwell arm
     (``add_maxwell_arm``: "arm"); its index is its slot in the body's joint."""
+
+
+class Shape(Handle):
+    """A shape on a body (``Model.add_shape``), or a beam's capsules: its kind ("sphere", "capsule", "box",
+    "half_space", "capsules"); ``shapes`` the indices of its shapes among the model's (one, or one per rfe), ``index``
+    the first."""
+
+    def __new__(cls, name: str, kind: str, shapes):
+        handle = super().__new__(cls, name, kind, int(shapes[0]))
+        handle.shapes = tuple(int(k) for k in shapes)
+        return handle
+
+    def __getnewargs__(self):
+        return str(self), self.kind, self.shapes
+
+
+class Contact(Handle):
+    """A contact between shapes (``Model.add_contact``): its kind is its law's (``rigidfem.laws.Contact``), its index
+    its place among the model's contacts."""

@@ -1,11 +1,12 @@
-"""Laws of force elements and of joint coordinates, each kind described once, by the C++ core.
+"""Laws of force elements, of joint coordinates and of contacts, each kind described once, by the C++ core.
 
 A law is a value: ``rf.laws.Rope(EA=2e8, length=12.0, DA=1e6)``, ``rf.laws.Friction(breakaway=3.0, coulomb=2.0)``.
 Its kind's description — the constants with their units, defaults, bounds and what they are, what a profile or
 a Python function means to it — comes from the C++ law (``cpp/include/rigidfem/laws.hpp``:
-``force_elements.hpp``, ``coordinate_laws.hpp``), and so do the checks of the values (a ValueError naming the
+``force_elements.hpp``, ``coordinate_laws.hpp``, ``contact.hpp``), and so do the checks of the values (a ValueError naming the
 constant, its unit and its bounds). ``Model.add_force_element(name, a, b, law)`` puts a force element's law between
-two points, ``Model.add_joint_law(name, body, law, coordinate)`` a joint coordinate's law on it; each law's constants
+two points, ``Model.add_joint_law(name, body, law, coordinate)`` a joint coordinate's law on it, ``Model.add_contact(name,
+a, b, law)`` a contact's between shapes; each law's constants
 marked as parameters become named parameters ``"<name>.<constant>"`` of the compiled system.
 
 >>> import rigidfem as rf
@@ -13,7 +14,7 @@ marked as parameters become named parameters ``"<name>.<constant>"`` of the comp
 >>> [(c.name, c.unit, c.value) for c in rope.constants]
 [('EA', 'N', 200000000.0), ('DA', 'N s', 0.0), ('length', 'm', 12.0)]
 >>> sorted(rf.laws.kinds())
-['Buffer', 'ForceFunction', 'Friction', 'Rope', 'SpringDamper', 'SpringDamping']
+['Buffer', 'Contact', 'ForceFunction', 'Friction', 'Rope', 'SpringDamper', 'SpringDamping']
 """
 
 from __future__ import annotations
@@ -117,8 +118,9 @@ def _law_class(info: dict) -> type:
         lines += ["", f"``profile``: {info['profile']}."]
     if info["function"]:
         lines += ["", f"``function``: {info['function']} (the slow path: called under the GIL)."]
-    where = ("``Model.add_force_element(name, a, b, law)``" if info["acts_on"] == "element" else
-             "``Model.add_joint_law(name, body, law, coordinate)``")
+    where = {"element": "``Model.add_force_element(name, a, b, law)``",
+             "coordinate": "``Model.add_joint_law(name, body, law, coordinate)``",
+             "contact": "``Model.add_contact(name, a, b, law)``"}[info["acts_on"]]
     if info["addable"]:
         lines += ["", f"Added by {where}."]
     else:

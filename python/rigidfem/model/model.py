@@ -12,7 +12,7 @@ import numpy as np
 
 from ..base import _checks, display
 import rigidfem._core as _core  # the compiled core, by its absolute name
-from . import force_elements, handles, joints, laws, loops, parameters
+from . import force_elements, handles, joints, laws, loops, parameters, shapes
 from ..base import persistence
 from .motion import constant as _constant
 from .._core import Body, JointSpec, Point, Profile
@@ -87,6 +87,7 @@ class Model(_core._Model):
         self._gravity0, self._calls, self._building = np.array(g, dtype=float), [], False  # the recipe (pickling)
         self._parameter_groups = {}  # prefix -> parameters.Group: the named parameters the builders declared
         self._beams = []  # the Beam handles add_beam returned (the viewer draws them)
+        self._names = set()  # the names of shapes and contacts (the others': bodies, parameters' groups)
 
     @property
     def gravity(self) -> np.ndarray:
@@ -332,17 +333,17 @@ class Model(_core._Model):
         return handles.Load(name, kind, self._nloads - 1)
 
     def _new_name(self, name) -> str:
-        """``name`` if it is a non-empty str not yet given to a body (an rfe included), coordinate, load, element
-        or law (the names of the bodies and of the parameters' groups); whether a loop's or an element's name is new
-        among its kind is judged by the core."""
+        """``name`` if it is a non-empty str not yet given to a body (an rfe included), coordinate, load, element,
+        law, shape or contact (the names of the bodies, of the parameters' groups, of the shapes and contacts); whether
+        a loop's or an element's name is new among its kind is judged by the core."""
         name = _checks.name(name)
         try:
-            taken = name in self._parameter_groups or self._body_index(name) >= -1  # -1: "ground"
+            taken = name in self._parameter_groups or name in self._names or self._body_index(name) >= -1  # -1: ground
         except ValueError:  # not a body's name
             taken = False
         if taken:
-            raise _checks.refuse(f"name: expected a name not yet given to a body, coordinate, load, element or law, "
-                                 f"got {name!r}")
+            raise _checks.refuse(f"name: expected a name not yet given to a body, coordinate, load, element, law, shape "
+                                 f"or contact, got {name!r}")
         return name
 
     def _point(self, point) -> Point:
@@ -440,6 +441,32 @@ class Model(_core._Model):
         force_elements.points(self, a, b)  # named before the law's constants
         law = laws.Rope(EA=EA, DA=DA, **force_elements.unstretched(length))
         return force_elements.add_force_element(self, name, a, b, law)
+
+    @recorded
+    def add_shape(self, name: str, body, shape) -> handles.Shape:
+        """Fix a shape (``rigidfem.shapes``: ``Sphere``, ``Capsule``, ``Box``, ``HalfSpace``) on ``body`` (a Body or
+        ``model.ground``), or one capsule on each rigid finite element of a beam (``body`` a ``Beam``, ``shape``
+        ``rigidfem.shapes.Capsules()``: the shapes ``"<name>[k]"``). Lengths in m, in the body's frame. Shapes touch
+        only through ``add_contact``. Returns the shape's handle (``.shapes``: the indices of its shapes)."""
+        handle = shapes.add_shape(self, self._new_name(name), body, shape)
+        self._names.add(handle.name)
+        return handle
+
+    @recorded
+    def add_contact(self, name: str, a, b, law) -> handles.Contact:
+        """Make the shapes ``a`` and ``b`` (handles from ``add_shape``, or lists of them) push each other apart where
+        they overlap, by the compliant ``law`` (``rigidfem.laws.Contact``: a normal force of the penetration with
+        Hunt–Crossley dissipation set by a coefficient of restitution, and regularised Coulomb friction with a
+        Stribeck fall). Every shape of ``a`` meets every shape of ``b`` (none on one body): spheres and capsules each
+        other and half-spaces, boxes half-spaces only. A half-space against n shapes costs O(n) an evaluation; a
+        model without contacts pays nothing. Returns the contact's handle."""
+        name = self._new_name(name)
+        if not isinstance(law, laws.Law) or law.info["acts_on"] != "contact":
+            raise _checks.refuse(f"law: expected a contact law (Contact from rigidfem.laws), got {law!r}")
+        index = self._add_contact(name, shapes.shape_indices(self, a, "a"), shapes.shape_indices(self, b, "b"),
+                                  law.kind, law.values)
+        self._names.add(name)
+        return handles.Contact(name, law.kind, index)
 
     @recorded
     def add_joint_law(self, name: str, body: Body, law, coordinate: str | None = None) -> handles.JointLaw:

@@ -244,9 +244,15 @@ def _scene(system, times, states, trails, title) -> dict:
     # the force elements as their laws say, the loops as their kinds do (System._segments)
     segments = [{"kind": kind, "a": [int(ia), [float(x) for x in ra]], "b": [int(ib), [float(x) for x in rb]]}
                 for kind, ia, ra, ib, rb in system._segments]
+    # the shapes of the contacts, each in its body's frame (System._shapes)
+    shapes = [{"kind": kind, "body": int(body), "a": np.asarray(a, float).tolist(), "b": np.asarray(b, float).tolist(),
+               "normal": np.asarray(n, float).tolist(), "half_extents": np.asarray(h, float).tolist(),
+               "rotation": np.asarray(R, float).ravel().tolist(), "radius": float(r)}
+              for kind, body, a, b, n, h, R, r in system._shapes]
     bodies, masses, inertias, centres = [], system.masses, system.inertias, system.centres_of_mass
     for i, n in enumerate(names):
-        box = None if i in in_beam else _equivalent_box(float(masses[i]), np.asarray(inertias[i]))
+        shaped = any(sh["body"] == i for sh in shapes)  # a body with shapes is shown by them
+        box = None if i in in_beam or shaped else _equivalent_box(float(masses[i]), np.asarray(inertias[i]))
         if i in base or (box is not None and max(box) > 2 * size):
             box = [0.08 * size] * 3
         bodies.append({"name": n, "box": box, "com": [float(x) for x in centres[i]],
@@ -254,7 +260,7 @@ def _scene(system, times, states, trails, title) -> dict:
     g = np.asarray(system.gravity, dtype=float)
     up = (-g / np.linalg.norm(g)).tolist() if np.linalg.norm(g) > 0 else [0.0, 0.0, 1.0]
     return {"title": title, "t": [float(x) for x in times], "size": size,
-            "centre": ((lo + hi) / 2).tolist(), "up": up, "bodies": bodies, "beams": beams, "segments": segments,
+            "centre": ((lo + hi) / 2).tolist(), "up": up, "bodies": bodies, "beams": beams, "segments": segments, "shapes": shapes,
             "trails": [dict(zip(("body", "r"), _point(p))) for p in trails],
             "poses": base64.b64encode(poses.astype("<f4").tobytes()).decode("ascii")}
 

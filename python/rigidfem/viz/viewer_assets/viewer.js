@@ -68,6 +68,42 @@
     return g;
   });
 
+  // shapes of the contacts, fixed in their bodies' frames (the ground's in the scene): translucent, a half-space as a
+  // square of the scene's size on its plane
+  const shapeMaterial = new THREE.MeshLambertMaterial({ color: 0x4f9e5a, transparent: true, opacity: 0.8 });
+  const planeMaterial = new THREE.MeshLambertMaterial({ color: 0xb8b8b0, transparent: true, opacity: 0.5,
+                                                        side: THREE.DoubleSide });
+  const yAxis = new THREE.Vector3(0, 1, 0), zAxis = new THREE.Vector3(0, 0, 1);
+  (D.shapes || []).forEach((s) => {
+    const shape = new THREE.Group();
+    if (s.kind === "sphere") {
+      shape.add(new THREE.Mesh(new THREE.SphereGeometry(s.radius, 20, 14), shapeMaterial));
+      shape.position.set(...s.a);
+    } else if (s.kind === "capsule") {  // a cylinder (along y) between two spheres
+      const a = new THREE.Vector3(...s.a), b = new THREE.Vector3(...s.b), len = a.distanceTo(b);
+      shape.add(new THREE.Mesh(new THREE.CylinderGeometry(s.radius, s.radius, len, 16, 1, true), shapeMaterial));
+      [-0.5, 0.5].forEach((y) => {
+        const end = new THREE.Mesh(new THREE.SphereGeometry(s.radius, 16, 12), shapeMaterial);
+        end.position.set(0, y * len, 0);
+        shape.add(end);
+      });
+      shape.position.copy(a).add(b).multiplyScalar(0.5);
+      if (len > 0) shape.quaternion.setFromUnitVectors(yAxis, b.clone().sub(a).normalize());
+    } else if (s.kind === "box") {
+      const h = s.half_extents, R = s.rotation;
+      shape.add(new THREE.Mesh(new THREE.BoxGeometry(2 * h[0], 2 * h[1], 2 * h[2]), shapeMaterial));
+      shape.position.set(...s.a);
+      shape.quaternion.setFromRotationMatrix(new THREE.Matrix4().set(R[0], R[1], R[2], 0, R[3], R[4], R[5], 0,
+                                                                     R[6], R[7], R[8], 0, 0, 0, 0, 1));
+    } else if (s.kind === "half_space") {
+      const plane = new THREE.Mesh(new THREE.PlaneGeometry(2 * L, 2 * L), planeMaterial);
+      shape.add(plane);
+      shape.position.set(...s.a);
+      shape.quaternion.setFromUnitVectors(zAxis, new THREE.Vector3(...s.normal));
+    }
+    (s.body >= 0 ? bodyObjects[s.body] : scene).add(shape);
+  });
+
   // beams: a tube through the rfes' origins and the tip, rebuilt at each frame
   const beamMaterial = new THREE.MeshLambertMaterial({ color: 0xd08030 });
   const beams = D.beams.map((beam) => {

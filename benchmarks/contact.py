@@ -1,0 +1,62 @@
+"""Contact at scale: ``python -m benchmarks contact [--quick]``.
+
+A steel strip of m rfes lying on the ground, one capsule per rfe against the ground's half-space (m + 1 pairs, all
+touching): the cost of one forward dynamics (timed in C++) and of the force Jacobians (from Python) with and without
+the contact, against m. The contacts' share grows linearly with m: the broad phase of a half-space against n shapes
+is the n narrow tests themselves.
+"""
+
+from __future__ import annotations
+
+import time
+
+import numpy as np
+
+import rigidfem as rf
+from rigidfem.studies.study import Table
+
+from ._common import cpp_seconds_per_call, machine, report
+
+SIZES = (10, 100, 1000)
+QUICK_SIZES = (10, 100)
+
+
+def strip_on_ground(m: int, contact: bool):
+    """A 1 m strip (20 × 5 mm, 5 mm up) of m sdes on a free-floating root, its capsules resting on the ground."""
+    model = rf.Model()
+    strip = model.add_beam("strip", model.ground, 1.0, rf.Material(E=2.1e11, rho=7850.0), rf.Section.rectangle(0.02, 0.005),
+                           m, joint=rf.Joint.free(), placement=rf.transform((0.0, 0.0, 0.004)))
+    if contact:
+        model.add_contact("on ground", model.add_shape("capsules", strip, rf.shapes.Capsules()),
+                          model.add_shape("floor", model.ground, rf.shapes.HalfSpace()),
+                          rf.laws.Contact(stiffness=1e7, exponent=1.0, restitution=0.5, impact_speed=0.1, mu_s=0.3,
+                                          mu_k=0.3))
+    return model.compile()
+
+
+def contact_cost(sizes=SIZES) -> Table:
+    rows = []
+    for m in sizes:
+        row = {"m": m}
+        for contact in (False, True):
+            s = strip_on_ground(m, contact)
+            q, qd = np.zeros(s.nq), np.full(s.nq, 1e-3)
+            key = "with" if contact else "without"
+            row[f"fd_us_{key}"] = cpp_seconds_per_call(s, q, qd) * 1e6
+            t0, n = time.perf_counter(), 3
+            for _ in range(n):
+                s.force_jacobians(0.0, q, qd)
+            row[f"jac_ms_{key}"] = (time.perf_counter() - t0) / n * 1e3
+            if contact:
+                row["overlaps"] = len(s.contact_states(0.0, q, qd))
+        row["fd_us_per_pair"] = (row["fd_us_with"] - row["fd_us_without"]) / (m + 1)
+        rows.append(row)
+    return Table(rows, ("m", "overlaps", "fd_us_without", "fd_us_with", "fd_us_per_pair", "jac_ms_without",
+                        "jac_ms_with"))
+
+
+def run(output_dir="bench", quick: bool = False) -> dict:
+    print(machine())
+    return report({"contact_cost": ("One forward dynamics (µs, in C++) and the force Jacobians (ms, from Python) of a "
+                                    "strip of m rfes on the ground, without and with a capsule per rfe against it",
+                                    contact_cost(QUICK_SIZES if quick else SIZES))}, output_dir)

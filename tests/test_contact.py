@@ -1,0 +1,238 @@
+"""Compliant contact between shapes on bodies (rigidfem.shapes, Model.add_contact, rigidfem.laws.Contact): the
+restitution against the Hunt–Crossley law's own invariant, Hertz's static penetration, a block sliding to rest by
+Coulomb friction, energy, the analytic Jacobians against central differences and the reverse mode against them,
+both engines, and bad input."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.optimize import brentq
+
+import rigidfem as rf
+from conftest import central_jacobians
+from test_derivatives import check_both_modes
+
+
+def drop(law, gravity=0.0, radius=0.1, mass=2.0):
+    """A ball on a vertical slide (prismatic z) above the ground z = 0: q is its centre's height above z = radius."""
+    model = rf.Model(gravity=(0.0, 0.0, -gravity))
+    ball = model.add_body("ball", model.ground, rf.Joint.prismatic("z"), mass, (0.01, 0.01, 0.01),
+                          placement=rf.transform((0.0, 0.0, radius)))
+    model.add_contact("bounce", model.add_shape("s", ball, rf.shapes.Sphere(radius)),
+                      model.add_shape("floor", model.ground, rf.shapes.HalfSpace()), law)
+    return model.compile()
+
+
+def rebound(e: float, v_e: float, v_in: float) -> float:
+    """The speed a free Hunt–Crossley impact F = k δᵖ (1 + α δ̇) leaves at, from its invariant v − ln(1 + α v)/α,
+    with α from e at v_e: solved here by brentq, independently of the core's bisection."""
+    u_e = brentq(lambda u: math.log1p(u) - math.log1p(-e * u) - u * (1 + e), 1e-9, (1 - 1e-15) / e)
+    alpha = u_e / v_e
+    g = lambda v: v - math.log1p(alpha * v) / alpha  # noqa: E731
+    return brentq(lambda w: g(-w) - g(v_in), 1e-12, (1 - 1e-15) / alpha)
+
+
+@pytest.mark.parametrize("exponent", [1.0, 1.5])
+@pytest.mark.parametrize("v_in", [2.0, 0.5, 5.0])
+def test_an_impact_leaves_with_the_restitution_of_hunt_crossleys_law(exponent, v_in):
+    """At the impact speed v_e the ball leaves at e v_e, whatever k and p; slower or faster, as the law's invariant
+    says (independent of the exponent and the stiffness)."""
+    law = rf.laws.Contact(stiffness=1e6, exponent=exponent, restitution=0.7, impact_speed=2.0)
+    r = rf.simulate(drop(law), 0.05, q0=[1e-3], qd0=[-v_in], method="dopri5", rtol=1e-11, atol=1e-13)
+    assert r.q[-1, 0] > 0.0  # left the ground
+    assert r.qd[-1, 0] == pytest.approx(rebound(0.7, 2.0, v_in), rel=1e-8)
+    if v_in == 2.0:
+        assert r.qd[-1, 0] == pytest.approx(0.7 * 2.0, rel=1e-8)
+
+
+def test_an_elastic_impact_keeps_the_energy_and_a_damped_one_loses_what_it_dissipates():
+    """e = 1: kinetic + contact energy constant through the impact; e < 1: the loss equals ∫ P dt."""
+    for e in (1.0, 0.6):
+        s = drop(rf.laws.Contact(stiffness=2e5, exponent=1.5, restitution=e, impact_speed=1.0), gravity=9.81)
+        r = rf.simulate(s, 0.4, q0=[0.05], qd0=[-1.0], method="dopri5", rtol=1e-11, atol=1e-13,
+                        t_eval=np.linspace(0.0, 0.4, 16001))
+        E, P = r.energy, r.dissipated_power
+        assert E[0] == pytest.approx(0.5 * 2.0 * 1.0 ** 2 + 2.0 * 9.81 * (0.1 + 0.05))
+        lost = np.concatenate([[0.0], np.cumsum(0.5 * (P[1:] + P[:-1]) * np.diff(r.t))])
+        assert np.abs(E + lost - E[0]).max() < 2e-6 * E[0]
+        assert (lost[-1] > 0.1 * E[0]) == (e < 1.0)
+
+
+@pytest.mark.parametrize("exponent", [1.0, 1.5])
+def test_a_resting_ball_sinks_to_hertzs_penetration(exponent):
+    """Statics: k δᵖ = m g."""
+    k, m, g = 3e5, 2.0, 9.81
+    s = drop(rf.laws.Contact(stiffness=k, exponent=exponent), gravity=g, mass=m)
+    eq = rf.static_equilibrium(s, q0=[-1e-3])
+    assert -eq.q[0] == pytest.approx((m * g / k) ** (1.0 / exponent), rel=1e-9)
+
+
+def sliding_block(mu, v0, smoothing=1e-5):
+    """A box on the ground (x slides, z falls), its corners touching; released at rest vertically."""
+    model = rf.Model()
+    block = model.add_body("block", model.ground, rf.Joint.planar("xz") if hasattr(rf.Joint, "planar") else None,
+                           1.0, (0.01, 0.01, 0.01))
+    return model, block
+
+
+def test_a_sliding_box_stops_where_coulomb_friction_says():
+    """A box sliding at v0 on the ground with μ stops after v0²/(2 μ g) (its four lower corners share the weight;
+    the regularised friction creeps at ~v_ε, a distance of order v_ε t)."""
+    mu, v0, g = 0.4, 2.0, 9.81
+    model = rf.Model(gravity=(0.0, 0.0, -g))
+    block = model.add_body("block", model.ground, rf.Joint.cylindrical("x") if False else rf.Joint.free(), 1.0,
+                           (0.01, 0.01, 0.01))
+    box = model.add_shape("box", block, rf.shapes.Box((0.1, 0.1, 0.05)))
+    floor = model.add_shape("floor", model.ground, rf.shapes.HalfSpace())
+    law = rf.laws.Contact(stiffness=1e7, exponent=1.0, restitution=0.2, impact_speed=0.1, mu_s=mu, mu_k=mu,
+                          smoothing=1e-5)
+    model.add_contact("on ground", box, floor, law)
+    s = model.compile()
+    names = s.coordinate_names
+    q0 = np.zeros(s.nq)
+    q0[names.index("block.z")] = 0.05 - 9.81 / 4e7  # at rest on its four corners, each k δ = m g/4
+    qd0 = np.zeros(s.nq)
+    qd0[names.index("block.x")] = v0
+    t_stop = v0 / (mu * g)
+    r = rf.simulate(s, 1.5 * t_stop, q0=q0, qd0=qd0, method="radau5", rtol=1e-8, atol=1e-10)
+    x = r.q[:, names.index("block.x")]
+    assert x[-1] == pytest.approx(v0 ** 2 / (2 * mu * g), rel=1e-3)
+    assert abs(r.qd[-1, names.index("block.x")]) < 1e-3
+
+
+def contact_scene(algorithm="recursive", friction=True):
+    """A 3D chain with every pair the core knows, overlapping at q = 0: a capsule (b), a sphere (c) and a box (d)
+    against the ground and against a deck on body a; the capsule against the sphere."""
+    model = rf.Model(gravity=(0.0, 0.0, -9.81))
+    a = model.add_body("a", model.ground, rf.Joint.spherical(), 2.0, (0.1, 0.2, 0.15), com=(0.4, 0.0, 0.0))
+    b = model.add_body("b", a, rf.Joint.universal(("y", "z")), 1.5, (0.05, 0.08, 0.07), com=(0.3, 0.1, 0.0),
+                       placement=rf.transform(translation=(0.8, 0.0, 0.0)))
+    c = model.add_body("c", a, rf.Joint.prismatic("y"), 0.7, (0.02, 0.03, 0.04), com=(0.0, 0.0, 0.1),
+                       placement=rf.transform(translation=(0.2, 0.0, -0.1)))
+    d = model.add_body("d", b, rf.Joint.revolute("x"), 0.9, (0.03, 0.02, 0.05), com=(0.0, 0.2, 0.0),
+                       placement=rf.transform(translation=(0.6, 0.0, 0.0)))
+    rod = model.add_shape("rod", b, rf.shapes.Capsule(0.15, (0.0, 0.0, 0.0), (0.5, 0.1, 0.0)))
+    ball = model.add_shape("ball", c, rf.shapes.Sphere(0.2, (0.7, 0.05, 0.05)))
+    brick = model.add_shape("brick", d, rf.shapes.Box((0.2, 0.1, 0.15), (0.1, 0.0, 0.0), rf.euler_zyx(0.3, 0.2, 0.1)))
+    floor = model.add_shape("floor", model.ground, rf.shapes.HalfSpace((0.1, 0.0, 1.0) / np.linalg.norm((0.1, 0.0, 1.0)),
+                                                                      (0.0, 0.0, -0.1)))
+    deck = model.add_shape("deck", a, rf.shapes.HalfSpace((0.0, 0.0, 1.0), (0.0, 0.0, -0.2)))
+    mu = dict(mu_s=0.6, mu_k=0.4, stribeck=0.3, smoothing=0.05) if friction else {}
+    law = rf.laws.Contact(stiffness=1e4, exponent=1.5, restitution=0.5, impact_speed=1.0, **mu)
+    model.add_contact("on ground", [rod, ball, brick], floor, law)
+    model.add_contact("on deck", deck, [rod, brick], law)
+    model.add_contact("rod and ball", rod, ball, rf.laws.Contact(stiffness=5e3, exponent=1.0, **mu))
+    return model.compile(algorithm)
+
+
+def states_in_contact(s, rng, n):
+    """n random states with overlaps of every contact and slip."""
+    found = 0
+    while found < n:
+        t, q, qd = 0.3, rng.uniform(-0.25, 0.25, s.nq), rng.uniform(-1.5, 1.5, s.nq)
+        touching = {c["contact"] for c in s.contact_states(t, q, qd) if c["normal_force"] > 0}
+        if touching == set(s.contact_names):
+            found += 1
+            yield t, q, qd
+
+
+@pytest.mark.parametrize("friction", [False, True])
+def test_the_contacts_jacobians_are_exact_and_both_engines_agree(friction):
+    """The recursive engine's analytic ∂f/∂q and ∂f/∂q̇ (automatic derivatives of the kernels, the contact point
+    sliding on both bodies, the deck's plane turning with its body) against central differences; the Lagrange
+    engine's forces and accelerations equal the recursive one's."""
+    rec, lag = contact_scene("recursive", friction), contact_scene("lagrange", friction)
+    rng = np.random.default_rng(3)
+    for t, q, qd in states_in_contact(rec, rng, 3):
+        Kq, Kqd = rec.force_jacobians(t, q, qd)
+        Fq, Fqd = central_jacobians(rec, t, q, qd, h=1e-7)
+        assert np.abs(Kq - Fq).max() < 2e-6 * np.abs(Fq).max()
+        assert np.abs(Kqd - Fqd).max() < 2e-6 * np.abs(Fqd).max()
+        np.testing.assert_allclose(lag.generalized_forces(t, q, qd), rec.generalized_forces(t, q, qd), rtol=1e-11,
+                                   atol=1e-9)
+        np.testing.assert_allclose(lag.forward_dynamics(t, q, qd), rec.forward_dynamics(t, q, qd), rtol=1e-9,
+                                   atol=1e-9)
+
+
+def test_both_modes_of_the_rnea_with_contacts():
+    """Forward (a direction) and reverse (a vector-Jacobian product) modes equal the analytic matrices."""
+    rng = np.random.default_rng(5)
+    s = contact_scene()
+    for _ in range(4):
+        check_both_modes(s, rng, 0.25)
+
+
+def test_contact_states_name_each_overlap_and_a_scene_without_contacts_has_none():
+    s = contact_scene()
+    states = s.contact_states(0.0, np.zeros(s.nq), np.zeros(s.nq))
+    assert {c["contact"] for c in states} <= set(s.contact_names) and states
+    for c in states:
+        assert c["gap"] < 0 and np.linalg.norm(c["normal"]) == pytest.approx(1.0)
+        assert np.dot(c["force"], c["normal"]) == pytest.approx(c["normal_force"])
+    model = rf.Model()
+    model.add_body("b", model.ground, rf.Joint.revolute("z"), 1.0, (1, 1, 1))
+    assert model.compile().contact_states(0.0, [0.0], [0.0]) == [] and model.compile().contact_names == []
+
+
+def test_restitution_one_is_elastic_and_the_law_is_judged():
+    law = rf.laws.Contact(restitution=1.0)
+    assert law.values["restitution"] == 1.0
+    for kwargs, name in ((dict(restitution=1.5), "restitution"), (dict(restitution=0.0), "restitution"),
+                         (dict(stiffness=-1.0), "stiffness"), (dict(exponent=0.5), "exponent"),
+                         (dict(mu_k=-0.1), "mu_k"), (dict(smoothing=0.0), "smoothing")):
+        with pytest.raises(ValueError, match=f"^{name}: expected"):
+            drop(rf.laws.Contact(**kwargs))
+
+
+def test_bad_shapes_and_contacts_are_refused_by_name():
+    model = rf.Model()
+    b = model.add_body("b", model.ground, rf.Joint.revolute("z"), 1.0, (1, 1, 1))
+    c = model.add_body("c", b, rf.Joint.revolute("z"), 1.0, (1, 1, 1))
+    for call, name in ((lambda: rf.shapes.Sphere("big"), "radius"), (lambda: rf.shapes.Capsule(0.1, (0, 0)), "a"),
+                       (lambda: model.add_shape("s", b, rf.shapes.Sphere(-1.0)), "radius"),
+                       (lambda: model.add_shape("s", b, rf.shapes.Sphere(0.0)), "radius"),
+                       (lambda: model.add_shape("s", b, rf.shapes.HalfSpace((0, 0, 2))), "normal"),
+                       (lambda: model.add_shape("s", b, rf.shapes.Box((0.1, -0.1, 0.1))), "half_extents"),
+                       (lambda: model.add_shape("s", b, rf.shapes.Box((0.1, 0.1, 0.1), rotation=2 * np.eye(3))),
+                        "rotation"),
+                       (lambda: model.add_shape("s", b, "sphere"), "shape"),
+                       (lambda: model.add_shape("s", b, rf.shapes.Capsules()), "body"),
+                       (lambda: model.add_shape("b", b, rf.shapes.Sphere(0.1)), "name")):
+        with pytest.raises(ValueError, match=f"^{name}: expected"):
+            call()
+    s1 = model.add_shape("s1", b, rf.shapes.Sphere(0.1))
+    s2 = model.add_shape("s2", c, rf.shapes.Box((0.1, 0.1, 0.1)))
+    h1 = model.add_shape("h1", model.ground, rf.shapes.HalfSpace())
+    h2 = model.add_shape("h2", c, rf.shapes.HalfSpace())
+    s3 = model.add_shape("s3", b, rf.shapes.Sphere(0.2))
+    law = rf.laws.Contact()
+    for call, name in ((lambda: model.add_contact("k", s1, s2, law), "b"),      # a box against a sphere
+                       (lambda: model.add_contact("k", h1, h2, law), "b"),      # two half-spaces
+                       (lambda: model.add_contact("k", s1, s3, law), "b"),      # one body
+                       (lambda: model.add_contact("k", s1, "h1", law), "b"),
+                       (lambda: model.add_contact("k", [], h1, law), "a"),
+                       (lambda: model.add_contact("k", s1, h1, rf.laws.Rope(EA=1.0)), "law"),
+                       (lambda: model.add_contact("s1", s1, h1, law), "name")):
+        with pytest.raises(ValueError, match=f"^{name}: expected"):
+            call()
+    assert model.add_contact("k", [s1, s2], h1, law).name == "k"
+
+
+def test_a_beams_capsules_land_on_the_ground_one_per_rfe():
+    """Capsules() puts one capsule on each rfe, of the section's radius: a round steel rod lying on the ground at the
+    height of its radius carries its weight on its rfes' contacts."""
+    d, L, m = 0.02, 1.0, 10
+    model = rf.Model(gravity=(0.0, 0.0, -9.81))
+    rod = model.add_beam("rod", model.ground, L, rf.Material(E=2.1e11, rho=7850.0), rf.Section.circle(d), m,
+                         joint=rf.Joint.prismatic("z"), placement=rf.transform((0.0, 0.0, d / 2)))
+    caps = model.add_shape("rod capsules", rod, rf.shapes.Capsules())
+    assert len(caps.shapes) == m + 1
+    model.add_contact("on ground", caps, model.add_shape("floor", model.ground, rf.shapes.HalfSpace()),
+                      rf.laws.Contact(stiffness=1e7, exponent=1.0))
+    s = model.compile()
+    eq = rf.static_equilibrium(s, q0=np.zeros(s.nq))
+    states = s.contact_states(0.0, eq.q, np.zeros(s.nq))
+    weight = 7850.0 * math.pi * d ** 2 / 4 * L * 9.81
+    assert sum(c["normal_force"] for c in states) == pytest.approx(weight, rel=1e-6)
+    assert all(c["gap"] > -1e-4 for c in states)  # the radius is the rod's: it sinks by k δ = w/n only
