@@ -3,7 +3,8 @@
 A steel strip of m rfes lying on the ground, one capsule per rfe against the ground's half-space (m + 1 pairs, all
 touching): the cost of one forward dynamics (timed in C++) and of the force Jacobians (from Python) with and without
 the contact, against m. The contacts' share grows linearly with m: the broad phase of a half-space against n shapes
-is the n narrow tests themselves.
+is the n narrow tests themselves. Then two strips crossing, a contact between their two groups of capsules: sweep and
+prune keeps the cost per capsule flat where the pairs grow as m².
 """
 
 from __future__ import annotations
@@ -55,8 +56,40 @@ def contact_cost(sizes=SIZES) -> Table:
                         "jac_ms_with"))
 
 
+def crossing_strips(m: int, contact: bool):
+    """Two strips of m sdes crossing at right angles, one lying on the other, a capsule per rfe: one contact between
+    the two groups of m + 1 capsules (sweep and prune)."""
+    model = rf.Model()
+    steel, section = rf.Material(E=2.1e11, rho=7850.0), rf.Section.circle(0.01)
+    one = model.add_beam("one", model.ground, 1.0, steel, section, m, joint=rf.Joint.spherical())
+    two = model.add_beam("two", model.ground, 1.0, steel, section, m, joint=rf.Joint.spherical(),
+                         placement=rf.transform((0.5, -0.5, 0.0099), euler_zyx=(np.pi / 2, 0.0, 0.0)))
+    if contact:
+        model.add_contact("touch", model.add_shape("one's", one, rf.shapes.Capsules()),
+                          model.add_shape("two's", two, rf.shapes.Capsules()), rf.laws.Contact(stiffness=1e7))
+    return model.compile()
+
+
+def crossing_cost(sizes=SIZES) -> Table:
+    rows = []
+    for m in sizes:
+        row = {"m": m, "pairs": (m + 1) ** 2}
+        for contact in (False, True):
+            s = crossing_strips(m, contact)
+            q, qd = np.zeros(s.nq), np.zeros(s.nq)
+            row[f"fd_us_{'with' if contact else 'without'}"] = cpp_seconds_per_call(s, q, qd) * 1e6
+            if contact:
+                row["overlaps"] = len(s.contact_states(0.0, q, qd))
+        row["contact_us_per_capsule"] = (row["fd_us_with"] - row["fd_us_without"]) / (2 * (m + 1))
+        rows.append(row)
+    return Table(rows, ("m", "pairs", "overlaps", "fd_us_without", "fd_us_with", "contact_us_per_capsule"))
+
+
 def run(output_dir="bench", quick: bool = False) -> dict:
     print(machine())
     return report({"contact_cost": ("One forward dynamics (µs, in C++) and the force Jacobians (ms, from Python) of a "
                                     "strip of m rfes on the ground, without and with a capsule per rfe against it",
-                                    contact_cost(QUICK_SIZES if quick else SIZES))}, output_dir)
+                                    contact_cost(QUICK_SIZES if quick else SIZES)),
+                   "contact_groups": ("One forward dynamics (µs, in C++) of two strips of m rfes crossing, one on the other, "
+                                      "without and with a contact between their capsules (sweep and prune over "
+                                      "(m + 1)² pairs)", crossing_cost(QUICK_SIZES if quick else SIZES))}, output_dir)

@@ -236,3 +236,128 @@ def test_a_beams_capsules_land_on_the_ground_one_per_rfe():
     weight = 7850.0 * math.pi * d ** 2 / 4 * L * 9.81
     assert sum(c["normal_force"] for c in states) == pytest.approx(weight, rel=1e-6)
     assert all(c["gap"] > -1e-4 for c in states)  # the radius is the rod's: it sinks by k δ = w/n only
+
+
+def test_the_adjoint_gradient_through_a_bounce_with_friction_agrees_with_differences_of_runs():
+    """A ball thrown onto the ground, bouncing and sliding under friction: dJ/dp of J = x + z at the end, by the
+    adjoint (its reverse mode through the contact's automatic derivatives), against central differences of whole
+    runs of the same fixed-step method."""
+    model = rf.Model()
+    ball = model.add_body("ball", model.ground, rf.Joint.free(), 2.0, (0.01, 0.01, 0.01),
+                          placement=rf.transform((0.0, 0.0, 0.1)))
+    model.add_contact("bounce", model.add_shape("s", ball, rf.shapes.Sphere(0.1)),
+                      model.add_shape("floor", model.ground, rf.shapes.HalfSpace()),
+                      rf.laws.Contact(stiffness=1e5, restitution=0.7, mu_s=0.5, mu_k=0.4, smoothing=1e-2))
+    s = model.compile()
+    names = s.coordinate_names
+    q0, qd0 = np.zeros(s.nq), np.zeros(s.nq)
+    q0[names.index("ball.z")], qd0[names.index("ball.x")], qd0[names.index("ball.z")] = 0.05, 1.0, -1.0
+    run = dict(dt=2e-4, q0=q0)
+    g = rf.gradient(s, 0.3, ["ball.mass", "qd0[ball.x]"], outputs={"p": ball}, terminal=lambda y: y["p"][0] + y["p"][2],
+                    qd0=qd0, **run)
+
+    def J(mass, vx):
+        changed = s.with_parameters({"ball.mass": mass})
+        start = qd0.copy()
+        start[names.index("ball.x")] = vx
+        r = rf.simulate(changed, 0.3, qd0=start, method="generalized_alpha", t_eval=[0.3], **run)
+        p = changed.position(ball, 0.3, r.q[-1])
+        return p[0] + p[2]
+
+    h = 1e-5
+    assert g.gradient["ball.mass"] == pytest.approx((J(2.0 + h, 1.0) - J(2.0 - h, 1.0)) / (2 * h), rel=1e-5)
+    assert g.gradient["qd0[ball.x]"] == pytest.approx((J(2.0, 1.0 + h) - J(2.0, 1.0 - h)) / (2 * h), rel=1e-6)
+
+
+def test_a_contacts_stiffness_and_friction_are_named_parameters_with_gradients():
+    """The law's k, μ_s and μ_k are named parameters ("<contact>.stiffness", ...): set by with_parameters like any
+    other, and the adjoint's gradient by them agrees with central differences of whole runs."""
+    model = rf.Model()
+    box = model.add_body("box", model.ground, rf.Joint.free(), 1.0, (0.01, 0.01, 0.01),
+                         placement=rf.transform((0.0, 0.0, 0.05)))
+    model.add_contact("slide", model.add_shape("brick", box, rf.shapes.Box((0.1, 0.1, 0.05))),
+                      model.add_shape("floor", model.ground, rf.shapes.HalfSpace()),
+                      rf.laws.Contact(stiffness=1e6, exponent=1.0, restitution=0.5, impact_speed=0.5, mu_s=0.5,
+                                      mu_k=0.3, smoothing=1e-2))
+    s = model.compile()
+    assert [p for p in s.parameters if p.startswith("slide.")] == ["slide.stiffness", "slide.mu_s", "slide.mu_k"]
+    assert s.parameters["slide.mu_k"].value == 0.3 and s.parameters["slide.stiffness"].unit == "N/m^p"
+    names = s.coordinate_names
+    q0, qd0 = np.zeros(s.nq), np.zeros(s.nq)
+    q0[names.index("box.z")], qd0[names.index("box.x")] = -9.81 / 4e6, 1.0  # on its corners, sliding
+    run = dict(dt=2e-4, q0=q0, qd0=qd0, newton_tol=1e-13)
+    picked = ["slide.stiffness", "slide.mu_s", "slide.mu_k"]
+    g = rf.gradient(s, 0.5, picked, outputs={"p": box}, terminal=lambda y: y["p"][0] + 10.0 * y["p"][2], **run)
+
+    def J(**values):
+        changed = s.with_parameters(values)
+        r = rf.simulate(changed, 0.5, method="generalized_alpha", t_eval=[0.5], **run)
+        p = changed.position(box, 0.5, r.q[-1])
+        return p[0] + 10.0 * p[2]
+
+    for name, value in zip(picked, (1e6, 0.5, 0.3)):
+        h = 1e-3 * value
+        fd = (J(**{name: value + h}) - J(**{name: value - h})) / (2 * h)
+        assert g.gradient[name] == pytest.approx(fd, rel=1e-4), name
+
+
+def crossing_rods(per_capsule: bool):
+    """Two round rods of 20 rfes crossing each other, their capsules in contact: one contact between the two groups
+    (sweep and prune: 21 × 21 pairs), or one contact per capsule of the first (each 1 × 21, tested pair by pair)."""
+    model = rf.Model()
+    steel, rod = rf.Material(E=2.1e11, rho=7850.0), rf.Section.circle(0.02)
+    one = model.add_beam("one", model.ground, 1.0, steel, rod, 20, joint=rf.Joint.spherical(),
+                         placement=rf.transform((0.0, 0.0, 0.0)))
+    two = model.add_beam("two", model.ground, 1.0, steel, rod, 20, joint=rf.Joint.spherical(),
+                         placement=rf.transform((0.5, -0.5, 0.015), euler_zyx=(np.pi / 2, 0.0, 0.0)))
+    a = model.add_shape("one's", one, rf.shapes.Capsules())
+    b = model.add_shape("two's", two, rf.shapes.Capsules())
+    law = rf.laws.Contact(stiffness=1e7, exponent=1.0, mu_s=0.3, mu_k=0.2)
+    if per_capsule:
+        for k, index in enumerate(a.shapes):
+            single = rf.model.handles.Shape(f"one's[{k}]", "capsule", [index])
+            model.add_contact(f"touch {k}", single, b, law)
+    else:
+        model.add_contact("touch", a, b, law)
+    return model.compile()
+
+
+def test_two_groups_meet_by_sweep_and_prune_as_pair_by_pair():
+    """The forces of one contact between two crossing rods' 21 capsules each (sweep and prune) equal those of 21
+    contacts tested pair by pair, at states where the rods bend and slide over each other."""
+    swept, paired = crossing_rods(False), crossing_rods(True)
+    rng = np.random.default_rng(11)
+    touched = 0
+    for _ in range(5):
+        q, qd = rng.normal(0.0, 0.02, swept.nq), rng.normal(0.0, 0.5, swept.nq)
+        touched += len(swept.contact_states(0.0, q, qd))
+        assert len(swept.contact_states(0.0, q, qd)) == len(paired.contact_states(0.0, q, qd))
+        np.testing.assert_allclose(swept.generalized_forces(0.0, q, qd), paired.generalized_forces(0.0, q, qd),
+                                   rtol=1e-12, atol=1e-9)
+    assert touched >= 5
+
+
+def test_a_box_on_a_heaving_deck_follows_it_and_is_pushed_by_its_acceleration():
+    """A box resting on a deck (a half-space on a moving base) that heaves as a sin ωt with a ω² < g: it stays on the
+    deck (every corner touching), and the deck pushes it with m (g + z̈_deck) (1e-3 of mg, the contact's own
+    oscillation aside)."""
+    a, omega, m, g = 0.05, 2.0 * np.pi, 3.0, 9.81
+    model = rf.Model()
+    deck = model.add_moving_base("deck", {"heave": rf.motion.harmonic(a, omega)})
+    box = model.add_body("box", model.ground, rf.Joint.free(), m, (0.05, 0.05, 0.05),
+                         placement=rf.transform((0.0, 0.0, 0.1)))
+    k = 1e7
+    law = rf.laws.Contact(stiffness=k, exponent=1.0, restitution=0.3, impact_speed=0.1, mu_s=0.5, mu_k=0.5,
+                          smoothing=1e-4)
+    model.add_contact("on deck", model.add_shape("brick", box, rf.shapes.Box((0.2, 0.2, 0.1))),
+                      model.add_shape("deck plane", deck, rf.shapes.HalfSpace()), law)
+    s = model.compile()
+    q0 = np.zeros(s.nq)
+    q0[s.coordinate_names.index("box.z")] = -m * g / k  # at rest on its four lower corners
+    t = np.linspace(0.5, 2.0, 61)
+    r = rf.simulate(s, 2.0, q0=q0, t_eval=t, method="radau5", rtol=1e-9, atol=1e-11)
+    for tk, q, qd in zip(r.t, r.q, r.qd):
+        states = s.contact_states(tk, q, qd)
+        assert len(states) == 4
+        push = sum(c["force"][2] for c in states)
+        assert push == pytest.approx(m * (g - a * omega ** 2 * np.sin(omega * tk)), abs=1e-3 * m * g)

@@ -131,7 +131,8 @@ void bind_dynamics(py::module_& m) {
                        const std::vector<std::pair<int, Mat4>>& bodies,
                        const std::vector<std::tuple<int, std::string, double>>& elements,
                        const std::vector<std::tuple<int, Vec3, Vec3>>& loads,
-                       const std::vector<std::tuple<std::string, int, int, ProfilePtr>>& profiles) {
+                       const std::vector<std::tuple<std::string, int, int, ProfilePtr>>& profiles,
+                       const std::vector<std::tuple<int, std::string, double>>& contacts) {
              // a copy of `base` with new constants and profiles (parameters.hpp): what named parameters set
              ConstantChanges c;
              for (const auto& [what, body, index, profile] : profiles) c.profiles.push_back({what, body, index, profile});
@@ -140,10 +141,11 @@ void bind_dynamics(py::module_& m) {
              for (const auto& [body, H] : bodies) c.bodies.push_back({body, H});
              for (const auto& [element, name, value] : elements) c.elements.push_back({element, name, value});
              for (const auto& [load, F, tau] : loads) c.loads.push_back({load, F, tau});
+             for (const auto& [contact, name, value] : contacts) c.contacts.push_back({contact, name, value});
              return with_constants(base, c);
            }),
            py::arg("base"), py::arg("coordinates"), py::arg("bodies"), py::arg("elements"), py::arg("loads"),
-           py::arg("profiles"))
+           py::arg("profiles"), py::arg("contacts"))
       .def_property_readonly(
           "algorithm", [](const System& s) { return s.algorithm == Algorithm::Recursive ? "recursive" : "lagrange"; },
           "'recursive' (O(n): RNEA, CRBA, ABA) or 'lagrange' (the book's formulation; always for linear joints).")

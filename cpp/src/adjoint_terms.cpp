@@ -85,6 +85,10 @@ ParameterVjp::ParameterVjp(const System& sys, const std::vector<SensitivityParam
       }
       for (std::size_t k = 0; k < sys.loops.size(); ++k)
         if (X->loops[k].drive != sys.loops[k].drive) add(Component::Actuator, static_cast<int>(k));
+      // a contact's law reaches the forces of every overlap, found anew at each state: such a parameter
+      // differences μᵀr whole
+      for (std::size_t k = 0; k < sys.contacts.size(); ++k)
+        if (X->contacts[k].law != sys.contacts[k].law) whole_[j] = true;
       // a link of varying length's rfes' inertias and flow loads scale with L(t) (d's, not X's constants), and
       // its length reaches every term: such a parameter differences μᵀr whole
       for (std::size_t f = 0; f < sys.flows.size(); ++f) {

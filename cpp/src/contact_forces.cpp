@@ -1,6 +1,11 @@
 #include "rigidfem/contact_forces.hpp"
 
+#include <algorithm>
 #include <cmath>
+#include <iterator>
+#include <utility>
+#include <vector>
+
 #include <unsupported/Eigen/AutoDiff>
 
 #include "rigidfem/errors.hpp"
@@ -146,34 +151,100 @@ bool overlap(ContactForce& c, const ContactLaw& law, double t) {
 
 }  // namespace
 
+namespace {
+
+// A half-space P against a shape O of another body: the point–plane features of O that overlap it.
+void plane_pair(const System& sys, const Data& d, bool spatial, int k, const Shape& P, const Shape& O,
+                const std::function<void(const ContactForce&)>& visit) {
+  if (P.body == O.body) return;
+  ContactForce c;
+  c.contact = k, c.body_a = P.body, c.body_b = O.body, c.plane = true;
+  c.Va = body_velocity(d, P.body, spatial), c.Vb = body_velocity(d, O.body, spatial);
+  c.p[0] = global(d, P.body, P.a), c.p[1] = turned(d, P.body, P.n);
+  shape_points(O, d, [&](const Vec3& x, double r) {
+    c.p[2] = x, c.rb = r;
+    if (c.p[1].dot(x - c.p[0]) - r < 0.0 && overlap(c, *sys.contacts[k].law, d.t)) visit(c);
+  });
+}
+
+// A swept sphere (a sphere or a capsule) at the state: its segment (global) and radius.
+struct Swept {
+  int shape;
+  Vec3 p0, p1;
+  double radius, lo, hi;  // its extent along the sweep's axis
+};
+
+Swept swept(const System& sys, const Data& d, int k, int axis) {
+  const Shape& S = sys.shapes[k];
+  Swept w{k, global(d, S.body, S.a), global(d, S.body, S.kind == ShapeKind::Capsule ? S.b : S.a), S.radius, 0.0, 0.0};
+  w.lo = std::min(w.p0(axis), w.p1(axis)) - w.radius, w.hi = std::max(w.p0(axis), w.p1(axis)) + w.radius;
+  return w;
+}
+
+// Two swept spheres of bodies a and b: their bounding spheres, then the closest points of their segments.
+void swept_pair(const System& sys, const Data& d, bool spatial, int k, const Swept& A, const Swept& B,
+                const std::function<void(const ContactForce&)>& visit) {
+  const int ba = sys.shapes[A.shape].body, bb = sys.shapes[B.shape].body;
+  if (ba == bb) return;
+  const double reach = 0.5 * ((A.p1 - A.p0).norm() + (B.p1 - B.p0).norm()) + A.radius + B.radius;
+  if (!((0.5 * (A.p0 + A.p1 - B.p0 - B.p1)).norm() < reach)) return;
+  ContactForce c;
+  c.contact = k, c.body_a = ba, c.body_b = bb;
+  c.Va = body_velocity(d, ba, spatial), c.Vb = body_velocity(d, bb, spatial);
+  c.p[0] = A.p0, c.p[1] = A.p1, c.p[2] = B.p0, c.p[3] = B.p1, c.ra = A.radius, c.rb = B.radius;
+  if (overlap(c, *sys.contacts[k].law, d.t)) visit(c);
+}
+
+// The pairs of two groups of swept spheres whose extents along x meet (sweep and prune: the extents sorted by
+// their lower ends, each meeting the other group's open ones): O((n_a + n_b) log(n_a + n_b) + pairs) where the
+// groups lie along x, against n_a n_b tests. Scratch per thread, kept between calls: no allocation once warm.
+void swept_groups(const System& sys, const Data& d, bool spatial, int k, const std::vector<int>& a,
+                  const std::vector<int>& b, const std::function<void(const ContactForce&)>& visit) {
+  thread_local std::vector<std::pair<Swept, bool>> all;  // (shape, in group a)
+  thread_local std::vector<const Swept*> open_a, open_b;
+  all.clear(), open_a.clear(), open_b.clear();
+  for (const int s : a) all.push_back({swept(sys, d, s, 0), true});
+  for (const int s : b) all.push_back({swept(sys, d, s, 0), false});
+  std::sort(all.begin(), all.end(), [](const auto& x, const auto& y) { return x.first.lo < y.first.lo; });
+  for (const auto& [w, in_a] : all) {
+    // the other group's open extents: those ending before this one starts are closed for good (the lower ends come
+    // in order), the others meet it; its own group's are pruned when the other group's next one comes
+    std::vector<const Swept*>& other = in_a ? open_b : open_a;
+    other.erase(std::remove_if(other.begin(), other.end(), [&](const Swept* o) { return o->hi < w.lo; }), other.end());
+    for (const Swept* o : other) in_a ? swept_pair(sys, d, spatial, k, w, *o, visit)
+                                      : swept_pair(sys, d, spatial, k, *o, w, visit);
+    (in_a ? open_a : open_b).push_back(&w);
+  }
+}
+
+}  // namespace
+
 void for_each_contact_force(const System& sys, const Data& d, bool spatial,
                             const std::function<void(const ContactForce&)>& visit) {
+  thread_local std::vector<int> sa, sb;
   for (int k = 0; k < static_cast<int>(sys.contacts.size()); ++k) {
     const Contact& C = sys.contacts[k];
+    const auto plane = [&](int s) { return sys.shapes[s].kind == ShapeKind::HalfSpace; };
+    // a half-space against every shape of the other group: O(n)
     for (const int ia : C.shapes_a)
-      for (const int ib : C.shapes_b) {
-        const Shape *A = &sys.shapes[ia], *B = &sys.shapes[ib];
-        if (A->body == B->body) continue;
-        if (B->kind == ShapeKind::HalfSpace) std::swap(A, B);  // the half-space is a's
-        ContactForce c;
-        c.contact = k, c.body_a = A->body, c.body_b = B->body;
-        c.Va = body_velocity(d, A->body, spatial), c.Vb = body_velocity(d, B->body, spatial);
-        if (A->kind == ShapeKind::HalfSpace) {
-          c.plane = true;
-          c.p[0] = global(d, A->body, A->a), c.p[1] = turned(d, A->body, A->n);
-          shape_points(*B, d, [&](const Vec3& x, double r) {
-            c.p[2] = x, c.rb = r;
-            if (c.p[1].dot(x - c.p[0]) - r < 0.0 && overlap(c, *C.law, d.t)) visit(c);
-          });
-          continue;
-        }
-        // two swept spheres: the segments' bounding spheres first
-        c.p[0] = global(d, A->body, A->a), c.p[1] = global(d, A->body, A->kind == ShapeKind::Capsule ? A->b : A->a);
-        c.p[2] = global(d, B->body, B->a), c.p[3] = global(d, B->body, B->kind == ShapeKind::Capsule ? B->b : B->a);
-        c.ra = A->radius, c.rb = B->radius;
-        const double reach = 0.5 * ((c.p[1] - c.p[0]).norm() + (c.p[3] - c.p[2]).norm()) + c.ra + c.rb;
-        if ((0.5 * (c.p[0] + c.p[1] - c.p[2] - c.p[3])).norm() < reach && overlap(c, *C.law, d.t)) visit(c);
-      }
+      if (plane(ia))
+        for (const int ib : C.shapes_b)
+          if (!plane(ib)) plane_pair(sys, d, spatial, k, sys.shapes[ia], sys.shapes[ib], visit);
+    for (const int ib : C.shapes_b)
+      if (plane(ib))
+        for (const int ia : C.shapes_a)
+          if (!plane(ia)) plane_pair(sys, d, spatial, k, sys.shapes[ib], sys.shapes[ia], visit);
+    // spheres and capsules against spheres and capsules (a box meets half-spaces only: Model::add_contact)
+    sa.clear(), sb.clear();
+    const auto is_swept = [&](int s) { return sys.shapes[s].kind == ShapeKind::Sphere || sys.shapes[s].kind == ShapeKind::Capsule; };
+    std::copy_if(C.shapes_a.begin(), C.shapes_a.end(), std::back_inserter(sa), is_swept);
+    std::copy_if(C.shapes_b.begin(), C.shapes_b.end(), std::back_inserter(sb), is_swept);
+    if (sa.size() * sb.size() > 64) {
+      swept_groups(sys, d, spatial, k, sa, sb, visit);
+    } else {
+      for (const int ia : sa)
+        for (const int ib : sb) swept_pair(sys, d, spatial, k, swept(sys, d, ia, 0), swept(sys, d, ib, 0), visit);
+    }
   }
 }
 

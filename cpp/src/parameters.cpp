@@ -51,6 +51,12 @@ std::shared_ptr<System> with_constants(const System& sys, const ConstantChanges&
     coordinate.laws[c.law] = coordinate.laws[c.law]->with_constant(c.name, c.value);
   }
   for (const auto& b : changes.bodies) set_inertia(s, b.body, b.H);
+  for (const auto& c : changes.contacts) {
+    if (c.contact < 0 || c.contact >= static_cast<int>(s.contacts.size()))
+      bad("contact", "a contact of this system (0.." + std::to_string(s.contacts.size()) + " - 1)",
+          std::to_string(c.contact));
+    s.contacts[c.contact].law = s.contacts[c.contact].law->with_constant(c.name, c.value);
+  }
   for (const auto& e : changes.elements) {
     if (e.element < 0 || e.element >= static_cast<int>(s.elements.size()))
       bad("element", "a force element of this system (0.." + std::to_string(s.elements.size()) + " - 1)",

@@ -61,13 +61,13 @@ class ContactLaw final : public Law {
         "F_n = k δᵖ (1 + α δ̇) (N, pushing the bodies apart while positive), α set by the restitution e at the impact "
         "speed v_e; friction f_t = −(μ_k + (μ_s − μ_k) exp(−(v_t/v_S)²)) F_n tanh(|v_t|/v_ε) v_t/|v_t| against the "
         "slip v_t",
-        {{"stiffness", "N/m^p", nullptr, 1e6, 0.0, true, "the contact stiffness k (F_n = k δᵖ)", false},
+        {{"stiffness", "N/m^p", nullptr, 1e6, 0.0, true, "the contact stiffness k (F_n = k δᵖ)", true},
          {"exponent", "1", nullptr, 1.5, 1.0, false, "the exponent p of the penetration (1 linear, 1.5 Hertz)", false},
          {"restitution", "1", nullptr, 1.0, 0.0, true, "the coefficient of restitution e at the impact speed", false},
          {"impact_speed", "m/s", nullptr, 1.0, 0.0, true, "the impact speed v_e at which the restitution is e",
           false},
-         {"mu_s", "1", nullptr, 0.0, 0.0, false, "the static friction coefficient μ_s", false},
-         {"mu_k", "1", nullptr, 0.0, 0.0, false, "the kinetic friction coefficient μ_k", false},
+         {"mu_s", "1", nullptr, 0.0, 0.0, false, "the static friction coefficient μ_s", true},
+         {"mu_k", "1", nullptr, 0.0, 0.0, false, "the kinetic friction coefficient μ_k", true},
          {"stribeck", "m/s", nullptr, 0.01, 0.0, true, "the Stribeck velocity v_S", false},
          {"smoothing", "m/s", nullptr, 1e-4, 0.0, true, "the regularising slip velocity v_ε of tanh(|v_t|/v_ε)",
           false}},
@@ -77,9 +77,14 @@ class ContactLaw final : public Law {
         nullptr};
     return info;
   }
-  explicit ContactLaw(std::vector<double> values) : Law(std::move(values)) {
-    if (c_.size() == description().constants.size() && c_[E] > 0.0 && c_[E] < 1.0 && c_[VE_IMPACT] > 0.0)
-      alpha_ = hunt_crossley_rate(c_[E]) / c_[VE_IMPACT];
+  explicit ContactLaw(std::vector<double> values) : Law(std::move(values)) { set_alpha(); }
+  /// A copy with the constant `name` set to `value` (a named parameter: parameters.hpp; the force is linear in those
+  /// marked so, k, μ_s and μ_k), unchecked; std::invalid_argument for a name the law does not have.
+  std::shared_ptr<const ContactLaw> with_constant(const std::string& name, double value) const {
+    auto law = std::make_shared<ContactLaw>(*this);
+    law->set(constant_index(name), value);
+    law->set_alpha();
+    return law;
   }
   const LawInfo& info() const override { return description(); }
   /// The constants' bounds, and e ≤ 1 (std::invalid_argument naming the constant).
@@ -126,7 +131,7 @@ class ContactLaw final : public Law {
   /// u = α v_e of the restitution e ∈ (0, 1): the root in (0, 1/e) of f(u) = ln(1 + u) − ln(1 − e u) − u (1 + e).
   /// f(0) = f'(0) = 0, f'' increases from e² − 1 < 0 and f → ∞ at 1/e: f is negative, then positive, with one root,
   /// bisected. Below 1 − e = 1e-6 its series root 3 (1 − e²)/(2 (1 + e³)) (Hunt–Crossley's 3(1 − e)/2 as e → 1).
-  static double hunt_crossley_rate(double e) {
+  static double hunt_crossley_rate(double e) {  // (see set_alpha)
     if (1.0 - e < 1e-6) return 1.5 * (1.0 - e * e) / (1.0 + e * e * e);
     const auto f = [e](double u) { return std::log1p(u) - std::log1p(-e * u) - u * (1.0 + e); };
     double lo = 0.5 / e, hi = 1.0 / e;
@@ -140,6 +145,11 @@ class ContactLaw final : public Law {
   }
 
  private:
+  void set_alpha() {
+    alpha_ = c_.size() == description().constants.size() && c_[E] > 0.0 && c_[E] < 1.0 && c_[VE_IMPACT] > 0.0
+                 ? hunt_crossley_rate(c_[E]) / c_[VE_IMPACT]
+                 : 0.0;
+  }
   double alpha_ = 0.0;
 };
 

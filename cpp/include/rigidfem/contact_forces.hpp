@@ -8,8 +8,8 @@
 /// Where g < 0 the contact pushes body b (the sphere's, capsule's or box's against a half-space) by
 /// f = F_n n + f_t at x_c and body a by −f there: F_n of the penetration δ = −g and its rate δ̇ = −n·v_rel, f_t of
 /// the slip v_t = (1 − n nᵀ) v_rel, with v_rel = v_b(x_c) − v_a(x_c) the bodies' velocities at the contact point.
-/// A half-space against n spheres, capsules or boxes costs O(n) features; two groups of spheres and capsules are
-/// paired through their bounding spheres.
+/// A half-space against n spheres, capsules or boxes costs O(n) features; two groups of spheres and capsules meet by
+/// sweep and prune (their extents along x sorted, only the overlapping ones tested; all pairs below 64).
 #pragma once
 
 #include <functional>

@@ -34,6 +34,11 @@ struct ConstantChanges {
     std::string name;  ///< the law's constant ("stiffness", "damping", "force"; a rope's "EA", "damping")
     double value = 0.0;
   };
+  struct ContactConstant {
+    int contact = -1;
+    std::string name;  ///< the contact law's constant ("stiffness", "mu_s", "mu_k")
+    double value = 0.0;
+  };
   struct LoadValues {
     int load = -1;
     Vec3 force = Vec3::Zero(), torque = Vec3::Zero();  ///< N, N·m
@@ -50,6 +55,7 @@ struct ConstantChanges {
   std::vector<ElementConstant> elements;
   std::vector<LoadValues> loads;
   std::vector<NewProfile> profiles;
+  std::vector<ContactConstant> contacts;
 };
 
 /// A copy of sys with the changes applied (O(n): the tables are copied). std::invalid_argument naming the

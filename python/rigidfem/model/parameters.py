@@ -80,15 +80,16 @@ class Changes:
     elements: list = field(default_factory=list)     #: tuples (element, constant's name, value)
     loads: list = field(default_factory=list)        #: tuples (load, F (3,), τ (3,))
     profiles: list = field(default_factory=list)     #: tuples (what, body, index, profile): see parameters.hpp
+    contacts: list = field(default_factory=list)     #: tuples (contact, constant's name, value)
 
     def __iadd__(self, other: Changes) -> Changes:
-        for name in ("coordinates", "bodies", "elements", "loads", "profiles"):
+        for name in ("coordinates", "bodies", "elements", "loads", "profiles", "contacts"):
             getattr(self, name).extend(getattr(other, name))
         return self
 
     def arguments(self) -> tuple:
         """The changes as the arguments of ``_core._System(base, ...)`` after ``base``."""
-        return self.coordinates, self.bodies, self.elements, self.loads, self.profiles
+        return self.coordinates, self.bodies, self.elements, self.loads, self.profiles, self.contacts
 
     def apply(self, base) -> _core._System:
         return _core._System(base, *self.arguments())
@@ -202,7 +203,8 @@ class BodyGroup(Group):
 
 class LawGroup(Group):
     """The constants of a law that are named parameters (its kind's description, ``rigidfem.laws``), at the values
-    it was built with: a force element's law (``target`` ("element", k)) or a joint coordinate's (("coordinate",
+    it was built with: a force element's law (``target`` ("element", k)), a contact's (("contact", k)) or a joint
+    coordinate's (("coordinate",
     body, slot, law): law −1 is the coordinate's own spring-damping law, k ≥ 0 its further law k). ``rotation``:
     the coordinate is a rotation (the constants' rotation units)."""
 
@@ -221,6 +223,8 @@ class LawGroup(Group):
         v = {k: values.get(k, p.value) for k, p in self.parameters.items()}
         if self.target[0] == "element":
             return Changes(elements=[(self.target[1], k, x) for k, x in v.items()])
+        if self.target[0] == "contact":
+            return Changes(contacts=[(self.target[1], k, x) for k, x in v.items()])
         _, body, slot, law = self.target
         return Changes(coordinates=[(body, slot, law, k, x) for k, x in v.items()])
 
