@@ -148,23 +148,15 @@ class Friction final : public CoordinateLaw {
   }
   explicit Friction(std::vector<double> values) : CoordinateLaw(std::move(values)) {}
   const LawInfo& info() const override { return description(); }
-  double force(double, double, double v, double) const override {
-    return -dry(v) * std::tanh(v / c_[VE]) - c_[B] * v;
-  }
-  /// (0, −g'(v) tanh(v/v_ε) − g(v) sech²(v/v_ε)/v_ε − b), g'(v) = −2 v/v_S² (F_S − F_C) e^{−(v/v_S)²}.
+  double force(double, double, double v, double) const override { return friction().force(v); }
+  /// (0, dQ/dq̇): laws.hpp's RegularisedFriction.
   std::pair<double, double> derivatives(double, double, double v, double) const override {
-    const double x = v / c_[VS], e = std::exp(-x * x), th = std::tanh(v / c_[VE]);
-    const double dg = -2.0 * x / c_[VS] * (c_[FS] - c_[FC]) * e;
-    return {0.0, -dg * th - dry(v) * (1.0 - th * th) / c_[VE] - c_[B]};
+    return {0.0, friction().rate_derivative(v)};
   }
   double power(double t, double q, double v) const override { return -force(t, q, v, 1.0) * v; }
 
  private:
-  /// g(v) = F_C + (F_S − F_C) e^{−(v/v_S)²}.
-  double dry(double v) const {
-    const double x = v / c_[VS];
-    return c_[FC] + (c_[FS] - c_[FC]) * std::exp(-x * x);
-  }
+  RegularisedFriction friction() const { return {c_[FS], c_[FC], c_[VS], c_[B], c_[VE]}; }
   std::shared_ptr<CoordinateLaw> clone() const override { return std::make_shared<Friction>(*this); }
 };
 

@@ -251,6 +251,49 @@ class Buffer final : public ElementLaw {
   std::shared_ptr<ElementLaw> clone() const override { return std::make_shared<Buffer>(*this); }
 };
 
+/// Sliding friction along an element (a cylinder's seals, a telescope's guide), against the rate of its length:
+///   F = −g(l̇) tanh(l̇/v_ε) − b l̇,   g(v) = F_C + (F_S − F_C) e^{−(v/v_S)²},
+/// the breakaway force F_S near rest falling to the Coulomb force F_C beyond the Stribeck velocity v_S, and a viscous
+/// b: the joints' Friction law (coordinate_laws.hpp) on an element's length, regularised for the same reason (a
+/// creep of ~v_ε where it should stick). Stores nothing; dissipates −F l̇ ≥ 0.
+class SlidingFriction final : public ElementLaw {
+ public:
+  enum { FS, FC, VS, B, VE };  // the constants' indices
+  static const LawInfo& description() {
+    static const LawInfo info{
+        "SlidingFriction", "element",
+        "F = −(F_C + (F_S − F_C) exp(−(l̇/v_S)²)) tanh(l̇/v_ε) − b l̇ (N, > 0 pushing the points apart): dry friction "
+        "against the rate of the element's length, with a Stribeck fall from the breakaway F_S to the Coulomb F_C, "
+        "and viscous friction b, regularised over v_ε",
+        {{"breakaway", "N", nullptr, 0.0, 0.0, false, "the breakaway (static) friction F_S", true},
+         {"coulomb", "N", nullptr, 0.0, 0.0, false, "the Coulomb (kinetic) friction F_C", true},
+         {"stribeck", "m/s", nullptr, 0.01, 0.0, true, "the Stribeck velocity v_S", false},
+         {"viscous", "N s/m", nullptr, 0.0, 0.0, false, "the viscous friction b", true},
+         {"smoothing", "m/s", nullptr, 1e-4, 0.0, true, "the regularising velocity v_ε of tanh(l̇/v_ε)", false}},
+        nullptr,
+        nullptr,
+        nullptr,
+        nullptr};
+    return info;
+  }
+  SlidingFriction(std::vector<double> values, ProfilePtr, AxialFunction) : ElementLaw(std::move(values), nullptr) {}
+  const LawInfo& info() const override { return description(); }
+  double force(double, double, double v, double) const override { return friction().force(v); }
+  /// (0, dF/dl̇): laws.hpp's RegularisedFriction.
+  std::pair<double, double> derivatives(double, double, double v, double) const override {
+    return {0.0, friction().rate_derivative(v)};
+  }
+  bool elastic() const override { return false; }
+  bool dissipative() const override { return true; }
+  double energy(double, double) const override { return 0.0; }
+  double power(double, double, double ld, double F) const override { return -F * ld; }
+  const char* drawn_as() const override { return "cylinder"; }
+
+ private:
+  RegularisedFriction friction() const { return {c_[FS], c_[FC], c_[VS], c_[B], c_[VE]}; }
+  std::shared_ptr<ElementLaw> clone() const override { return std::make_shared<SlidingFriction>(*this); }
+};
+
 /// A kind of force element as the bindings make it: its description, and its maker from the constants' values
 /// (in the description's order), a profile and a Python function (each null where the kind takes none).
 struct ElementLawKind {
@@ -272,6 +315,10 @@ inline const std::vector<ElementLawKind>& element_law_kinds() {
       {Buffer::description,
        [](std::vector<double> v, ProfilePtr p, AxialFunction f) -> std::shared_ptr<const ElementLaw> {
          return std::make_shared<Buffer>(std::move(v), std::move(p), std::move(f));
+       }},
+      {SlidingFriction::description,
+       [](std::vector<double> v, ProfilePtr p, AxialFunction f) -> std::shared_ptr<const ElementLaw> {
+         return std::make_shared<SlidingFriction>(std::move(v), std::move(p), std::move(f));
        }},
   };
   return kinds;

@@ -50,6 +50,23 @@ struct LawInfo {
 /// formulation's Jacobians): its truncation (∝ h²) and round-off (∝ 1/h) both near 1e-10 relative.
 inline double difference_step(double x) { return 6e-6 * std::max(1.0, std::abs(x)); }
 
+/// Regularised dry and viscous friction against a velocity v (the joints' Friction, an element's SlidingFriction):
+///   Q = −g(v) tanh(v/v_ε) − b v,  g(v) = F_C + (F_S − F_C) e^{−(v/v_S)²},
+/// and dQ/dv = −g'(v) tanh(v/v_ε) − g(v) sech²(v/v_ε)/v_ε − b with g'(v) = −2 v/v_S² (F_S − F_C) e^{−(v/v_S)²}.
+struct RegularisedFriction {
+  double FS, FC, vS, b, ve;  ///< breakaway, Coulomb (N or N·m), Stribeck and smoothing velocities, viscous
+  double force(double v) const { return -dry(v) * std::tanh(v / ve) - b * v; }
+  double rate_derivative(double v) const {
+    const double x = v / vS, th = std::tanh(v / ve);
+    const double dg = -2.0 * x / vS * (FS - FC) * std::exp(-x * x);
+    return -dg * th - dry(v) * (1.0 - th * th) / ve - b;
+  }
+  double dry(double v) const {
+    const double x = v / vS;
+    return FC + (FS - FC) * std::exp(-x * x);
+  }
+};
+
 /// A scalar function of time and one state's value and rate, given from Python: a force element's F(t, l, l̇) (N),
 /// a joint coordinate's Q(t, q, q̇) (N or N·m).
 using ScalarFunction = std::function<double(double, double, double)>;

@@ -14,7 +14,7 @@ marked as parameters become named parameters ``"<name>.<constant>"`` of the comp
 >>> [(c.name, c.unit, c.value) for c in rope.constants]
 [('EA', 'N', 200000000.0), ('DA', 'N s', 0.0), ('length', 'm', 12.0)]
 >>> sorted(rf.laws.kinds())
-['Buffer', 'Contact', 'ForceFunction', 'Friction', 'Rope', 'SpringDamper', 'SpringDamping']
+['Buffer', 'Contact', 'ForceFunction', 'Friction', 'Rope', 'SlidingFriction', 'SpringDamper', 'SpringDamping']
 """
 
 from __future__ import annotations
