@@ -241,9 +241,14 @@ void for_each_contact_force(const System& sys, const Data& d, bool spatial,
     std::copy_if(C.shapes_b.begin(), C.shapes_b.end(), std::back_inserter(sb), is_swept);
     if (sa.size() * sb.size() > 64) {
       swept_groups(sys, d, spatial, k, sa, sb, visit);
-    } else {
-      for (const int ia : sa)
-        for (const int ib : sb) swept_pair(sys, d, spatial, k, swept(sys, d, ia, 0), swept(sys, d, ib, 0), visit);
+    } else {  // a few pairs: each shape placed once, every pair tested
+      thread_local std::vector<Swept> wb;
+      wb.clear();
+      for (const int ib : sb) wb.push_back(swept(sys, d, ib, 0));
+      for (const int ia : sa) {
+        const Swept wa = swept(sys, d, ia, 0);
+        for (const Swept& w : wb) swept_pair(sys, d, spatial, k, wa, w, visit);
+      }
     }
   }
 }

@@ -161,7 +161,7 @@ def shape_indices(model, group, argument: str) -> list[int]:
         raise _checks.refuse(f"{argument}: expected a shape of this model (Model.add_shape) or a list of them, "
                              f"got {group!r}")
     indices = [k for h in items for k in h.shapes]
-    if any(k >= len(model._shape_table) or model._shape_table[k]["name"] not in (h, f"{h}[{j}]")
-           for h in items for j, k in enumerate(h.shapes)):
+    names = [row["name"] for row in model._shape_table]  # built once: the table is made anew at each access
+    if any(k >= len(names) or names[k] not in (h, f"{h}[{j}]") for h in items for j, k in enumerate(h.shapes)):
         raise _checks.refuse(f"{argument}: expected shapes of this model, got {group!r}")
     return indices
