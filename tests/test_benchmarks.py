@@ -290,3 +290,5 @@ def test_contact_benchmark_quick():
     table = contact.contact_cost((10,))
     row = table.rows[0]
     assert row["overlaps"] == 2 * 11 and row["fd_us_with"] > 0 and row["jac_ms_with"] > 0
+    for row in contact.impact_accuracy(("dopri5",), (1e-6,)).rows:  # p = 1 and 1.5
+        assert row["error_located"] < row["error_crossed"] and 1 / 3 < row["estimate_over_error_located"] < 3

@@ -8,6 +8,7 @@ import math
 import numpy as np
 import pytest
 from scipy.optimize import brentq
+from scipy.special import beta
 
 import rigidfem as rf
 from conftest import central_jacobians
@@ -361,3 +362,121 @@ def test_a_box_on_a_heaving_deck_follows_it_and_is_pushed_by_its_acceleration():
         assert len(states) == 4
         push = sum(c["force"][2] for c in states)
         assert push == pytest.approx(m * (g - a * omega ** 2 * np.sin(omega * tk)), abs=1e-3 * m * g)
+
+
+def test_hertzs_impact_lasts_and_peaks_as_the_closed_form_says():
+    """An elastic Hertz impact (p = 3/2, e = 1) of a ball at v: δ_max = (5 m v²/(4 k))^(2/5), the peak force
+    k δ_max^(3/2) and the duration 2 (δ_max/v) ∫₀¹ (1 − x^(5/2))^(−1/2) dx = (4/5) B(2/5, 1/2) δ_max/v. The
+    onset and separation are the contact's own events; the deepest point an event of the rate."""
+    k, mass, v = 1e6, 2.0, 1.5
+    system = drop(rf.laws.Contact(stiffness=k, exponent=1.5, restitution=1.0), mass=mass)
+    deepest = rf.Event("deepest", "ball.z", rate=True, direction=1)
+    r = rf.simulate(system, 0.05, "dopri5", q0=[1e-3], qd0=[-v], rtol=1e-12, atol=1e-14, events=[deepest])
+    delta_max = (5.0 * mass * v ** 2 / (4.0 * k)) ** 0.4
+    onset, separation = r.event_times("bounce")
+    assert separation - onset == pytest.approx(0.8 * beta(0.4, 0.5) * delta_max / v, rel=1e-9)
+    (bottom,) = [f for f in r.events if f.event == "deepest"]
+    assert -bottom.q[0] == pytest.approx(delta_max, rel=1e-9)
+    states = system.contact_states(bottom.t, bottom.q, bottom.qd)
+    assert states[0]["normal_force"] == pytest.approx(k * delta_max ** 1.5, rel=1e-8)
+    assert r.qd[-1, 0] == pytest.approx(v, rel=1e-9)  # elastic: it leaves as it came
+
+
+@pytest.mark.parametrize("v_in", [0.01, 0.1, 1.0, 10.0])
+@pytest.mark.parametrize("exponent", [1.0, 1.5])
+def test_the_restitution_holds_over_impact_speeds_from_a_centimetre_to_ten_metres_per_second(exponent, v_in):
+    """The speed at separation (the contact's event, terminal) against the law's invariant at every impact speed
+    in 0.01–10 m/s, and e v_e at the impact speed the restitution was set at."""
+    left = rf.Event("left", "bounce", direction=1, terminal=True)
+    for e_at, v in ((v_in, v_in), (1.0, v_in)):
+        law = rf.laws.Contact(stiffness=1e6, exponent=exponent, restitution=0.6, impact_speed=e_at)
+        r = rf.simulate(drop(law), 10.0, "dopri5", q0=[1e-6], qd0=[-v], rtol=1e-11, atol=1e-15, events=[left])
+        assert r.events[-1].event == "left"
+        assert r.events[-1].qd[0] == pytest.approx(rebound(0.6, e_at, v), rel=1e-7)
+
+
+@pytest.mark.parametrize("ratio", [0.9, 1.1])
+def test_a_block_on_an_incline_holds_below_mu_s_and_slides_above_at_the_kinetic_rate(ratio):
+    """A block (a sphere that cannot turn: joint x, z) on a plane tilted by α (gravity turned): at tan α = 0.9 μ_s it
+    creeps at the regularised law's v with μ(v) tanh(v/v_ε) = tan α (micro-metres per second: it holds); at
+    tan α = 1.1 μ_s it slides, accelerating at g (sin α − μ_k cos α) once v ≫ v_S."""
+    mu_s, mu_k, g, v_eps, v_s = 0.5, 0.3, 9.81, 1e-5, 0.01
+    alpha = math.atan(ratio * mu_s)
+    model = rf.Model(gravity=(g * math.sin(alpha), 0.0, -g * math.cos(alpha)))
+    block = model.add_body("block", model.ground, rf.Joint.custom(["x", "z"]), 1.0, (0.01, 0.01, 0.01),
+                           placement=rf.transform((0.0, 0.0, 0.05)))
+    k = 1e6
+    model.add_contact("on slope", model.add_shape("s", block, rf.shapes.Sphere(0.05)),
+                      model.add_shape("slope", model.ground, rf.shapes.HalfSpace()),
+                      rf.laws.Contact(stiffness=k, exponent=1.0, restitution=0.2, impact_speed=0.1, mu_s=mu_s,
+                                      mu_k=mu_k, stribeck=v_s, smoothing=v_eps))
+    s = model.compile()
+    settled = -g * math.cos(alpha) / k  # resting on the slope: k δ = m g cos α
+    t_eval = [1.0, 1.5, 2.0]
+    r = rf.simulate(s, 2.0, "radau5", q0=[0.0, settled], rtol=1e-10, atol=1e-13, t_eval=t_eval)
+    v = r.qd[:, 0]
+    if ratio < 1.0:
+        mu = lambda u: mu_k + (mu_s - mu_k) * math.exp(-(u / v_s) ** 2)  # noqa: E731
+        creep = brentq(lambda u: mu(u) * math.tanh(u / v_eps) - math.tan(alpha), 0.0, 10 * v_eps)
+        assert v[-1] == pytest.approx(creep, rel=1e-6)
+        assert r.q[-1, 0] < 1e-4
+    else:
+        assert v[1] > 10 * v_s
+        assert (v[2] - v[1]) / 0.5 == pytest.approx(g * (math.sin(alpha) - mu_k * math.cos(alpha)), rel=1e-6)
+
+
+def test_st_venants_rod_strikes_a_wall_for_2l_over_c_and_leaves_at_its_speed():
+    """A free steel rod (axial sdes) at v0 against a rigid wall (a contact of stiffness 0.5 m EA/L, elastic): St-Venant's
+    contact lasts 2L/c (c = √(E/ρ)) and the rod leaves at −v0. The duration, from the contact's onset to its
+    separation (events), converges to 2L/c at first order in m; the rebound of the centre of mass is within 0.3 % of
+    v0 (what stays behind is the discrete rod's vibration)."""
+    E, rho, d, L, v0 = 2.1e11, 7850.0, 0.02, 1.0, 1.0
+    EA, T = E * math.pi * d * d / 4, 2 * L / math.sqrt(E / rho)
+    errors = []
+    for m in (8, 16, 32, 64):
+        model = rf.Model(gravity=(0.0, 0.0, 0.0))
+        rod = model.add_beam("rod", model.ground, L, rf.Material(E=E, rho=rho), rf.Section.circle(d), m,
+                             formulation="classical", deform=["axial"], joint=rf.Joint.prismatic("x"))
+        wall = rf.shapes.HalfSpace(normal=(-1.0, 0.0, 0.0), point=(L + d / 2 + 1e-6, 0.0, 0.0))
+        model.add_contact("hit", model.add_shape("caps", rod, rf.shapes.Capsules()),
+                          model.add_shape("wall", model.ground, wall),
+                          rf.laws.Contact(stiffness=0.5 * m * EA / L, exponent=1.0, restitution=1.0))
+        s = model.compile()
+        qd0 = np.zeros(s.nq)
+        qd0[0] = v0
+        r = rf.simulate(s, 2 * T, "auto", qd0=qd0, rtol=1e-9, atol=1e-13, t_eval=[1.8 * T, 2 * T])
+        onset, separation = r.event_times("hit")
+        errors.append(abs((separation - onset) / T - 1.0))
+        x = np.array([[r.position(body)[k, 0] for body in rod.rfes] for k in range(2)])
+        masses = np.array(s.masses)
+        assert masses @ (x[1] - x[0]) / masses.sum() / (0.2 * T) == pytest.approx(-v0, rel=6e-3 if m == 8 else 3e-3)
+    assert all(1.6 < a / b < 2.4 for a, b in zip(errors, errors[1:])) and errors[-1] < 0.04
+
+
+def test_a_cantilever_strikes_a_stop_converging_in_m_and_in_time_with_an_honest_error_bar():
+    """A steel rod clamped at one end sags under gravity onto a ball 2 mm below its tip. The first strike's time
+    (the contact's event) converges in m at second order; the tip's error bar (the second run at tolerances / 10)
+    is within 3x of its true error (a run at rtol = 1e-12) through the strikes."""
+    d, L = 0.02, 1.0
+
+    def cantilever(m):
+        model = rf.Model(gravity=(0.0, 0.0, -9.81))
+        rod = model.add_beam("rod", model.ground, L, rf.Material(E=2.1e11, rho=7850.0), rf.Section.circle(d), m,
+                             deform=["bend_y"])
+        stop = rf.shapes.Sphere(0.01, center=(L, 0.0, -d / 2 - 2e-3 - 0.01))
+        model.add_contact("strike", model.add_shape("caps", rod, rf.shapes.Capsules()),
+                          model.add_shape("stop", model.ground, stop),
+                          rf.laws.Contact(stiffness=1e8, exponent=1.5, restitution=0.5, impact_speed=0.1))
+        return model.compile(), rod
+
+    first = [rf.simulate(cantilever(m)[0], 0.03, rtol=1e-9, atol=1e-12).event_times("strike")[0] for m in (4, 8, 16, 32)]
+    steps = np.abs(np.diff(first))
+    assert all(steps[1:] < steps[:-1] / 2.5)
+    s, rod = cantilever(8)
+    t_eval = np.linspace(0.0, 0.1, 201)
+    tip = lambda r: r.position(rod.tip)[:, 2]  # noqa: E731
+    truth = tip(rf.simulate(s, 0.1, "radau5", t_eval=t_eval, rtol=1e-12, atol=1e-15))
+    r = rf.simulate(s, 0.1, t_eval=t_eval, rtol=1e-6, atol=1e-9)
+    assert len(r.event_times("strike")) >= 4
+    error, estimated = np.abs(tip(r) - truth).max(), np.abs(r.error_estimate.of(tip)).max()
+    assert error / 3 < estimated < 3 * error

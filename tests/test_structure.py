@@ -125,7 +125,8 @@ LAYERS = [
     {"lagrange", "recursive", "derivatives"},  # the formulations
     {"dynamics"},                              # the only place that chooses one
     {"error_measure", "sensitivities"},        # the outputs an error is measured on; the sensitivity equations
-    {"integrators", "stepper", "newton_matrix", "gmres", "outputs", "timing", "auto_method", "newmark", "radau"},
+    {"integrators", "stepper", "newton_matrix", "gmres", "outputs", "timing", "auto_method", "newmark", "radau",
+     "events"},
     {"adjoint"},                               # the methods' transposes over whole runs
 ]
 RANK = {name: k for k, layer in enumerate(LAYERS) for name in layer}

@@ -119,6 +119,39 @@ void bind_integrators(py::module_& m) {
           py::arg("plus"), py::arg("minus"), py::arg("h"), py::arg("S0"),
           "A direction of the forward sensitivities: the system at p + h and, for a central difference, at p - h "
           "(None, None: an initial value), and [dq0/dp, dqd0/dp] (2 nq).")
+      .def(
+          "add_event",
+          [](IntegratorOptions& o, const std::string& kind, const std::string& name, int index, const Vec3& r,
+             const Vec3& axis, double value, int direction, bool terminal, bool restarts, const py::object& function) {
+            // kind: "coordinate", "rate", "point", "contact" or "function" (function(t, q, qd), called with the GIL)
+            static const std::pair<const char*, EventSpec::Kind> kinds[] = {
+                {"coordinate", EventSpec::Kind::Coordinate}, {"rate", EventSpec::Kind::Rate},
+                {"point", EventSpec::Kind::Point}, {"contact", EventSpec::Kind::Contact},
+                {"function", EventSpec::Kind::Function}};
+            EventSpec e;
+            bool known = false;
+            for (const auto& [k, value_kind] : kinds)
+              if (kind == k) e.kind = value_kind, known = true;
+            if (!known) bad("events", "'coordinate', 'rate', 'point', 'contact' or 'function' events", kind);
+            e.name = name, e.index = index, e.r = r, e.axis = axis, e.value = value, e.direction = direction;
+            e.terminal = terminal, e.restarts = restarts;
+            if (!function.is_none()) {
+              // the reference is dropped under the GIL wherever the last copy dies
+              std::shared_ptr<py::object> f(new py::object(function), [](py::object* x) {
+                py::gil_scoped_acquire gil;
+                delete x;
+              });
+              e.function = [f](double t, const VecX& q, const VecX& qd) {
+                py::gil_scoped_acquire gil;
+                return (*f)(t, q, qd).cast<double>();
+              };
+            }
+            o.events.push_back(std::move(e));
+          },
+          py::arg("kind"), py::arg("name"), py::arg("index"), py::arg("r"), py::arg("axis"), py::arg("value"),
+          py::arg("direction"), py::arg("terminal"), py::arg("restarts"), py::arg("function"),
+          "An event of the run (events.hpp): its kind, name, index (coordinate, body or contact), r and axis (a "
+          "point's), the value g crosses, direction, terminal, restarts, and function(t, q, qd) for 'function'.")
       .def_property(
           "stiff_method", [](const IntegratorOptions& o) { return method_name(o.stiff_method); },
           [](IntegratorOptions& o, const std::string& name) { o.stiff_method = parse_method(name); })
@@ -230,10 +263,13 @@ void bind_integrators(py::module_& m) {
         stats["omega_max"] = st.omega_max;
         stats["probe_steps"] = st.probe_steps;
         stats["model_size"] = st.model_size;
+        stats["event_restarts"] = st.event_restarts;
+        py::list events;  // (event, t, direction, y, dt/dp) each
+        for (const EventRecord& e : tr.events) events.append(py::make_tuple(e.event, e.t, e.direction, e.y, e.dt_dp));
         return py::make_tuple(VecX(Eigen::Map<const VecX>(tr.t.data(), tr.t.size())), stack(tr.q, s.nq),
                               stack(tr.qd, s.nq), stats, tr.interrupted, failure, stack(tr.s, s.nz),
                               multipliers(tr.lambda, s.nl),
-                              stack(tr.sensitivities, 2 * s.nq * static_cast<int>(o.sensitivities.size())));
+                              stack(tr.sensitivities, 2 * s.nq * static_cast<int>(o.sensitivities.size())), events);
       },
       py::arg("system"), py::arg("t0"), py::arg("t_end"), py::arg("q0"), py::arg("qd0"), py::arg("t_eval"),
       py::arg("options"), py::arg("keep_going"));

@@ -3,6 +3,7 @@
 #include <algorithm>
 #include <cmath>
 #include <iterator>
+#include <limits>
 #include <utility>
 #include <vector>
 
@@ -251,6 +252,56 @@ void for_each_contact_force(const System& sys, const Data& d, bool spatial,
       }
     }
   }
+}
+
+double contact_gap(const System& sys, const Data& d, int k) {
+  const Contact& C = sys.contacts[k];
+  const auto plane = [&](int s) { return sys.shapes[s].kind == ShapeKind::HalfSpace; };
+  double gap = std::numeric_limits<double>::infinity();
+  // g = n·(x_B − o) − r_B of every feature of the other group's shapes against each half-space
+  const auto against_plane = [&](const Shape& P, const Shape& O) {
+    if (P.body == O.body) return;
+    const Vec3 o = global(d, P.body, P.a), n = turned(d, P.body, P.n);
+    shape_points(O, d, [&](const Vec3& x, double r) { gap = std::min(gap, n.dot(x - o) - r); });
+  };
+  for (const int ia : C.shapes_a)
+    for (const int ib : C.shapes_b)
+      if (plane(ia) != plane(ib)) plane(ia) ? against_plane(sys.shapes[ia], sys.shapes[ib])
+                                            : against_plane(sys.shapes[ib], sys.shapes[ia]);
+  // g = |p_B − p_A| − r_A − r_B of two swept spheres, from the closest points of their segments
+  const auto pair_gap = [&](const Swept& A, const Swept& B) {
+    if (sys.shapes[A.shape].body == sys.shapes[B.shape].body) return;
+    double s = 0.0, t = 0.0;
+    closest_points<double>(A.p0, A.p1, B.p0, B.p1, s, t);
+    const Vec3 pa = A.p0 + s * (A.p1 - A.p0), pb = B.p0 + t * (B.p1 - B.p0);
+    gap = std::min(gap, (pb - pa).norm() - A.radius - B.radius);
+  };
+  std::vector<Swept> wa, wb;
+  double reach = 0.0;  // the largest radius: pairs whose extents along x lie farther apart have larger gaps
+  for (const int s : C.shapes_a)
+    if (!plane(s) && sys.shapes[s].kind != ShapeKind::Box) wa.push_back(swept(sys, d, s, 0)), reach = std::max(reach, wa.back().radius);
+  for (const int s : C.shapes_b)
+    if (!plane(s) && sys.shapes[s].kind != ShapeKind::Box) wb.push_back(swept(sys, d, s, 0)), reach = std::max(reach, wb.back().radius);
+  if (wa.size() * wb.size() <= 4096) {
+    for (const Swept& A : wa)
+      for (const Swept& B : wb) pair_gap(A, B);
+    return gap;
+  }
+  // many pairs: only those whose extents, widened by `reach`, meet (the others' gaps exceed reach): g = min(reach, ...)
+  // is then the same continuous function, at O(n log n + pairs)
+  std::vector<std::pair<const Swept*, bool>> all;
+  for (const Swept& w : wa) all.push_back({&w, true});
+  for (const Swept& w : wb) all.push_back({&w, false});
+  std::sort(all.begin(), all.end(), [](const auto& x, const auto& y) { return x.first->lo < y.first->lo; });
+  std::vector<const Swept*> open_a, open_b;
+  for (const auto& [w, in_a] : all) {
+    std::vector<const Swept*>& other = in_a ? open_b : open_a;
+    other.erase(std::remove_if(other.begin(), other.end(), [&](const Swept* o) { return o->hi + reach < w->lo; }),
+                other.end());
+    for (const Swept* o : other) pair_gap(*w, *o);
+    (in_a ? open_a : open_b).push_back(w);
+  }
+  return std::min(gap, reach);
 }
 
 Eigen::Matrix<double, 6, 24> contact_jacobian(const System& sys, const ContactForce& c) {

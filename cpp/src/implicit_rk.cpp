@@ -121,6 +121,7 @@ class ImplicitRk : public Stepper {
       for (int j = 0; j < P; ++j) Sq_.col(j) = y0.segment(k0 + 2 * n_ * j, n_), Sv_.col(j) = y0.segment(k0 + 2 * n_ * j + n_, n_);
       sensitivity_accelerations(t0);
     }
+    restarted();
   }
 
   /// Loops: (q, q̇) onto the constraint manifold at t after each accepted step (closure residual
@@ -239,6 +240,8 @@ class ImplicitRk : public Stepper {
   /// The tolerances the estimate is held to, for the tolerances asked.
   virtual const Tolerances& controlled(const Tolerances& asked) { return asked; }
   virtual void accepted() {}
+  /// A new start (the run's, or a step taken again after an event): no last step to predict from.
+  virtual void restarted() {}
 
   /// [S_q, S_q̇] of each parameter in turn (2 nq P; empty without sensitivities).
   VecX sensitivity_blocks() const {
@@ -585,6 +588,7 @@ class Esdirk final : public ImplicitRk {
     h_previous_ = h_;
     have_previous_ = true;
   }
+  void restarted() override { have_previous_ = false; }
 
   /// Stage i: A_i solving r(A_i) = M(Q_i) A_i − f(Q_i, V_i, t_i) = 0 by A_i ← A_i − S⁻¹ r, with
   /// V_i = v̂ + γh A_i, Q_i = q̂ + γh V_i (left in V_.col(i), Q_).
@@ -910,6 +914,7 @@ class Radau5 final : public ImplicitRk, public RadauAccess {
     have_previous_ = true;
     rejected_ = false;
   }
+  void restarted() override { have_previous_ = false, rejected_ = false; }
 
   /// Hairer's estimate: x = (I − g J)⁻¹ g [f(y_n) + Σ dd_i (Y_i − y_n)/h], g = h d₁, J the Jacobian
   /// of [q̇, q̈]: with b = [b₁, b₂] the bracket, (M + g C + g² K) x_q = M (g² b₂ + g b₁) + g² C b₁ and

@@ -163,6 +163,18 @@ class Recorder {
     }
     while (next_ < t_eval_.size() && t_eval_(next_) <= t0) push(t_eval_(next_++), y0, &stepper);
   }
+  /// A terminal event at t (within the last accepted step) with the state y there: the requested times up to t by
+  /// dense output, or t itself when every step is recorded; the run ends.
+  void end(double t, const VecX& y, const Stepper& stepper) {
+    if (t_eval_.size() == 0) {
+      push(t, y, &stepper);
+      return;
+    }
+    while (next_ < t_eval_.size() && t_eval_(next_) <= t) {
+      const double te = t_eval_(next_++);
+      push(te, te == t ? y : stepper.dense(te), &stepper);
+    }
+  }
   /// Forgets every output (a run that starts again from t0).
   void clear() {
     traj_.t.clear(), traj_.q.clear(), traj_.qd.clear(), traj_.s.clear(), traj_.lambda.clear();
@@ -295,6 +307,12 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
   StepSizeControl control(stepper->control());
   stepper->start(t0, y0);
   out.start(t0, stepper->state(), *stepper);
+  EventLocator events(sys, o.events, static_cast<int>(o.sensitivities.size()));
+  if (!events.empty()) events.start(t0, stepper->state());
+  VecX y_start;          // events: the state at the step's start, to take the step again
+  EventRecord cap;       // a root that restarts: the steps end there
+  bool capped = false;
+  int retaken = 0;       // times the step from the current t was taken again
   const Tolerances* tol = choice ? &choice->tolerances() : &asked;
   double h = o.dt > 0.0 ? std::min(o.dt, span) : stepper->initial_step(span, *tol, o.max_step);
 
@@ -307,6 +325,7 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
       hs = std::min({h, o.max_step, t_end - t});
       if (t + hs > near_end) hs = t_end - t;
       t1 = t + hs >= near_end ? t_end : t + hs;
+      if (capped && t1 >= cap.t) t1 = cap.t, hs = cap.t - t;  // to the root the step was cut at
     } else {
       t1 = t0 + static_cast<double>(stats.steps + 1) * grid;
       if (t1 > near_end) t1 = t_end;
@@ -318,6 +337,7 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
       step_failure(t, hs, "the step size fell below the minimum: the problem is too stiff or singular for this method");
     if (measure && !measured) measure->at(t, stepper->state()), measured = true;  // linearised at the step's start
     double err = 0.0;
+    if (!events.empty() && adaptive) y_start = stepper->state();
     if (!stepper->attempt(t, hs, adaptive ? tol : nullptr, err)) {
       if (!adaptive)
         step_failure(t, hs, "Newton iterations did not converge in newton_max_iterations = " +
@@ -337,6 +357,34 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
     stepper->accept();
     measured = false;
     if (sys.nl > 0) stepper->project(t1);
+    if (!events.empty()) {
+      const auto dense = [&](double te) { return stepper->dense(te); };
+      const std::vector<EventRecord> found =
+          events.roots(t, t1, stepper->state(), dense, capped && t1 == cap.t ? &cap : nullptr);
+      // the first root inside the step (not within 1e-9 of it from either end) that restarts: the step again from its
+      // start, ending there (adaptive runs; a fourth time from the same start, the root is taken where this step's
+      // dense output puts it)
+      const double near = 1e-9 * (t1 - t) + 16.0 * std::numeric_limits<double>::epsilon() * std::abs(t1);
+      const auto restart = std::find_if(found.begin(), found.end(), [&](const EventRecord& r) {
+        return adaptive && r.t > t + near && r.t < t1 - near && events.spec(r.event).restarts;
+      });
+      if (restart != found.end() && retaken < 3) {
+        cap = *restart, capped = true, ++retaken, ++stats.event_restarts;
+        stepper->start(t, y_start);
+        continue;
+      }
+      if (capped && t1 == cap.t) capped = false;
+      retaken = 0;
+      for (const EventRecord& r : found) {
+        traj.events.push_back(r);
+        if (!events.spec(r.event).terminal) continue;
+        ++stats.steps;
+        out.end(r.t, r.y, *stepper);
+        last_q = r.y.head(n);
+        return;
+      }
+      events.commit();
+    }
     t = t1;
     ++stats.steps;
     const VecX& y = stepper->state();
@@ -353,6 +401,8 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
         out.clear();
         out.start(t0, stepper->state(), *stepper);
         last_q = q0;
+        traj.events.clear(), capped = false, retaken = 0;
+        if (!events.empty()) events.start(t0, stepper->state());
       }
       measured = false;
     }

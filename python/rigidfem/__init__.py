@@ -41,6 +41,7 @@ from .model.model import Model, System
 from .model.parameters import Parameter
 from .simulation import options, sensitivities  # the C++ method and option tables; forward sensitivities
 from .simulation.error_control import ErrorEstimate
+from .simulation.events import Event
 from .simulation.integration import simulate
 from .simulation.options import integrator_options, methods
 from .simulation.result import Result, load_npz
@@ -79,6 +80,7 @@ __all__ = [
     "Body",
     "Data",
     "Equilibrium",
+    "Event",
     "Gradient",
     "ErrorEstimate",
     "Joint",

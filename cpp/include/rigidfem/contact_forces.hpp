@@ -37,6 +37,12 @@ struct ContactForce {
 void for_each_contact_force(const System& sys, const Data& d, bool spatial,
                             const std::function<void(const ContactForce&)>& visit);
 
+/// The smallest gap (m) between the shapes of contact k at d's frames (d.T), overlapping or not: negative once they
+/// overlap (its events' function: onset and separation). Where two groups of many spheres and capsules meet, the
+/// pairs whose extents along x lie farther apart than the largest radius are left out and the gap is capped there
+/// (the same continuous function near zero).
+double contact_gap(const System& sys, const Data& d, int k);
+
 /// J = ∂(x_c × f, f)/∂ε (6×24) of one overlap: the change of the wrench on body b about the global origin when the
 /// bodies move by the twists W_a, W_b (a material point x moves by W_v + W_ω × x) and their spatial velocities
 /// change by δV_a, δV_b, ε = (W_a, δV_a, W_b, δV_b); by automatic differentiation of the kernels (exact).

@@ -14,6 +14,7 @@
 #include <vector>
 
 #include "rigidfem/error_measure.hpp"
+#include "rigidfem/events.hpp"
 #include "rigidfem/sensitivities.hpp"
 #include "rigidfem/system.hpp"
 
@@ -83,6 +84,8 @@ struct IntegratorOptions {
   /// Forward sensitivities (sensitivities.hpp) integrated with the state by the explicit Runge–Kutta methods
   /// and the Newmark family; their error is not controlled (the steps are the state's).
   std::vector<SensitivityParameter> sensitivities;
+  /// Functions whose roots the run locates (events.hpp): recorded in Trajectory::events, terminal ones end the run.
+  std::vector<EventSpec> events;
 };
 
 /// An option's value as the Python layer gives and shows it: none, a number, an integer, a flag, a name or
@@ -124,6 +127,7 @@ struct IntegratorStats {
   double stiff_at = std::numeric_limits<double>::quiet_NaN();
   /// auto: the time (s) its stiff method took over for the rest of the run, NaN if the run ended on dopri5.
   double switched_at = std::numeric_limits<double>::quiet_NaN();
+  long event_restarts = 0;  ///< steps taken again to end at a root that restarts (a contact's onset or separation)
   long auto_trials = 0;  ///< auto: trials of its stiff method (a lost trial returns to dopri5)
   /// auto: the spectral radius of y' = (q̇, q̈)'s Jacobian at t0 (rad/s; ω_max for an undamped
   /// structure), NaN for the other methods.
@@ -143,6 +147,7 @@ struct Trajectory {
   std::vector<VecX> lambda;
   /// (len t) x (2 nq P) the sensitivities [S_q, S_q̇] of each parameter in turn; empty rows without them.
   std::vector<VecX> sensitivities;
+  std::vector<EventRecord> events;  ///< the roots located, in time order
   IntegratorStats stats;
   bool interrupted = false;  ///< the monitor asked to stop: the trajectory ends early
   /// The exception that ended the run early — a SimulationError (numerical failure, max_steps),

@@ -52,6 +52,7 @@ import numpy as np
 from ..base import _checks, _interrupt
 import rigidfem._core as _core  # the compiled core, by its absolute name
 from . import error_control
+from . import events as events_
 from . import sensitivities as sensitivities_
 from . import options as options_
 from ..base._progress import ProgressBar
@@ -64,7 +65,7 @@ __doc__ = __doc__.replace("{methods}", "\n".join(f"- ``{m.name}`` ({m.family}{f'
 
 def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=None, qd0=None, s0=None,
              t_eval=None, progress: bool = False, stop=None, error_estimate: bool = False, sensitivities=None,
-             **options) -> Result:
+             events=None, contact_events: bool = True, **options) -> Result:
     """Integrate ``system`` from ``t0`` to ``t_end`` (s) in C++ (no Python per step).
 
     The run's arguments come by name after ``method``; the integrator's ``**options`` (``dt``,
@@ -137,6 +138,15 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
         (``"q0[<coordinate>]"``, ``"qd0[<coordinate>]"``), integrated with the state by every C++
         method (``rigidfem.sensitivities``); ``Result.sensitivity(name)`` and
         ``Result.position_sensitivity(point, name)`` return them.
+    events : list of rigidfem.Event, optional
+        Functions whose zeros the run locates (``rigidfem.simulation.events``): a coordinate or its rate, a point's
+        position along an axis, a contact's gap, or a Python function of (t, q, qd) (the slow path). Each root is
+        located on the method's dense output to 1e-12 of its step and recorded in ``Result.events`` (time, state,
+        direction, and dt*/dp with ``sensitivities``); a terminal one ends the run there. C++ methods only.
+    contact_events : bool
+        Locate every contact's onset and separation (``Model.add_contact``; True by default, C++ methods): adaptive
+        methods take the step that crossed one again so that it ends there, and the impact's error is controlled
+        like the rest of the run. They are recorded in ``Result.events`` under the contacts' names.
     **options
         The integrator's options (``rigidfem.integrator_options``):
 
@@ -215,6 +225,12 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
         x.set_error_on(outputs)
     _core._check_options(system, t0, t_end, q0, qd0, t_eval, judged)  # the values, once (the sensitivities': integrate)
     names = sensitivities_.directions(system, sensitivities, opt, t0, t_end)
+    events = events_.as_list(events)
+    specs = events_.compiled(system, events, _checks.boolean(contact_events, "contact_events") and not scipy)
+    if specs and scipy:
+        raise _checks.refuse(f"method: expected a C++ method for a run with events, got {method!r}")
+    for spec in specs:
+        opt.add_event(*spec)
     if names and scipy:  # the options are checked first: a bad one is named whatever the method
         raise _checks.refuse(f"method: expected a C++ method that integrates sensitivities (dopri5, rk4, generalized_alpha, "
                          f"...), got {method!r}")
@@ -245,7 +261,7 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
         if bar is not None:
             bar.close()
     t, q, qd, stats, interrupted, failure, *extra = run
-    arms, own, raw = extra if extra else (np.zeros((len(t), 0)), None, None)
+    arms, own, raw, records = extra if extra else (np.zeros((len(t), 0)), None, None, [])
     if own is not None and not (system.nl and np.isfinite(own).all()):
         own = None  # the method has no multipliers of its own (NaN rows from _core._integrate)
     if scipy:
@@ -253,10 +269,12 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
     if system.nl:
         stats["loop_reactions"] = _reactions_source(own, method)
     call = dict(o, method=method, t_end=t_end, t0=t0, q0=q0, qd0=qd0, s0=s0, t_eval=t_eval if len(t_eval) else None,
-                rtol=rtol, atol=atol, max_steps=max_steps, max_step=max_step)
+                rtol=rtol, atol=atol, max_steps=max_steps, max_step=max_step, events=events,
+                contact_events=contact_events)
     result = Result(system, t, q, qd, stats, method, interrupted, arms, own,
                     dict(call, outputs=bool(outputs), fixed=fixed),
-                    sensitivities=sensitivities_.split(system, names, raw) if names else {}, made_by=simulate)
+                    sensitivities=sensitivities_.split(system, names, raw) if names else {}, made_by=simulate,
+                    events=events_.fired(system, specs, records, names))
     if failure is not None:
         message, time, cause = failure
         error = _core.SimulationError(message)

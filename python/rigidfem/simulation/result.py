@@ -13,6 +13,7 @@ import numpy as np
 from ..base import _checks, display, export
 import rigidfem._core as _core  # the compiled core, by its absolute name
 from . import error_control
+from . import events as events_
 from . import options as options_
 from ..model import parameters as parameters_
 from ..base.persistence import Versioned, read_result
@@ -60,6 +61,9 @@ class Result(Versioned):
     made_by: object = field(default=None, repr=False)
     #: the names of q's columns (``system.coordinate_names``; the saved ones for a result loaded without its system)
     coordinate_names: list = field(default=None, repr=False)
+    #: the located roots of the run's events (``simulate(events=...)``, the contacts' onsets and separations), in
+    #: time order: ``rigidfem.simulation.events.Fired`` (event, t, direction, q, qd, dt_dp)
+    events: list = field(default_factory=list, repr=False)
 
     def __post_init__(self):
         if self.arm_forces is None:
@@ -202,6 +206,20 @@ class Result(Versioned):
             dx += (up - down) / (2.0 * h)
         return dx
 
+    def event_times(self, name: str) -> np.ndarray:
+        """The times (s) of the roots of the event called ``name`` (``simulate(events=...)``, or a contact's name: its
+        onsets and separations), in order; ValueError for a name the run had no event of."""
+        known = {e[1] for e in self._event_specs()} if self.system is not None and self.run else set()
+        if name not in known | {f.event for f in self.events}:
+            raise _checks.refuse(f"name: expected the name of one of the run's events ({sorted(known) or 'none'}), "
+                                 f"got {name!r}")
+        return np.array([f.t for f in self.events if f.event == name])
+
+    def _event_specs(self) -> list:
+        """The run's events as it compiled them (the contacts' own with them)."""
+        return events_.compiled(self.system, self.run.get("events"), self.run.get("contact_events", True) and
+                                not str(self.method).startswith("scipy:"))
+
     def __repr__(self) -> str:
         s = self.stats
         chosen = f" ({s['method']})" if s.get("method", self.method) != self.method else ""
@@ -259,11 +277,16 @@ def _estimate_error(result: Result):
     run = result.run
     if run is None or result.made_by is None:
         raise _checks.refuse("result: expected a Result made by rigidfem.simulate (a loaded one has no run to repeat)")
-    if result.interrupted or not len(result.t) or result.t[-1] < run["t_end"]:
+    terminal = [e for e in run.get("events") or [] if isinstance(e, events_.Event) and e.terminal]
+    ended = bool(terminal) and bool(result.events) and result.events[-1].t == result.t[-1]  # at a terminal root
+    if result.interrupted or not len(result.t) or (result.t[-1] < run["t_end"] and not ended):
         raise _checks.refuse("result: expected a finished run for its error estimate, got one that stopped at "
                          f"t = {result.t[-1] if len(result.t) else run['t0']:g} s")
     kw = {k: v for k, v in run.items() if k not in ("outputs", "fixed")}
     kw["t_eval"], kw["stiffness_warning"] = result.t, False
+    if ended:  # the second run to the same end, its events located but none ending it
+        kw["t_end"] = result.t[-1]
+        kw["events"] = [dataclasses.replace(e, terminal=False) for e in run["events"]]
     if run["fixed"]:
         kw["dt"] = run["dt"] / 2.0
         order = options_.method(run["method"]).order  # Richardson's factor 2^p/(2^p − 1)
