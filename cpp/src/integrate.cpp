@@ -275,6 +275,25 @@ class StepSizeControl {
   int stiff_steps_ = 0, nonstiff_steps_ = 0;
 };
 
+/// After a step cut a hair before a root where the right-hand side changes (a contact's onset or separation) the run
+/// goes on from t + τ, the state there by the step's dense output, τ the smallest (from 4ε max(1, |t|), by factors of
+/// 4, up to 1e-6 of the step h) that puts the event's function on its new side. The next step's first stage then takes
+/// the new side's right-hand side and its Jacobian (a linear contact's jumps from 0 to k at touch-down: the
+/// sensitivities' equations feel it), not the old side's limit at t*; the state moves by O(τ²) against the steps'
+/// own errors. Returns the time the run goes on from (t* itself where no such τ is found).
+double past_root(EventLocator& events, const EventRecord& root, double t, double h, Stepper& stepper) {
+  double tau = 4.0 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t));
+  for (; tau <= 1e-6 * h; tau *= 4.0) {
+    const VecX y = stepper.dense(t + tau);
+    const double g = events.g(root.event, t + tau, y);
+    if ((g > 0.0 ? 1 : (g < 0.0 ? -1 : 0)) == root.direction) {
+      stepper.start(t + tau, y);
+      return t + tau;
+    }
+  }
+  return t;
+}
+
 /// The one loop, into traj: attempt a step, control its size by the error estimate (adaptive runs)
 /// or keep to the grid t0 + k·dt (fixed steps), record the outputs it covers, ask the monitor; the
 /// last step lands on t_end exactly. last_q: the last accepted coordinates.
@@ -310,6 +329,8 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
   EventLocator events(sys, o.events, static_cast<int>(o.sensitivities.size()));
   if (!events.empty()) events.start(t0, stepper->state());
   VecX y_start;          // events: the state at the step's start, to take the step again
+  double y_start_time = t0;
+  bool arrived = false;  // the last step ended at a root that restarts
   EventRecord cap;       // a root that restarts: the steps end there
   bool capped = false;
   int retaken = 0;       // times the step from the current t was taken again
@@ -337,7 +358,7 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
       step_failure(t, hs, "the step size fell below the minimum: the problem is too stiff or singular for this method");
     if (measure && !measured) measure->at(t, stepper->state()), measured = true;  // linearised at the step's start
     double err = 0.0;
-    if (!events.empty() && adaptive) y_start = stepper->state();
+    if (!events.empty() && adaptive) y_start = stepper->state(), y_start_time = t;
     if (!stepper->attempt(t, hs, adaptive ? tol : nullptr, err)) {
       if (!adaptive)
         step_failure(t, hs, "Newton iterations did not converge in newton_max_iterations = " +
@@ -369,11 +390,15 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
         return adaptive && r.t > t + near && r.t < t1 - near && events.spec(r.event).restarts;
       });
       if (restart != found.end() && retaken < 3) {
+        // the step ends a hair (1e-9 of it) before the root: its last stages stay on the old side, as the dense
+        // output has them, whatever the re-taken step's own error; past_root crosses afterwards
         cap = *restart, capped = true, ++retaken, ++stats.event_restarts;
+        cap.t -= std::min(1e-9 * (t1 - t) + 16.0 * std::numeric_limits<double>::epsilon() * std::abs(cap.t),
+                          0.5 * (cap.t - t));
         stepper->start(t, y_start);
         continue;
       }
-      if (capped && t1 == cap.t) capped = false;
+      if (capped && t1 == cap.t) capped = false, arrived = true;
       retaken = 0;
       for (const EventRecord& r : found) {
         traj.events.push_back(r);
@@ -390,6 +415,10 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
     const VecX& y = stepper->state();
     out.step(t, y, *stepper);
     last_q = y.head(n);
+    if (arrived) {
+      arrived = false;
+      if (t < near_end) t = past_root(events, cap, t, t - y_start_time, *stepper);
+    }
     if (choice && choice->after_step(t, stepper->h_rho(), stats)) {  // auto changes method
       AutoChoice::HandOver next = choice->hand_over(t, h, y, stats);
       stepper = std::move(next.stepper);

@@ -5,9 +5,12 @@
 /// on (and the crossing goes the event's direction), its root t* in [t, t1] is located on the method's dense output
 /// y(t) by the Illinois method, to a bracket of 1e-12 of the step (or the rounding of t). A terminal event ends the
 /// run there. An event that `restarts` (a contact's onset and separation: the contact force begins or ends, the
-/// right-hand side is not smooth there) has the step taken again from its start by adaptive methods, ending at t*:
-/// each step then covers a smooth stretch, so its error estimate holds across the impact as anywhere else (fixed-step
-/// runs keep their grid and locate only).
+/// right-hand side is not smooth there) has the step taken again from its start by adaptive methods, ending a hair
+/// (1e-9 of the step) before t* so that all its stages see the old side; the run then goes on from just past t*
+/// (integrate.cpp: past_root), so that the next step's first stage sees the new side. Each step covers a smooth
+/// stretch: its error estimate holds across the impact as anywhere else, and the sensitivities, whose equations take
+/// the Jacobian (a linear contact's jumps from 0 to k), stay exact. Such a root is recorded where that step ends, within
+/// 1e-9 of the step of t*. Fixed-step runs keep their grid and locate only.
 ///
 /// With forward sensitivities S_j = ∂y/∂p_j the event time's own, from g(t*(p), y(t*(p), p)) = 0:
 ///   dt*/dp_j = −(∂g/∂y · S_j)/ġ,   ġ = ∂g/∂t + ∂g/∂y · ẏ,

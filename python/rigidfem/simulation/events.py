@@ -10,8 +10,10 @@ root is located on the dense output by the Illinois method to a bracket of 1e-12
 
 A run with contacts locates every contact's onset and separation (the gap of its shapes crossing zero) unless
 ``simulate(..., contact_events=False)``: the contact force starts or ends there, a kink in the right-hand side, and
-adaptive methods take the step that crossed it again from its start so that it ends at the root. Each step then
-covers a smooth stretch and its error estimate holds across the impact as anywhere else.
+adaptive methods take the step that crossed it again from its start so that it ends a hair (1e-9 of the step) before
+the root, then go on from a hair past it. Each step then covers a smooth stretch: its error estimate holds across the
+impact as anywhere else, and the sensitivities' equations see the Jacobian change where it does. Such a root is
+recorded where that step ends.
 
 With ``sensitivities=[...]`` each root carries dt*/dp = −(∂g/∂y · S)/ġ (``Fired.dt_dp``, s per unit of p).
 """
