@@ -365,6 +365,9 @@ void bind_model(py::module_& m) {
             return kinds;
           },
           "The loop kinds, each a dict: kind, rows (constraint equations), free (what it leaves free).")
+      .def("_wind", &Model::wind, py::arg("element"), py::arg("body"), py::arg("coordinate"), py::arg("radius"),
+           "Winds force element `element` (a rope) on the drum whose rotation is coordinate `coordinate` (-1: the\n"
+           "only one) of body `body`'s joint, of radius `radius` (m): l_u = l0 + r phi, and the drum takes r P.")
       .def(
           "_add_force_element",
           [](Model& model, const std::string& name, int a, const Vec3& point_a, int b, const Vec3& point_b,

@@ -114,11 +114,14 @@ double ParameterVjp::power(const System& X, const Data& d, const Component& c, c
       return V_[b].dot(I * d.a[b] + crossf(d.v[b], I * d.v[b]));
     }
     case Component::Coordinate:  // −μ_k Q_k
-      return -mu(X.coords[c.index].free_index) * passive_force(X, d, c.index);
-    case Component::Element: {  // −F e·(V_b(x_b) − V_a(x_a)) = −F δl
+      return -mu(X.coords[c.index].free_index) * passive_force(X, d, c.index, true);
+    case Component::Element: {  // −F e·(V_b(x_b) − V_a(x_a)) = −F δl, and a drum's −μ_φ r P
       const ForceElement& E = X.elements[c.index];
       const ElementState s = element_state(d, E, true);
-      return -s.F * s.e.dot(velocity(E.body_b, s.xb) - velocity(E.body_a, s.xa));
+      double p = -s.F * s.e.dot(velocity(E.body_b, s.xb) - velocity(E.body_a, s.xa));
+      if (E.drum >= 0 && X.coords[E.drum].free_index >= 0)
+        p -= mu(X.coords[E.drum].free_index) * E.radius * E.law->pull(d.t, s.extension());
+      return p;
     }
     case Component::Load: {  // −V_bᵀ (x × F + τ, F)
       const Load& L = X.loads[c.index];

@@ -18,10 +18,12 @@ Vec6 turned_inertia_times(const Vec6& s, const Mat6& I, const Vec6& x) { return 
 struct Tangent {
   explicit Tangent(const System& sys)
       : inside(sys.nbodies), W(sys.nbodies, Vec6::Zero()), v(sys.nbodies, Vec6::Zero()), a(sys.nbodies),
-        f(sys.nbodies) {}
+        f(sys.nbodies), dq(VecX::Zero(sys.nq)), dqd(VecX::Zero(sys.nq)), dQ(VecX::Zero(sys.nq)) {}
   std::vector<char> inside;  // body moved by the direction (its frame, or its velocity)
   std::vector<Vec6> W;       // the twist δT_p T_p⁻¹ that carries body p's frame (zero: it stays)
   std::vector<Vec6> v, a, f;  // δv_p, δa_p, δf̄_p (v zero for a body the direction leaves)
+  VecX dq, dqd;  // the direction's (δq, δq̇) (nq): the drums' δφ of the ropes wound on them
+  VecX dQ;       // δQ of the free coordinates' generalised forces outside the RNEA (a drum's r δP)
 };
 
 // A load on a body (the load's own point moving with it: the geometric term of the tangent).
@@ -40,19 +42,29 @@ std::pair<Vec3, Vec3> point_tangent(const Data& d, const Tangent& w, int b, cons
   return {dx, w.v[b].tail<3>() + w.v[b].head<3>().cross(x) + d.v[b].head<3>().cross(dx)};
 }
 
+// The free index of a rope's drum coordinate, −1 for none (not wound, or a prescribed drum).
+int drum_index(const System& sys, const ForceElement& E) { return E.drum >= 0 ? sys.coords[E.drum].free_index : -1; }
+
 // The change of a force element's force f_B = F e = −f_A along the tangent (its points' motion
 // under the fixed force is the geometric term of BodyLoad): with δd = δr_B − δr_A,
-//   δe = (1 − e eᵀ) δd / l,  δl = e·δd,  δl̇ = δe·ḋ + e·δḋ,  δf_B = (F_l δl + F_l̇ δl̇) e + F δe,
-// applied at r_B and r_A as −δf_ext.
-void element_tangent(const Data& d, const ForceElement& E, const ElementState& st, Tangent& w) {
+//   δe = (1 − e eᵀ) δd / l,  δl = e·δd,  δl̇ = δe·ḋ + e·δḋ,  δf_B = (F_l δl + F_l̇ δl̇ + F_s δs + F_ṡ δṡ) e + F δe,
+// applied at r_B and r_A as −δf_ext; a rope wound on a free drum φ (δs = r δφ) changes the drum's r P by
+// r (P_l δl + P_l̇ δl̇ + P_s δs + P_ṡ δṡ), into w.dQ.
+void element_tangent(const System& sys, const Data& d, const ForceElement& E, const ElementState& st, Tangent& w) {
   const auto [dxb, dvb] = point_tangent(d, w, E.body_b, st.xb);
   const auto [dxa, dva] = point_tangent(d, w, E.body_a, st.xa);
   const Vec3 dd = dxb - dxa, ddd = dvb - dva;
-  if (dd.isZero(0.0) && ddd.isZero(0.0)) return;
+  const int k = drum_index(sys, E);
+  const double ds = k >= 0 ? E.radius * w.dq(k) : 0.0, dsd = k >= 0 ? E.radius * w.dqd(k) : 0.0;
+  if (dd.isZero(0.0) && ddd.isZero(0.0) && ds == 0.0 && dsd == 0.0) return;
   const Vec3 de = (dd - st.e * st.e.dot(dd)) / st.l;
   const double dl = st.e.dot(dd), dld = de.dot(st.vb - st.va) + st.e.dot(ddd);
-  const auto [Fl, Fld] = E.law->derivatives(d.t, st.l, st.ld, d.load_factor);
-  const Vec3 df = (Fl * dl + Fld * dld) * st.e + st.F * de;
+  const ExtensionDerivatives F = E.law->derivatives(d.t, st.extension(), d.load_factor);
+  if (k >= 0) {
+    const ExtensionDerivatives P = E.law->pull_derivatives(d.t, st.extension());
+    w.dQ(k) += E.radius * (P.l * dl + P.ld * dld + P.s * ds + P.sd * dsd);
+  }
+  const Vec3 df = (F.l * dl + F.ld * dld + F.s * ds + F.sd * dsd) * st.e + st.F * de;
   for (const auto& [body, x, f] : {std::tuple<int, Vec3, Vec3>{E.body_b, st.xb, df}, {E.body_a, st.xa, -df}}) {
     if (body < 0) continue;
     w.f[body].head<3>() -= x.cross(f);
@@ -141,7 +153,7 @@ struct LoadTerms {
   // The tangents of the loads, the elements' and the contacts' forces and the flowing material's loads.
   void tangent(const Data& d, const System& sys, Tangent& w) const {
     loads_tangent(loads, w);
-    for (std::size_t k = 0; k < elements.size(); ++k) element_tangent(d, sys.elements[k], elements[k], w);
+    for (std::size_t k = 0; k < elements.size(); ++k) element_tangent(sys, d, sys.elements[k], elements[k], w);
     for (std::size_t k = 0; k < contacts.size(); ++k) contact_tangent(contacts[k], contact_J[k], w);
     for (const FlowTerm& f : flows) flow_tangent(f, w);
   }
@@ -157,6 +169,9 @@ struct LoadTerms {
 void tangent_column(const System& sys, const Data& d, const LoadTerms& terms, int uj, int bj, bool position, Tangent& w,
                     Eigen::Ref<VecX> col) {
   const Vec6& s = d.axes[uj];
+  const int j = sys.use_q[uj];  // the column's own free coordinate: δq_j = 1 or δq̇_j = 1 (a drum pays out with it)
+  w.dq.setZero(), w.dqd.setZero(), w.dQ.setZero();
+  (position ? w.dq : w.dqd)(j) = 1.0;
   auto turned = [&](int p, int u) { return position && w.inside[p] && (p != bj || u > uj); };
   for (int p = 0; p < sys.nbodies; ++p) {
     w.inside[p] = p == bj || (p > bj && sys.parent[p] >= 0 && w.inside[sys.parent[p]]);  // parent[p] < p
@@ -194,7 +209,7 @@ void tangent_column(const System& sys, const Data& d, const LoadTerms& terms, in
   accumulate_subtrees(sys, w.f);
   for (int k = 0; k < sys.nq; ++k) {
     const int b = sys.coords[sys.free_coords[k]].body, u = sys.q_use[k];
-    col(k) = d.axes[u].dot(w.f[b]) + (turned(b, u) ? crossm(s, d.axes[u]).dot(d.sf[b]) : 0.0);
+    col(k) = d.axes[u].dot(w.f[b]) + (turned(b, u) ? crossm(s, d.axes[u]).dot(d.sf[b]) : 0.0) - w.dQ(k);
   }
 }
 
@@ -205,6 +220,7 @@ VecX rnea_directional_derivative(const System& sys, Data& d, const VecX& dq, con
   rnea_pass(sys, d);
   const LoadTerms terms(sys, d);
   Tangent w(sys);
+  w.dq = dq, w.dqd = dqd;
   std::vector<Vec6> W_before(sys.nuses);  // the twist carrying each use's axis: δs_u = W ×m s_u
   static const Vec6 O6 = Vec6::Zero();
   for (int p = 0; p < sys.nbodies; ++p) {
@@ -235,7 +251,7 @@ VecX rnea_directional_derivative(const System& sys, Data& d, const VecX& dq, con
   VecX out(sys.nq);
   for (int k = 0; k < sys.nq; ++k) {
     const int i = sys.free_coords[k], b = sys.coords[i].body, u = sys.q_use[k];
-    out(k) = d.axes[u].dot(w.f[b]) + crossm(W_before[u], d.axes[u]).dot(d.sf[b]);
+    out(k) = d.axes[u].dot(w.f[b]) + crossm(W_before[u], d.axes[u]).dot(d.sf[b]) - w.dQ(k);
     // −δQ of the coordinate's own spring-damping law and its further laws
     const Coordinate& c = sys.coords[i];
     out(k) += c.spring.variation(dq(k), dqd(k), d.spring_scale(i));
@@ -297,10 +313,18 @@ ResidualVjp rnea_vector_jacobian_product(const System& sys, Data& d, const VecX&
     Vec3 df = Vec3::Zero();
     if (E.body_b >= 0) df += st.xb.cross(H[E.body_b].head<3>()) - H[E.body_b].tail<3>();
     if (E.body_a >= 0) df -= st.xa.cross(H[E.body_a].head<3>()) - H[E.body_a].tail<3>();
-    const auto [Fl, Fld] = E.law->derivatives(d.t, st.l, st.ld, d.load_factor);
-    // df = (F_l δl + F_l̇ δl̇) e + F δe; δl̇ = δe·(v_b − v_a) + e·δḋ; δl = e·δd; δe = (1 − e eᵀ) δd / l
+    const ExtensionDerivatives F = E.law->derivatives(d.t, st.extension(), d.load_factor);
+    // df = (F_l δl + F_l̇ δl̇ + F_s δs + F_ṡ δṡ) e + F δe; δl̇ = δe·(v_b − v_a) + e·δḋ; δl = e·δd;
+    // δe = (1 − e eᵀ) δd / l; a free drum's row −r δP (δs = r δφ) adds −μ_φ r (P_l, P_l̇) to (δl̄, δl̇̄)
     const double ed = st.e.dot(df);
-    const double dl_bar = Fl * ed, dld_bar = Fld * ed;
+    double dl_bar = F.l * ed, dld_bar = F.ld * ed;
+    if (const int kd = drum_index(sys, E); kd >= 0) {
+      const ExtensionDerivatives P = E.law->pull_derivatives(d.t, st.extension());
+      const double m = mu(kd) * E.radius;
+      dl_bar -= m * P.l, dld_bar -= m * P.ld;
+      out.q(kd) += E.radius * (F.s * ed - m * P.s);
+      out.qd(kd) += E.radius * (F.sd * ed - m * P.sd);
+    }
     const Vec3 de_bar = st.F * df + (st.vb - st.va) * dld_bar;
     const Vec3 ddd_bar = st.e * dld_bar;
     const Vec3 dd_bar = st.e * dl_bar + (de_bar - st.e * st.e.dot(de_bar)) / st.l;

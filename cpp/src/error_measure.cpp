@@ -102,7 +102,7 @@ void ErrorMeasure::at(double t, const VecX& y) {
     for (std::size_t j = 0; j < sys_.elements.size(); ++j) {
       const ElementState s = element_state(d_, sys_.elements[j], false);
       element_e_[j] = s.e;
-      element_dF_[j] = sys_.elements[j].law->derivatives(t, s.l, s.ld, 1.0);
+      element_dF_[j] = sys_.elements[j].law->derivatives(t, s.extension(), 1.0);
     }
   if (need_loops_) {
     if (!dl_) dl_ = std::make_unique<Data>(sys_);
@@ -157,7 +157,7 @@ double ErrorMeasure::norm(const Eigen::Ref<const VecX>& e, double h, double atol
       }
       case Kind::Coordinate: eps = std::max(std::abs(e(o.index)), h * std::abs(e(n + o.index))); break;
       case Kind::Element: {
-        // δF = F_l δl + F_l̇ δl̇, δl = e·(δr_B − δr_A), δl̇ = e·(δṙ_B − δṙ_A)
+        // δF = F_l δl + F_l̇ δl̇ (+ F_s δs + F_ṡ δṡ of a rope's drum), δl = e·(δr_B − δr_A), δl̇ = e·(δṙ_B − δṙ_A)
         const ForceElement& E = sys_.elements[o.index];
         const auto moved = [&](const std::vector<Vec6>& tw, int body, const Vec3& r) -> Vec3 {
           if (body < 0) return Vec3::Zero();
@@ -166,7 +166,11 @@ double ErrorMeasure::norm(const Eigen::Ref<const VecX>& e, double h, double atol
         const Vec3& u = element_e_[o.index];
         const double dl = u.dot(moved(dq_, E.body_b, E.point_b) - moved(dq_, E.body_a, E.point_a));
         const double dld = u.dot(moved(dv_, E.body_b, E.point_b) - moved(dv_, E.body_a, E.point_a));
-        eps = std::abs(element_dF_[o.index].first * dl + element_dF_[o.index].second * dld);
+        const ExtensionDerivatives& F = element_dF_[o.index];
+        double ds = 0.0, dsd = 0.0;
+        if (E.drum >= 0 && sys_.coords[E.drum].free_index >= 0)
+          ds = E.radius * e(sys_.coords[E.drum].free_index), dsd = E.radius * e(n + sys_.coords[E.drum].free_index);
+        eps = std::abs(F.l * dl + F.ld * dld + F.s * ds + F.sd * dsd);
         break;
       }
       case Kind::Loop: {

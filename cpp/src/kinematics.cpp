@@ -197,8 +197,9 @@ ElementState element_state(const Data& d, const ForceElement& element, bool spat
                                    "' coincide (l = 0: its line of action is undefined)");
   s.e = r / s.l;
   s.ld = s.e.dot(s.vb - s.va);
-  element.law->check(d.t, element.name);
-  s.F = element.law->force(d.t, s.l, s.ld, d.load_factor);
+  if (element.drum >= 0) s.s = element.radius * d.qa(element.drum), s.sd = element.radius * d.qda(element.drum);
+  element.law->check(d.t, s.extension(), element.name);
+  s.F = element.law->force(d.t, s.extension(), d.load_factor);
   return s;
 }
 
@@ -206,11 +207,15 @@ std::pair<AppliedLoad, AppliedLoad> element_loads(const ElementState& s) {
   return {{s.xb, s.F * s.e, Vec3::Zero()}, {s.xa, -s.F * s.e, Vec3::Zero()}};
 }
 
-double passive_force(const System& sys, const Data& d, int i) {
+double passive_force(const System& sys, const Data& d, int i, bool spatial) {
   const Coordinate& c = sys.coords[i];
-  // −s (k (q − q⁰) + c q̇) − Σ s_arm + λ Q₀ + Σ Q_law
+  // −s (k (q − q⁰) + c q̇) − Σ s_arm + λ Q₀ + Σ Q_law + Σ r P of the ropes it winds
   double Q = c.spring.elastic_force(d.qa(i), d.qda(i), d.spring_scale(i)) - d.arm_force(i) + d.load_factor * c.spring.force;
   for (const auto& law : c.laws) Q += law->force(d.t, d.qa(i), d.qda(i), d.load_factor);
+  for (const int k : c.drums) {
+    const ForceElement& E = sys.elements[k];
+    Q += E.radius * E.law->pull(d.t, element_state(d, E, spatial).extension());
+  }
   return Q;
 }
 

@@ -34,7 +34,7 @@ void lagrange_forces(const System& sys, Data& d) {
   load_composites(sys, d);
   inertia_composites(sys, d);
   // f_i = Σ_{uses of q_i} tr(U_u (Z̄_b − W̄_b)) + Q_i^passive.
-  for (int k = 0; k < sys.nq; ++k) d.f(k) = passive_force(sys, d, sys.free_coords[k]);
+  for (int k = 0; k < sys.nq; ++k) d.f(k) = passive_force(sys, d, sys.free_coords[k], false);
   for (int b = 0; b < sys.nbodies; ++b)
     for (int u = sys.use_start[b]; u < sys.use_start[b + 1]; ++u)
       if (sys.use_q[u] >= 0) d.f(sys.use_q[u]) += trace_product(d.U[u], d.Zbar[b] - d.Wbar[b]);
@@ -68,7 +68,7 @@ void lagrange_mass_matrix(const System& sys, Data& d) {
 
 void lagrange_driving_forces(const System& sys, Data& d) {
   inertia_composites(sys, d);
-  for (int k = 0; k < sys.np; ++k) d.tau(k) = -passive_force(sys, d, sys.drive_coords[k]);
+  for (int k = 0; k < sys.np; ++k) d.tau(k) = -passive_force(sys, d, sys.drive_coords[k], false);
   for (int b = 0; b < sys.nbodies; ++b)
     for (int u = sys.use_start[b]; u < sys.use_start[b + 1]; ++u)
       if (sys.use_drive[u] >= 0) d.tau(sys.use_drive[u]) += trace_product(d.U[u], d.Wbar[b] - d.Zbar[b]);

@@ -249,7 +249,7 @@ void Model::truncate(int n) {
   flows_.erase(std::remove_if(flows_.begin(), flows_.end(), [n](const Flow& f) { return f.first + f.elements >= n; }),
                flows_.end());
   elements_.erase(std::remove_if(elements_.begin(), elements_.end(),
-                                 [n](const ForceElement& e) { return std::max(e.body_a, e.body_b) >= n; }),
+                                 [n](const ForceElement& e) { return std::max({e.body_a, e.body_b, e.drum_body}) >= n; }),
                   elements_.end());
 }
 
@@ -340,6 +340,20 @@ int Model::add_force_element(const ForceElement& element) {
   element.law->validate();
   elements_.push_back(with_unique_name(element, elements_, "force element"));
   return static_cast<int>(elements_.size()) - 1;
+}
+
+void Model::wind(int element, int body, int coordinate, double radius) {
+  if (element < 0 || element >= static_cast<int>(elements_.size()))
+    bad("element", "a force element's index 0.." + std::to_string(elements_.size()), std::to_string(element));
+  ForceElement& E = elements_[element];
+  if (!E.law->winds())
+    bad("element", "a force element whose law winds on a drum (a Rope)", std::string("a ") + E.law->info().kind);
+  if (E.law->profile())
+    bad("length", "a constant unstretched length l₀ for a rope wound on a drum (the drum pays it out)", "a profile");
+  if (E.drum_body >= 0) bad("element", "a force element not yet wound on a drum", "'" + E.name + "', wound");
+  const int slot = resolve_coordinate(body, coordinate);
+  if (!(radius > 0.0 && std::isfinite(radius))) bad("radius", "a positive finite drum radius in m", num8(radius));
+  E.drum_body = body, E.drum_slot = slot, E.radius = radius;
 }
 
 int Model::add_shape(const Shape& shape) {

@@ -34,7 +34,7 @@ double elastic_energy(const System& sys, const Data& d) {
     for (const auto& law : c.laws) V += law->energy(d.t, d.qa(i));
   }
   for (const ForceElement& E : sys.elements)  // what each element's law stores (force_elements.hpp)
-    if (E.law->elastic()) V += E.law->energy(d.t, element_state(d, E, false).l);
+    if (E.law->elastic()) V += E.law->energy(d.t, element_state(d, E, false).extension());
   if (!sys.contacts.empty()) V += contact_energy(sys, d);  // what the contacts store (contact.hpp)
   return V;
 }
@@ -50,7 +50,7 @@ double dissipated_power(const System& sys, const Data& d) {
   for (const ForceElement& E : sys.elements)  // what each element's law dissipates (force_elements.hpp)
     if (E.law->dissipative()) {
       const ElementState s = element_state(d, E, false);
-      P += E.law->power(d.t, s.l, s.ld, s.F);
+      P += E.law->power(d.t, s.extension(), s.F);
     }
   if (!sys.contacts.empty()) P += contact_power(sys, d);  // what the contacts dissipate (contact.hpp)
   return P;

@@ -72,7 +72,7 @@ void rnea_forces(const System& sys, Data& d) {
   // f = −(Sᵀ f̄)_free + passive: what drives the free coordinates besides A q̈.
   for (int k = 0; k < sys.nq; ++k) {
     const int i = sys.free_coords[k];
-    d.f(k) = -d.axes[sys.q_use[k]].dot(d.sf[sys.coords[i].body]) + passive_force(sys, d, i);
+    d.f(k) = -d.axes[sys.q_use[k]].dot(d.sf[sys.coords[i].body]) + passive_force(sys, d, i, true);
   }
 }
 
@@ -181,7 +181,7 @@ void aba(const System& sys, Data& d) {
     for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) {
       const int i = sys.use_coord[u];
       if (sys.use_drive[u] >= 0) d.c[p] += d.axes[u] * d.qdda(i);
-      if (sys.use_q[u] >= 0) d.qdd(sys.use_q[u]) = passive_force(sys, d, i);
+      if (sys.use_q[u] >= 0) d.qdd(sys.use_q[u]) = passive_force(sys, d, i, true);
     }
   }
   articulated_inertias(sys, d, nullptr);
@@ -214,7 +214,7 @@ void rnea_driving_forces(const System& sys, Data& d) {
   // Row i of the full equations: s_iᵀ f̄_p = Q_i^passive + τ_i.
   for (int k = 0; k < sys.np; ++k) {
     const int i = sys.drive_coords[k];
-    d.tau(k) = d.axes[own_use(sys, i)].dot(d.sf[sys.coords[i].body]) - passive_force(sys, d, i);
+    d.tau(k) = d.axes[own_use(sys, i)].dot(d.sf[sys.coords[i].body]) - passive_force(sys, d, i, true);
   }
 }
 

@@ -75,7 +75,7 @@ class ErrorMeasure {
   double moved_ = 0.0;                 // the farthest a centre of mass has moved from xc0_ so far (m)
   std::vector<Mat3> gyration_;         // (nbodies) R I_C Rᵀ / m, global (m²)
   std::vector<Vec3> element_e_;        // (nelements) unit vectors e of the elements
-  std::vector<std::pair<double, double>> element_dF_;  // (nelements) ∂F/∂l, ∂F/∂l̇
+  std::vector<ExtensionDerivatives> element_dF_;  // (nelements) ∂F/∂(l, l̇, s, ṡ)
   VecX scale_;                          // (outputs) the running max |z_k| (coordinates, elements, loops)
   bool need_loops_ = false, need_elements_ = false;
 };

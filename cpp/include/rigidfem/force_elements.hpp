@@ -23,6 +23,16 @@ namespace rigidfem {
 /// An axial force function F(t, l, l̇) (N) of an element's length l (m) and rate l̇ (m/s): a Python law.
 using AxialFunction = ScalarFunction;
 
+/// An element's extension: its length l (m) and rate l̇ (m/s) and, for a rope wound on a drum (ForceElement::drum),
+/// the length s = r φ the drum has paid out since φ = 0 (m) and its rate ṡ (m/s); 0 for any other element.
+struct Extension {
+  double l = 0.0, ld = 0.0, s = 0.0, sd = 0.0;
+};
+/// The derivatives of a function of the extension (an element's force, a drum's pull) by l, l̇, s and ṡ.
+struct ExtensionDerivatives {
+  double l = 0.0, ld = 0.0, s = 0.0, sd = 0.0;
+};
+
 /// What a kind of force element knows, in one class per kind (SpringDamper, Rope below), each describing itself
 /// (laws.hpp: its constants, profile and function): its axial force and the force's derivatives, the energy it
 /// stores, the power it dissipates and how it is drawn. A new kind is a class here and its row in
@@ -30,19 +40,24 @@ using AxialFunction = ScalarFunction;
 /// parameters, the viewer) and the site's table read the row.
 class ElementLaw : public Law {
  public:
-  /// SimulationError where the law cannot be evaluated at t (element `name`); nothing by default.
-  virtual void check(double /*t*/, const std::string& /*name*/) const {}
-  /// F(t, l, l̇) (N, > 0 pushing the points apart), its applied part scaled by the load factor λ (as loads
+  /// SimulationError where the law cannot be evaluated at t and x (element `name`); nothing by default.
+  virtual void check(double /*t*/, const Extension& /*x*/, const std::string& /*name*/) const {}
+  /// F(t, x) (N, > 0 pushing the points apart), its applied part scaled by the load factor λ (as loads
   /// and applied generalised forces are; springs and dampers are not).
-  virtual double force(double t, double l, double ld, double load_factor) const = 0;
-  /// (∂F/∂l, ∂F/∂l̇).
-  virtual std::pair<double, double> derivatives(double t, double l, double ld, double load_factor) const = 0;
+  virtual double force(double t, const Extension& x, double load_factor) const = 0;
+  /// ∂F/∂(l, l̇, s, ṡ).
+  virtual ExtensionDerivatives derivatives(double t, const Extension& x, double load_factor) const = 0;
   /// Whether it stores energy (energy is then asked) and dissipates power (power is then asked).
   virtual bool elastic() const = 0;
   virtual bool dissipative() const = 0;
-  /// The energy (J) it stores at length l, and the power (W) it dissipates at (l, l̇) with the force F.
-  virtual double energy(double t, double l) const = 0;
-  virtual double power(double t, double l, double ld, double F) const = 0;
+  /// The energy (J) it stores at x, and the power (W) it dissipates at x with the force F.
+  virtual double energy(double t, const Extension& x) const = 0;
+  virtual double power(double t, const Extension& x, double F) const = 0;
+  /// Whether it can be wound on a drum (a rope): then the drum's coordinate φ takes the generalised force r P.
+  virtual bool winds() const { return false; }
+  /// P (N): the pull on the drum, −∂V/∂s − ∂D/∂ṡ of its energy V and dissipation function D; and its derivatives.
+  virtual double pull(double /*t*/, const Extension& /*x*/) const { return 0.0; }
+  virtual ExtensionDerivatives pull_derivatives(double /*t*/, const Extension& /*x*/) const { return {}; }
   /// How the viewer draws the element: "spring", "cylinder", "rope".
   virtual const char* drawn_as() const = 0;
   /// A copy with the constant `name` set to `value` (a named parameter: parameters.hpp), unchecked;
@@ -92,26 +107,27 @@ class SpringDamper final : public ElementLaw {
   SpringDamper(std::vector<double> values, ProfilePtr profile, AxialFunction law)
       : ElementLaw(std::move(values), std::move(profile)), law_(std::move(law)) {}
   const LawInfo& info() const override { return description(); }
-  double force(double t, double l, double ld, double load_factor) const override {
+  double force(double t, const Extension& x, double load_factor) const override {
     double applied = c_[F0];
     if (profile_) applied += profile_->at(t).q;
-    if (law_) applied += law_(t, l, ld);
-    return -c_[K] * (l - c_[L0]) - c_[C] * ld + load_factor * applied;
+    if (law_) applied += law_(t, x.l, x.ld);
+    return -c_[K] * (x.l - c_[L0]) - c_[C] * x.ld + load_factor * applied;
   }
   /// −k and −c, plus λ times the law's by central differences (steps 6e-6 max(1, |x|)).
-  std::pair<double, double> derivatives(double t, double l, double ld, double load_factor) const override {
-    std::pair<double, double> dF{-c_[K], -c_[C]};
+  ExtensionDerivatives derivatives(double t, const Extension& x, double load_factor) const override {
+    ExtensionDerivatives dF{-c_[K], -c_[C]};
     if (law_) {
+      const double l = x.l, ld = x.ld;
       const double hl = 6e-6 * std::max(1.0, std::abs(l)), hd = 6e-6 * std::max(1.0, std::abs(ld));
-      dF.first += load_factor * (law_(t, l + hl, ld) - law_(t, l - hl, ld)) / (2.0 * hl);
-      dF.second += load_factor * (law_(t, l, ld + hd) - law_(t, l, ld - hd)) / (2.0 * hd);
+      dF.l += load_factor * (law_(t, l + hl, ld) - law_(t, l - hl, ld)) / (2.0 * hl);
+      dF.ld += load_factor * (law_(t, l, ld + hd) - law_(t, l, ld - hd)) / (2.0 * hd);
     }
     return dF;
   }
   bool elastic() const override { return c_[K] != 0.0; }
   bool dissipative() const override { return c_[C] != 0.0; }
-  double energy(double, double l) const override { return 0.5 * c_[K] * std::pow(l - c_[L0], 2); }
-  double power(double, double, double ld, double) const override { return c_[C] * std::pow(ld, 2); }
+  double energy(double, const Extension& x) const override { return 0.5 * c_[K] * std::pow(x.l - c_[L0], 2); }
+  double power(double, const Extension& x, double) const override { return c_[C] * std::pow(x.ld, 2); }
   /// A cylinder where it has no spring and pushes (a force, its profile or its function), else a spring.
   const char* drawn_as() const override {
     return c_[K] == 0.0 && (c_[F0] != 0.0 || profile_ || law_) ? "cylinder" : "spring";
@@ -156,41 +172,62 @@ class Rope final : public ElementLaw {
       bad("length", "a profile l_u(t) with a positive length at t = 0 in m", num(c_[LENGTH], 8));
     ElementLaw::validate();
   }
-  void check(double t, const std::string& name) const override {
-    const double lu = unstretched_length(t).first;
+  void check(double t, const Extension& x, const std::string& name) const override {
+    const double lu = unstretched_length(t, x).first;
     if (!(lu > 0.0))
-      throw SimulationError(t, "the unstretched length of rope '" + name + "' is l_u = " + num(lu) +
-                                   " m (a rope needs l_u > 0)");
+      throw SimulationError(t, "the unstretched length of rope '" + name + "' is l_u = " + num(lu) + " m (a rope needs "
+                               "l_u > 0" + (x.s != 0.0 ? ": its drum has wound it all in)" : ")"));
   }
-  double force(double t, double l, double ld, double) const override { return -tension(t, l, ld); }
-  /// The active branch: EA/l_u, DA/l_u while taut, nothing while slack.
-  std::pair<double, double> derivatives(double t, double l, double ld, double) const override {
-    const double lu = unstretched_length(t).first;
-    return tension(t, l, ld) > 0.0 ? std::pair<double, double>{-c_[EA] / lu, -c_[DA] / lu}
-                                   : std::pair<double, double>{0.0, 0.0};
+  double force(double t, const Extension& x, double) const override { return -tension(t, x); }
+  /// The active branch while taut (T > 0), nothing while slack: with l_u = l_u(t) + s and T = N/l_u,
+  /// N = EA (l − l_u) + DA (l̇ − l̇_u): ∂T/∂l = EA/l_u, ∂T/∂l̇ = DA/l_u, ∂T/∂s = −(EA + T)/l_u, ∂T/∂ṡ = −DA/l_u.
+  ExtensionDerivatives derivatives(double t, const Extension& x, double) const override {
+    const double T = tension(t, x);
+    if (!(T > 0.0)) return {};
+    const double lu = unstretched_length(t, x).first;
+    return {-c_[EA] / lu, -c_[DA] / lu, (c_[EA] + T) / lu, c_[DA] / lu};
   }
   bool elastic() const override { return true; }
   bool dissipative() const override { return true; }
-  double energy(double t, double l) const override {
-    const double lu = unstretched_length(t).first;
-    const double stretch = std::max(0.0, l - lu);
+  /// ½ EA/l_u (l − l_u)² while stretched.
+  double energy(double t, const Extension& x) const override {
+    const double lu = unstretched_length(t, x).first;
+    const double stretch = std::max(0.0, x.l - lu);
     return 0.5 * c_[EA] / lu * stretch * stretch;
   }
-  double power(double t, double, double ld, double F) const override {
-    const auto [lu, lud] = unstretched_length(t);
-    return F < 0.0 ? c_[DA] / lu * (ld - lud) * (ld - lud) : 0.0;
+  /// DA/l_u (l̇ − l̇_u)² while it pulls.
+  double power(double t, const Extension& x, double F) const override {
+    const auto [lu, lud] = unstretched_length(t, x);
+    return F < 0.0 ? c_[DA] / lu * (x.ld - lud) * (x.ld - lud) : 0.0;
+  }
+  bool winds() const override { return true; }
+  /// P = −∂V/∂s − ∂D/∂ṡ = T + ½ EA ε² while taut (ε = (l − l_u)/l_u; D = ½ DA/l_u (l̇ − l̇_u)²), 0 while slack: the
+  /// drum's r P turns it by the energy the rope stores and dissipates, to the last term (T r alone would leave
+  /// ½ EA ε² ṡ unaccounted).
+  double pull(double t, const Extension& x) const override {
+    const double T = tension(t, x);
+    if (!(T > 0.0)) return 0.0;
+    const double lu = unstretched_length(t, x).first, eps = (x.l - lu) / lu;
+    return T + 0.5 * c_[EA] * eps * eps;
+  }
+  /// ∂P/∂l = (EA + EA ε)/l_u, ∂P/∂l̇ = DA/l_u, ∂P/∂s = −(EA + T + EA ε (1 + ε))/l_u, ∂P/∂ṡ = −DA/l_u (taut).
+  ExtensionDerivatives pull_derivatives(double t, const Extension& x) const override {
+    const double T = tension(t, x);
+    if (!(T > 0.0)) return {};
+    const double lu = unstretched_length(t, x).first, eps = (x.l - lu) / lu;
+    return {c_[EA] * (1.0 + eps) / lu, c_[DA] / lu, -(c_[EA] + T + c_[EA] * eps * (1.0 + eps)) / lu, -c_[DA] / lu};
   }
   const char* drawn_as() const override { return "rope"; }
-  /// l_u and l̇_u at t (m, m/s).
-  std::pair<double, double> unstretched_length(double t) const {
-    if (!profile_) return {c_[LENGTH], 0.0};
-    const MotionState s = profile_->at(t);
-    return {s.q, s.qd};
+  /// l_u and l̇_u at t (m, m/s): the winch's l_u(t) or the length, plus what a drum has paid out, s and ṡ.
+  std::pair<double, double> unstretched_length(double t, const Extension& x) const {
+    if (!profile_) return {c_[LENGTH] + x.s, x.sd};
+    const MotionState p = profile_->at(t);
+    return {p.q + x.s, p.qd + x.sd};
   }
   /// T ≥ 0 (N).
-  double tension(double t, double l, double ld) const {
-    const auto [lu, lud] = unstretched_length(t);
-    return std::max(0.0, (c_[EA] * (l - lu) + c_[DA] * (ld - lud)) / lu);
+  double tension(double t, const Extension& x) const {
+    const auto [lu, lud] = unstretched_length(t, x);
+    return std::max(0.0, (c_[EA] * (x.l - lu) + c_[DA] * (x.ld - lud)) / lu);
   }
 
  private:
@@ -225,25 +262,25 @@ class Buffer final : public ElementLaw {
   }
   Buffer(std::vector<double> values, ProfilePtr, AxialFunction) : ElementLaw(std::move(values), nullptr) {}
   const LawInfo& info() const override { return description(); }
-  double force(double, double l, double ld, double) const override {
-    const double d = c_[L0] - l;
-    return d > 0.0 ? std::max(0.0, c_[K] * std::pow(d, c_[N]) * (1.0 - c_[ALPHA] * ld)) : 0.0;
+  double force(double, const Extension& x, double) const override {
+    const double d = c_[L0] - x.l;
+    return d > 0.0 ? std::max(0.0, c_[K] * std::pow(d, c_[N]) * (1.0 - c_[ALPHA] * x.ld)) : 0.0;
   }
   /// ∂F/∂l = −k n δⁿ⁻¹ (1 + α δ̇), ∂F/∂l̇ = −k α δⁿ while it pushes, else 0.
-  std::pair<double, double> derivatives(double t, double l, double ld, double lambda) const override {
-    if (!(force(t, l, ld, lambda) > 0.0)) return {0.0, 0.0};
-    const double d = c_[L0] - l;
-    return {-c_[K] * c_[N] * std::pow(d, c_[N] - 1.0) * (1.0 - c_[ALPHA] * ld), -c_[K] * c_[ALPHA] * std::pow(d, c_[N])};
+  ExtensionDerivatives derivatives(double t, const Extension& x, double lambda) const override {
+    if (!(force(t, x, lambda) > 0.0)) return {};
+    const double d = c_[L0] - x.l;
+    return {-c_[K] * c_[N] * std::pow(d, c_[N] - 1.0) * (1.0 - c_[ALPHA] * x.ld), -c_[K] * c_[ALPHA] * std::pow(d, c_[N])};
   }
   bool elastic() const override { return true; }
   bool dissipative() const override { return c_[ALPHA] != 0.0; }
-  double energy(double, double l) const override {
-    const double d = c_[L0] - l;
+  double energy(double, const Extension& x) const override {
+    const double d = c_[L0] - x.l;
     return d > 0.0 ? c_[K] * std::pow(d, c_[N] + 1.0) / (c_[N] + 1.0) : 0.0;
   }
-  double power(double, double l, double ld, double F) const override {
-    const double d = c_[L0] - l;
-    return F > 0.0 ? c_[K] * c_[ALPHA] * std::pow(d, c_[N]) * ld * ld : 0.0;
+  double power(double, const Extension& x, double F) const override {
+    const double d = c_[L0] - x.l;
+    return F > 0.0 ? c_[K] * c_[ALPHA] * std::pow(d, c_[N]) * x.ld * x.ld : 0.0;
   }
   const char* drawn_as() const override { return "spring"; }
 
@@ -278,15 +315,15 @@ class SlidingFriction final : public ElementLaw {
   }
   SlidingFriction(std::vector<double> values, ProfilePtr, AxialFunction) : ElementLaw(std::move(values), nullptr) {}
   const LawInfo& info() const override { return description(); }
-  double force(double, double, double v, double) const override { return friction().force(v); }
+  double force(double, const Extension& x, double) const override { return friction().force(x.ld); }
   /// (0, dF/dl̇): laws.hpp's RegularisedFriction.
-  std::pair<double, double> derivatives(double, double, double v, double) const override {
-    return {0.0, friction().rate_derivative(v)};
+  ExtensionDerivatives derivatives(double, const Extension& x, double) const override {
+    return {0.0, friction().rate_derivative(x.ld)};
   }
   bool elastic() const override { return false; }
   bool dissipative() const override { return true; }
-  double energy(double, double) const override { return 0.0; }
-  double power(double, double, double ld, double F) const override { return -F * ld; }
+  double energy(double, const Extension&) const override { return 0.0; }
+  double power(double, const Extension& x, double F) const override { return -F * x.ld; }
   const char* drawn_as() const override { return "cylinder"; }
 
  private:
@@ -330,6 +367,11 @@ struct ForceElement {
   int body_a = -1, body_b = -1;
   Vec3 point_a = Vec3::Zero(), point_b = Vec3::Zero();  ///< m, in the frames of bodies a and b
   std::shared_ptr<const ElementLaw> law;
+  /// A rope wound on a drum (Model::wind): the drum's coordinate φ, slot `drum_slot` of body `drum_body`'s joint (−1:
+  /// none), and its radius r (m); compile() sets `drum`, its index among the System's coordinates. The drum pays out
+  /// s = r φ of unstretched rope (l_u = l₀ + r φ) and takes the generalised force r P (ElementLaw::pull).
+  int drum_body = -1, drum_slot = 0, drum = -1;
+  double radius = 0.0;
 };
 
 }  // namespace rigidfem

@@ -164,6 +164,9 @@ class Model {
   /// Adds a force element between two bodies (force_elements.hpp); returns its index. Checks the
   /// bodies, points, parameters and name (non-empty, new among the elements').
   int add_force_element(const ForceElement& element);
+  /// Winds force element `element` (a law that winds: a rope) on the drum whose rotation is coordinate `coordinate`
+  /// (−1: the only one) of body `body`'s joint, of radius `radius` (m): its unstretched length becomes l₀ + r φ.
+  void wind(int element, int body, int coordinate, double radius);
   /// Adds a shape fixed on a body (contact.hpp); returns its index. Checks the body, the geometry and the name.
   int add_shape(const Shape& shape);
   /// Adds a contact between two groups of shapes (contact.hpp); returns its index. Checks the shapes, their pairs

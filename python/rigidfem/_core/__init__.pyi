@@ -256,6 +256,11 @@ class _Model:
         """
         Removes the bodies n, n + 1, ... (undo of a failed builder).
         """
+    def _wind(self, element: typing.SupportsInt | typing.SupportsIndex, body: typing.SupportsInt | typing.SupportsIndex, coordinate: typing.SupportsInt | typing.SupportsIndex, radius: typing.SupportsFloat | typing.SupportsIndex) -> None:
+        """
+        Winds force element `element` (a rope) on the drum whose rotation is coordinate `coordinate` (-1: the
+        only one) of body `body`'s joint, of radius `radius` (m): l_u = l0 + r phi, and the drum takes r P.
+        """
     @property
     def _nelements(self) -> int:
         ...

@@ -6,6 +6,7 @@ evaluate the book's equations of motion A(q) q̈ = f(q, q̇, t). SI units throug
 
 from __future__ import annotations
 
+import math
 from collections.abc import Callable
 
 import numpy as np
@@ -431,16 +432,41 @@ class Model(_core._Model):
         return force_elements.add_force_element(self, name, a, b, law)
 
     @recorded
-    def add_rope(self, name: str, a, b, *, EA: float, length, DA: float = 0.0) -> handles.Element:
+    def add_rope(self, name: str, a, b, *, EA: float, length, DA: float = 0.0, drum=None,
+                 radius: float | None = None) -> handles.Element:
         """A massless rope between the points ``a`` and ``b`` (book ch. 7.1: a hoisting rope): it
         only pulls, with the tension T = (EA (l − l_u) + DA (l̇ − l̇_u))/l_u while positive, 0 when
         slack. ``EA`` (N) is its axial stiffness, ``DA`` (N·s) its axial damping, and ``length`` its unstretched
         length l_u (m): a number or a ``rigidfem.motion`` profile l_u(t) paid out by a winch
-        (``rf.laws.Rope``). Returns its handle; ``System.element_states`` gives its force F = −T (N)."""
+        (``rf.laws.Rope``). Returns its handle; ``System.element_states`` gives its force F = −T (N).
+
+        ``drum`` winds it on a drum of ``radius`` r (m): a body whose joint's rotation φ (rad; its only coordinate,
+        or ``(body, "ry")`` to name one) pays it out, l_u = ``length`` + r φ. Its coordinate may be free (the drum's
+        inertia, driven by a torque or a law of the state: ``add_torque``, ``add_joint_law``) or prescribed (a speed:
+        ``prescribe``). The drum takes the generalised force r P, P = T + ½ EA ε² while taut (ε = (l − l_u)/l_u):
+        −∂/∂(r φ) of the energy the rope stores and dissipates, so that the energy balance holds to the last term.
+        The point ``a`` is where the rope leaves the drum (or a sheave it runs over), fixed on ``a``'s body."""
         name = self._new_name(name)
         force_elements.points(self, a, b)  # named before the law's constants
+        wound = None
+        if drum is not None or radius is not None:
+            body, coordinate = drum if isinstance(drum, tuple) and len(drum) == 2 else (drum, None)
+            if not isinstance(body, Body):
+                raise _checks.refuse(f"drum: expected a body whose joint's rotation pays the rope out, or (body, "
+                                     f"coordinate), got {drum!r}")
+            k = self._coordinate(body, coordinate)
+            r = _checks.real(radius, "radius", "a positive drum radius in m")
+            if not (r > 0.0 and math.isfinite(r)):
+                raise _checks.refuse(f"radius: expected a positive finite drum radius in m, got {radius!r}")
+            if isinstance(length, Profile):
+                raise _checks.refuse(f"length: expected a number l0 in m for a rope wound on a drum (the drum pays it "
+                                     f"out: l_u = l0 + r phi), got {length!r}")
+            wound = (body.index, k, r)
         law = laws.Rope(EA=EA, DA=DA, **force_elements.unstretched(length))
-        return force_elements.add_force_element(self, name, a, b, law)
+        handle = force_elements.add_force_element(self, name, a, b, law)
+        if wound is not None:
+            self._wind(handle.index, *wound)
+        return handle
 
     @recorded
     def add_shape(self, name: str, body, shape) -> handles.Shape:

@@ -1,0 +1,136 @@
+"""A rope wound on a drum (Model.add_rope(..., drum=, radius=)): the drum's rotation pays it out, l_u = l₀ + r φ, and
+takes r P. Checked against a SciPy solution of the hanging load's own equation (a drum at a prescribed speed), the
+energy balance with a motor torque (a free drum), the Jacobians against central differences in both modes and
+engines, and the adjoint gradient by the rope's EA against differences of whole runs."""
+
+import math
+
+import numpy as np
+import pytest
+from scipy.integrate import solve_ivp
+
+import rigidfem as rf
+from conftest import central_jacobians
+from test_derivatives import check_both_modes
+
+G, H = 9.81, 5.0  # gravity (m/s²); the sheave's height (m)
+
+
+def winch(m=200.0, EA=2e6, DA=2e3, r=0.3, l0=2.0, J=4.0, drive=None, algorithm="recursive", torque=None):
+    """A load of m kg on a vertical slide (z) hanging from a sheave at height H by a rope wound on a drum of radius r
+    and inertia J (rotation y, φ): the rope's unstretched length l_u = l₀ + r φ. The drum prescribed (drive), or free
+    under a torque profile."""
+    model = rf.Model(gravity=(0.0, 0.0, -G))
+    drum = model.add_body("drum", model.ground, rf.Joint.revolute("y"), 20.0, (J, J, J),
+                          placement=rf.transform((-1.0, 0.0, H)))
+    load = model.add_body("load", model.ground, rf.Joint.prismatic("z"), m, (1.0, 1.0, 1.0))
+    model.add_rope("rope", model.ground.point((0.0, 0.0, H)), load.origin, EA=EA, DA=DA, length=l0, drum=drum, radius=r)
+    if drive is not None:
+        model.prescribe(drum, drive)
+    if torque is not None:
+        model.add_torque("motor", drum, (0.0, 1.0, 0.0), scale=torque)
+    return model.compile(algorithm=algorithm)
+
+
+def test_a_drum_at_a_prescribed_speed_lowers_the_load_as_its_own_equation_says():
+    """φ = ω t: the load's m z̈ = −m g + T(l = H − z, l_u = l₀ + r ω t), solved here by SciPy (1e-12), independently
+    of the model's coordinates and of its rope law."""
+    m, EA, DA, r, l0, w = 200.0, 2e6, 2e3, 0.3, 2.0, 1.5
+    system = winch(m, EA, DA, r, l0, drive=rf.motion.polynomial([0.0, w]))
+    z0 = H - l0 * (1 + m * G / EA)  # hanging at rest
+
+    def rhs(t, y):
+        z, v = y
+        lu, lud = l0 + r * w * t, r * w
+        T = max(0.0, (EA * (H - z - lu) + DA * (-v - lud)) / lu)
+        return [v, -G + T / m]
+
+    t_eval = np.linspace(0.0, 2.0, 41)
+    ref = solve_ivp(rhs, (0.0, 2.0), [z0, 0.0], method="DOP853", rtol=1e-12, atol=1e-14, t_eval=t_eval)
+    res = rf.simulate(system, 2.0, "dopri5", q0=[z0], t_eval=t_eval, rtol=1e-11, atol=1e-13)
+    assert np.abs(res.q[:, 0] - ref.y[0]).max() < 1e-9
+    # the drum's torque holds the rope's pull: r P, P = T + ½ EA ε² (the load lowered at r ω)
+    assert ref.y[0][-1] == pytest.approx(z0 - r * w * 2.0, abs=5e-3)
+
+
+def test_a_motor_driven_drum_keeps_the_energy_balance_to_the_last_term():
+    """A free drum of inertia J under a motor torque M(t) lifting the load: the kinetic, gravity and rope energies
+    change by ∫ M φ̇ dt − ∫ DA/l_u (l̇ − l̇_u)² dt (trapezoids over 12,001 outputs), to 3e-8 of the energy moved. The
+    drum takes r (T + ½ EA ε²): with T r alone ½ EA ε² ṡ, about 2 J here (7e-4 of it), would be missing."""
+    m, r = 200.0, 0.3
+    torque = rf.motion.polynomial([-1.2 * m * G * r, 50.0])  # more than the load's weight: it winds in, speeding up
+    system = winch(m=m, r=r, torque=torque)
+    z0 = H - 2.0 * (1 + m * G / 2e6)
+    t_eval = np.linspace(0.0, 1.5, 12001)
+    res = rf.simulate(system, 1.5, "dopri5", q0=[0.0, z0], t_eval=t_eval, rtol=1e-11, atol=1e-13)
+    phi_dot = res.qd[:, 0]
+    motor = (-1.2 * m * G * r + 50.0 * t_eval) * phi_dot
+
+    def integral(f):
+        return np.concatenate([[0.0], np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(t_eval))])
+
+    E = res.energy
+    balance = E - E[0] - integral(motor) + integral(res.dissipated_power)
+    moved = np.abs(E - E[0]).max()
+    assert phi_dot[-1] < -1.0 and moved > 1e3  # the drum winds the rope in: the load rises
+    assert np.abs(balance).max() < 3e-8 * moved
+
+
+@pytest.mark.parametrize("algorithm", ["recursive", "lagrange"])
+def test_the_drums_coupling_has_exact_jacobians_in_both_modes_and_engines(algorithm):
+    """∂f/∂q and ∂f/∂q̇ with the drum's row and column (the rope's force by φ, the drum's pull by z) against central
+    differences; the recursive engine's forward and reverse modes against them; both engines' forces agree."""
+    system = winch(torque=rf.motion.constant(-500.0), algorithm=algorithm)
+    t, q, qd = 0.3, np.array([0.4, H - 2.2]), np.array([-0.7, 0.9])  # l = 2.2 m, l_u = 2.12 m: taut
+    Kq, Kqd = system.force_jacobians(t, q, qd)
+    Fq, Fqd = central_jacobians(system, t, q, qd, h=1e-6)
+    assert abs(Kq[0, 1]) > 1e5 and abs(Kq[1, 0]) > 1e5  # coupled both ways
+    np.testing.assert_allclose(Kq, Fq, rtol=2e-6, atol=2e-6 * np.abs(Fq).max())
+    np.testing.assert_allclose(Kqd, Fqd, rtol=2e-6, atol=2e-6 * np.abs(Fqd).max())
+    if algorithm == "recursive":
+        check_both_modes(system, np.random.default_rng(5))  # z in (-1, 1) m: the rope taut
+        lagrange = winch(torque=rf.motion.constant(-500.0), algorithm="lagrange")
+        np.testing.assert_allclose(system.forward_dynamics(t, q, qd), lagrange.forward_dynamics(t, q, qd), rtol=1e-10)
+
+
+def test_the_adjoint_gradient_by_the_ropes_stiffness_through_a_wound_rope():
+    """rf.gradient by "rope.EA" and "rope.DA" of the load's height after 0.5 s against central differences of whole
+    runs (1e-6): the adjoint's parameter terms hold the drum's pull too."""
+    system = winch(torque=rf.motion.constant(-1.1 * 200.0 * G * 0.3))
+    z0 = H - 2.0 * (1 + 200.0 * G / 2e6)
+    run = dict(dt=1e-3, q0=[0.0, z0], newton_tol=1e-13)
+    g = rf.gradient(system, 0.5, ["rope.EA", "rope.DA"], outputs={"z": "load.z"}, terminal=lambda y: y["z"], **run)
+
+    def height(**values):
+        r = rf.simulate(system.with_parameters(values), 0.5, method="generalized_alpha", t_eval=[0.5], **run)
+        return r.q[-1, 1]
+
+    for name, value in (("rope.EA", 2e6), ("rope.DA", 2e3)):
+        h = 1e-4 * value
+        fd = (height(**{name: value + h}) - height(**{name: value - h})) / (2 * h)
+        assert g[name] == pytest.approx(fd, rel=1e-6, abs=1e-12)
+
+
+def test_bad_drums_are_refused_by_name():
+    model = rf.Model()
+    drum = model.add_body("drum", model.ground, rf.Joint.revolute("y"), 1.0, (1.0, 1.0, 1.0))
+    load = model.add_body("load", model.ground, rf.Joint.prismatic("z"), 1.0, (1.0, 1.0, 1.0))
+    two = model.add_body("two", model.ground, rf.Joint.universal(), 1.0, (1.0, 1.0, 1.0))
+    sheave = model.ground.point((0.0, 0.0, 5.0))
+    with pytest.raises(ValueError, match="radius: expected a positive"):
+        model.add_rope("r1", sheave, load.origin, EA=1e6, length=1.0, drum=drum, radius=0.0)
+    with pytest.raises(ValueError, match="drum: expected a body"):
+        model.add_rope("r2", sheave, load.origin, EA=1e6, length=1.0, drum="drum", radius=0.3)
+    with pytest.raises(ValueError, match="coordinate: expected a coordinate name"):
+        model.add_rope("r3", sheave, load.origin, EA=1e6, length=1.0, drum=two, radius=0.3)
+    with pytest.raises(ValueError, match="length: expected a number l0"):
+        model.add_rope("r4", sheave, load.origin, EA=1e6, length=rf.motion.polynomial([1.0, 0.1]), drum=drum,
+                       radius=0.3)
+    with pytest.raises(ValueError, match="radius: expected a positive drum radius"):
+        model.add_rope("r5", sheave, load.origin, EA=1e6, length=1.0, drum=drum)
+    model.add_rope("r6", sheave, load.origin, EA=1e6, length=1.0, drum=(two, "ry"), radius=0.3)  # a named rotation
+    s = model.compile()
+    # wound all in: the drum's φ = −l₀/r leaves no rope
+    with pytest.raises(rf.SimulationError, match="its drum has wound it all in"):
+        s.generalized_forces(0.0, np.array([0.0, 0.0, 0.0, -1.0 / 0.3 - 0.1]), np.zeros(4))
+    assert math.isfinite(s.generalized_forces(0.0, np.zeros(4), np.zeros(4))[0])
