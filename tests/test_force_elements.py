@@ -346,3 +346,39 @@ def test_sliding_friction_stops_a_block_and_its_derivatives_are_exact():
         Fq, Fqd = central_jacobians(rec, t, q, qd)
         assert np.abs(Kq - Fq).max() < 1e-7 * np.abs(Fq).max()
         assert np.abs(Kqd - Fqd).max() < 1e-7 * np.abs(Fqd).max()
+
+
+def test_a_position_controlled_actuators_seal_friction_adds_to_the_force_it_must_exert():
+    """Friction on an actuator under position control: a SlidingFriction element between the actuator's own points.
+    The motion is the actuator's, so the run is the frictionless one, and the actuator's force (its loop's reaction)
+    is the frictionless force less the seal's F(l̇) = −(F_C + (F_S − F_C) e^{−(l̇/v_S)²}) tanh(l̇/v_ε) − b l̇, computed
+    here (1e-8 of the force; the reactions of dopri5's outputs, the forward dynamics' at each state): the cylinder
+    pushes harder while extending and pulls harder while retracting."""
+    FS, FC, vS, b, ve = 800.0, 500.0, 0.05, 200.0, 1e-3
+
+    def luffed(seal):
+        model = rf.Model(gravity=(0.0, -9.81, 0.0))
+        boom = model.add_body("boom", model.ground, rf.Joint.revolute("z"), 5.0, (0.01, 1.7, 1.7), com=(1.0, 0.0, 0.0))
+        a, tip = model.ground.point((0.5, 0.0, 0.0)), boom.point((1.0, 0.0, 0.0))
+        model.add_actuator("cylinder", a, tip, rf.motion.harmonic(0.15, 2.0, offset=1.0))  # extends, then retracts
+        if seal:
+            model.add_force_element("seal", a, tip, rf.laws.SlidingFriction(breakaway=FS, coulomb=FC, stribeck=vS,
+                                                                             viscous=b, smoothing=ve))
+        return model.compile()
+
+    t = np.linspace(0.0, 3.0, 301)
+    runs = []
+    for seal in (False, True):
+        s = luffed(seal)
+        q0, qd0 = s.assemble([np.arccos((0.25 + 1.0 - 1.0) / 1.0)], [0.0])
+        runs.append(rf.simulate(s, 3.0, method="dopri5", rtol=1e-10, atol=1e-12, q0=q0, qd0=qd0, t_eval=t))
+    plain, sealed = runs
+    np.testing.assert_allclose(sealed.q, plain.q, atol=1e-9)
+    # l̇ at the outputs (the actuator's l = 1 + 0.15 sin 2t)
+    s = luffed(True)
+    v = np.array([s.element_states(tk, q, qd)[0, 1] for tk, q, qd in zip(t, sealed.q, sealed.qd)])
+    np.testing.assert_allclose(v, 0.3 * np.cos(2.0 * t), atol=1e-6)
+    friction = -(FC + (FS - FC) * np.exp(-(v / vS) ** 2)) * np.tanh(v / ve) - b * v
+    F_plain, F_sealed = plain.loop_reactions[:, 0, 0], sealed.loop_reactions[:, 0, 0]
+    np.testing.assert_allclose(F_sealed, F_plain - friction, atol=1e-8 * np.abs(F_sealed).max())
+    assert (F_sealed - F_plain)[v > 0.05].min() > FC and (F_sealed - F_plain)[v < -0.05].max() < -FC
