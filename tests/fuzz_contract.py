@@ -129,11 +129,20 @@ FEATURES = (
     "npz_foreign_files",   # ... load_npz of a file that is not a saved Result (junk, another archive)
     "system_takers",       # every public function taking a system given a Model, None or a string
     "ground_handles",      # the ground (model.ground, a Body) as an output of rf.gradient
+    # -- events and ropes wound on drums (66c0bd2)
+    "events",              # simulate(events=[rf.Event(...)], contact_events=...): coordinates, rates, points along an
+                           # axis, contacts' gaps, Python functions (good, returning strings/NaN, raising); Result.events
+                           # checked (times within [t0, t_end], in order, a terminal run ending at its root), event_times
+    "event_name_types",    # ... Result.event_times given an unhashable name (a list, a dict)
+    "event_extreme_axes",  # ... a point's axis of finite components whose norm overflows or underflows (1e300, 1e-300)
+    "events_estimate",     # ... Result.error_estimate of a run that a terminal event ended (with and without t_eval)
+    "rope_drums",          # add_rope(..., drum=body or (body, coordinate), radius=r) on random models and a winch sample
+    "drum_retry",          # ... a rope refused for its drum added again under the same name (the refusal left no trace)
 )
 
 #: The features of the newer entry points' generators (Gen.entry_case draws cases on samples when one is on).
 ENTRY_FEATURES = ("gradient", "sensitivities", "parameters", "resolve", "view", "sweep", "sea", "loaded_results",
-                  "system_takers")
+                  "system_takers", "events")
 
 #: Features whose generators hit known contract violations: the suite leaves them out (scripts/fuzz.py
 #: runs everything). Delete an entry once its fix is in, to put the generator back into the suite.
@@ -249,6 +258,39 @@ def drive_nan(t):
 
 def drive_raises(t):
     raise LawError("drive")
+
+
+# -- the functions g(t, q, qd) of rf.Event (fz.late_nan(k): finite for k calls, NaN after)
+def ev_sine(t, q, qd):
+    return np.sin(60.0 * t) - 0.3
+
+
+def ev_q(t, q, qd):
+    return float(np.sum(q)) - 0.01 if len(q) else t
+
+
+def ev_str(t, q, qd):
+    return "abc"
+
+
+def ev_none(t, q, qd):
+    return None
+
+
+def ev_vector(t, q, qd):
+    return np.array([1.0, 2.0])
+
+
+def ev_nan(t, q, qd):
+    return nan
+
+
+def ev_inf(t, q, qd):
+    return inf
+
+
+def ev_raises(t, q, qd):
+    raise LawError("event")
 
 
 def _foreign():
@@ -511,6 +553,259 @@ def rao_shape(w):
 
     return np.zeros(np.size(w) + 1, dtype=complex)
 
+
+# -- events (rf.Event) and ropes wound on drums
+
+
+def cname(system, k: int) -> str:
+    """The k-th (modulo nq) free coordinate's name of ``system``, or 'nope' when it has none."""
+    names = list(system.coordinate_names)
+    return names[k % len(names)] if names else "nope"
+
+
+def late_nan(k: int):
+    """An event function g(t, q, qd) = sin(60 t) - 0.3 for its first k calls, NaN after (one per case)."""
+    import numpy as np
+
+    calls = [0]
+
+    def g(t, q, qd):
+        calls[0] += 1
+        return float(np.sin(60.0 * t) - 0.3) if calls[0] <= k else float("nan")
+    return g
+
+
+def winch(driven: bool = False, named: bool = False):
+    """A load of 50 kg on a vertical slide (z) hanging 3 m below a sheave by a rope wound on a drum (rotation y, radius
+    0.3 m): a motor's torque of 120 N m (the load's pull is 147 N m: it sinks), or a drum prescribed to wind at 2 rad/s.
+    ``named``: the drum's joint is a cylindrical one, its rotation named (drum, "ry")."""
+    model = rf.Model(gravity=(0.0, 0.0, -9.81))
+    joint = rf.Joint.cylindrical("y", stiffness=[1e4, 0.0]) if named else rf.Joint.revolute("y")
+    drum = model.add_body("drum", model.ground, joint, 20.0, (0.5, 0.9, 0.5))
+    load = model.add_body("load", model.ground, rf.Joint.prismatic("z"), 50.0, (0.1, 0.1, 0.1))
+    rope = model.add_rope("rope", model.ground.point((0.0, 0.0, 3.0)), load.origin, EA=2e6, DA=2e3, length=3.0,
+                          drum=(drum, "ry") if named else drum, radius=0.3)
+    if driven:
+        model.prescribe(drum, rf.motion.ramp(-2.0, 0.0, 0.1), coordinate="ry" if named else None)
+    else:
+        model.add_torque("motor", drum, (0.0, -1.0, 0.0), scale=rf.motion.constant(120.0))
+    return model, {"drum": drum, "load": load, "rope": rope}
+
+
+def level(q0, k: int, delta: float) -> float:
+    """q0[k % nq] + delta: a level that a coordinate starting at q0 crosses once it moves by delta (delta when q0 is no
+    vector of finite numbers)."""
+    import numpy as np
+
+    try:
+        q = np.asarray(q0, dtype=float).ravel()
+        x = float(q[k % len(q)]) + delta if len(q) else delta
+    except Exception:  # noqa: BLE001 -- a bad q0: judged by simulate
+        return delta
+    return x if math.isfinite(x) else delta
+
+
+def point_level(system, point, axis, q0, delta: float, t0: float = 0.0) -> float:
+    """The position of ``point`` along ``axis`` at (t0, q0), plus delta: a level the point crosses once it moves by
+    delta that way (delta when any of it is bad)."""
+    import numpy as np
+
+    try:
+        a = np.asarray({"x": (1.0, 0.0, 0.0), "y": (0.0, 1.0, 0.0), "z": (0.0, 0.0, 1.0)}.get(axis, axis)
+                       if isinstance(axis, str) else axis, dtype=float)
+        a = a / np.linalg.norm(a)
+        q = np.zeros(system.nq) if q0 is None else np.asarray(q0, dtype=float)
+        x = float(np.asarray(system.position(point, t0, q)) @ a) + delta
+    except Exception:  # noqa: BLE001 -- a bad point, axis or q0: judged by the calls
+        return delta
+    return x if math.isfinite(x) else delta
+
+
+def _event_list(value):
+    """simulate's ``events`` as a list of rf.Event, or None when it is not one (None, an Event, an iterable of them)."""
+    if value is None:
+        return []
+    if isinstance(value, rf.Event):
+        return [value]
+    if isinstance(value, (str, bytes, dict)):
+        return None
+    try:
+        value = list(value)
+    except TypeError:
+        return None
+    return value if all(isinstance(e, rf.Event) for e in value) else None
+
+
+def _axis_ok(axis) -> bool:
+    """A point event's axis: 'x', 'y', 'z' or a real 3-vector with a finite, non-zero component."""
+    import numpy as np
+
+    if isinstance(axis, str):
+        return axis in ("x", "y", "z")
+    if axis is None or isinstance(axis, bytes):
+        return False
+    try:
+        a = np.asarray(axis)
+    except Exception:  # noqa: BLE001
+        return False
+    return a.dtype.kind in "iuf" and a.shape == (3,) and bool(np.all(np.isfinite(a))) and bool(np.any(a != 0))
+
+
+def _events_bad(value, system, method, contact_events) -> bool:
+    """Whether simulate's ``events`` are invalid for ``system`` (as the documentation says): not a list of rf.Event,
+    names twice (the contacts' own events carry the contacts' names when ``contact_events``), a scipy: method with
+    events, an ``of`` that is no free coordinate's or contact's name, no point or body of the system's model on a
+    moving body with an axis, nor a function; an axis or a rate where they do not belong. (A function's returns are
+    judged by the generator.)"""
+    import numpy as np
+
+    events = _event_list(value)
+    if events is None:
+        return True
+    if not isinstance(system, rf.System):
+        return False  # judged by the system argument
+    scipy = isinstance(method, str) and method.startswith("scipy:")
+    if events and scipy:
+        return True
+    own = list(system.contact_names) if contact_events is True and not scipy else []
+    names = [e.name for e in events] + own
+    if len(set(names)) != len(names):
+        return True
+    model = getattr(system, "_model_id", 0)
+    for e in events:
+        of = e.of
+        if isinstance(of, (rf.Point, rf.Body)):
+            body = of.body if isinstance(of, rf.Point) else of.index
+            if e.rate or (of.model and model and of.model != model) or not 0 <= body < system.nbodies:
+                return True
+            if isinstance(of, rf.Point) and not np.all(np.isfinite(np.asarray(of.r, dtype=float))):
+                return True
+            if not _axis_ok(e.axis):
+                return True
+        elif isinstance(of, str):
+            if e.axis is not None:
+                return True
+            if not (of in system.coordinate_names or (of in system.contact_names and not e.rate)):
+                return True
+        elif callable(of) and not isinstance(of, (rf.Model, rf.System)):
+            if e.axis is not None or e.rate:
+                return True
+        else:
+            return True
+    return False
+
+
+def _terminal(res) -> set:
+    """The names of the run's terminal events."""
+    return {e.name for e in (res.run or {}).get("events") or [] if isinstance(e, rf.Event) and e.terminal}
+
+
+def _finished(res) -> bool:
+    """Whether a Result's run went to its end: t_end, or a terminal event's root (not interrupted)."""
+    try:
+        if res.interrupted or not len(res.t) or not res.run:
+            return False
+        t_end = res.run["t_end"]
+        if res.t[-1] >= t_end - 1e-12 * max(1.0, abs(t_end)):
+            return True
+        return any(f.event in _terminal(res) for f in res.events)
+    except Exception:  # noqa: BLE001 -- not a run's Result: judged by the call
+        return True
+
+
+def ok(value):
+    """``value`` if it is True; AssertionError saying what it is (a check's finding) otherwise."""
+    if value is not True:
+        raise AssertionError(str(value))
+    return True
+
+
+def events_within(res):
+    """True, or what is wrong: every root's time within [t0, t_end] and not after the run's last output."""
+    t0, t_end = res.run["t0"], res.run["t_end"]
+    for f in res.events:
+        if not t0 <= f.t <= t_end:
+            return f"event {f.event!r} at t = {f.t!r} outside [t0, t_end] = [{t0!r}, {t_end!r}]"
+    return True
+
+
+def events_ordered(res):
+    """True, or what is wrong: the roots in non-decreasing time."""
+    ts = [f.t for f in res.events]
+    for k in range(1, len(ts)):
+        if ts[k] < ts[k - 1]:
+            return f"event times decrease: {res.events[k - 1].event!r} at {ts[k - 1]!r} then {res.events[k].event!r} " \
+                   f"at {ts[k]!r}"
+    return True
+
+
+def terminal_end(res):
+    """True, or what is wrong: a run ended by a terminal event ends at its root (its last output is the root without
+    t_eval, at or before it with), no root follows it; a run without one (not interrupted) reaches t_end."""
+    import numpy as np
+
+    if res.interrupted or not len(res.t):
+        return True
+    terminal = _terminal(res)
+    k = next((i for i, f in enumerate(res.events) if f.event in terminal), None)
+    t_eval = res.run.get("t_eval")
+    if k is None:
+        if not len(res.events) or t_eval is not None:
+            return True
+        t_end = res.run["t_end"]
+        if abs(res.t[-1] - t_end) > 1e-12 * max(1.0, abs(t_end)):
+            return f"no terminal event fired, yet the run ended at t = {res.t[-1]!r} before t_end = {t_end!r}"
+        return True
+    root = res.events[k]
+    later = [f for f in res.events[k + 1:] if f.t > root.t]
+    if later:
+        return f"event {later[0].event!r} at t = {later[0].t!r} recorded after the terminal {root.event!r} at {root.t!r}"
+    if t_eval is None and res.t[-1] != root.t:
+        return f"terminal event {root.event!r} at t = {root.t!r} but res.t[-1] = {res.t[-1]!r}"
+    if t_eval is not None and not res.t[-1] <= root.t:
+        return f"terminal event {root.event!r} at t = {root.t!r} but an output after it, res.t[-1] = {res.t[-1]!r}"
+    if t_eval is not None and len(res.t) != int(np.sum(np.asarray(t_eval) <= root.t)):
+        return f"terminal event {root.event!r} at t = {root.t!r}: {len(res.t)} outputs, t_eval has " \
+               f"{int(np.sum(np.asarray(t_eval) <= root.t))} up to it"
+    return True
+
+
+def events_consistent(res):
+    """True, or what is wrong: each root names an event of the run (or a contact), crosses in a direction its event
+    allows, carries a finite state of nq numbers, and a coordinate's (rate's) root has it at the event's level."""
+    import numpy as np
+
+    system = res.system
+    events = {e.name: e for e in _event_list(res.run.get("events")) or []}
+    contacts = list(system.contact_names) if res.run.get("contact_events", True) is True else []
+    names = list(system.coordinate_names)
+    for f in res.events:
+        e = events.get(f.event)
+        if e is None and f.event not in contacts:
+            return f"a root of {f.event!r}, which is no event of the run"
+        if f.direction not in (-1, 1) or (e is not None and e.direction and f.direction != e.direction):
+            return f"event {f.event!r} at t = {f.t!r} crossed in direction {f.direction!r}" + \
+                (f" (its event's: {e.direction!r})" if e is not None else "")
+        if np.shape(f.q) != (system.nq,) or np.shape(f.qd) != (system.nq,) or \
+                not (np.all(np.isfinite(f.q)) and np.all(np.isfinite(f.qd))):
+            return f"event {f.event!r} at t = {f.t!r}: its state is not {system.nq} finite numbers each"
+        if e is not None and isinstance(e.of, str) and e.of in names:
+            j = names.index(e.of)
+            x, run = (f.qd[j], res.qd[:, j]) if e.rate else (f.q[j], res.q[:, j])
+            scale = 1.0 + abs(e.value) + float(np.max(np.abs(run))) if len(run) else 1.0
+            if abs(x - e.value) > 1e-6 * scale:
+                return f"event {f.event!r} at t = {f.t!r}: {e.of}{' rate' if e.rate else ''} = {x!r} there, not " \
+                       f"its level {e.value!r}"
+    return True
+
+
+def times_agree(res, name, times) -> bool:
+    """Whether Result.event_times(name) gave the times of the roots of ``name`` in Result.events."""
+    import numpy as np
+
+    return np.array_equal(np.asarray(times, dtype=float), np.array([f.t for f in res.events if f.event == name]))
+
+
 GOOD_LAWS = ("law_spring",)
 BAD_LAWS = ("law_nan", "law_string", "law_none", "law_vector")
 GOOD_DRIVES = ("drive_sine",)
@@ -578,7 +873,10 @@ VALUE_MESSAGE = re.compile(r"^([A-Za-z_][\w.]*(?:\[[^\]]*\])?(?:, ?[A-Za-z_][\w.
 TIME_IN_MESSAGE = re.compile(r"\bt = [-+]?(?:\d|inf|nan)")
 VECTOR_ROLES = {"q": 1, "qd": 1, "qdd": 1, "q0": 1, "qd0": 1, "y": 2}
 OPTIONAL_ROLES = {"q0", "qd0"}  # None is the default (zeros): simulate's q0, qd0; statics' q0; modal's q, qd
-RUNTIME_ROLES = set(VECTOR_ROLES) | {"t", "topt", "rtol", "atol", "cname", "sname", "pvalues", "lsys", "outputs"}
+RUNTIME_ROLES = set(VECTOR_ROLES) | {"t", "topt", "rtol", "atol", "cname", "sname", "pvalues", "lsys", "outputs",
+                                     "finished"}
+# (role "events", simulate's events judged against the system, is not among them: its static "bad" -- an event function
+# returning a string -- holds too)
 
 #: Violation kinds (a call's outcome breaking the contract), and the crash/hang of a case.
 VIOLATIONS = ("crash", "hang", "other_exception", "type_error", "accepted_bad", "rejected_valid", "wrong_name",
@@ -768,9 +1066,10 @@ def run_case(case: dict, base: dict, progress=None) -> list:
             extreme |= bool(a.get("x"))
         began = time.perf_counter()
         try:
-            args, kw = [], {}
+            args, kw, given = [], {}, {}
             for name, a, key in items:
                 v = eval(a["e"], ns)  # a nested constructor may raise here: the call's outcome
+                given[name] = v
                 if key is None:
                     args.append(v)
                 else:
@@ -804,10 +1103,18 @@ def run_case(case: dict, base: dict, progress=None) -> list:
                                                     and list(v.coordinate_names) == list(saved))
                 elif role == "outputs":
                     is_bad = not _outputs_ok(v, system)
+                elif role == "finished":  # a Result whose error estimate needs its run to have gone to its end
+                    is_bad = not _finished(v)
                 else:
                     is_bad = False
                 if is_bad:
                     bad |= {name, *a.get("names", ())}
+            for name, a, key in items:  # simulate's events: judged with the system, method and contact_events given
+                if a.get("role") == "events":
+                    passed = given.get("system", system)
+                    if _events_bad(given[name], passed if isinstance(passed, rf.System) else None,
+                                   given.get("method", "auto"), given.get("contact_events", True)):
+                        bad |= {name, *a.get("names", ())}
             if step.get("omit_t") and getattr(system, "np", 0) > 0:
                 bad.add("t")
             bad |= set(step.get("absent_bad", ()))  # left out although required (dt of a fixed step)
@@ -1544,6 +1851,13 @@ SAMPLES = {
                     ("h['block']",), 1, 0, False),
     "four_bar": ("rf.samples.four_bar()", ("h['crank']", "h['coupler'].point((0.8, 0.0, 0.0))"),
                  ("h['rocker']",), 3, 0, True),
+    # a rope wound on a drum (feature rope_drums): fz.winch
+    "winch": ("fz.winch()", ("h['load']", "h['drum'].point((0.3, 0.0, 0.0))", "h['load'].origin"),
+              ("h['drum']", "h['load']"), 2, 0, False),
+    "winch_driven": ("fz.winch(driven=True)", ("h['load']", "h['drum'].point((0.3, 0.0, 0.0))"), ("h['load']",), 1, 1,
+                     False),
+    "winch_named": ("fz.winch(named=True)", ("h['load']", "h['drum'].point((0.0, 0.0, 0.3))"),
+                    ("h['drum']", "h['load']"), 3, 0, False),
 }
 
 
@@ -1565,6 +1879,8 @@ class Gen:
         self.counter = 0
         self.uncertain = False  # whether the model built may differ from what the generator tracks
         self.laws: set = set()  # (body index, coordinate) with a force law
+        self.contact_names: list = []  # the names (as expressions) of the contacts added (or tried)
+        self.drum_next = False  # the next rope is wound on a drum
 
     # -- drawing helpers (integer strategies cached: building a strategy costs more than drawing)
     _ints: dict = {}
@@ -1769,7 +2085,10 @@ class Gen:
             values[key] = self.choice(["-1.0", "nan", "inf", "'x'", "0.0" if key in ("stiffness", "restitution", "smoothing") else "-2.0"])
         law = "rf.laws.Contact(" + ", ".join(f"{k}={v}" for k, v in values.items()) + ")"
         group = lambda g: g[0][0] if len(g) == 1 else "[" + ", ".join(v for v, _, _ in g) + "]"  # noqa: E731
-        self.emit("model.add_contact", [self.fresh_name(), A(group(a)), A(group(b)), A(law, bad=bad, names=tuple(values))],
+        name = self.fresh_name()
+        if not name.get("bad") and self.on("events"):
+            self.contact_names.append(name["e"])  # added or refused: an event of it is judged by the system's names
+        self.emit("model.add_contact", [name, A(group(a)), A(group(b)), A(law, bad=bad, names=tuple(values))],
                   ["name", "a", "b", "law"], label="add_contact", ambiguous=True)
 
     def add_body(self):
@@ -2040,7 +2359,7 @@ class Gen:
             return f"rf.Point({b['index']}, {vec(self.vec3())})", False, False
         return f"{h}.point({vec(self.vec3())})", False, False
 
-    def add_loop_or_element(self):
+    def add_loop_or_element(self, kind=None):
         """A loop joint, an actuator, a spring-damper or a rope between two points of the model (or the
         ground): random ones rarely close at q = 0, so the runs that follow mostly end in the
         SimulationError of an assembly that fails; refusing a pair (two points of one body) or taking it
@@ -2048,7 +2367,7 @@ class Gen:
         (a, bad_a, _), (b, bad_b, _) = self.point(), self.point(good_only=True)
         if self.chance(0.3):
             b = f"model.ground.point({vec(self.vec3())})"
-        kind = self.choice(["loop", "loop", "actuator", "spring", "rope"])
+        kind = kind or self.choice(["loop", "loop", "actuator", "spring", "rope"])
         bad = bad_a or bad_b
         if kind == "loop":
             joint = self.choice(["'revolute'", "'spherical'", "'universal'", "'prismatic'", "'cylindrical'", "'fixed'",
@@ -2075,8 +2394,86 @@ class Gen:
                 kw["EA"] = kw.pop("stiffness")
                 if "damping" in kw:
                     kw["DA"] = kw.pop("damping")
-            self.emit(fn, [self.fresh_name(), A(a, bad=bad_a, names=ROLE_NAMES["point"]), A(b)], ["name", "a", "b"], kw,
-                      label=fn.split(".")[1], ambiguous=not bad)
+            wound = kind == "rope" and self.on("rope_drums") and (self.drum_next or self.chance(0.4)) and self.drum(kw)
+            self.drum_next = False
+            name = self.fresh_name()
+            # (a valid element is ambiguous: a and b may be points of one body; a bad drum is refused first, except a
+            # joint of several coordinates or none, found once the element is in, after a and b: "b" may come first)
+            self.emit(fn, [name, A(a, bad=bad_a, names=ROLE_NAMES["point"]), A(b)], ["name", "a", "b"], kw,
+                      label="add_rope:drum" if wound else fn.split(".")[1], ambiguous=not bad and wound != "bad")
+            if wound == "bad" and not bad_a and not name.get("bad") and not name.get("soft") and \
+                    self.on("drum_retry") and self.chance(0.5):
+                # refused: nothing of it stays in the model, its name is free (a refusal naming name is a violation)
+                self.emit(fn, [name, A(a), A(b)], ["name", "a", "b"], {"EA": A("1e4"), "length": A("1.0")},
+                          label="add_rope:retry", ambiguous=True, message=r"^(?!name: expected a name not yet given)")
+
+    def drum(self, kw) -> str:
+        """Wind the rope of ``kw`` on a drum (drum=, radius=, a number l0 as its length): mostly a body with a rotation
+        (alone: the body; one of several: (body, "rz")), now and then a bad radius, a profile as length, a drum that is
+        no body, a joint of several coordinates (or none) without a name, a coordinate the joint has not, the ground or
+        a foreign body; a translation pays out too (soft: taken or refused). Returns "good", "bad" or "soft"."""
+        rot = [b for b in self.bodies if any(c.startswith("r") for c in b["coords"])]
+        unnamed = [b for b in self.bodies if len(b["coords"]) != 1]
+        moving = [b for b in self.bodies if "x" in b["coords"] or "y" in b["coords"] or "z" in b["coords"]]
+        kind = self.choice(["good"] * 8 + ["radius", "profile", "nonbody", "unnamed", "unnamed", "coordinate",
+                                           "translation", "ground"])
+        if kind in ("good", "radius", "profile") and not rot:
+            kind = "nonbody"
+        if (kind == "unnamed" and not unnamed) or (kind == "translation" and not moving) or \
+                (kind == "coordinate" and not self.bodies):
+            kind = "ground"
+        kw["length"] = A(fl(self.choice([0.5, 1.0, 3.0])))
+        radius = A(fl(self.choice([0.3, 0.3, 0.05, 1.0, 1e-3])))
+        names = ("drum", "coordinate", "radius")
+        state = "bad"
+
+        def on(b):  # a body with a rotation as the drum: the body itself when its joint has one coordinate
+            rc = [c for c in b["coords"] if c.startswith("r")]
+            if len(b["coords"]) == 1 and self.chance(0.7):
+                return self.handle(b)
+            return f"({self.handle(b)}, {self.choice(rc)!r})"
+
+        if kind == "good":
+            drum, state = A(on(self.choice(rot))), "good"
+        elif kind == "radius":
+            drum = A(on(self.choice(rot)))
+            r = self.choice(["0.0", "-0.3", "nan", "inf", "'0.3'", "True", "None", "absent"])
+            radius = None if r == "absent" else A(r, bad=True, names=("radius",))
+        elif kind == "profile":
+            drum = A(on(self.choice(rot)))
+            kw["length"] = A(self.choice(["rf.motion.polynomial([1.0, 0.1])", "rf.motion.constant(1.0)"]), bad=True,
+                             names=("length",))
+        elif kind == "nonbody":
+            b = self.choice(self.bodies) if self.bodies else None
+            h = self.handle(b) if b else "model.ground"
+            options = [f"{h}.origin", "None", f"({h},)", f"[{h}, 'rz']", "3", f"({h}, 'rz', 1)"] + \
+                ([repr(b["name"])] if b and b.get("name") else []) + [bm["var"] for bm in self.beams[:1]]
+            drum = A(self.choice(options), bad=True, names=("drum",))
+        elif kind == "unnamed":
+            drum = A(self.handle(self.choice(unnamed)), bad=True, names=("drum", "coordinate", "b"))
+        elif kind == "coordinate":
+            b = self.choice(self.bodies)
+            other = [c for c in ("x", "y", "z", "rx", "ry", "rz") if c not in b["coords"]]
+            c = self.choice(["'w'", "3", "None"] + [repr(c) for c in other])
+            # (body, None) is the body alone: fine for a joint of one coordinate
+            drum = A(f"({self.handle(b)}, {c})", bad=not (c == "None" and len(b["coords"]) == 1),
+                     names=("drum", "coordinate", "b"))
+            state = "good" if not drum.get("bad") else "bad"
+        elif kind == "translation":  # a translation pays out rope as a rotation does: r x (taken, or refused by name)
+            b = self.choice(moving)
+            tc = [c for c in b["coords"] if c in ("x", "y", "z")]
+            drum = A(self.handle(b) if len(b["coords"]) == 1 else f"({self.handle(b)}, {self.choice(tc)!r})", soft=True,
+                     names=("drum", "coordinate"))
+            state = "soft"
+        else:
+            drum = A(self.choice(["model.ground", "(model.ground, 'rz')", "fb[0]", "(fb[1], 'rz')", "fbeam.rfes[1]"]),
+                     bad=True, names=("drum", "coordinate"))
+        kw["drum"] = drum
+        if radius is not None:
+            kw["radius"] = radius
+        if state == "good" and self.chance(0.3):
+            kw["DA"] = A(fl(self.choice([0.0, 10.0, 1e3])))
+        return state
 
     def add_load(self):
         kind = self.choice(["force", "force", "torque", "generalized"])
@@ -2176,6 +2573,10 @@ class Gen:
         if self.on("loops_and_elements"):
             for _ in range(self.choice([0, 0, 1, 1, 2])):
                 self.add_loop_or_element()
+        if self.on("rope_drums") and self.chance(0.25) and \
+                any(c.startswith("r") for b in self.bodies for c in b["coords"]):
+            self.drum_next = True  # a rope wound on a drum: models with a body that rotates
+            self.add_loop_or_element("rope")
         if self.on("contacts") and self.chance(0.4):
             self.add_contact()
         if self.on("model_body_lookup") and self.chance(0.05):
@@ -2408,6 +2809,7 @@ class Gen:
             kw["stiffness_warning"] = A("False")
         if self.chance(0.03):
             kw["progress"] = A("True")
+        events = self.events_kw(kw, method) if self.on("events") and self.chance(0.2) else None
         out = self.new("res")
         # rtol = atol = 0 together: refused by some methods, run by others
         amb = kw.get("rtol", {}).get("e") in ("0.0",) and kw.get("atol", {}).get("e") in ("0.0",)
@@ -2420,9 +2822,11 @@ class Gen:
             absent = []  # an adaptive Newmark run needs no dt
         if steps and not kw["first_step"].get("bad") and kw.get("adaptive", {}).get("names") == ["adaptive", "dt"]:
             del kw["adaptive"]["bad"]  # adaptive=False without dt: first_step serves as the step
-        self.emit("rf.simulate", args, params, kw, out=out, label=f"simulate:{mlabel}", ambiguous=amb,
-                  absent_bad=absent)
+        self.emit("rf.simulate", args, params, kw, out=out, label="simulate:events" if events else f"simulate:{mlabel}",
+                  ambiguous=amb, absent_bad=absent, late=bool(events and events["late"]))
         self.results.append(out)
+        if events or (self.contact_names and self.chance(0.5)):  # (the contacts' own events)
+            self.event_checks(out, events or {"names": [], "terminal": False, "late": False})
 
     def tol(self, key, scalar=False):
         if scalar:
@@ -2646,7 +3050,7 @@ class Gen:
         n = self.choice([3, 6, 10, 15, 25])
         # the newer entry points on the random model (those that need no model: sea, sweep, now and then)
         extra = [k for k in ("gradient", "sensitivities", "parameters", "view", "loaded_results", "sea", "sweep",
-                             "system_takers") if self.on(k)]
+                             "system_takers", "events") if self.on(k)]
         for _ in range(n):
             kind = self.choice(["system"] * 8 + ["simulate"] * 3 + ["result"] * 2 + ["analysis", "stages", "misc",
                                                                                       "misc", "core"] + extra)
@@ -2664,11 +3068,12 @@ class Gen:
         return {"gradient": self.gradient_case_call, "sensitivities": self.sensitivities_call,
                 "parameters": self.parameters_call, "resolve": self.resolve_call, "view": self.view_call,
                 "sweep": self.sweep_call, "sea": self.sea_call, "loaded_results": self.loaded_call,
-                "system_takers": self.system_taker_call}
+                "system_takers": self.system_taker_call, "events": self.events_call}
 
     def entry_case(self):
         """A case on a small sample (compiled as ``system``, handles ``h``) calling the newer entry points."""
-        kind = self.choice(list(SAMPLES) + ["pendulum", "double_pendulum", "cantilever", "cantilever"])
+        kind = self.choice([k for k in SAMPLES if self.on("rope_drums") or not k.startswith("winch")] +
+                           ["pendulum", "double_pendulum", "cantilever", "cantilever"])
         expr, points, bodies, nq, npres, loops = SAMPLES[kind]
         expr = expr.replace("@E", str(self.choice([2, 3, 4, 6])))
         self.emit(expr, out="model, h", label="samples." + kind, attr=True)
@@ -3429,6 +3834,206 @@ class Gen:
         said = {"model": "a Model", "'system'": "'system'", "None": "None"}[wrong]
         self.emit(fn, args, names, kw, label="system:" + fn.split(".")[-1],
                   message=r"^system: expected a compiled System \(call model\.compile\(\)\), got " + re.escape(said))
+
+    # -- events: rf.Event, simulate(events=..., contact_events=...), Result.events and event_times
+    GOOD_EVENT_FUNCTIONS = ("ev_sine", "ev_q")
+    BAD_EVENT_FUNCTIONS = ("ev_str", "ev_none", "ev_vector", "ev_nan", "ev_inf")  # a ValueError or SimulationError
+
+    def event_name(self) -> dict:
+        """An event's name: a new one (n0, n1, ...), now and then a contact's (taken by the contact's own event when
+        contact_events: judged at the run) or a bad one."""
+        if self.chance(0.03):
+            return A(self.choice(["''", "3", "None"]), bad=True, names=("name",))
+        if self.contact_names and self.chance(0.05):
+            return A(self.choice(self.contact_names))
+        name = f"n{self.other_names}"
+        self.other_names += 1
+        return A(repr(name))
+
+    def event_axis(self):
+        """A point event's axis (None: left out, refused at the run naming axis)."""
+        if self.chance(0.08):
+            return self.choice([None, A("None"), A("'w'"), A("(0.0, 0.0, 0.0)"), A("(nan, 0.0, 0.0)"), A("(1.0, 0.0)"),
+                                A("'X'")])
+        if self.on("event_extreme_axes") and self.chance(0.03):  # finite and non-zero: valid
+            return A(self.choice(["(1e300, 1e300, 0.0)", "(1e-300, 0.0, 0.0)", "(0.0, 1e200, 1e200)"]), x=True)
+        if self.chance(0.7):
+            return A(repr(self.choice(AXES)))
+        v = self.vec3()
+        if not any(v):
+            v[0] = 1.0
+        return A(vec(v))
+
+    def event_step(self, sysv="system", q0="None", t0=0.0):
+        """An rf.Event made in a step of its own: (its variable or None when its constructor is meant to refuse it,
+        info {"name", "terminal", "bad": its function returns no number (refused naming events, or a NaN a
+        SimulationError), "late"}). What it is of (a coordinate, a contact, a point, ...) is judged at the run."""
+        name = self.event_name()
+        info = {"name": name["e"], "terminal": False, "bad": False, "late": False}
+        # (the first and last options are ordinary ones: hypothesis draws the ends of a range often)
+        kind = self.choice(["coordinate", "odd", "rate", "point", "point", "body", "function", "function"] +
+                           ["contact"] * (3 if self.contact_names else 0) + ["coordinate"] * 3)
+        nq = self.nq_known if self.sample_points else self.nq_guess()
+        if kind in ("coordinate", "rate") and nq == 0 and not self.chance(0.1):
+            kind = self.choice(["function", "point"])  # no free coordinate (fz.cname gives 'nope': refused)
+        kw, near = {}, None  # near: the expression of a level just off the start (crossed soon if it moves that way)
+        if kind in ("coordinate", "rate"):
+            prescribed = [f"'{b['name']}.{c}'" for b in self.bodies if b.get("name") for c in b["prescribed"]]
+            if prescribed and self.chance(0.1):  # a prescribed coordinate is no free one: refused at the run
+                of = A(self.choice(prescribed))
+            else:
+                k = self.integer(0, 7)
+                of = A(f"fz.cname({sysv}, {k})")
+                if kind == "coordinate":
+                    near = f"fz.level({q0}, {k}, {fl(self.choice([0.01, -0.01, 1e-4, -0.1]))})"
+            if kind == "rate":
+                kw["rate"] = A("True")
+                near = fl(self.choice([0.01, -0.01, 0.1, -0.1]))  # from rest (qd0 = 0 mostly)
+            if self.chance(0.05):  # an axis is a point's: refused at the run
+                kw["axis"] = A(self.choice(["'x'", "(0.0, 0.0, 1.0)"]))
+        elif kind in ("point", "body"):
+            if self.sample_points:
+                if self.chance(0.1):
+                    e, pbad = self.any_point()
+                else:
+                    e, pbad = (self.good_point() if kind == "point" else self.choice(self.sample_bodies)), False
+            elif kind == "point":
+                e, pbad, _ = self.point()
+            else:
+                e, pbad = (self.handle(self.choice(self.bodies)) if self.bodies and not self.chance(0.1)
+                           else "model.ground"), False
+            of = A(e, soft=pbad, names=("point", "body", "r"))  # a bad point's own constructor may refuse it here
+            axis = self.event_axis()
+            if axis is not None:
+                kw["axis"] = axis
+                near = f"fz.point_level({sysv}, {e}, {axis['e']}, {q0}, {fl(self.choice([0.01, -0.01, 1e-3]))}, " \
+                       f"{fl(t0)})"
+            if self.chance(0.04):  # a rate is a coordinate's: refused at the run
+                kw["rate"] = A("True")
+        elif kind == "contact":
+            of = A(self.choice(self.contact_names))
+        elif kind == "function":
+            f = self.choice(["ev_sine", "late"] + list(self.BAD_EVENT_FUNCTIONS) + ["ev_raises"] +
+                            list(self.GOOD_EVENT_FUNCTIONS) * 3)
+            if f == "late":  # NaN after some calls: a SimulationError, or none if the run ends first
+                of, info["late"] = A(f"fz.late_nan({self.integer(1, 40)})"), True
+            else:
+                of = A(f)
+                if f in self.BAD_EVENT_FUNCTIONS:
+                    info["bad"] = info["late"] = True  # (judged where the run evaluates it first)
+                elif f == "ev_raises":
+                    self.flags["raising_callbacks"] = True
+        else:
+            of = A(self.choice(["'nope'", "3", "None", "model", "fb[0]", "(0.0, 0.0, 1.0)", "'link'"]))
+        if self.chance(0.05):
+            kw["value"] = A(self.choice(["nan", "inf", "-inf", "'x'", "None"]), bad=True, names=("value",))
+            near = None
+        elif near and self.chance(0.6):
+            kw["value"] = A(near)
+        elif self.chance(0.5):
+            kw["value"] = A(fl(self.choice([0.0, 1e300, 1e3, 0.1, -0.2, 0.5, -1.0, 0.0])))
+        if self.chance(0.05):
+            kw["direction"] = A(self.choice(["2", "-2", "True", "None", "'up'", "0.5"]), bad=True, names=("direction",))
+        elif self.chance(0.5):
+            kw["direction"] = A(self.choice(["1", "-1", "0"]))
+        if self.chance(0.03):
+            kw["terminal"] = A(self.choice(["1", "'yes'", "None"]), bad=True, names=("terminal",))
+        elif self.chance(0.25):
+            kw["terminal"] = A("True")
+            info["terminal"] = True
+        if self.chance(0.02):
+            kw["rate"] = A(self.choice(["1", "'yes'"]), bad=True, names=("rate",))
+        bad = name.get("bad") or any(a.get("bad") for a in kw.values())
+        var = None if bad else self.new("ev")
+        self.emit("rf.Event", [name, of], ["name", "of"], kw, out=var, label="Event")
+        return var, info
+
+    def events_kw(self, kw, method, sysv="system") -> dict:
+        """Events (their steps, then kw["events"], sometimes kw["contact_events"]) for a run of ``method``; returns
+        {"names": those of the run's events, "terminal", "late"}."""
+        q0 = kw["q0"]["e"] if "q0" in kw else "None"
+        t0 = float(eval(kw["t0"]["e"], {"nan": math.nan, "inf": math.inf})) if "t0" in kw else 0.0
+        made = [self.event_step(sysv, q0, t0 if math.isfinite(t0) else 0.0) for _ in range(self.choice([1, 1, 2, 3]))]
+        made = [(v, i) for v, i in made if v]
+        evs = [v for v, _ in made]
+        form = self.choice(["list", "bad", "dup", "empty", "single", "tuple"] + ["list"] * 7)
+        if form == "single" and len(evs) == 1:
+            e = evs[0]
+        elif form == "tuple":
+            e = "(" + "".join(v + ", " for v in evs) + ")"
+        elif form == "dup" and evs:  # one event twice: a name twice, refused naming events
+            e = "[" + ", ".join(evs + [evs[0]]) + "]"
+        elif form == "bad":
+            e = self.choice(["'x'", "3", "[None]", "[1.0]", "{'a': 1}"] + [f"[{v}.name]" for v in evs[:1]])
+        elif form == "empty":
+            e, evs, made = "[]", [], []
+        else:
+            e = "[" + ", ".join(evs) + "]"
+        infos = [i for _, i in made]
+        kw["events"] = A(e, bad=any(i["bad"] for i in infos), role="events", names=("events", "method", "axis"))
+        if self.chance(0.03):
+            kw["contact_events"] = A(self.choice(["'yes'", "1", "None"]), bad=True, names=("contact_events",))
+        elif self.chance(0.2):
+            kw["contact_events"] = A(self.choice(["True", "False"]))
+        return {"names": [i["name"] for i in infos], "terminal": any(i["terminal"] for i in infos),
+                "late": any(i["late"] for i in infos)}
+
+    def event_checks(self, res, info):
+        """The run's roots checked (within [t0, t_end], in order, a terminal run ending at its root, consistent), then
+        event_times of its events (good and bad names) and, after a terminal run, its error estimate."""
+        for check in ("events_within", "events_ordered", "terminal_end", "events_consistent"):
+            self.emit(f"fz.{check}", [A(res)], ["result"], label=f"events:{check}", expect="fz.ok(_)")
+        for _ in range(self.integer(0, 2)):
+            if info["names"] and not self.chance(0.2):
+                name = self.choice(info["names"])
+                self.emit(f"{res}.event_times", [A(name)], ["name"], label="Result.event_times",
+                          expect=f"fz.times_agree({res}, {name}, _)")
+            elif self.contact_names and self.chance(0.5):  # the contact may have been refused, or contact_events off
+                name = self.choice(self.contact_names)
+                self.emit(f"{res}.event_times", [A(name, soft=True, names=("name",))], ["name"],
+                          label="Result.event_times", expect=f"fz.times_agree({res}, {name}, _)")
+            else:
+                e = self.choice(["'nope'", "3", "None"] + (["['x']", "{}"] if self.on("event_name_types") else []))
+                self.emit(f"{res}.event_times", [A(e, bad=True, names=("name",))], ["name"], label="Result.event_times")
+        if info["terminal"] and self.on("events_estimate") and self.chance(0.4):
+            # finished (at t_end or a terminal root, not interrupted): its estimate may not be refused
+            self.emit("getattr", [A(res, role="finished", names=("result",)), A("'error_estimate'")],
+                      ["result", "name"], label="Result.error_estimate(events)")
+
+    EVENT_METHODS = ("dopri5", "dopri5", "rk4", "radau5", "generalized_alpha", "esdirk43", "auto", "newmark", "hht",
+                     "bs23", "rkf45", "euler", "symplectic_euler", "implicit_spring")
+
+    def events_call(self):
+        """A run of a sample (or the random model) with events, long enough for them to fire, then its checks."""
+        sysv = self.pick_system()
+        methods = [m for m in self.EVENT_METHODS if m in METHODS or m == "auto"]
+        method = self.choice(methods + (["scipy:RK45", "scipy:Radau"] if self.chance(0.1) else []))
+        t0 = self.choice([0.0, 0.0, 0.0, 0.1])
+        t_end = t0 + self.choice([0.05, 0.2, 0.5, 1.0])
+        implicit = method in ("radau5", "generalized_alpha", "esdirk43", "newmark", "hht", "implicit_spring", "auto")
+        kw = {"method": A(repr(method)), "max_steps": A("1000" if implicit else "5000")}
+        if t0:
+            kw["t0"] = A(fl(t0))
+        if method in FIXED_STEP:
+            kw["dt"] = A(fl((t_end - t0) / self.choice([50, 200])))
+        if self.chance(0.6):
+            kw["q0"] = A(f"V({sysv}.nq, {self.seed()}, 0.5)")
+        if self.chance(0.3):
+            kw["t_eval"] = A(f"np.linspace({fl(t0)}, {fl(t_end)}, {self.choice([2, 5, 11])})")
+        if self.chance(0.2):
+            kw["rtol"] = A(self.choice(["1e-3", "1e-8"]))
+        if self.chance(0.1):
+            kw["sensitivities"] = A(f"list({sysv}.parameters)[:1]", soft=True, names=("sensitivities", "method"))
+        if self.chance(0.04):
+            kw["stop"] = A("set_event()")
+        info = self.events_kw(kw, method, sysv)
+        out = self.new("res")
+        self.emit("rf.simulate", [A(sysv), A(fl(t_end))], ["system", "t_end"], kw, out=out, label="simulate:events",
+                  sys=sysv, late=info["late"])
+        if sysv == "system":
+            self.results.append(out)
+        self.res_info()[out] = {"sys": sysv, "loaded": False}
+        self.event_checks(out, info)
 
 
 def strategy(features=None):

@@ -189,7 +189,8 @@ def test_every_builder_takes_the_name_of_what_it_adds_first():
     coordinate's own laws, which the coordinate names) takes ``name`` first, required, and refuses a number, None,
     "" and a name given already, naming ``name``."""
     named = [n for n in dir(rf.Model) if n.startswith("add_") and n not in ("add_generalized_force", "add_maxwell_arm")]
-    assert len(named) == 14, named  # bodies, beams and bases; loads, loops, actuators, elements, laws; shapes, contacts
+    assert len(named) == 15, named  # bodies, beams and bases; loads, loops, actuators, elements, laws; shapes,
+    # contacts; sheaves
     for n in named:
         first = list(inspect.signature(getattr(rf.Model, n)).parameters.values())[1]
         assert (first.name, first.default, first.kind) == ("name", inspect.Parameter.empty,
@@ -201,7 +202,9 @@ def test_every_builder_takes_the_name_of_what_it_adds_first():
              "add_force": lambda nm: model.add_force(nm, body, (1.0, 0.0, 0.0)),
              "add_torque": lambda nm: model.add_torque(nm, body, (1.0, 0.0, 0.0)),
              "add_rope": lambda nm: model.add_rope(nm, model.ground, body.point((1, 0, 0)), EA=1e3, length=1.0),
-             "add_joint_law": lambda nm: model.add_joint_law(nm, body, rf.laws.Friction())}
+             "add_joint_law": lambda nm: model.add_joint_law(nm, body, rf.laws.Friction()),
+             "add_sheave": lambda nm: model.add_sheave(nm, *ropes, mu=0.2, wrap=3.0)}
+    ropes = [model.add_rope(f"span {k}", model.ground, body.point((1, 0, 0)), EA=1e3, length=1.0) for k in (1, 2)]
     for n, call in calls.items():
         for bad in (3, None, "", "push"):
             with pytest.raises(ValueError, match="^name: expected"):

@@ -134,3 +134,81 @@ def test_bad_drums_are_refused_by_name():
     with pytest.raises(rf.SimulationError, match="its drum has wound it all in"):
         s.generalized_forces(0.0, np.array([0.0, 0.0, 0.0, -1.0 / 0.3 - 0.1]), np.zeros(4))
     assert math.isfinite(s.generalized_forces(0.0, np.zeros(4), np.zeros(4))[0])
+
+
+def sheave(M1, M2, mu=0.3, wrap=math.pi, EA=1e8, DA=2e5, smoothing=1e-4):
+    """Two loads on vertical slides hanging from one rope over a fixed sheave 5 m up: the heavy one (M1) on the span
+    "left", the light one (M2) on "right", which runs over the sheave with friction μ and wrap θ."""
+    model = rf.Model(gravity=(0.0, 0.0, -G))
+    heavy = model.add_body("heavy", model.ground, rf.Joint.prismatic("z"), M1, (1.0, 1.0, 1.0),
+                           placement=rf.transform((-0.5, 0.0, 0.0)))
+    light = model.add_body("light", model.ground, rf.Joint.prismatic("z"), M2, (1.0, 1.0, 1.0),
+                           placement=rf.transform((0.5, 0.0, 0.0)))
+    left = model.add_rope("left", model.ground.point((-0.5, 0.0, H)), heavy, EA=EA, DA=DA, length=H)
+    right = model.add_rope("right", model.ground.point((0.5, 0.0, H)), light, EA=EA, DA=DA, length=H)
+    model.add_sheave("sheave", left, right, mu=mu, wrap=wrap, mass=0.1, smoothing=smoothing)
+    s = model.compile()
+    q0 = np.zeros(s.nq)
+    q0[s.coordinate_names.index("heavy.z")] = -M1 * G * H / EA  # each at its own static stretch
+    q0[s.coordinate_names.index("light.z")] = -M2 * G * H / EA
+    return s, q0
+
+
+@pytest.mark.parametrize("ratio", [0.8, 1.5])
+def test_a_rope_over_a_sheave_holds_below_eulers_ratio_and_slips_at_it(ratio):
+    """The capstan: loads in the ratio M1/M2 = 0.8 e^{μθ} hold, the rope creeping at the regularised law's
+    u̇ = v_ε atanh(ln(M1/M2)/(μθ)) (1e-3); at 1.5 e^{μθ} the rope slips with the tensions in Euler's ratio,
+    T_left = e^{μθ} T_right + m_s ü (1e-6 of T_left; m_s = 0.1 kg the slipping rope's mass, 7e-4 of it here), and the
+    loads accelerate at g (M1 − M2 e^{μθ})/(M1 + M2 e^{μθ} + m_s) (1e-4). The energy lost is ∫ P dt of
+    dissipated_power, the sheave's friction with the ropes' dampers (1e-5 of the energy moved and lost)."""
+    mu, wrap, v_eps = 0.3, math.pi, 1e-4
+    euler = math.exp(mu * wrap)
+    M2 = 10.0
+    M1 = ratio * euler * M2
+    s, q0 = sheave(M1, M2, mu, wrap, smoothing=v_eps)
+    t = np.linspace(0.0, 2.0, 4001)
+    r = rf.simulate(s, 2.0, "radau5", q0=q0, t_eval=t, rtol=1e-10, atol=1e-13)
+    u, light = s.coordinate_names.index("sheave.rz"), s.coordinate_names.index("light.z")
+    T = -r.element_forces  # left, right
+    if ratio < 1.0:
+        assert r.qd[-1, u] == pytest.approx(v_eps * math.atanh(math.log(M1 / M2) / (mu * wrap)), rel=1e-3)
+        assert abs(r.q[-1, u]) < 1e-3
+    else:
+        udd = np.gradient(r.qd[:, u], t, edge_order=2)[-1]
+        assert T[-1, 0] == pytest.approx(euler * T[-1, 1] + 0.1 * udd, rel=1e-6)
+        k1, k2 = np.searchsorted(t, [1.5, 2.0])
+        accel = (r.qd[k2, light] - r.qd[k1, light]) / (t[k2] - t[k1])
+        assert accel == pytest.approx(G * (M1 - M2 * euler) / (M1 + M2 * euler + 0.1), rel=1e-4)
+    # from 0.1 s on, past the slip's first transient (faster than the outputs' 0.5 ms)
+    k = np.searchsorted(t, 0.1)
+    E, P = r.energy[k:], r.dissipated_power[k:]
+    lost = np.concatenate([[0.0], np.cumsum(0.5 * (P[1:] + P[:-1]) * np.diff(t[k:]))])
+    assert np.abs(E + lost - E[0]).max() < 1e-5 * (np.abs(E - E[0]).max() + lost[-1])
+
+
+def test_a_sheaves_coupling_has_exact_jacobians_and_bad_sheaves_are_refused():
+    """∂f/∂q, ∂f/∂q̇ with the slip's row and column and the capstan's rate derivative against central differences
+    (2e-6), both modes of the RNEA to round-off; bad arguments named."""
+    s, q0 = sheave(30.0, 10.0, smoothing=0.05)
+    t, q, qd = 0.0, q0 + np.array([-0.01, 0.02, 0.03]), np.array([0.01, -0.02, 0.02])
+    Kq, Kqd = s.force_jacobians(t, q, qd)
+    Fq, Fqd = central_jacobians(s, t, q, qd, h=1e-7)
+    np.testing.assert_allclose(Kq, Fq, rtol=2e-6, atol=2e-6 * np.abs(Fq).max())
+    np.testing.assert_allclose(Kqd, Fqd, rtol=2e-6, atol=2e-6 * np.abs(Fqd).max())
+    assert abs(Kqd[2, 2]) > 1e3  # the capstan's friction by the slip's rate
+    check_both_modes(s, np.random.default_rng(7), spread=0.01)
+    model = rf.Model()
+    a = model.add_body("a", model.ground, rf.Joint.prismatic("z"), 1.0, (1.0, 1.0, 1.0))
+    left = model.add_rope("left", model.ground.point((0.0, 0.0, 5.0)), a, EA=1e6, length=4.0)
+    spring = model.add_spring_damper("spring", model.ground.point((0.0, 0.0, 5.0)), a, stiffness=1.0, length=4.0)
+    with pytest.raises(ValueError, match="out_of: expected a rope of this model"):
+        model.add_sheave("s1", left, spring, mu=0.2, wrap=3.0)
+    with pytest.raises(ValueError, match="out_of: expected a rope other than into"):
+        model.add_sheave("s2", left, left, mu=0.2, wrap=3.0)
+    right = model.add_rope("right", model.ground.point((0.0, 0.0, 5.0)), a, EA=1e6, length=4.0)
+    with pytest.raises(ValueError, match="mu: expected a finite number >= 0"):
+        model.add_sheave("s3", left, right, mu=-0.2, wrap=3.0)
+    with pytest.raises(ValueError, match="mass: expected a positive finite mass"):
+        model.add_sheave("s5", left, right, mu=0.2, wrap=3.0, mass=0.0)
+    with pytest.raises(ValueError, match="into: expected a rope of this model"):
+        model.add_sheave("s4", "left", left, mu=0.2, wrap=3.0)

@@ -366,8 +366,10 @@ void bind_model(py::module_& m) {
           },
           "The loop kinds, each a dict: kind, rows (constraint equations), free (what it leaves free).")
       .def("_wind", &Model::wind, py::arg("element"), py::arg("body"), py::arg("coordinate"), py::arg("radius"),
-           "Winds force element `element` (a rope) on the drum whose rotation is coordinate `coordinate` (-1: the\n"
-           "only one) of body `body`'s joint, of radius `radius` (m): l_u = l0 + r phi, and the drum takes r P.")
+           py::arg("capstan") = 0.0, py::arg("smoothing") = 0.0,
+           "Winds force element `element` (a rope) on coordinate `coordinate` (-1: the only one) of body `body`'s\n"
+           "joint, of radius `radius` (m): l_u gains r q, and the coordinate takes r P c, c the capstan's friction\n"
+           "exp(-sgn(r) capstan tanh(qd/smoothing)).")
       .def(
           "_add_force_element",
           [](Model& model, const std::string& name, int a, const Vec3& point_a, int b, const Vec3& point_b,

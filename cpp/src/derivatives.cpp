@@ -42,27 +42,34 @@ std::pair<Vec3, Vec3> point_tangent(const Data& d, const Tangent& w, int b, cons
   return {dx, w.v[b].tail<3>() + w.v[b].head<3>().cross(x) + d.v[b].head<3>().cross(dx)};
 }
 
-// The free index of a rope's drum coordinate, −1 for none (not wound, or a prescribed drum).
-int drum_index(const System& sys, const ForceElement& E) { return E.drum >= 0 ? sys.coords[E.drum].free_index : -1; }
-
 // The change of a force element's force f_B = F e = −f_A along the tangent (its points' motion
 // under the fixed force is the geometric term of BodyLoad): with δd = δr_B − δr_A,
 //   δe = (1 − e eᵀ) δd / l,  δl = e·δd,  δl̇ = δe·ḋ + e·δḋ,  δf_B = (F_l δl + F_l̇ δl̇ + F_s δs + F_ṡ δṡ) e + F δe,
-// applied at r_B and r_A as −δf_ext; a rope wound on a free drum φ (δs = r δφ) changes the drum's r P by
-// r (P_l δl + P_l̇ δl̇ + P_s δs + P_ṡ δṡ), into w.dQ.
+// applied at r_B and r_A as −δf_ext. A rope wound on free coordinates q_k (drums, a sheave's slip: δs = Σ r_k δq_k)
+// changes each one's r_k P c_k by r_k (c_k δP + P c_k' δq̇_k), δP = P_l δl + P_l̇ δl̇ + P_s δs + P_ṡ δṡ, into w.dQ.
 void element_tangent(const System& sys, const Data& d, const ForceElement& E, const ElementState& st, Tangent& w) {
   const auto [dxb, dvb] = point_tangent(d, w, E.body_b, st.xb);
   const auto [dxa, dva] = point_tangent(d, w, E.body_a, st.xa);
   const Vec3 dd = dxb - dxa, ddd = dvb - dva;
-  const int k = drum_index(sys, E);
-  const double ds = k >= 0 ? E.radius * w.dq(k) : 0.0, dsd = k >= 0 ? E.radius * w.dqd(k) : 0.0;
-  if (dd.isZero(0.0) && ddd.isZero(0.0) && ds == 0.0 && dsd == 0.0) return;
+  double ds = 0.0, dsd = 0.0;
+  bool wound_moves = false;
+  for (const Winding& wi : E.windings)
+    if (const int k = sys.coords[wi.coord].free_index; k >= 0) {
+      ds += wi.radius * w.dq(k), dsd += wi.radius * w.dqd(k);
+      wound_moves = wound_moves || w.dq(k) != 0.0 || w.dqd(k) != 0.0;
+    }
+  if (dd.isZero(0.0) && ddd.isZero(0.0) && !wound_moves) return;
   const Vec3 de = (dd - st.e * st.e.dot(dd)) / st.l;
   const double dl = st.e.dot(dd), dld = de.dot(st.vb - st.va) + st.e.dot(ddd);
   const ExtensionDerivatives F = E.law->derivatives(d.t, st.extension(), d.load_factor);
-  if (k >= 0) {
+  if (!E.windings.empty()) {
     const ExtensionDerivatives P = E.law->pull_derivatives(d.t, st.extension());
-    w.dQ(k) += E.radius * (P.l * dl + P.ld * dld + P.s * ds + P.sd * dsd);
+    const double P0 = E.law->pull(d.t, st.extension()), dP = P.l * dl + P.ld * dld + P.s * ds + P.sd * dsd;
+    for (const Winding& wi : E.windings)
+      if (const int k = sys.coords[wi.coord].free_index; k >= 0) {
+        const auto [c, dc] = wi.factor(d.qda(wi.coord));
+        w.dQ(k) += wi.radius * (c * dP + P0 * dc * w.dqd(k));
+      }
   }
   const Vec3 df = (F.l * dl + F.ld * dld + F.s * ds + F.sd * dsd) * st.e + st.F * de;
   for (const auto& [body, x, f] : {std::tuple<int, Vec3, Vec3>{E.body_b, st.xb, df}, {E.body_a, st.xa, -df}}) {
@@ -315,15 +322,23 @@ ResidualVjp rnea_vector_jacobian_product(const System& sys, Data& d, const VecX&
     if (E.body_a >= 0) df -= st.xa.cross(H[E.body_a].head<3>()) - H[E.body_a].tail<3>();
     const ExtensionDerivatives F = E.law->derivatives(d.t, st.extension(), d.load_factor);
     // df = (F_l δl + F_l̇ δl̇ + F_s δs + F_ṡ δṡ) e + F δe; δl̇ = δe·(v_b − v_a) + e·δḋ; δl = e·δd;
-    // δe = (1 − e eᵀ) δd / l; a free drum's row −r δP (δs = r δφ) adds −μ_φ r (P_l, P_l̇) to (δl̄, δl̇̄)
+    // δe = (1 − e eᵀ) δd / l; each free winding's row −r_k (c_k δP + P c_k' δq̇_k) adds −μ_k r_k c_k (P_l, P_l̇, P_s,
+    // P_ṡ) to (δl̄, δl̇̄, δs̄, δṡ̄), and δs = Σ r_k δq_k
     const double ed = st.e.dot(df);
-    double dl_bar = F.l * ed, dld_bar = F.ld * ed;
-    if (const int kd = drum_index(sys, E); kd >= 0) {
+    double dl_bar = F.l * ed, dld_bar = F.ld * ed, s_bar = F.s * ed, sd_bar = F.sd * ed;
+    if (!E.windings.empty()) {
       const ExtensionDerivatives P = E.law->pull_derivatives(d.t, st.extension());
-      const double m = mu(kd) * E.radius;
-      dl_bar -= m * P.l, dld_bar -= m * P.ld;
-      out.q(kd) += E.radius * (F.s * ed - m * P.s);
-      out.qd(kd) += E.radius * (F.sd * ed - m * P.sd);
+      const double P0 = E.law->pull(d.t, st.extension());
+      for (const Winding& wi : E.windings)
+        if (const int k = sys.coords[wi.coord].free_index; k >= 0) {
+          const auto [c, dc] = wi.factor(d.qda(wi.coord));
+          const double m = mu(k) * wi.radius;
+          dl_bar -= m * c * P.l, dld_bar -= m * c * P.ld, s_bar -= m * c * P.s, sd_bar -= m * c * P.sd;
+          out.qd(k) -= m * P0 * dc;
+        }
+      for (const Winding& wi : E.windings)
+        if (const int k = sys.coords[wi.coord].free_index; k >= 0)
+          out.q(k) += wi.radius * s_bar, out.qd(k) += wi.radius * sd_bar;
     }
     const Vec3 de_bar = st.F * df + (st.vb - st.va) * dld_bar;
     const Vec3 ddd_bar = st.e * dld_bar;

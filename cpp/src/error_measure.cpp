@@ -168,8 +168,8 @@ double ErrorMeasure::norm(const Eigen::Ref<const VecX>& e, double h, double atol
         const double dld = u.dot(moved(dv_, E.body_b, E.point_b) - moved(dv_, E.body_a, E.point_a));
         const ExtensionDerivatives& F = element_dF_[o.index];
         double ds = 0.0, dsd = 0.0;
-        if (E.drum >= 0 && sys_.coords[E.drum].free_index >= 0)
-          ds = E.radius * e(sys_.coords[E.drum].free_index), dsd = E.radius * e(n + sys_.coords[E.drum].free_index);
+        for (const Winding& w : E.windings)
+          if (const int k = sys_.coords[w.coord].free_index; k >= 0) ds += w.radius * e(k), dsd += w.radius * e(n + k);
         eps = std::abs(F.l * dl + F.ld * dld + F.s * ds + F.sd * dsd);
         break;
       }

@@ -197,7 +197,7 @@ ElementState element_state(const Data& d, const ForceElement& element, bool spat
                                    "' coincide (l = 0: its line of action is undefined)");
   s.e = r / s.l;
   s.ld = s.e.dot(s.vb - s.va);
-  if (element.drum >= 0) s.s = element.radius * d.qa(element.drum), s.sd = element.radius * d.qda(element.drum);
+  for (const Winding& w : element.windings) s.s += w.radius * d.qa(w.coord), s.sd += w.radius * d.qda(w.coord);
   element.law->check(d.t, s.extension(), element.name);
   s.F = element.law->force(d.t, s.extension(), d.load_factor);
   return s;
@@ -209,12 +209,13 @@ std::pair<AppliedLoad, AppliedLoad> element_loads(const ElementState& s) {
 
 double passive_force(const System& sys, const Data& d, int i, bool spatial) {
   const Coordinate& c = sys.coords[i];
-  // −s (k (q − q⁰) + c q̇) − Σ s_arm + λ Q₀ + Σ Q_law + Σ r P of the ropes it winds
+  // −s (k (q − q⁰) + c q̇) − Σ s_arm + λ Q₀ + Σ Q_law + Σ r P c of the ropes wound on it
   double Q = c.spring.elastic_force(d.qa(i), d.qda(i), d.spring_scale(i)) - d.arm_force(i) + d.load_factor * c.spring.force;
   for (const auto& law : c.laws) Q += law->force(d.t, d.qa(i), d.qda(i), d.load_factor);
-  for (const int k : c.drums) {
+  for (const auto& [k, j] : c.windings) {
     const ForceElement& E = sys.elements[k];
-    Q += E.radius * E.law->pull(d.t, element_state(d, E, spatial).extension());
+    const Winding& w = E.windings[j];
+    Q += w.radius * E.law->pull(d.t, element_state(d, E, spatial).extension()) * w.factor(d.qda(i)).first;
   }
   return Q;
 }

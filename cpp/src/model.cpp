@@ -249,7 +249,11 @@ void Model::truncate(int n) {
   flows_.erase(std::remove_if(flows_.begin(), flows_.end(), [n](const Flow& f) { return f.first + f.elements >= n; }),
                flows_.end());
   elements_.erase(std::remove_if(elements_.begin(), elements_.end(),
-                                 [n](const ForceElement& e) { return std::max({e.body_a, e.body_b, e.drum_body}) >= n; }),
+                                 [n](const ForceElement& e) {
+                                   return std::max(e.body_a, e.body_b) >= n ||
+                                          std::any_of(e.windings.begin(), e.windings.end(),
+                                                      [n](const Winding& w) { return w.body >= n; });
+                                 }),
                   elements_.end());
 }
 
@@ -342,7 +346,7 @@ int Model::add_force_element(const ForceElement& element) {
   return static_cast<int>(elements_.size()) - 1;
 }
 
-void Model::wind(int element, int body, int coordinate, double radius) {
+void Model::wind(int element, int body, int coordinate, double radius, double capstan, double smoothing) {
   if (element < 0 || element >= static_cast<int>(elements_.size()))
     bad("element", "a force element's index 0.." + std::to_string(elements_.size()), std::to_string(element));
   ForceElement& E = elements_[element];
@@ -350,10 +354,14 @@ void Model::wind(int element, int body, int coordinate, double radius) {
     bad("element", "a force element whose law winds on a drum (a Rope)", std::string("a ") + E.law->info().kind);
   if (E.law->profile())
     bad("length", "a constant unstretched length l₀ for a rope wound on a drum (the drum pays it out)", "a profile");
-  if (E.drum_body >= 0) bad("element", "a force element not yet wound on a drum", "'" + E.name + "', wound");
   const int slot = resolve_coordinate(body, coordinate);
-  if (!(radius > 0.0 && std::isfinite(radius))) bad("radius", "a positive finite drum radius in m", num8(radius));
-  E.drum_body = body, E.drum_slot = slot, E.radius = radius;
+  for (const Winding& w : E.windings)
+    if (w.body == body && w.slot == slot) bad("element", "a rope not yet wound on this coordinate", "'" + E.name + "'");
+  if (!(radius != 0.0 && std::isfinite(radius))) bad("radius", "a non-zero finite radius in m", num8(radius));
+  if (!(capstan >= 0.0 && std::isfinite(capstan))) bad("capstan", "a non-negative finite μθ", num8(capstan));
+  if (capstan > 0.0 && !(smoothing > 0.0 && std::isfinite(smoothing)))
+    bad("smoothing", "a positive finite regularising rate", num8(smoothing));
+  E.windings.push_back({body, slot, -1, radius, capstan, smoothing});
 }
 
 int Model::add_shape(const Shape& shape) {

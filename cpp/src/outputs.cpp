@@ -47,11 +47,18 @@ double dissipated_power(const System& sys, const Data& d) {
     P += c.spring.power(d.qda(i), d.spring_scale(i));
     for (const auto& law : c.laws) P += law->power(d.t, d.qa(i), d.qda(i));
   }
-  for (const ForceElement& E : sys.elements)  // what each element's law dissipates (force_elements.hpp)
+  for (const ForceElement& E : sys.elements) {  // what each element's law dissipates (force_elements.hpp)
     if (E.law->dissipative()) {
       const ElementState s = element_state(d, E, false);
       P += E.law->power(d.t, s.extension(), s.F);
     }
+    // a capstan's friction: of the generalised force r P c on its coordinate, r P (c − 1) opposes q̇
+    for (const Winding& w : E.windings)
+      if (w.capstan != 0.0) {
+        const double qd = d.qda(w.coord);
+        P -= w.radius * E.law->pull(d.t, element_state(d, E, false).extension()) * (w.factor(qd).first - 1.0) * qd;
+      }
+  }
   if (!sys.contacts.empty()) P += contact_power(sys, d);  // what the contacts dissipate (contact.hpp)
   return P;
 }

@@ -105,13 +105,13 @@ std::shared_ptr<const System> Model::compile(Algorithm algorithm) const {
       if (s.coords[i].free_index >= 0) ++s.nq_of[p], ++k;
   }
   for (int i : s.free_coords) s.q_use.push_back(own_use(s, i));
-  // ropes wound on drums: the drum's coordinate, and on it the elements it pays out
-  for (int k = 0; k < static_cast<int>(s.elements.size()); ++k) {
-    ForceElement& E = s.elements[k];
-    if (E.drum_body < 0) continue;
-    E.drum = s.coord_start[E.drum_body] + E.drum_slot;
-    s.coords[E.drum].drums.push_back(k);
-  }
+  // ropes wound on drums and sheaves: each winding's coordinate, and on it the windings it takes
+  for (int k = 0; k < static_cast<int>(s.elements.size()); ++k)
+    for (int j = 0; j < static_cast<int>(s.elements[k].windings.size()); ++j) {
+      Winding& w = s.elements[k].windings[j];
+      w.coord = s.coord_start[w.body] + w.slot;
+      s.coords[w.coord].windings.push_back({k, j});
+    }
   return sys;
 }
 

@@ -23,8 +23,8 @@ namespace rigidfem {
 /// An axial force function F(t, l, l̇) (N) of an element's length l (m) and rate l̇ (m/s): a Python law.
 using AxialFunction = ScalarFunction;
 
-/// An element's extension: its length l (m) and rate l̇ (m/s) and, for a rope wound on a drum (ForceElement::drum),
-/// the length s = r φ the drum has paid out since φ = 0 (m) and its rate ṡ (m/s); 0 for any other element.
+/// An element's extension: its length l (m) and rate l̇ (m/s) and, for a rope wound on drums or sheaves
+/// (ForceElement::windings), the length s = Σ r q they have paid out (m) and its rate ṡ (m/s); 0 for any other element.
 struct Extension {
   double l = 0.0, ld = 0.0, s = 0.0, sd = 0.0;
 };
@@ -361,17 +361,34 @@ inline const std::vector<ElementLawKind>& element_law_kinds() {
   return kinds;
 }
 
+/// A coordinate a rope is wound on (Model::wind): a drum's rotation φ (radius r, m) or the slip u of a rope over a
+/// sheave (radius ±1). It pays out r q of unstretched rope and takes the generalised force r P c(q̇), with the
+/// capstan's regularised friction c = exp(−sgn(r) μθ tanh(q̇/v_ε)) (c = 1 without: μθ = 0): in slip the tensions on
+/// either side of a sheave stand in Euler's ratio e^{μθ}, and the friction's power −r P (c − 1) q̇ is never negative.
+struct Winding {
+  int body = -1, slot = 0;  ///< the coordinate: slot `slot` of body `body`'s joint
+  int coord = -1;           ///< its index among the System's coordinates (set by compile())
+  double radius = 0.0;      ///< r (m per unit of the coordinate)
+  double capstan = 0.0;     ///< μθ: the friction coefficient times the wrap angle (rad)
+  double smoothing = 0.0;   ///< v_ε: the rate (the coordinate's unit per s) over which the friction is regularised
+  /// (c, dc/dq̇) at the coordinate's rate q̇.
+  std::pair<double, double> factor(double qd) const {
+    if (capstan == 0.0) return {1.0, 0.0};
+    const double k = (radius > 0.0 ? -1.0 : 1.0) * capstan, th = std::tanh(qd / smoothing);
+    const double c = std::exp(k * th);
+    return {c, c * k * (1.0 - th * th) / smoothing};
+  }
+};
+
 /// One force element as the user describes it: two points, and its kind's law. Body −1 is the ground.
 struct ForceElement {
   std::string name;
   int body_a = -1, body_b = -1;
   Vec3 point_a = Vec3::Zero(), point_b = Vec3::Zero();  ///< m, in the frames of bodies a and b
   std::shared_ptr<const ElementLaw> law;
-  /// A rope wound on a drum (Model::wind): the drum's coordinate φ, slot `drum_slot` of body `drum_body`'s joint (−1:
-  /// none), and its radius r (m); compile() sets `drum`, its index among the System's coordinates. The drum pays out
-  /// s = r φ of unstretched rope (l_u = l₀ + r φ) and takes the generalised force r P (ElementLaw::pull).
-  int drum_body = -1, drum_slot = 0, drum = -1;
-  double radius = 0.0;
+  /// A rope wound on drums and sheaves (Model::wind): they pay out s = Σ r_k q_k of unstretched rope
+  /// (l_u = l₀ + s) and each takes r_k P c_k (ElementLaw::pull, Winding::factor).
+  std::vector<Winding> windings;
 };
 
 }  // namespace rigidfem

@@ -51,7 +51,7 @@ AppliedLoad applied_load(const Data& d, const Load& L);
 struct ElementState {
   Vec3 xa, xb, va, vb, e;
   double l, ld, F;
-  double s = 0.0, sd = 0.0;  ///< wound on a drum: the length paid out, r φ (m), and its rate (m/s)
+  double s = 0.0, sd = 0.0;  ///< wound on drums or sheaves: the length paid out, Σ r q (m), and its rate (m/s)
   Extension extension() const { return {l, ld, s, sd}; }
 };
 ElementState element_state(const Data& d, const ForceElement& element, bool spatial);
@@ -109,8 +109,8 @@ void for_each_body_load(const System& sys, const Data& d, bool spatial, Visit&& 
 }
 
 /// Q_i of the laws on coordinate i (all coordinates): its spring-damping law −s (k (q − q⁰) + c q̇) + λ Q₀, its
-/// Maxwell arms' −Σ s (d.arm_force), its further laws' Q(t, q, q̇) (coordinate_laws.hpp) and, as a drum, the pull
-/// r P of each rope wound on it (force_elements.hpp; its state from d.v where `spatial`, else d.Td).
+/// Maxwell arms' −Σ s (d.arm_force), its further laws' Q(t, q, q̇) (coordinate_laws.hpp) and, as a drum or a sheave's
+/// slip, r P c of each rope wound on it (force_elements.hpp: Winding; its state from d.v where `spatial`, else d.Td).
 double passive_force(const System& sys, const Data& d, int i, bool spatial);
 /// (∂Q/∂q_i, ∂Q/∂q̇_i) of coordinate i's further laws (coordinate_laws.hpp) at d's state: the spring-damping
 /// law's own are exact constants the callers take from Coordinate::spring, and the arms' are internal variables.

@@ -164,9 +164,10 @@ class Model {
   /// Adds a force element between two bodies (force_elements.hpp); returns its index. Checks the
   /// bodies, points, parameters and name (non-empty, new among the elements').
   int add_force_element(const ForceElement& element);
-  /// Winds force element `element` (a law that winds: a rope) on the drum whose rotation is coordinate `coordinate`
-  /// (−1: the only one) of body `body`'s joint, of radius `radius` (m): its unstretched length becomes l₀ + r φ.
-  void wind(int element, int body, int coordinate, double radius);
+  /// Winds force element `element` (a law that winds: a rope) on coordinate `coordinate` (−1: the only one) of body
+  /// `body`'s joint, a drum of radius `radius` (m; non-zero, negative to pay in as it turns forward) or a sheave's slip:
+  /// its unstretched length gains r q, and the coordinate takes r P c (Winding: the capstan's μθ and v_ε).
+  void wind(int element, int body, int coordinate, double radius, double capstan = 0.0, double smoothing = 0.0);
   /// Adds a shape fixed on a body (contact.hpp); returns its index. Checks the body, the geometry and the name.
   int add_shape(const Shape& shape);
   /// Adds a contact between two groups of shapes (contact.hpp); returns its index. Checks the shapes, their pairs

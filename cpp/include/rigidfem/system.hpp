@@ -23,7 +23,8 @@ struct Coordinate {
   SpringDamping spring;    ///< its own spring, damper and constant applied force (coordinate_laws.hpp)
   std::vector<std::shared_ptr<const CoordinateLaw>> laws;  ///< further laws (a Python function, friction)
   ProfilePtr drive;        ///< prescribed motion, or null
-  std::vector<int> drums;  ///< the force elements (ropes) wound on it as a drum: it takes r P of each
+  /// The ropes wound on it (a drum, a sheave's slip): (element, winding) pairs; it takes r P c of each.
+  std::vector<std::pair<int, int>> windings;
   std::string name;        ///< "body.rz"
 };
 

@@ -256,10 +256,11 @@ class _Model:
         """
         Removes the bodies n, n + 1, ... (undo of a failed builder).
         """
-    def _wind(self, element: typing.SupportsInt | typing.SupportsIndex, body: typing.SupportsInt | typing.SupportsIndex, coordinate: typing.SupportsInt | typing.SupportsIndex, radius: typing.SupportsFloat | typing.SupportsIndex) -> None:
+    def _wind(self, element: typing.SupportsInt | typing.SupportsIndex, body: typing.SupportsInt | typing.SupportsIndex, coordinate: typing.SupportsInt | typing.SupportsIndex, radius: typing.SupportsFloat | typing.SupportsIndex, capstan: typing.SupportsFloat | typing.SupportsIndex = 0.0, smoothing: typing.SupportsFloat | typing.SupportsIndex = 0.0) -> None:
         """
-        Winds force element `element` (a rope) on the drum whose rotation is coordinate `coordinate` (-1: the
-        only one) of body `body`'s joint, of radius `radius` (m): l_u = l0 + r phi, and the drum takes r P.
+        Winds force element `element` (a rope) on coordinate `coordinate` (-1: the only one) of body `body`'s
+        joint, of radius `radius` (m): l_u gains r q, and the coordinate takes r P c, c the capstan's friction
+        exp(-sgn(r) capstan tanh(qd/smoothing)).
         """
     @property
     def _nelements(self) -> int:

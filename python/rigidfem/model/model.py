@@ -469,6 +469,47 @@ class Model(_core._Model):
         return handle
 
     @recorded
+    def add_sheave(self, name: str, into: handles.Element, out_of: handles.Element, *, mu: float, wrap: float,
+                   mass: float = 1.0, smoothing: float = 1e-3) -> Body:
+        """A rope running over a fixed sheave (or a bollard, a capstan) with friction: the ropes ``into`` and
+        ``out_of`` (``add_rope`` handles, the two spans on either side, each at its own constant length or on its
+        drum) exchange rope through a slip coordinate u (m, the coordinate ``"<name>.rz"``): l_u of ``into`` gains u,
+        that of ``out_of`` loses it. The rope slips towards the side that pulls harder once the tensions' ratio reaches
+        Euler's e^{μθ} (``mu`` μ, ``wrap`` θ in rad), regularised over the slip speed ``smoothing`` v_ε (m/s): the
+        slip takes P_into − P_out e^{μθ tanh(u̇/v_ε)}, so below that ratio the rope creeps at about v_ε and at it slides.
+        ``mass`` (kg) is the rope's mass that slips, the slip's inertia (a small one keeps u an ordinary coordinate:
+        ``"<name>"`` is a body turning about its own centre, u in rad = m at 1 m, that gravity does not move). The
+        friction's power is in ``dissipated_power``. Returns the body."""
+        name = self._new_name(name)
+        ropes = []
+        for argument, rope in (("into", into), ("out_of", out_of)):
+            if not (isinstance(rope, handles.Element) and self._owns_element(rope) and
+                    self._element_law(rope.index)[0] == "Rope"):
+                raise _checks.refuse(f"{argument}: expected a rope of this model (Model.add_rope's handle), got {rope!r}")
+            ropes.append(rope)
+        if ropes[0].index == ropes[1].index:
+            raise _checks.refuse(f"out_of: expected a rope other than into, got {out_of!r} twice")
+        mu_ = _checks.real(mu, "mu", "a friction coefficient >= 0")
+        wrap_ = _checks.real(wrap, "wrap", "a wrap angle in rad >= 0")
+        for argument, value in (("mu", mu_), ("wrap", wrap_)):
+            if not (value >= 0.0 and math.isfinite(value)):
+                raise _checks.refuse(f"{argument}: expected a finite number >= 0, got {value!r}")
+        m = _checks.real(mass, "mass", "the slipping rope's mass in kg")
+        if not (m > 0.0 and math.isfinite(m)):
+            raise _checks.refuse(f"mass: expected a positive finite mass in kg (the slip's inertia), got {mass!r}")
+        v = _checks.real(smoothing, "smoothing", "a regularising slip speed in m/s")
+        if not (v > 0.0 and math.isfinite(v)):
+            raise _checks.refuse(f"smoothing: expected a positive finite slip speed in m/s, got {smoothing!r}")
+        slip = self.add_body(name, self.ground, joints.Joint.revolute("z"), m, (m, m, m))
+        self._wind(ropes[0].index, slip.index, -1, 1.0)
+        self._wind(ropes[1].index, slip.index, -1, -1.0, mu_ * wrap_, v)
+        return slip
+
+    def _owns_element(self, handle) -> bool:
+        """Whether ``handle`` names a force element of this model."""
+        return 0 <= handle.index < self._nelements and str(handle) in self._parameter_groups
+
+    @recorded
     def add_shape(self, name: str, body, shape) -> handles.Shape:
         """Fix a shape (``rigidfem.shapes``: ``Sphere``, ``Capsule``, ``Box``, ``HalfSpace``) on ``body`` (a Body or
         ``model.ground``), or one capsule on each rigid finite element of a beam (``body`` a ``Beam``, ``shape``
