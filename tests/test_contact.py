@@ -271,7 +271,7 @@ def test_the_adjoint_gradient_through_a_bounce_with_friction_agrees_with_differe
 
 
 def test_a_contacts_stiffness_and_friction_are_named_parameters_with_gradients():
-    """The law's k, μ_s and μ_k are named parameters ("<contact>.stiffness", ...): set by with_parameters like any
+    """The law's k, e, μ_s and μ_k are named parameters ("<contact>.stiffness", ...): set by with_parameters like any
     other, and the adjoint's gradient by them agrees with central differences of whole runs."""
     model = rf.Model()
     box = model.add_body("box", model.ground, rf.Joint.free(), 1.0, (0.01, 0.01, 0.01),
@@ -281,13 +281,15 @@ def test_a_contacts_stiffness_and_friction_are_named_parameters_with_gradients()
                       rf.laws.Contact(stiffness=1e6, exponent=1.0, restitution=0.5, impact_speed=0.5, mu_s=0.5,
                                       mu_k=0.3, smoothing=1e-2))
     s = model.compile()
-    assert [p for p in s.parameters if p.startswith("slide.")] == ["slide.stiffness", "slide.mu_s", "slide.mu_k"]
+    assert [p for p in s.parameters if p.startswith("slide.")] == ["slide.stiffness", "slide.restitution", "slide.mu_s",
+                                                                     "slide.mu_k"]
+    assert not s.parameters["slide.restitution"].linear  # differenced centrally (its α is a root of e's relation)
     assert s.parameters["slide.mu_k"].value == 0.3 and s.parameters["slide.stiffness"].unit == "N/m^p"
     names = s.coordinate_names
     q0, qd0 = np.zeros(s.nq), np.zeros(s.nq)
     q0[names.index("box.z")], qd0[names.index("box.x")] = -9.81 / 4e6, 1.0  # on its corners, sliding
     run = dict(dt=2e-4, q0=q0, qd0=qd0, newton_tol=1e-13)
-    picked = ["slide.stiffness", "slide.mu_s", "slide.mu_k"]
+    picked = ["slide.stiffness", "slide.restitution", "slide.mu_s", "slide.mu_k"]
     g = rf.gradient(s, 0.5, picked, outputs={"p": box}, terminal=lambda y: y["p"][0] + 10.0 * y["p"][2], **run)
 
     def J(**values):
@@ -296,7 +298,7 @@ def test_a_contacts_stiffness_and_friction_are_named_parameters_with_gradients()
         p = changed.position(box, 0.5, r.q[-1])
         return p[0] + 10.0 * p[2]
 
-    for name, value in zip(picked, (1e6, 0.5, 0.3)):
+    for name, value in zip(picked, (1e6, 0.5, 0.5, 0.3)):
         h = 1e-3 * value
         fd = (J(**{name: value + h}) - J(**{name: value - h})) / (2 * h)
         assert g.gradient[name] == pytest.approx(fd, rel=1e-4), name

@@ -158,21 +158,23 @@ def test_bad_events_are_refused_by_name():
 def test_forward_sensitivities_through_located_impacts_agree_with_differences_of_whole_runs(method):
     """The forward sensitivities of the state after two bounces of a linear contact (every onset and separation
     located: the steps end on the old side, the next begins on the new, so that the sensitivities' equations take the
-    Jacobian's jump from 0 to k where it happens) by the contact's stiffness and the drop height, against central
-    differences of whole runs: 1e-6 (crossed by the steps instead: 1e-3). The compliant force is continuous at onset
+    Jacobian's jump from 0 to k where it happens) by the contact's stiffness, its restitution (a parameter the force is
+    not linear in: differenced centrally) and the drop height, against central differences of whole runs: 1e-6
+    (crossed by the steps instead: 1e-3). The compliant force is continuous at onset
     and separation, so the sensitivities themselves do not jump there."""
     law = rf.laws.Contact(stiffness=1e6, exponent=1.0, restitution=0.8, impact_speed=2.0)
     system = drop(law, gravity=G)
     kw = dict(method=method, rtol=1e-12, atol=1e-14, t_eval=[0.6])
-    names = ["bounce.stiffness", "q0[ball.z]"]
+    names = ["bounce.stiffness", "bounce.restitution", "q0[ball.z]"]
     r = rf.simulate(system, 0.6, q0=[0.2], sensitivities=names, **kw)
     assert len(r.event_times("bounce")) == 4 and r.stats["event_restarts"] >= 4
-    for name, value in zip(names, (1e6, 0.2)):
+    for name, value in zip(names, (1e6, 0.8, 0.2)):
         h = 1e-4 * value
         ends = []
         for d in (h, -h):
-            changed = system.with_parameters({name: value + d}) if name == "bounce.stiffness" else system
-            ends.append(rf.simulate(changed, 0.6, q0=[0.2 + (d if name != "bounce.stiffness" else 0.0)], **kw))
+            initial = name.startswith("q0")
+            changed = system if initial else system.with_parameters({name: value + d})
+            ends.append(rf.simulate(changed, 0.6, q0=[0.2 + (d if initial else 0.0)], **kw))
         dq, dqd = ((a - b)[-1, 0] / (2 * h) for a, b in ((ends[0].q, ends[1].q), (ends[0].qd, ends[1].qd)))
         S = r.sensitivity(name)
         assert S[0][-1, 0] == pytest.approx(dq, rel=1e-6)

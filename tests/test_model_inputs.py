@@ -458,6 +458,8 @@ def test_every_builder_returns_a_handle_with_its_name():
     }
     made["add_contact"] = m.add_contact("touch", made["add_shape"], m.add_shape("floor", m.ground, rf.shapes.HalfSpace()),
                                         rf.laws.Contact())
+    over = m.add_rope("over", m.ground.point((0, 4, 0)), b, EA=1e5, length=2.0)
+    made["add_sheave"] = m.add_sheave("sheave", made["add_rope"], over, mu=0.2, wrap=3.0)
     builders = {n for n, f in inspect.getmembers(rf.Model, inspect.isfunction) if n.startswith("add_") or n == "prescribe"}
     assert builders == set(made), builders ^ set(made)
     for builder, handle in made.items():

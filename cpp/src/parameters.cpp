@@ -57,6 +57,8 @@ std::shared_ptr<System> with_constants(const System& sys, const ConstantChanges&
           std::to_string(c.contact));
     s.contacts[c.contact].law = s.contacts[c.contact].law->with_constant(c.name, c.value);
   }
+  // a contact's restitution is bounded above (e <= 1) as well as below: its law judges the values it was given
+  for (const auto& c : changes.contacts) s.contacts[c.contact].law->validate();
   for (const auto& e : changes.elements) {
     if (e.element < 0 || e.element >= static_cast<int>(s.elements.size()))
       bad("element", "a force element of this system (0.." + std::to_string(s.elements.size()) + " - 1)",

@@ -29,6 +29,9 @@ struct Constant {
   bool positive;              ///< lower excluded: values > lower
   const char* doc;            ///< what it is ("the element's spring k")
   bool parameter;             ///< a named parameter of a compiled system (System.parameters)
+  /// The equations are linear in it: its derivatives are one-sided differences of any step, exact to round-off;
+  /// otherwise central differences of the systems at p ± h (a contact's restitution).
+  bool linear = true;
 };
 
 /// What a kind of law is, described once.

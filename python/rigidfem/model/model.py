@@ -526,7 +526,7 @@ class Model(_core._Model):
         Hunt–Crossley dissipation set by a coefficient of restitution, and regularised Coulomb friction with a
         Stribeck fall). Every shape of ``a`` meets every shape of ``b`` (none on one body): spheres and capsules each
         other and half-spaces, boxes half-spaces only. A half-space against n shapes costs O(n) an evaluation; a
-        model without contacts pays nothing. The law's stiffness, mu_s and mu_k become the named parameters
+        model without contacts pays nothing. The law's stiffness, restitution, mu_s and mu_k become the named parameters
         ``"<name>.stiffness"``, ... (``System.parameters``). Returns the contact's handle."""
         name = self._new_name(name)
         if not isinstance(law, laws.Law) or law.info["acts_on"] != "contact":

@@ -26,9 +26,10 @@ bodies with a ``.mass`` of their own: ``rho`` and the section set them.
 ``System.parameters`` lists them with their values and units; ``System.with_parameters({name:
 value})`` returns the system at other values (O(n): its tables are copied with the new constants,
 the model is not compiled again), which simulates exactly as the model built with those values.
-Every constant they set enters the equations of motion linearly (inertias, springs, dampers, applied
+Every constant they set but one enters the equations of motion linearly (inertias, springs, dampers, applied
 forces), which is what makes the sensitivities' derivatives by them exact to round-off
-(``cpp/include/rigidfem/sensitivities.hpp``).
+(``cpp/include/rigidfem/sensitivities.hpp``); a contact's restitution does not (``Parameter.linear`` False), and
+is differenced centrally, as a profile's numbers are.
 """
 
 from __future__ import annotations
@@ -211,7 +212,7 @@ class LawGroup(Group):
     def __init__(self, prefix, target: tuple, info: dict, values: dict, rotation: bool = False):
         super().__init__(prefix, {c["name"]: Parameter(f"{prefix}.{c['name']}", float(values[c["name"]]),
                                                        c["rotation_unit"] if rotation else c["unit"], c["doc"],
-                                                       c["lower"], c["positive"])
+                                                       c["lower"], c["positive"], c["linear"])
                                   for c in info["constants"] if c["parameter"]})
         self.target, self.info, self.values, self.rotation = tuple(target), info, dict(values), rotation
 
@@ -385,9 +386,12 @@ class Parameters:
     def profile_step(self, name: str, t0: float, t1: float) -> float:
         """h for a profile's number: a trial step δ = 1e-6 max(|p|, 1) moves q(t) over 41 times in [t0, t1] by
         at most Δ; h = δ · 1e-6 max(1, |q|) / Δ, so that the central difference's truncation (∝ h²) and
-        round-off (∝ 1/h) both stay near 1e-10 of the derivative; at most 1e3 δ."""
+        round-off (∝ 1/h) both stay near 1e-10 of the derivative; at most 1e3 δ. A law's constant the equations
+        are not linear in (a contact's restitution): δ itself."""
         prefix, short = self.where[name]
         group = self.groups[prefix]
+        if not isinstance(group, ProfileGroup):
+            return 1e-6 * max(abs(self.values[name]), 1.0)
         changed = self._current(prefix)
         times = np.linspace(t0, t1, 41)
         key = (prefix, float(t0), float(t1))
