@@ -179,3 +179,27 @@ def test_forward_sensitivities_through_located_impacts_agree_with_differences_of
         S = r.sensitivity(name)
         assert S[0][-1, 0] == pytest.approx(dq, rel=1e-6)
         assert S[1][-1, 0] == pytest.approx(dqd, rel=1e-6)
+
+
+def test_contacts_touching_at_the_same_instant_are_located_each_once():
+    """Two balls dropped from the same height (and 1e-12 m apart) onto one floor, each its own contact: their onsets
+    and separations come at the same instant; the steps end before them together and go on past them together, each
+    event recorded once, onsets and separations alternating. A user's event on a contact's gap beside the contact's
+    own, likewise."""
+    model = rf.Model(gravity=(0.0, 0.0, -G))
+    floor = model.add_shape("floor", model.ground, rf.shapes.HalfSpace())
+    for i in range(2):
+        ball = model.add_body(f"ball{i}", model.ground, rf.Joint.prismatic("z"), 2.0, (0.01, 0.01, 0.01),
+                              placement=rf.transform((float(i), 0.0, 0.1)))
+        model.add_contact(f"bounce{i}", model.add_shape(f"s{i}", ball, rf.shapes.Sphere(0.1)), floor,
+                          rf.laws.Contact(stiffness=1e5, exponent=1.5, restitution=0.7))
+    system = model.compile()
+    for method in ("auto", "dopri5", "radau5", "esdirk43"):
+        for dz in (0.0, 1e-12):
+            r = rf.simulate(system, 1.0, method, q0=[0.5, 0.5 + dz])
+            for name in ("bounce0", "bounce1"):
+                directions = [f.direction for f in r.events if f.event == name]
+                assert directions == [-1, 1] * 4, (method, dz, name, directions)
+            np.testing.assert_allclose(r.event_times("bounce0"), r.event_times("bounce1"), atol=1e-9)
+    r = rf.simulate(system, 1.0, "dopri5", q0=[0.5, 0.7], events=[rf.Event("gap", "bounce0")])
+    np.testing.assert_allclose(r.event_times("gap"), r.event_times("bounce0"), atol=1e-12)

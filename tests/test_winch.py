@@ -212,3 +212,33 @@ def test_a_sheaves_coupling_has_exact_jacobians_and_bad_sheaves_are_refused():
         model.add_sheave("s5", left, right, mu=0.2, wrap=3.0, mass=0.0)
     with pytest.raises(ValueError, match="into: expected a rope of this model"):
         model.add_sheave("s4", "left", left, mu=0.2, wrap=3.0)
+
+
+def test_a_refused_sheave_leaves_the_model_as_it_was_and_its_mass_is_its_inertia():
+    """A sheave over a rope paid out by a winch's profile is refused before anything is added (no body left, no rope
+    half-wound); another model's rope handle is refused; "<sheave>.mass" sets the slip's inertia, and gravity does no
+    work on it."""
+    model = rf.Model(gravity=(0.0, 0.0, -G))
+    a = model.add_body("a", model.ground, rf.Joint.prismatic("z"), 1.0, (1.0, 1.0, 1.0))
+    b = model.add_body("b", model.ground, rf.Joint.prismatic("z"), 1.0, (1.0, 1.0, 1.0),
+                       placement=rf.transform((1.0, 0.0, 0.0)))
+    winched = model.add_rope("winched", model.ground.point((0.0, 0.0, 5.0)), a, EA=1e5,
+                             length=rf.motion.polynomial([4.0, 0.1]))
+    right = model.add_rope("right", model.ground.point((1.0, 0.0, 5.0)), b, EA=1e5, length=4.0)
+    with pytest.raises(ValueError, match="^out_of: expected a rope of constant unstretched length"):
+        model.add_sheave("sh", right, winched, mu=0.2, wrap=3.0)
+    other = rf.Model()
+    c = other.add_body("c", other.ground, rf.Joint.prismatic("z"), 1.0, (1.0, 1.0, 1.0))
+    foreign = other.add_rope("right", other.ground.point((0.0, 0.0, 5.0)), c, EA=1e5, length=4.0)
+    with pytest.raises(ValueError, match="^into: expected a rope of this model"):
+        model.add_sheave("sh", foreign, right, mu=0.2, wrap=3.0)
+    s = model.compile()
+    assert s.coordinate_names == ["a.z", "b.z"]  # nothing left behind
+    plain = model.compile()
+    np.testing.assert_allclose(s.generalized_forces(0.0, np.zeros(2), np.ones(2)),
+                               plain.generalized_forces(0.0, np.zeros(2), np.ones(2)))
+    s2, q0 = sheave(30.0, 10.0)
+    pull = lambda T: T + T * T / (2 * 1e8)  # noqa: E731  (P = T + ½ EA ε², ε = T/EA, at each load's static stretch)
+    assert s2.generalized_forces(0.0, q0, np.zeros(3))[2] == pytest.approx(pull(30.0 * G) - pull(10.0 * G), rel=1e-9)
+    for m in (0.1, 10.0):
+        assert s2.with_parameters({"sheave.mass": m}).mass_matrix(0.0, q0)[2, 2] == pytest.approx(m, rel=1e-5)

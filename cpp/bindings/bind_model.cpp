@@ -127,7 +127,8 @@ py::dict law_kind(const LawInfo& info, bool addable) {
                               py::arg("rotation_unit") = c.rotation_unit ? c.rotation_unit : c.unit,
                               py::arg("default") = c.value, py::arg("lower") = c.lower,
                               py::arg("positive") = c.positive, py::arg("doc") = c.doc,
-                              py::arg("parameter") = c.parameter, py::arg("linear") = c.linear));
+                              py::arg("parameter") = c.parameter, py::arg("linear") = c.linear,
+                              py::arg("upper") = c.upper));
   auto text = [](const char* s) -> py::object { return s ? py::object(py::str(s)) : py::object(py::none()); };
   return py::dict(py::arg("kind") = info.kind, py::arg("acts_on") = info.acts_on, py::arg("doc") = info.doc,
                   py::arg("constants") = constants, py::arg("profile") = text(info.profile),
@@ -451,7 +452,7 @@ void bind_model(py::module_& m) {
             return kinds;
           },
           "Every kind of law, each a dict: kind, acts_on ('element', 'coordinate' or 'contact'), doc, constants (name, unit,\n"
-          "rotation_unit, default, lower, positive, doc, parameter, linear), profile, profile_name, profile_units, function,\n"
+          "rotation_unit, default, lower, positive, doc, parameter, linear, upper), profile, profile_name, profile_units, function,\n"
           "addable (False: every coordinate's own spring-damping law).")
       .def_static(
           "_check_law",

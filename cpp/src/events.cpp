@@ -101,9 +101,9 @@ double EventLocator::locate(int k, double a, double ga, double b, double gb, con
 
 VecX EventLocator::time_sensitivities(int k, double t, const VecX& y, double h,
                                       const std::function<VecX(double)>& dense) {
-  VecX dt_dp(P_);
-  if (P_ == 0) return dt_dp;
+  VecX dt_dp = VecX::Zero(P_);
   const int m = 2 * sys_.nq, first = m + sys_.nz;
+  if (P_ == 0 || m == 0) return dt_dp;  // nothing moves (nq = 0): the roots are the functions' of t alone
   // ġ by central differences along the dense output, δ = 1e-5 h
   const double delta = 1e-5 * h;
   const double gdot = (g(k, t + delta, dense(t + delta)) - g(k, t - delta, dense(t - delta))) / (2.0 * delta);
@@ -124,24 +124,29 @@ VecX EventLocator::time_sensitivities(int k, double t, const VecX& y, double h,
 }
 
 std::vector<EventRecord> EventLocator::roots(double t, double t1, const VecX& y1,
-                                             const std::function<VecX(double)>& dense, const EventRecord* arrived) {
+                                             const std::function<VecX(double)>& dense,
+                                             const std::vector<EventRecord>* arrived) {
   std::vector<EventRecord> found;
   next_side_ = side_, next_g_.assign(events_.size(), 0.0);
   for (int k = 0; k < static_cast<int>(events_.size()); ++k) {
     const double g1 = next_g_[k] = g(k, t1, y1);
     const int s1 = sign(g1);
-    if (arrived && arrived->event == k) {  // the step was cut at its root: it fires at t1, with the step's end
-      next_side_[k] = arrived->direction;
-      found.push_back({k, t1, arrived->direction, y1, time_sensitivities(k, t1, y1, t1 - t, dense)});
+    const auto cut = arrived ? std::find_if(arrived->begin(), arrived->end(),
+                                            [k](const EventRecord& r) { return r.event == k; })
+                             : std::vector<EventRecord>::const_iterator();
+    if (arrived && cut != arrived->end()) {  // the step was cut before its root: it fires at t1, with the step's end
+      next_side_[k] = cut->direction;
+      found.push_back({k, t1, cut->direction, y1, time_sensitivities(k, t1, y1, t1 - t, dense), cut->located});
       continue;
     }
     if (s1 == 0 || s1 == side_[k]) continue;
     next_side_[k] = s1;
     if (side_[k] == 0 || (events_[k].direction != 0 && events_[k].direction != s1)) continue;  // not a root it asks
-    // g went to side s1 within the step; from g_k(t) on the old side (else at t itself: a root the side kept)
-    const double root = sign(g_[k]) == s1 ? t : locate(k, t, g_[k], t1, g1, dense);
+    if (sign(g_[k]) == s1) continue;  // on side s1 at both ends: no crossing within the step (see roots())
+    // g went to side s1 within the step, from g_k(t) on the old side
+    const double root = locate(k, t, g_[k], t1, g1, dense);
     const VecX y = root == t1 ? y1 : dense(root);
-    found.push_back({k, root, s1, y, time_sensitivities(k, root, y, t1 - t, dense)});
+    found.push_back({k, root, s1, y, time_sensitivities(k, root, y, t1 - t, dense), root});
   }
   std::stable_sort(found.begin(), found.end(), [](const EventRecord& a, const EventRecord& b) { return a.t < b.t; });
   return found;

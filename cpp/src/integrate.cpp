@@ -275,18 +275,24 @@ class StepSizeControl {
   int stiff_steps_ = 0, nonstiff_steps_ = 0;
 };
 
-/// After a step cut a hair before a root where the right-hand side changes (a contact's onset or separation) the run
-/// goes on from t + τ, the state there by the step's dense output, τ the smallest (from 4ε max(1, |t|), by factors of
-/// 4, up to 1e-6 of the step h) that puts the event's function on its new side. The next step's first stage then takes
-/// the new side's right-hand side and its Jacobian (a linear contact's jumps from 0 to k at touch-down: the
-/// sensitivities' equations feel it), not the old side's limit at t*; the state moves by O(τ²) against the steps'
-/// own errors. Returns the time the run goes on from (t* itself where no such τ is found).
-double past_root(EventLocator& events, const EventRecord& root, double t, double h, Stepper& stepper) {
-  double tau = 4.0 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t));
-  for (; tau <= 1e-6 * h; tau *= 4.0) {
+/// After a step cut a hair before roots where the right-hand side changes (contacts' onsets and separations: the
+/// cluster of those within 1e-6 of the step of the first) the run goes on from t + τ, the state there by the step's
+/// dense output, τ the smallest (from 4ε max(1, |t|), by factors of 4, up to twice the cluster's reach past t or 1e-6
+/// of the step h) that puts every one of their functions on its new side. The next step's first stage then takes the
+/// new side's right-hand side and its Jacobian (a linear contact's jumps from 0 to k at touch-down: the
+/// sensitivities' equations feel it), not the old side's limit; the state moves by O(τ²) against the steps' own
+/// errors. Returns the time the run goes on from (t itself where no such τ is found).
+double past_root(EventLocator& events, const std::vector<EventRecord>& roots, double t, double h, Stepper& stepper) {
+  double reach = 0.0;
+  for (const EventRecord& r : roots) reach = std::max(reach, r.located - t);
+  const double limit = std::max(1e-6 * h, 2.0 * reach);
+  for (double tau = 4.0 * std::numeric_limits<double>::epsilon() * std::max(1.0, std::abs(t)); tau <= limit; tau *= 4.0) {
     const VecX y = stepper.dense(t + tau);
-    const double g = events.g(root.event, t + tau, y);
-    if ((g > 0.0 ? 1 : (g < 0.0 ? -1 : 0)) == root.direction) {
+    const bool crossed = std::all_of(roots.begin(), roots.end(), [&](const EventRecord& r) {
+      const double g = events.g(r.event, t + tau, y);
+      return (g > 0.0 ? 1 : (g < 0.0 ? -1 : 0)) == r.direction;
+    });
+    if (crossed) {
       stepper.start(t + tau, y);
       return t + tau;
     }
@@ -330,8 +336,9 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
   if (!events.empty()) events.start(t0, stepper->state());
   VecX y_start;          // events: the state at the step's start, to take the step again
   double y_start_time = t0;
-  bool arrived = false;  // the last step ended at a root that restarts
-  EventRecord cap;       // a root that restarts: the steps end there
+  bool arrived = false;  // the last step ended before roots that restart
+  std::vector<EventRecord> cap;  // roots that restart: the steps end a hair before the first (cap_t)
+  double cap_t = 0.0;
   bool capped = false;
   int retaken = 0;       // times the step from the current t was taken again
   const Tolerances* tol = choice ? &choice->tolerances() : &asked;
@@ -346,7 +353,7 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
       hs = std::min({h, o.max_step, t_end - t});
       if (t + hs > near_end) hs = t_end - t;
       t1 = t + hs >= near_end ? t_end : t + hs;
-      if (capped && t1 >= cap.t) t1 = cap.t, hs = cap.t - t;  // to the root the step was cut at
+      if (capped && t1 >= cap_t) t1 = cap_t, hs = cap_t - t;  // to the roots the step was cut at
     } else {
       t1 = t0 + static_cast<double>(stats.steps + 1) * grid;
       if (t1 > near_end) t1 = t_end;
@@ -381,24 +388,30 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
     if (!events.empty()) {
       const auto dense = [&](double te) { return stepper->dense(te); };
       const std::vector<EventRecord> found =
-          events.roots(t, t1, stepper->state(), dense, capped && t1 == cap.t ? &cap : nullptr);
+          events.roots(t, t1, stepper->state(), dense, capped && t1 == cap_t ? &cap : nullptr);
       // the first root inside the step (not within 1e-9 of it from either end) that restarts: the step again from its
-      // start, ending there (adaptive runs; a fourth time from the same start, the root is taken where this step's
-      // dense output puts it)
+      // start, ending there (adaptive runs; a fourth time from the same start, the roots are taken where this step's
+      // dense output puts them)
       const double near = 1e-9 * (t1 - t) + 16.0 * std::numeric_limits<double>::epsilon() * std::abs(t1);
-      const auto restart = std::find_if(found.begin(), found.end(), [&](const EventRecord& r) {
-        return adaptive && r.t > t + near && r.t < t1 - near && events.spec(r.event).restarts;
+      const auto restarts = [&](const EventRecord& r) { return adaptive && events.spec(r.event).restarts; };
+      const auto first = std::find_if(found.begin(), found.end(), [&](const EventRecord& r) {
+        return restarts(r) && r.t > t + near && r.t < t1 - near;
       });
-      if (restart != found.end() && retaken < 3) {
-        // the step ends a hair (1e-9 of it) before the root: its last stages stay on the old side, as the dense
-        // output has them, whatever the re-taken step's own error; past_root crosses afterwards
-        cap = *restart, capped = true, ++retaken, ++stats.event_restarts;
-        cap.t -= std::min(1e-9 * (t1 - t) + 16.0 * std::numeric_limits<double>::epsilon() * std::abs(cap.t),
-                          0.5 * (cap.t - t));
+      if (first != found.end() && retaken < 3) {
+        // the step ends a hair (1e-9 of it) before the first root: its last stages stay on the old side, as the
+        // dense output has them, whatever the re-taken step's own error. The roots within 1e-6 of the step after it
+        // (two contacts touching together, or a user's event on a contact's gap) arrive with it; past_root crosses
+        // them all afterwards.
+        cap.clear();
+        for (const EventRecord& r : found)
+          if (restarts(r) && r.t >= first->t && r.t <= first->t + 1e-6 * (t1 - t)) cap.push_back(r);
+        cap_t = first->t - std::min(1e-9 * (t1 - t) + 16.0 * std::numeric_limits<double>::epsilon() * std::abs(first->t),
+                                    0.5 * (first->t - t));
+        capped = true, ++retaken, ++stats.event_restarts;
         stepper->start(t, y_start);
         continue;
       }
-      if (capped && t1 == cap.t) capped = false, arrived = true;
+      if (capped && t1 == cap_t) capped = false, arrived = true;
       retaken = 0;
       for (const EventRecord& r : found) {
         traj.events.push_back(r);

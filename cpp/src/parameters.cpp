@@ -2,6 +2,7 @@
 #include "rigidfem/parameters.hpp"
 
 #include <cmath>
+#include <stdexcept>
 
 #include "rigidfem/errors.hpp"
 
@@ -58,7 +59,13 @@ std::shared_ptr<System> with_constants(const System& sys, const ConstantChanges&
     s.contacts[c.contact].law = s.contacts[c.contact].law->with_constant(c.name, c.value);
   }
   // a contact's restitution is bounded above (e <= 1) as well as below: its law judges the values it was given
-  for (const auto& c : changes.contacts) s.contacts[c.contact].law->validate();
+  for (const auto& c : changes.contacts) {
+    try {
+      s.contacts[c.contact].law->validate();
+    } catch (const std::invalid_argument& e) {
+      bad("values", "values of contact '" + s.contacts[c.contact].name + "' its law accepts", e.what());
+    }
+  }
   for (const auto& e : changes.elements) {
     if (e.element < 0 || e.element >= static_cast<int>(s.elements.size()))
       bad("element", "a force element of this system (0.." + std::to_string(s.elements.size()) + " - 1)",

@@ -64,7 +64,7 @@ class ContactLaw final : public Law {
         {{"stiffness", "N/m^p", nullptr, 1e6, 0.0, true, "the contact stiffness k (F_n = k δᵖ)", true},
          {"exponent", "1", nullptr, 1.5, 1.0, false, "the exponent p of the penetration (1 linear, 1.5 Hertz)", false},
          {"restitution", "1", nullptr, 1.0, 0.0, true, "the coefficient of restitution e at the impact speed", true,
-          false},
+          false, 1.0},
          {"impact_speed", "m/s", nullptr, 1.0, 0.0, true, "the impact speed v_e at which the restitution is e",
           false},
          {"mu_s", "1", nullptr, 0.0, 0.0, false, "the static friction coefficient μ_s", true},
@@ -88,11 +88,6 @@ class ContactLaw final : public Law {
     return law;
   }
   const LawInfo& info() const override { return description(); }
-  /// The constants' bounds, and e ≤ 1 (std::invalid_argument naming the constant).
-  void validate() const override {
-    Law::validate();
-    if (c_[E] > 1.0) bad("restitution", "a coefficient of restitution in (0, 1]", num(c_[E], 8));
-  }
   /// Hunt–Crossley's α (s/m).
   double alpha() const { return alpha_; }
   /// F_n(δ, δ̇) (N): k δᵖ (1 + α δ̇) where δ > 0 and that is positive, else 0 (S: double or an automatic derivative).

@@ -51,6 +51,7 @@ struct EventRecord {
   double t = 0.0;
   int direction = 0;
   VecX y, dt_dp;
+  double located = 0.0;  ///< the root's time on the dense output (t itself, unless a step was cut before it)
 };
 
 /// The state of a run's events: the side each g is on, and their roots.
@@ -63,10 +64,12 @@ class EventLocator {
   /// The sides at the run's start (an event exactly at zero there takes the side it goes to, later).
   void start(double t0, const VecX& y0);
   /// The roots within the accepted step (t, t1] (y1 at t1, `dense` its dense output), earliest first. `arrived`: the
-  /// root the step was cut at (it fires at t1 with the step's end state), or null. The sides the step crossed to are
-  /// taken by commit() (not where the step is taken again).
+  /// roots the step was cut before (they fire at t1 with the step's end state), or null. The sides the step crossed
+  /// to are taken by commit() (not where the step is taken again). An event whose function is on the same side at
+  /// both ends of the step, other than the side it is taken to be on (an arrival the state had not yet completed),
+  /// takes that side without a record.
   std::vector<EventRecord> roots(double t, double t1, const VecX& y1, const std::function<VecX(double)>& dense,
-                                 const EventRecord* arrived);
+                                 const std::vector<EventRecord>* arrived);
   /// The step of the last roots() call stands: its end values and sides become the current ones.
   void commit();
   /// g_k(t, y) (y = [q, q̇, ...]).

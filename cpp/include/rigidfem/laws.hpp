@@ -32,6 +32,7 @@ struct Constant {
   /// The equations are linear in it: its derivatives are one-sided differences of any step, exact to round-off;
   /// otherwise central differences of the systems at p ± h (a contact's restitution).
   bool linear = true;
+  double upper = std::numeric_limits<double>::infinity();  ///< the largest value it takes (included)
 };
 
 /// What a kind of law is, described once.
@@ -91,7 +92,9 @@ class Law {
       const Constant& c = law.constants[k];
       const double x = c_[k];
       const bool bounded = c.lower > -std::numeric_limits<double>::infinity();
-      if (std::isfinite(x) && (!bounded || (c.positive ? x > c.lower : x >= c.lower))) continue;
+      if (std::isfinite(x) && (!bounded || (c.positive ? x > c.lower : x >= c.lower)) && x <= c.upper) continue;
+      if (std::isfinite(x) && x > c.upper)
+        bad(c.name, "a number <= " + num(c.upper, 8) + " in " + c.unit + " (" + c.doc + ")", num(x, 8));
       const std::string kind = !bounded ? "finite" : c.lower == 0.0 ? (c.positive ? "positive" : "non-negative")
                                                                    : (c.positive ? "> " : ">= ") + num(c.lower, 8);
       bad(c.name, (bounded && c.lower != 0.0 ? "a number " + kind : "a " + kind + " number") + " in " + c.unit +

@@ -180,7 +180,7 @@ class _Model:
     def _law_kinds() -> list:
         """
         Every kind of law, each a dict: kind, acts_on ('element', 'coordinate' or 'contact'), doc, constants (name, unit,
-        rotation_unit, default, lower, positive, doc, parameter, linear), profile, profile_name, profile_units, function,
+        rotation_unit, default, lower, positive, doc, parameter, linear, upper), profile, profile_name, profile_units, function,
         addable (False: every coordinate's own spring-damping law).
         """
     @staticmethod

@@ -38,8 +38,9 @@ def _changed(system, name: str, argument: str):
     profile (a motion in time: statics and modes hold the drives at t)."""
     params = system._parameters
     if not params.parameter(name, argument).linear:
-        raise _checks.refuse(f"{argument}: expected a constant's parameter (statics and modes at one t), got the "
-                         f"profile's {name!r}")
+        raise _checks.refuse(f"{argument}: expected a parameter the equations are linear in (statics and modes at one "
+                             f"t difference it one-sidedly), got {name!r}, a profile's number or a contact's "
+                             "restitution")
     h = params.step(name)
     return params.shifted(system, name, h), h
 

@@ -111,6 +111,7 @@ def _law_class(info: dict) -> type:
     lines = [info["doc"], "", "Constants (keyword arguments, their defaults):", ""]
     for c in info["constants"]:
         bound = "" if c["lower"] == -math.inf else f", {'>' if c['positive'] else '>='} {c['lower']:g}"
+        bound += f", <= {c['upper']:g}" if c["upper"] < math.inf else ""
         unit = c["unit"] if c["unit"] == c["rotation_unit"] else f"{c['unit']} or {c['rotation_unit']}"
         lines.append(f"- ``{c['name']}`` = {c['default']:g} ({unit}{bound}): {c['doc']}"
                      + ("" if c["parameter"] else " (not a named parameter)"))
@@ -149,5 +150,6 @@ def table() -> str:
                 continue
             unit = c["unit"] if c["unit"] == c["rotation_unit"] else f"{c['unit']} or {c['rotation_unit']}"
             bound = "any" if c["lower"] == -math.inf else f"{'>' if c['positive'] else '≥'} {c['lower']:g}"
+            bound += f", ≤ {c['upper']:g}" if c["upper"] < math.inf else ""
             lines.append(f"| {first} | {on} | `{c['name']}` | {unit} | {c['default']:g} | {bound} | {c['doc']} |")
     return "\n".join(lines)

@@ -441,7 +441,8 @@ class Model(_core._Model):
         (``rf.laws.Rope``). Returns its handle; ``System.element_states`` gives its force F = −T (N).
 
         ``drum`` winds it on a drum of ``radius`` r (m): a body whose joint's rotation φ (rad; its only coordinate,
-        or ``(body, "ry")`` to name one) pays it out, l_u = ``length`` + r φ. Its coordinate may be free (the drum's
+        or ``(body, "ry")`` to name one) pays it out, l_u = ``length`` + r φ. (A translation x pays out r x: a
+        linear winch, r then a ratio.) Its coordinate may be free (the drum's
         inertia, driven by a torque or a law of the state: ``add_torque``, ``add_joint_law``) or prescribed (a speed:
         ``prescribe``). The drum takes the generalised force r P, P = T + ½ EA ε² while taut (ε = (l − l_u)/l_u):
         −∂/∂(r φ) of the energy the rope stores and dissipates, so that the energy balance holds to the last term.
@@ -451,10 +452,11 @@ class Model(_core._Model):
         wound = None
         if drum is not None or radius is not None:
             body, coordinate = drum if isinstance(drum, tuple) and len(drum) == 2 else (drum, None)
-            if not isinstance(body, Body):
-                raise _checks.refuse(f"drum: expected a body whose joint's rotation pays the rope out, or (body, "
-                                     f"coordinate), got {drum!r}")
+            if not isinstance(body, Body) or body.index < 0 or not self._owns(body):
+                raise _checks.refuse(f"drum: expected a body of this model whose joint's rotation pays the rope out, "
+                                     f"or (body, coordinate), got {drum!r}")
             k = self._coordinate(body, coordinate)
+            self._coordinate_name(body.index, k)  # a joint of several coordinates needs one named: judged before adding
             r = _checks.real(radius, "radius", "a positive drum radius in m")
             if not (r > 0.0 and math.isfinite(r)):
                 raise _checks.refuse(f"radius: expected a positive finite drum radius in m, got {radius!r}")
@@ -478,14 +480,18 @@ class Model(_core._Model):
         Euler's e^{μθ} (``mu`` μ, ``wrap`` θ in rad), regularised over the slip speed ``smoothing`` v_ε (m/s): the
         slip takes P_into − P_out e^{μθ tanh(u̇/v_ε)}, so below that ratio the rope creeps at about v_ε and at it slides.
         ``mass`` (kg) is the rope's mass that slips, the slip's inertia (a small one keeps u an ordinary coordinate:
-        ``"<name>"`` is a body turning about its own centre, u in rad = m at 1 m, that gravity does not move). The
-        friction's power is in ``dissipated_power``. Returns the body."""
+        ``"<name>"`` is a point mass 1 m from an axis along gravity, turning about it: u in rad = m of rope, and
+        gravity does no work on it; its named parameter ``"<name>.mass"`` sets that inertia). The friction's power is
+        in ``dissipated_power``. Returns the body."""
         name = self._new_name(name)
         ropes = []
         for argument, rope in (("into", into), ("out_of", out_of)):
             if not (isinstance(rope, handles.Element) and self._owns_element(rope) and
                     self._element_law(rope.index)[0] == "Rope"):
                 raise _checks.refuse(f"{argument}: expected a rope of this model (Model.add_rope's handle), got {rope!r}")
+            if f"{rope}.length" in self._parameter_groups:  # its unstretched length a winch's profile
+                raise _checks.refuse(f"{argument}: expected a rope of constant unstretched length (a sheave passes rope "
+                                     f"from one span to the other), got {rope!r}, paid out by a winch's profile")
             ropes.append(rope)
         if ropes[0].index == ropes[1].index:
             raise _checks.refuse(f"out_of: expected a rope other than into, got {out_of!r} twice")
@@ -500,14 +506,22 @@ class Model(_core._Model):
         v = _checks.real(smoothing, "smoothing", "a regularising slip speed in m/s")
         if not (v > 0.0 and math.isfinite(v)):
             raise _checks.refuse(f"smoothing: expected a positive finite slip speed in m/s, got {smoothing!r}")
-        slip = self.add_body(name, self.ground, joints.Joint.revolute("z"), m, (m, m, m))
+        # a point mass (its own inertia a millionth of m r²) 1 m from an axis along gravity: I = m (1 + 1e-6) kg·m²
+        axis = -self._gravity0 / np.linalg.norm(self._gravity0) if np.any(self._gravity0) else np.array([0.0, 0.0, 1.0])
+        x = np.cross(axis, [1.0, 0.0, 0.0] if abs(axis[0]) < 0.9 else [0.0, 1.0, 0.0])
+        x /= np.linalg.norm(x)
+        frame = np.eye(4)
+        frame[:3, :3] = np.column_stack([x, np.cross(axis, x), axis])
+        slip = self.add_body(name, self.ground, joints.Joint.revolute("z"), m, (1e-6 * m,) * 3, com=(1.0, 0.0, 0.0),
+                             placement=frame)
         self._wind(ropes[0].index, slip.index, -1, 1.0)
         self._wind(ropes[1].index, slip.index, -1, -1.0, mu_ * wrap_, v)
         return slip
 
     def _owns_element(self, handle) -> bool:
         """Whether ``handle`` names a force element of this model."""
-        return 0 <= handle.index < self._nelements and str(handle) in self._parameter_groups
+        group = self._parameter_groups.get(str(handle))
+        return isinstance(group, parameters.LawGroup) and group.target == ("element", handle.index)
 
     @recorded
     def add_shape(self, name: str, body, shape) -> handles.Shape:

@@ -58,16 +58,19 @@ class Parameter:
     positive: bool = field(default=False, repr=False)
     #: whether the equations are linear in it (the constants; not a profile's numbers)
     linear: bool = field(default=True, repr=False)
+    #: the largest value allowed (included; a contact's restitution: 1)
+    maximum: float = field(default=math.inf, repr=False)
 
     def check(self, value, argument: str = "values") -> float:
         """The value as a float, or ValueError naming ``argument``, the parameter and the values it takes."""
         bound = f" > {self.minimum:g}" if self.positive else "" if self.minimum == -math.inf else f" >= {self.minimum:g}"
+        bound += f" and <= {self.maximum:g}" if self.maximum < math.inf else ""
         expected = f"{self.name} to be a finite value{bound} in {self.unit} ({self.description})"
         try:
             x = _core._real(value, argument, "a number")
         except (TypeError, ValueError):
             raise _checks.refuse(f"{argument}: expected {expected}, got {value!r}") from None
-        if not math.isfinite(x) or (x <= self.minimum if self.positive else x < self.minimum):
+        if not math.isfinite(x) or (x <= self.minimum if self.positive else x < self.minimum) or x > self.maximum:
             raise _checks.refuse(f"{argument}: expected {expected}, got {value!r}")
         return x
 
@@ -212,7 +215,7 @@ class LawGroup(Group):
     def __init__(self, prefix, target: tuple, info: dict, values: dict, rotation: bool = False):
         super().__init__(prefix, {c["name"]: Parameter(f"{prefix}.{c['name']}", float(values[c["name"]]),
                                                        c["rotation_unit"] if rotation else c["unit"], c["doc"],
-                                                       c["lower"], c["positive"], c["linear"])
+                                                       c["lower"], c["positive"], c["linear"], c["upper"])
                                   for c in info["constants"] if c["parameter"]})
         self.target, self.info, self.values, self.rotation = tuple(target), info, dict(values), rotation
 
@@ -307,7 +310,7 @@ class Parameters:
                              f" got {name!r}")
         prefix, short = self.where[name]
         p = self.groups[prefix].parameters[short]
-        return Parameter(p.name, self.values[name], p.unit, p.description, p.minimum, p.positive, p.linear)
+        return Parameter(p.name, self.values[name], p.unit, p.description, p.minimum, p.positive, p.linear, p.maximum)
 
     def listing(self) -> dict[str, Parameter]:
         return {name: self.parameter(name) for name in self.values}
@@ -373,14 +376,14 @@ class Parameters:
         try:
             h = self.profile_step(name, t0, t1)
         except ValueError as e:
-            raise _checks.refuse(f"{argument}: expected parameters that can change alone, got {name!r}, whose profile "
+            raise _checks.refuse(f"{argument}: expected parameters that can change alone, got {name!r}, which "
                              f"refuses p ± 1e-6 max(|p|, 1) ({e})") from None
         for low, high in ((-1.0, 1.0), (-2.0, 0.0), (0.0, 2.0)):
             try:
                 return self.shifted(base, name, high * h), self.shifted(base, name, low * h), h
             except ValueError:
                 continue
-        raise _checks.refuse(f"{argument}: expected a parameter whose profile takes values beside "
+        raise _checks.refuse(f"{argument}: expected a parameter that takes values beside "
                          f"{name} = {self.values[name]:g} (p ± {h:.3g}), got none on either side")
 
     def profile_step(self, name: str, t0: float, t1: float) -> float:

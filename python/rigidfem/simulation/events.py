@@ -20,6 +20,7 @@ With ``sensitivities=[...]`` each root carries dt*/dp = −(∂g/∂y · S)/ġ (
 
 from __future__ import annotations
 
+import numbers
 from dataclasses import dataclass, field
 
 import numpy as np
@@ -70,8 +71,10 @@ class Event:
         object.__setattr__(self, "value", _checks.real(self.value, "value", "the level g crosses (a finite number)"))
         if not np.isfinite(self.value):
             raise _checks.refuse(f"value: expected a finite level, got {self.value!r}")
-        if isinstance(self.direction, bool) or self.direction not in (-1, 0, 1):
+        if not isinstance(self.direction, (int, np.integer)) or isinstance(self.direction, bool) \
+                or self.direction not in (-1, 0, 1):
             raise _checks.refuse(f"direction: expected -1, 0 or 1, got {self.direction!r}")
+        object.__setattr__(self, "direction", int(self.direction))
         _checks.boolean(self.terminal, "terminal")
         _checks.boolean(self.rate, "rate")
 
@@ -172,8 +175,10 @@ def _axis(event: Event) -> np.ndarray:
             raise _checks.refuse(f"axis: expected 'x', 'y', 'z' or a 3-vector, got {axis!r}")
         return np.array(AXES[axis])
     v = _checks.reals(axis, (3,), "axis")
-    if not np.linalg.norm(v) > 0.0:
+    size = np.abs(v).max()
+    if not size > 0.0:
         raise _checks.refuse(f"axis: expected a non-zero 3-vector, got {axis!r}")
+    v = v / size  # scaled first: a tiny vector's norm would underflow
     return v / np.linalg.norm(v)
 
 
@@ -181,11 +186,11 @@ def _checked(function, name: str):
     """``function`` returning a float, or ValueError naming ``events`` and what it returned."""
     def g(t, q, qd):
         value = function(t, q, qd)
-        try:
-            return float(value)
-        except (TypeError, ValueError):
+        if isinstance(value, (str, bytes, bool)) or not isinstance(value, (numbers.Real, np.floating, np.integer)) \
+                and not (isinstance(value, np.ndarray) and value.shape == () and value.dtype.kind in "fi"):
             raise _checks.refuse(f"events: expected the function of event {name!r} to return a number, got "
-                                 f"{value!r} at t = {t:g} s") from None
+                                 f"{value!r} at t = {t:g} s")
+        return float(value)
     return g
 
 

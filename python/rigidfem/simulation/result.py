@@ -210,7 +210,7 @@ class Result(Versioned):
         """The times (s) of the roots of the event called ``name`` (``simulate(events=...)``, or a contact's name: its
         onsets and separations), in order; ValueError for a name the run had no event of."""
         known = {e[1] for e in self._event_specs()} if self.system is not None and self.run else set()
-        if name not in known | {f.event for f in self.events}:
+        if not isinstance(name, str) or name not in known | {f.event for f in self.events}:
             raise _checks.refuse(f"name: expected the name of one of the run's events ({sorted(known) or 'none'}), "
                                  f"got {name!r}")
         return np.array([f.t for f in self.events if f.event == name])
@@ -249,7 +249,7 @@ class Result(Versioned):
     def to_npz(self, path):
         """Save t, q, qd, the forward sensitivities (if any), coordinate_names, method, stats and interrupted in a
         NumPy archive at ``path`` (a str or ``os.PathLike``); ``rigidfem.load_npz(path, system)`` reads it back.
-        Returns ``path``."""
+        The run's events (``events``) are not saved. Returns ``path``."""
         return export.to_npz(self, _checks.path(path))
 
 
