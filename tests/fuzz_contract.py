@@ -138,6 +138,8 @@ FEATURES = (
     "events_estimate",     # ... Result.error_estimate of a run that a terminal event ended (with and without t_eval)
     "rope_drums",          # add_rope(..., drum=body or (body, coordinate), radius=r) on random models and a winch sample
     "drum_retry",          # ... a rope refused for its drum added again under the same name (the refusal left no trace)
+    "drum_foreign",        # ... the ground or another model's body as the drum
+    "events_sensitivities_nq0",  # ... events with forward sensitivities on a system without free coordinates
 )
 
 #: The features of the newer entry points' generators (Gen.entry_case draws cases on samples when one is on).
@@ -621,6 +623,18 @@ def point_level(system, point, axis, q0, delta: float, t0: float = 0.0) -> float
     return x if math.isfinite(x) else delta
 
 
+def ball():
+    """A ball (radius 0.1 m, 2 kg) on a vertical slide (z, its centre's height above 0.1 m) over the floor z = 0, under
+    gravity; the contact 'bounce' (stiffness 1e5, exponent 1.5, restitution 0.7)."""
+    model = rf.Model(gravity=(0.0, 0.0, -9.81))
+    ball = model.add_body("ball", model.ground, rf.Joint.prismatic("z"), 2.0, (0.01, 0.01, 0.01),
+                          placement=rf.transform((0.0, 0.0, 0.1)))
+    bounce = model.add_contact("bounce", model.add_shape("s", ball, rf.shapes.Sphere(0.1)),
+                               model.add_shape("floor", model.ground, rf.shapes.HalfSpace()),
+                               rf.laws.Contact(stiffness=1e5, exponent=1.5, restitution=0.7))
+    return model, {"ball": ball, "bounce": bounce}
+
+
 def _event_list(value):
     """simulate's ``events`` as a list of rf.Event, or None when it is not one (None, an Event, an iterable of them)."""
     if value is None:
@@ -790,10 +804,16 @@ def events_consistent(res):
                 not (np.all(np.isfinite(f.q)) and np.all(np.isfinite(f.qd))):
             return f"event {f.event!r} at t = {f.t!r}: its state is not {system.nq} finite numbers each"
         if e is not None and isinstance(e.of, str) and e.of in names:
+            # the root is located in time, to 1e-12 of its step (at most the run's span): g there is within that
+            # time its rate (q'(t*) for a coordinate, the largest slope of the outputs' q' for a rate)
             j = names.index(e.of)
             x, run = (f.qd[j], res.qd[:, j]) if e.rate else (f.q[j], res.q[:, j])
             scale = 1.0 + abs(e.value) + float(np.max(np.abs(run))) if len(run) else 1.0
-            if abs(x - e.value) > 1e-6 * scale:
+            span = float(res.run["t_end"] - res.run["t0"])
+            with np.errstate(divide="ignore", invalid="ignore"):  # (outputs at one time twice: an inf slope)
+                slope = abs(float(f.qd[j])) if not e.rate else float(np.max(np.abs(np.diff(run) / np.diff(res.t)),
+                                                                              initial=0.0)) if len(run) > 1 else 0.0
+            if abs(x - e.value) > 1e-6 * scale + 1e-11 * span * slope:
                 return f"event {f.event!r} at t = {f.t!r}: {e.of}{' rate' if e.rate else ''} = {x!r} there, not " \
                        f"its level {e.value!r}"
     return True
@@ -915,7 +935,7 @@ def _finite(value, depth: int = 0) -> bool:
 #: Fields of the package's dataclasses that are not results: the system, a run's arguments and counts (a model size
 #: of NaN means "the run held the state"), the function that made it, a Plan's runs and handles, a Gradient's stats.
 UNCHECKED_FIELDS = ("system", "history", "stats", "run", "made_by", "estimate", "runs", "handles", "solution",
-                    "simulate_options", "minimum")  # a Parameter's minimum is -inf for a profile's number
+                    "simulate_options", "minimum", "maximum")  # a Parameter's bounds: -inf, inf where it has none
 
 
 def _parameter_values(values, system) -> tuple[bool, bool]:
@@ -941,7 +961,7 @@ def _parameter_values(values, system) -> tuple[bool, bool]:
             x = float(v)
         except OverflowError:
             return True, False
-        if not math.isfinite(x) or (x <= p.minimum if p.positive else x < p.minimum):
+        if not math.isfinite(x) or (x <= p.minimum if p.positive else x < p.minimum) or x > p.maximum:
             bad = True
         unsure |= not p.linear
         # 1e300 or 1e-300 may make a constant it scales overflow: "values: expected values whose ... are finite"
@@ -1858,6 +1878,8 @@ SAMPLES = {
                      False),
     "winch_named": ("fz.winch(named=True)", ("h['load']", "h['drum'].point((0.0, 0.0, 0.3))"),
                     ("h['drum']", "h['load']"), 3, 0, False),
+    # a ball bouncing on the floor, its contact 'bounce' (feature events): fz.ball
+    "ball": ("fz.ball()", ("h['ball']", "h['ball'].point((0.0, 0.0, -0.1))"), ("h['ball']",), 1, 0, False),
 }
 
 
@@ -1881,6 +1903,7 @@ class Gen:
         self.laws: set = set()  # (body index, coordinate) with a force law
         self.contact_names: list = []  # the names (as expressions) of the contacts added (or tried)
         self.drum_next = False  # the next rope is wound on a drum
+        self.drum_absent: list = []  # the drum's arguments left out (radius)
 
     # -- drawing helpers (integer strategies cached: building a strategy costs more than drawing)
     _ints: dict = {}
@@ -2400,7 +2423,8 @@ class Gen:
             # (a valid element is ambiguous: a and b may be points of one body; a bad drum is refused first, except a
             # joint of several coordinates or none, found once the element is in, after a and b: "b" may come first)
             self.emit(fn, [name, A(a, bad=bad_a, names=ROLE_NAMES["point"]), A(b)], ["name", "a", "b"], kw,
-                      label="add_rope:drum" if wound else fn.split(".")[1], ambiguous=not bad and wound != "bad")
+                      label="add_rope:drum" if wound else fn.split(".")[1], ambiguous=not bad and wound != "bad",
+                      absent_bad=self.drum_absent if wound else [])
             if wound == "bad" and not bad_a and not name.get("bad") and not name.get("soft") and \
                     self.on("drum_retry") and self.chance(0.5):
                 # refused: nothing of it stays in the model, its name is free (a refusal naming name is a violation)
@@ -2422,6 +2446,8 @@ class Gen:
         if (kind == "unnamed" and not unnamed) or (kind == "translation" and not moving) or \
                 (kind == "coordinate" and not self.bodies):
             kind = "ground"
+        if kind == "ground" and not self.on("drum_foreign"):
+            kind = "nonbody"
         kw["length"] = A(fl(self.choice([0.5, 1.0, 3.0])))
         radius = A(fl(self.choice([0.3, 0.3, 0.05, 1.0, 1e-3])))
         names = ("drum", "coordinate", "radius")
@@ -2471,6 +2497,7 @@ class Gen:
         kw["drum"] = drum
         if radius is not None:
             kw["radius"] = radius
+        self.drum_absent = ["radius"] if radius is None else []  # left out: refused naming it
         if state == "good" and self.chance(0.3):
             kw["DA"] = A(fl(self.choice([0.0, 10.0, 1e3])))
         return state
@@ -2810,6 +2837,11 @@ class Gen:
         if self.chance(0.03):
             kw["progress"] = A("True")
         events = self.events_kw(kw, method) if self.on("events") and self.chance(0.2) else None
+        if events and "sensitivities" in kw and not self.on("events_sensitivities_nq0"):
+            del kw["sensitivities"]  # (nq_guess may miss a coordinate prescribed twice: nq = 0 after all)
+        elif events and self.on("events_sensitivities_nq0") and self.nq_guess() == 0 and self.chance(0.5):
+            # no free coordinate: sensitivities of nothing, the roots' dt*/dp zero (refused with a scipy: method)
+            kw["sensitivities"] = A("list(system.parameters)[:1]", soft=True, names=("sensitivities", "method"))
         out = self.new("res")
         # rtol = atol = 0 together: refused by some methods, run by others
         amb = kw.get("rtol", {}).get("e") in ("0.0",) and kw.get("atol", {}).get("e") in ("0.0",)
@@ -3072,8 +3104,10 @@ class Gen:
 
     def entry_case(self):
         """A case on a small sample (compiled as ``system``, handles ``h``) calling the newer entry points."""
-        kind = self.choice([k for k in SAMPLES if self.on("rope_drums") or not k.startswith("winch")] +
-                           ["pendulum", "double_pendulum", "cantilever", "cantilever"])
+        kind = self.choice([k for k in SAMPLES if (self.on("rope_drums") or not k.startswith("winch")) and
+                            (self.on("events") or k != "ball")] + ["pendulum", "double_pendulum", "cantilever", "cantilever"])
+        if kind == "ball":
+            self.contact_names = ["'bounce'"]
         expr, points, bodies, nq, npres, loops = SAMPLES[kind]
         expr = expr.replace("@E", str(self.choice([2, 3, 4, 6])))
         self.emit(expr, out="model, h", label="samples." + kind, attr=True)
@@ -3277,7 +3311,10 @@ class Gen:
                                      "list(S.parameters)[:1] + ['qd0[' + c + ']' for c in S.coordinate_names[:1]]",
                                      "[]", "None"])), soft=True, names=("sensitivities", "method"))
         method = self.choice(self.SENSITIVITY_METHODS)
-        kw = {"method": A(repr(method)), "sensitivities": names, "max_steps": A("1000")}
+        # (an implicit run differentiated by a drive's numbers runs whole systems at p +- h: esdirk43's 399 steps of 47
+        # coordinates took 9.7 s, 800 000 right-hand sides, and the case timed out on a busy machine; 100 steps, 2.4 s)
+        implicit = method in ("generalized_alpha", "newmark", "hht", "radau5", "esdirk43", "auto", "implicit_spring")
+        kw = {"method": A(repr(method)), "sensitivities": names, "max_steps": A("100" if implicit else "1000")}
         if self.chance(0.05):  # refused with sensitivities, taken without (an empty list, None)
             kw["method"] = A(self.choice(["'scipy:RK45'", "'scipy:Radau'"]), soft=True, names=("method", "sensitivities"))
         t_end = self.choice([0.02, 0.05])
@@ -3852,9 +3889,9 @@ class Gen:
 
     def event_axis(self):
         """A point event's axis (None: left out, refused at the run naming axis)."""
-        if self.chance(0.08):
-            return self.choice([None, A("None"), A("'w'"), A("(0.0, 0.0, 0.0)"), A("(nan, 0.0, 0.0)"), A("(1.0, 0.0)"),
-                                A("'X'")])
+        if self.chance(0.08):  # (an Event holds its axis as given: a NaN in it is no NaN it made)
+            return self.choice([None, A("None"), A("'w'"), A("(0.0, 0.0, 0.0)"), A("(nan, 0.0, 0.0)", x=True),
+                                A("(1.0, 0.0)"), A("'X'")])
         if self.on("event_extreme_axes") and self.chance(0.03):  # finite and non-zero: valid
             return A(self.choice(["(1e300, 1e300, 0.0)", "(1e-300, 0.0, 0.0)", "(0.0, 1e200, 1e200)"]), x=True)
         if self.chance(0.7):
@@ -3995,7 +4032,7 @@ class Gen:
             else:
                 e = self.choice(["'nope'", "3", "None"] + (["['x']", "{}"] if self.on("event_name_types") else []))
                 self.emit(f"{res}.event_times", [A(e, bad=True, names=("name",))], ["name"], label="Result.event_times")
-        if info["terminal"] and self.on("events_estimate") and self.chance(0.4):
+        if info["terminal"] and self.on("events_estimate") and self.chance(0.7):
             # finished (at t_end or a terminal root, not interrupted): its estimate may not be refused
             self.emit("getattr", [A(res, role="finished", names=("result",)), A("'error_estimate'")],
                       ["result", "name"], label="Result.error_estimate(events)")
@@ -4018,14 +4055,18 @@ class Gen:
             kw["dt"] = A(fl((t_end - t0) / self.choice([50, 200])))
         if self.chance(0.6):
             kw["q0"] = A(f"V({sysv}.nq, {self.seed()}, 0.5)")
-        if self.chance(0.3):
+        if self.chance(0.4):
             kw["t_eval"] = A(f"np.linspace({fl(t0)}, {fl(t_end)}, {self.choice([2, 5, 11])})")
         if self.chance(0.2):
             kw["rtol"] = A(self.choice(["1e-3", "1e-8"]))
-        if self.chance(0.1):
+        nq0 = self.nq_known == 0 if self.sample_points else self.nq_guess() == 0
+        if self.chance(0.2) or (nq0 and self.on("events_sensitivities_nq0") and self.chance(0.5)):
             kw["sensitivities"] = A(f"list({sysv}.parameters)[:1]", soft=True, names=("sensitivities", "method"))
         if self.chance(0.04):
             kw["stop"] = A("set_event()")
+        nq0 = self.nq_known == 0 if self.sample_points else True  # (a random model's nq: a guess)
+        if "sensitivities" in kw and nq0 and not self.on("events_sensitivities_nq0"):
+            del kw["sensitivities"]
         info = self.events_kw(kw, method, sysv)
         out = self.new("res")
         self.emit("rf.simulate", [A(sysv), A(fl(t_end))], ["system", "t_end"], kw, out=out, label="simulate:events",

@@ -277,15 +277,15 @@ def _estimate_error(result: Result):
     run = result.run
     if run is None or result.made_by is None:
         raise _checks.refuse("result: expected a Result made by rigidfem.simulate (a loaded one has no run to repeat)")
-    terminal = [e for e in run.get("events") or [] if isinstance(e, events_.Event) and e.terminal]
-    ended = bool(terminal) and bool(result.events) and result.events[-1].t == result.t[-1]  # at a terminal root
+    terminal = {e.name for e in run.get("events") or [] if isinstance(e, events_.Event) and e.terminal}
+    ended = bool(result.events) and result.events[-1].event in terminal  # at a terminal root (outputs up to it)
     if result.interrupted or not len(result.t) or (result.t[-1] < run["t_end"] and not ended):
         raise _checks.refuse("result: expected a finished run for its error estimate, got one that stopped at "
                          f"t = {result.t[-1] if len(result.t) else run['t0']:g} s")
     kw = {k: v for k, v in run.items() if k not in ("outputs", "fixed")}
     kw["t_eval"], kw["stiffness_warning"] = result.t, False
     if ended:  # the second run to the same end, its events located but none ending it
-        kw["t_end"] = result.t[-1]
+        kw["t_end"] = result.events[-1].t
         kw["events"] = [dataclasses.replace(e, terminal=False) for e in run["events"]]
     if run["fixed"]:
         kw["dt"] = run["dt"] / 2.0
