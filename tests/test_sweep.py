@@ -231,3 +231,29 @@ def test_dask_local_cluster_with_two_workers_equals_serial():
     serial = rf.sweep(pendulum, grid=GRID, executor="serial", as_frame=False)
     assert len(workers) == 2
     same_rows(dask.rows, serial.rows)
+
+
+class _BreaksAtSubmit(concurrent.futures.ProcessPoolExecutor):
+    """A process pool whose worker dies between submissions: the third batch and those after it are refused with
+    BrokenProcessPool at submit (a race of a real pool, made certain here)."""
+
+    def __init__(self):
+        super().__init__(2)
+        self.submitted = 0
+
+    def submit(self, *args, **kwargs):
+        self.submitted += 1
+        if self.submitted > 2:
+            raise concurrent.futures.process.BrokenProcessPool("a child process terminated abruptly")
+        return super().submit(*args, **kwargs)
+
+
+def test_a_pool_that_breaks_while_batches_are_submitted_runs_the_rest_alone():
+    """Batches refused at submit (the pool broke meanwhile) are recorded like a batch whose worker died: each of their
+    cases runs again alone, so every case gets its value (errors="record"), and errors="raise" names the function."""
+    with _BreaksAtSubmit() as pool:
+        table = rf.sweep(dies_or_returns, [{"k": k} for k in (0, 1, 4, 5, 6, 7, 8, 9)], executor=pool, errors="record",
+                         as_frame=False)
+    assert [r["value"] for r in table.rows] == [k * k for k in (0, 1, 4, 5, 6, 7, 8, 9)]
+    with _BreaksAtSubmit() as pool, pytest.raises(ValueError, match="^function: expected a function that returns"):
+        rf.sweep(dies_or_returns, [{"k": k} for k in (0, 1, 4, 5, 6, 7, 8, 9)], executor=pool, errors="raise")

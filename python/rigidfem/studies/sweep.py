@@ -217,8 +217,16 @@ def _submit_all(executor, function, cases, seeds, record_errors, stop, batches) 
                 for b in batches]
     options = {"pure": False} if _is_dask_client(executor) else {}
     packed = isinstance(executor, concurrent.futures.ProcessPoolExecutor)
-    return [executor.submit(run_cases, function, [cases[k] for k in b], [seeds[k] for k in b], record_errors,
-                            packed, **options) for b in batches]
+    futures = []
+    for b in batches:
+        try:
+            futures.append(executor.submit(run_cases, function, [cases[k] for k in b], [seeds[k] for k in b],
+                                           record_errors, packed, **options))
+        except BrokenProcessPool as e:  # a worker died before every batch was in: the rest fail as its batch did
+            failed = concurrent.futures.Future()
+            failed.set_exception(e)
+            futures.append(failed)
+    return futures
 
 
 def _as_completed(executor, futures):
