@@ -2417,6 +2417,9 @@ class Gen:
                 kw["EA"] = kw.pop("stiffness")
                 if "damping" in kw:
                     kw["DA"] = kw.pop("damping")
+                if self.chance(0.3):  # a heavy rope (its span's weight), or a bad mass per length
+                    mu = self.choice(["0.0", "2.0", "30.0", "-1.0", "nan"])
+                    kw["mass_per_length"] = A(mu, bad=mu in ("-1.0", "nan"))
             wound = kind == "rope" and self.on("rope_drums") and (self.drum_next or self.chance(0.4)) and self.drum(kw)
             self.drum_next = False
             name = self.fresh_name()

@@ -16,15 +16,16 @@ from test_derivatives import check_both_modes
 G, H = 9.81, 5.0  # gravity (m/s²); the sheave's height (m)
 
 
-def winch(m=200.0, EA=2e6, DA=2e3, r=0.3, l0=2.0, J=4.0, drive=None, algorithm="recursive", torque=None):
-    """A load of m kg on a vertical slide (z) hanging from a sheave at height H by a rope wound on a drum of radius r
-    and inertia J (rotation y, φ): the rope's unstretched length l_u = l₀ + r φ. The drum prescribed (drive), or free
-    under a torque profile."""
+def winch(m=200.0, EA=2e6, DA=2e3, r=0.3, l0=2.0, J=4.0, drive=None, algorithm="recursive", torque=None, mu=0.0):
+    """A load of m kg on a vertical slide (z) hanging from a sheave at height H by a rope (μ kg/m) wound on a drum of
+    radius r and inertia J (rotation y, φ): the rope's unstretched length l_u = l₀ + r φ. The drum prescribed (drive),
+    or free under a torque profile."""
     model = rf.Model(gravity=(0.0, 0.0, -G))
     drum = model.add_body("drum", model.ground, rf.Joint.revolute("y"), 20.0, (J, J, J),
                           placement=rf.transform((-1.0, 0.0, H)))
     load = model.add_body("load", model.ground, rf.Joint.prismatic("z"), m, (1.0, 1.0, 1.0))
-    model.add_rope("rope", model.ground.point((0.0, 0.0, H)), load.origin, EA=EA, DA=DA, length=l0, drum=drum, radius=r)
+    model.add_rope("rope", model.ground.point((0.0, 0.0, H)), load.origin, EA=EA, DA=DA, length=l0, drum=drum, radius=r,
+                   mass_per_length=mu)
     if drive is not None:
         model.prescribe(drum, drive)
     if torque is not None:
@@ -53,18 +54,20 @@ def test_a_drum_at_a_prescribed_speed_lowers_the_load_as_its_own_equation_says()
     assert ref.y[0][-1] == pytest.approx(z0 - r * w * 2.0, abs=5e-3)
 
 
-def test_a_motor_driven_drum_keeps_the_energy_balance_to_the_last_term():
+@pytest.mark.parametrize("mu", [0.0, 30.0])
+def test_a_motor_driven_drum_keeps_the_energy_balance_to_the_last_term(mu):
     """A free drum of inertia J under a motor torque M(t) lifting the load: the kinetic, gravity and rope energies
     change by ∫ M φ̇ dt − ∫ DA/l_u (l̇ − l̇_u)² dt (trapezoids over 12,001 outputs), to 3e-8 of the energy moved. The
-    drum takes r (T + ½ EA ε²): with T r alone ½ EA ε² ṡ, about 2 J here (7e-4 of it), would be missing."""
+    drum takes r (T + ½ EA ε²): with T r alone ½ EA ε² ṡ, about 2 J here (7e-4 of it), would be missing. A heavy
+    rope (μ = 30 kg/m) too: its span's potential is in the gravity energy, and the drum winds its weight in."""
     m, r = 200.0, 0.3
-    torque = rf.motion.polynomial([-1.2 * m * G * r, 50.0])  # more than the load's weight: it winds in, speeding up
-    system = winch(m=m, r=r, torque=torque)
-    z0 = H - 2.0 * (1 + m * G / 2e6)
+    torque = rf.motion.polynomial([-(1.2 * m + 2.0 * mu) * G * r, 50.0])  # more than the weight: it winds in
+    system = winch(m=m, r=r, torque=torque, mu=mu)
+    z0 = H - 2.0 * (1 + (m + mu) * G / 2e6)  # the span's weight: half on the load (T = (m + ½ μ l_u) g)
     t_eval = np.linspace(0.0, 1.5, 12001)
     res = rf.simulate(system, 1.5, "dopri5", q0=[0.0, z0], t_eval=t_eval, rtol=1e-11, atol=1e-13)
     phi_dot = res.qd[:, 0]
-    motor = (-1.2 * m * G * r + 50.0 * t_eval) * phi_dot
+    motor = (-(1.2 * m + 2.0 * mu) * G * r + 50.0 * t_eval) * phi_dot
 
     def integral(f):
         return np.concatenate([[0.0], np.cumsum(0.5 * (f[1:] + f[:-1]) * np.diff(t_eval))])
@@ -74,6 +77,92 @@ def test_a_motor_driven_drum_keeps_the_energy_balance_to_the_last_term():
     moved = np.abs(E - E[0]).max()
     assert phi_dot[-1] < -1.0 and moved > 1e3  # the drum winds the rope in: the load rises
     assert np.abs(balance).max() < 3e-8 * moved
+
+
+def test_a_heavy_rope_holds_its_load_and_its_drum_as_the_hanging_continuum_does():
+    """A load m hanging at rest on l_u of rope of μ kg/m: in the continuum, T(σ) = (m + μ σ) g at σ of unstretched rope
+    above the load, so the rope is stretched by (m g l_u + ½ μ g l_u²)/EA and the drum holds r (m + μ l_u) g. The model
+    (a straight span, half its weight on each point) rests at that stretch (the load's z̈ = 0 to 1e-9 g) and its drum
+    turns under J φ̈ = r (m + μ l_u) g to O(ε) (ε = 2e-6 here); the massless rope would miss μ l_u = 40 % of the load."""
+    m, mu, r, J, EA, l0, phi = 200.0, 20.0, 0.3, 4.0, 1e9, 2.0, 10.0
+    system = winch(m=m, EA=EA, r=r, l0=l0, J=J, mu=mu)
+    lu = l0 + r * phi
+    stretch = (m * G * lu + 0.5 * mu * G * lu**2) / EA
+    acc = system.forward_dynamics(0.0, np.array([phi, H - lu - stretch]), np.zeros(2))
+    assert abs(acc[1]) < 1e-9 * G
+    eps = stretch / lu
+    assert J * acc[0] == pytest.approx(r * (m + mu * lu) * G, rel=3 * eps)
+    assert J * acc[0] > 1.3 * r * m * G
+
+
+def test_a_drum_lowering_a_heavy_rope_follows_the_inextensible_ropes_closed_form():
+    """A free drum lets the load and the rope down: for an inextensible rope the drop x obeys
+    (m + J/r²) ẍ = (m + μ (l₀ + x)) g (the rope's weight grows as it leaves the drum), so x = (a/b)(cosh √b t − 1),
+    a = (m + μ l₀) g/M, b = μ g/M, M = m + J/r² (the rope stays taut while m + μ l_u < M). A stiff rope (EA = 1e9 N)
+    follows it to 1e-5 m over 1 s (2.9 m of drop); the massless rope falls 0.57 m short."""
+    m, mu, r, J, l0 = 200.0, 20.0, 0.3, 20.0, 2.0
+    t = np.linspace(0.0, 1.0, 11)
+
+    def drop(mu):
+        system = winch(m=m, EA=1e9, DA=1e6, r=r, l0=l0, J=J, mu=mu)
+        z0 = H - l0 - (m * G * l0 + 0.5 * mu * G * l0**2) / 1e9
+        res = rf.simulate(system, 1.0, q0=[0.0, z0], t_eval=t, rtol=1e-10, atol=1e-12)
+        assert (res.element_forces < -100.0).all()  # taut
+        return z0 - res.q[:, 1], r * res.q[:, 0]
+
+    M = m + J / r**2
+    a, b = (m + mu * l0) * G / M, mu * G / M
+    x = a / b * (np.cosh(np.sqrt(b) * t) - 1.0)
+    load, paid_out = drop(mu)
+    np.testing.assert_allclose(load, x, atol=1e-5)
+    np.testing.assert_allclose(paid_out, x, atol=1e-5)
+    assert x[-1] - drop(0.0)[0][-1] > 0.5
+
+
+def heavy_crane(mu=25.0, DA=3e3):
+    """A jib turning about y at the ground (4 m), a drum on it (rotation y) paying a heavy rope out over the jib's tip
+    to a load free in the x-z plane: the rope's both points move, so its weights' and pull's derivatives are whole."""
+    model = rf.Model(gravity=(0.0, 0.0, -G))
+    jib = model.add_body("jib", model.ground, rf.Joint.revolute("y", stiffness=4e5), 500.0, (20.0, 600.0, 600.0),
+                         com=(2.0, 0.0, 0.0))
+    drum = model.add_body("drum", jib, rf.Joint.revolute("y"), 30.0, (2.0, 2.0, 2.0),
+                          placement=rf.transform((0.5, 0.0, 0.3)))
+    load = model.add_body("load", model.ground, rf.Joint.custom(("x", "z")), 150.0, (1.0, 1.0, 1.0))
+    model.add_rope("rope", jib.point((4.0, 0.0, 0.0)), load.origin, EA=5e6, DA=DA, length=3.0, drum=drum, radius=0.25,
+                   mass_per_length=mu)
+    model.add_torque("motor", drum, (0.0, 1.0, 0.0), scale=rf.motion.constant(-0.25 * 160.0 * G))
+    return model.compile()
+
+
+def test_a_heavy_ropes_jacobians_are_exact_in_both_modes_and_its_adjoint_gradient_by_its_mass():
+    """∂f/∂q, ∂f/∂q̇ of the heavy rope's weights (½ μ l_u g on the tip, μ s taken from the drum there) and pull
+    (½ μ g·(r_B − r_A)) against central differences (2e-6); forward and reverse modes to round-off; rf.gradient by
+    "rope.mass_per_length" and "rope.EA" of the load's height after 0.4 s against central differences of whole runs
+    (1e-6)."""
+    system = heavy_crane()
+    names = system.coordinate_names
+    t, q, qd = 0.0, np.array([0.02, 0.4, 3.5, -3.3]), np.array([0.1, -0.5, 0.3, 0.2])
+    assert names == ["jib.ry", "drum.ry", "load.x", "load.z"]
+    Kq, Kqd = system.force_jacobians(t, q, qd)
+    Fq, Fqd = central_jacobians(system, t, q, qd, h=1e-6)
+    np.testing.assert_allclose(Kq, Fq, rtol=2e-6, atol=2e-6 * np.abs(Fq).max())
+    np.testing.assert_allclose(Kqd, Fqd, rtol=2e-6, atol=2e-6 * np.abs(Fqd).max())
+    light = heavy_crane(mu=0.0)
+    assert np.abs(light.generalized_forces(t, q, qd) - system.generalized_forces(t, q, qd)).max() > 1e2
+    check_both_modes(system, np.random.default_rng(11), spread=0.05)
+    q0 = np.array([0.0, 0.0, 4.0, -3.0])
+    run = dict(dt=1e-3, q0=q0, newton_tol=1e-13)
+    grad = rf.gradient(system, 0.4, ["rope.mass_per_length", "rope.EA"], outputs={"z": "load.z"},
+                       terminal=lambda y: y["z"], **run)
+
+    def height(**values):
+        r = rf.simulate(system.with_parameters(values), 0.4, method="generalized_alpha", t_eval=[0.4], **run)
+        return r.q[-1, 3]
+
+    for name, value in (("rope.mass_per_length", 25.0), ("rope.EA", 5e6)):
+        h = 1e-4 * value
+        fd = (height(**{name: value + h}) - height(**{name: value - h})) / (2 * h)
+        assert grad[name] == pytest.approx(fd, rel=1e-6, abs=1e-6 * abs(fd))
 
 
 @pytest.mark.parametrize("algorithm", ["recursive", "lagrange"])

@@ -115,13 +115,13 @@ double ParameterVjp::power(const System& X, const Data& d, const Component& c, c
     }
     case Component::Coordinate:  // −μ_k Q_k
       return -mu(X.coords[c.index].free_index) * passive_force(X, d, c.index, true);
-    case Component::Element: {  // −F e·(V_b(x_b) − V_a(x_a)) = −F δl, and each winding's −μ_k r P c
+    case Component::Element: {  // −(F e + w_B)·V_b(x_b) + (F e − w_A)·V_a(x_a), and each winding's −μ_k r P c
       const ForceElement& E = X.elements[c.index];
-      const ElementState s = element_state(d, E, true);
-      double p = -s.F * s.e.dot(velocity(E.body_b, s.xb) - velocity(E.body_a, s.xa));
+      const ElementState s = element_state(X, d, E, true);
+      double p = -(s.F * s.e + s.wb).dot(velocity(E.body_b, s.xb)) + (s.F * s.e - s.wa).dot(velocity(E.body_a, s.xa));
       for (const Winding& w : E.windings)
         if (const int k = X.coords[w.coord].free_index; k >= 0)
-          p -= mu(k) * w.radius * E.law->pull(d.t, s.extension()) * w.factor(d.qda(w.coord)).first;
+          p -= mu(k) * w.radius * s.P * w.factor(d.qda(w.coord)).first;
       return p;
     }
     case Component::Load: {  // −V_bᵀ (x × F + τ, F)

@@ -46,7 +46,8 @@ std::pair<Vec3, Vec3> point_tangent(const Data& d, const Tangent& w, int b, cons
 // under the fixed force is the geometric term of BodyLoad): with δd = δr_B − δr_A,
 //   δe = (1 − e eᵀ) δd / l,  δl = e·δd,  δl̇ = δe·ḋ + e·δḋ,  δf_B = (F_l δl + F_l̇ δl̇ + F_s δs + F_ṡ δṡ) e + F δe,
 // applied at r_B and r_A as −δf_ext. A rope wound on free coordinates q_k (drums, a sheave's slip: δs = Σ r_k δq_k)
-// changes each one's r_k P c_k by r_k (c_k δP + P c_k' δq̇_k), δP = P_l δl + P_l̇ δl̇ + P_s δs + P_ṡ δṡ, into w.dQ.
+// changes each one's r_k P c_k by r_k (c_k δP + P c_k' δq̇_k), δP = P_l δl + P_l̇ δl̇ + P_s δs + P_ṡ δṡ + ½ λ μ g·δd,
+// into w.dQ, and a heavy one's weights by δw_B = ½ λ μ δs g = −δw_A (kinematics.hpp: ElementState).
 void element_tangent(const System& sys, const Data& d, const ForceElement& E, const ElementState& st, Tangent& w) {
   const auto [dxb, dvb] = point_tangent(d, w, E.body_b, st.xb);
   const auto [dxa, dva] = point_tangent(d, w, E.body_a, st.xa);
@@ -62,16 +63,17 @@ void element_tangent(const System& sys, const Data& d, const ForceElement& E, co
   const Vec3 de = (dd - st.e * st.e.dot(dd)) / st.l;
   const double dl = st.e.dot(dd), dld = de.dot(st.vb - st.va) + st.e.dot(ddd);
   const ExtensionDerivatives F = E.law->derivatives(d.t, st.extension(), d.load_factor);
+  const Vec3 g_half = 0.5 * d.load_factor * E.law->span_mass_rate() * sys.gravity;  // ½ λ μ g
   if (!E.windings.empty()) {
     const ExtensionDerivatives P = E.law->pull_derivatives(d.t, st.extension());
-    const double P0 = E.law->pull(d.t, st.extension()), dP = P.l * dl + P.ld * dld + P.s * ds + P.sd * dsd;
+    const double dP = P.l * dl + P.ld * dld + P.s * ds + P.sd * dsd + g_half.dot(dd);
     for (const Winding& wi : E.windings)
       if (const int k = sys.coords[wi.coord].free_index; k >= 0) {
         const auto [c, dc] = wi.factor(d.qda(wi.coord));
-        w.dQ(k) += wi.radius * (c * dP + P0 * dc * w.dqd(k));
+        w.dQ(k) += wi.radius * (c * dP + st.P * dc * w.dqd(k));
       }
   }
-  const Vec3 df = (F.l * dl + F.ld * dld + F.s * ds + F.sd * dsd) * st.e + st.F * de;
+  const Vec3 df = (F.l * dl + F.ld * dld + F.s * ds + F.sd * dsd) * st.e + st.F * de + ds * g_half;
   for (const auto& [body, x, f] : {std::tuple<int, Vec3, Vec3>{E.body_b, st.xb, df}, {E.body_a, st.xa, -df}}) {
     if (body < 0) continue;
     w.f[body].head<3>() -= x.cross(f);
@@ -149,7 +151,7 @@ struct LoadTerms {
     for_each_body_load(sys, d, true, [&](int body, const AppliedLoad& a, bool follower) {
       loads.push_back({body, follower, a});
     });
-    for (const ForceElement& E : sys.elements) elements.push_back(element_state(d, E, true));
+    for (const ForceElement& E : sys.elements) elements.push_back(element_state(sys, d, E, true));
     for_each_flow_term(sys, d, true, [&](const FlowTerm& f) { flows.push_back(f); });
     if (!sys.contacts.empty())
       for_each_contact_force(sys, d, true, [&](const ContactForce& c) {
@@ -325,16 +327,19 @@ ResidualVjp rnea_vector_jacobian_product(const System& sys, Data& d, const VecX&
     // δe = (1 − e eᵀ) δd / l; each free winding's row −r_k (c_k δP + P c_k' δq̇_k) adds −μ_k r_k c_k (P_l, P_l̇, P_s,
     // P_ṡ) to (δl̄, δl̇̄, δs̄, δṡ̄), and δs = Σ r_k δq_k
     const double ed = st.e.dot(df);
-    double dl_bar = F.l * ed, dld_bar = F.ld * ed, s_bar = F.s * ed, sd_bar = F.sd * ed;
+    // a heavy rope's weights δw_B = −δw_A = ½ λ μ δs g, and its pull's ½ λ μ g·δd
+    const Vec3 g_half = 0.5 * d.load_factor * E.law->span_mass_rate() * sys.gravity;
+    double dl_bar = F.l * ed, dld_bar = F.ld * ed, s_bar = F.s * ed + g_half.dot(df), sd_bar = F.sd * ed;
+    double pull_bar = 0.0;  // Σ μ_k r_k c_k
     if (!E.windings.empty()) {
       const ExtensionDerivatives P = E.law->pull_derivatives(d.t, st.extension());
-      const double P0 = E.law->pull(d.t, st.extension());
       for (const Winding& wi : E.windings)
         if (const int k = sys.coords[wi.coord].free_index; k >= 0) {
           const auto [c, dc] = wi.factor(d.qda(wi.coord));
           const double m = mu(k) * wi.radius;
           dl_bar -= m * c * P.l, dld_bar -= m * c * P.ld, s_bar -= m * c * P.s, sd_bar -= m * c * P.sd;
-          out.qd(k) -= m * P0 * dc;
+          pull_bar += m * c;
+          out.qd(k) -= m * st.P * dc;
         }
       for (const Winding& wi : E.windings)
         if (const int k = sys.coords[wi.coord].free_index; k >= 0)
@@ -342,7 +347,7 @@ ResidualVjp rnea_vector_jacobian_product(const System& sys, Data& d, const VecX&
     }
     const Vec3 de_bar = st.F * df + (st.vb - st.va) * dld_bar;
     const Vec3 ddd_bar = st.e * dld_bar;
-    const Vec3 dd_bar = st.e * dl_bar + (de_bar - st.e * st.e.dot(de_bar)) / st.l;
+    const Vec3 dd_bar = st.e * dl_bar + (de_bar - st.e * st.e.dot(de_bar)) / st.l - pull_bar * g_half;
     point_adjoint(E.body_b, st.xb, dd_bar, ddd_bar);
     point_adjoint(E.body_a, st.xa, -dd_bar, -ddd_bar);
   }

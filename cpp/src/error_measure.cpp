@@ -100,7 +100,7 @@ void ErrorMeasure::at(double t, const VecX& y) {
   }
   if (need_elements_)
     for (std::size_t j = 0; j < sys_.elements.size(); ++j) {
-      const ElementState s = element_state(d_, sys_.elements[j], false);
+      const ElementState s = element_state(sys_, d_, sys_.elements[j], false);
       element_e_[j] = s.e;
       element_dF_[j] = sys_.elements[j].law->derivatives(t, s.extension(), 1.0);
     }
@@ -115,7 +115,7 @@ void ErrorMeasure::at(double t, const VecX& y) {
     const OutputSpec& o = outputs_[k];
     double z = 0.0;
     if (o.kind == Kind::Coordinate) z = std::abs(y(o.index));
-    if (o.kind == Kind::Element) z = std::abs(element_state(d_, sys_.elements[o.index], false).F);
+    if (o.kind == Kind::Element) z = std::abs(element_state(sys_, d_, sys_.elements[o.index], false).F);
     if (o.kind == Kind::Loop)
       z = lambda_.segment(sys_.loop_row[o.index], sys_.loop_row[o.index + 1] - sys_.loop_row[o.index])
               .cwiseAbs()

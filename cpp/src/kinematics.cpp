@@ -186,7 +186,7 @@ void moving_point(const Data& d, int b, const Vec3& p, bool spatial, Vec3& x, Ve
 
 }  // namespace
 
-ElementState element_state(const Data& d, const ForceElement& element, bool spatial) {
+ElementState element_state(const System& sys, const Data& d, const ForceElement& element, bool spatial) {
   ElementState s;
   moving_point(d, element.body_a, element.point_a, spatial, s.xa, s.va);
   moving_point(d, element.body_b, element.point_b, spatial, s.xb, s.vb);
@@ -200,11 +200,17 @@ ElementState element_state(const Data& d, const ForceElement& element, bool spat
   for (const Winding& w : element.windings) s.s += w.radius * d.qa(w.coord), s.sd += w.radius * d.qda(w.coord);
   element.law->check(d.t, s.extension(), element.name);
   s.F = element.law->force(d.t, s.extension(), d.load_factor);
+  // a heavy span: w_B = ½ λ m g, w_A = λ (½ m − μ s) g; P = P_law + ½ λ μ g·(r_B − r_A) on its drums
+  const Vec3 g = d.load_factor * sys.gravity;
+  const double mu = element.law->span_mass_rate();
+  if (const double m = element.law->span_mass(d.t, s.extension()); m != 0.0)
+    s.wb = 0.5 * m * g, s.wa = (0.5 * m - mu * s.s) * g;
+  if (!element.windings.empty()) s.P = element.law->pull(d.t, s.extension()) + 0.5 * mu * g.dot(r);
   return s;
 }
 
 std::pair<AppliedLoad, AppliedLoad> element_loads(const ElementState& s) {
-  return {{s.xb, s.F * s.e, Vec3::Zero()}, {s.xa, -s.F * s.e, Vec3::Zero()}};
+  return {{s.xb, s.F * s.e + s.wb, Vec3::Zero()}, {s.xa, -s.F * s.e + s.wa, Vec3::Zero()}};
 }
 
 double passive_force(const System& sys, const Data& d, int i, bool spatial) {
@@ -215,7 +221,7 @@ double passive_force(const System& sys, const Data& d, int i, bool spatial) {
   for (const auto& [k, j] : c.windings) {
     const ForceElement& E = sys.elements[k];
     const Winding& w = E.windings[j];
-    Q += w.radius * E.law->pull(d.t, element_state(d, E, spatial).extension()) * w.factor(d.qda(i)).first;
+    Q += w.radius * element_state(sys, d, E, spatial).P * w.factor(d.qda(i)).first;
   }
   return Q;
 }

@@ -22,6 +22,13 @@ double gravity_energy(const System& sys, const Data& d) {
   check_data(sys, d);
   double V = 0.0;
   for (int p = 0; p < sys.nbodies; ++p) V -= sys.gravity.dot((d.T[p] * d.H[p].col(3)).head<3>());
+  // heavy ropes' spans: −½ m g·(r_A + r_B) + μ s g·r_A (kinematics.hpp: ElementState)
+  for (const ForceElement& E : sys.elements)
+    if (E.law->span_mass_rate() != 0.0) {
+      const ElementState s = element_state(sys, d, E, false);
+      const double m = E.law->span_mass(d.t, s.extension()), mu = E.law->span_mass_rate();
+      V -= sys.gravity.dot(0.5 * m * (s.xa + s.xb) - mu * s.s * s.xa);
+    }
   return V;
 }
 
@@ -34,7 +41,7 @@ double elastic_energy(const System& sys, const Data& d) {
     for (const auto& law : c.laws) V += law->energy(d.t, d.qa(i));
   }
   for (const ForceElement& E : sys.elements)  // what each element's law stores (force_elements.hpp)
-    if (E.law->elastic()) V += E.law->energy(d.t, element_state(d, E, false).extension());
+    if (E.law->elastic()) V += E.law->energy(d.t, element_state(sys, d, E, false).extension());
   if (!sys.contacts.empty()) V += contact_energy(sys, d);  // what the contacts store (contact.hpp)
   return V;
 }
@@ -49,14 +56,14 @@ double dissipated_power(const System& sys, const Data& d) {
   }
   for (const ForceElement& E : sys.elements) {  // what each element's law dissipates (force_elements.hpp)
     if (E.law->dissipative()) {
-      const ElementState s = element_state(d, E, false);
+      const ElementState s = element_state(sys, d, E, false);
       P += E.law->power(d.t, s.extension(), s.F);
     }
     // a capstan's friction: of the generalised force r P c on its coordinate, r P (c − 1) opposes q̇
     for (const Winding& w : E.windings)
       if (w.capstan != 0.0) {
         const double qd = d.qda(w.coord);
-        P -= w.radius * E.law->pull(d.t, element_state(d, E, false).extension()) * (w.factor(qd).first - 1.0) * qd;
+        P -= w.radius * element_state(sys, d, E, false).P * (w.factor(qd).first - 1.0) * qd;
       }
   }
   if (!sys.contacts.empty()) P += contact_power(sys, d);  // what the contacts dissipate (contact.hpp)
@@ -106,7 +113,7 @@ MatX element_states(const System& sys, Data& d, double t, const Eigen::Ref<const
   kinematics(sys, d);  // with rates: l̇ needs Ṫ
   MatX S(sys.elements.size(), 3);
   for (std::size_t k = 0; k < sys.elements.size(); ++k) {
-    const ElementState e = element_state(d, sys.elements[k], false);
+    const ElementState e = element_state(sys, d, sys.elements[k], false);
     S.row(k) << e.l, e.ld, e.F;
   }
   return S;
@@ -137,7 +144,7 @@ StateOutputs evaluate_outputs(const System& sys, const Eigen::Ref<const VecX>& t
     out.elastic(k) = elastic_energy(sys, d) + arm_energy(sys, s);
     out.power(k) = dissipated_power(sys, d) + arm_power(sys, s);
     for (std::size_t e = 0; e < sys.elements.size(); ++e)
-      out.element_forces(k, static_cast<Eigen::Index>(e)) = element_state(d, sys.elements[e], false).F;
+      out.element_forces(k, static_cast<Eigen::Index>(e)) = element_state(sys, d, sys.elements[e], false).F;
     forward_dynamics(sys, d, t(k), Q.row(k).transpose(), QD.row(k).transpose());
     out.qdd.row(k) = d.qdd.transpose();
     driving_forces(sys, d);

@@ -58,6 +58,11 @@ class ElementLaw : public Law {
   /// P (N): the pull on the drum, −∂V/∂s − ∂D/∂ṡ of its energy V and dissipation function D; and its derivatives.
   virtual double pull(double /*t*/, const Extension& /*x*/) const { return 0.0; }
   virtual ExtensionDerivatives pull_derivatives(double /*t*/, const Extension& /*x*/) const { return {}; }
+  /// The mass of its free span (kg), hanging on its two points (a heavy rope's μ l_u), and that mass's rate per metre
+  /// paid out, ∂m/∂s (kg/m): the span's weight m g is shared by its ends, ½ m g on each, and its potential
+  /// V = −½ m g·(r_B − r_A) (relative to the rope on the drum) pulls the drum by ½ (∂m/∂s) g·(r_B − r_A). None by default.
+  virtual double span_mass(double /*t*/, const Extension& /*x*/) const { return 0.0; }
+  virtual double span_mass_rate() const { return 0.0; }
   /// How the viewer draws the element: "spring", "cylinder", "rope".
   virtual const char* drawn_as() const = 0;
   /// A copy with the constant `name` set to `value` (a named parameter: parameters.hpp), unchecked;
@@ -138,23 +143,27 @@ class SpringDamper final : public ElementLaw {
   AxialFunction law_;  ///< F_law(t, l, l̇), N (the slow path through Python), or null
 };
 
-/// A rope (book ch. 7.1: the hoisting rope of a crane), massless and tension-only, of axial stiffness EA
-/// and damping DA, whose unstretched length l_u(t) a winch pays out:
+/// A rope (book ch. 7.1: the hoisting rope of a crane), tension-only, of axial stiffness EA and damping DA, whose
+/// unstretched length l_u(t) a winch pays out:
 ///   T = (EA (l − l_u) + DA (l̇ − l̇_u)) / l_u  when positive, else 0 (slack),   F = −T,
 /// a spring EA/l_u and a damper DA/l_u acting only while the rope pulls; stores ½ EA/l_u (l − l_u)² while
-/// stretched and dissipates DA/l_u (l̇ − l̇_u)² while it pulls.
+/// stretched and dissipates DA/l_u (l̇ − l̇_u)² while it pulls. Of mass μ per metre of unstretched rope, its free span
+/// of mass μ l_u weighs on its two points (ElementLaw::span_mass), more of it as a drum pays it out.
 class Rope final : public ElementLaw {
  public:
-  enum { EA, DA, LENGTH };  // the constants' indices
+  enum { EA, DA, LENGTH, MU };  // the constants' indices
   static const LawInfo& description() {
     static const LawInfo info{
         "Rope", "element",
-        "T = (EA (l − l_u) + DA (l̇ − l̇_u)) / l_u while positive, 0 when slack (N, pulling: F = −T): a massless "
+        "T = (EA (l − l_u) + DA (l̇ − l̇_u)) / l_u while positive, 0 when slack (N, pulling: F = −T): a "
         "tension-only rope of unstretched length l_u, constant or paid out by a winch l_u(t); stores ½ EA/l_u (l − "
-        "l_u)² while stretched, dissipates DA/l_u (l̇ − l̇_u)² while it pulls",
+        "l_u)² while stretched, dissipates DA/l_u (l̇ − l̇_u)² while it pulls; its free span's weight μ l_u g hangs "
+        "half on each point",
         {{"EA", "N", nullptr, 1.0, 0.0, true, "the rope's axial stiffness EA", true},
          {"DA", "N s", nullptr, 0.0, 0.0, false, "the rope's axial damping DA", true},
-         {"length", "m", nullptr, 1.0, 0.0, true, "the rope's unstretched length l_u (without a winch)", false}},
+         {"length", "m", nullptr, 1.0, 0.0, true, "the rope's unstretched length l_u (without a winch)", false},
+         {"mass_per_length", "kg/m", nullptr, 0.0, 0.0, false,
+          "the rope's mass μ per metre of unstretched rope (its free span's weight; 0: massless)", true}},
         "the unstretched length l_u(t) (m) a winch pays out, instead of length",
         "length",
         "the winch's (m, s, m/s)",
@@ -217,6 +226,11 @@ class Rope final : public ElementLaw {
     const double lu = unstretched_length(t, x).first, eps = (x.l - lu) / lu;
     return {c_[EA] * (1.0 + eps) / lu, c_[DA] / lu, -(c_[EA] + T + c_[EA] * eps * (1.0 + eps)) / lu, -c_[DA] / lu};
   }
+  /// μ l_u (kg) and μ.
+  double span_mass(double t, const Extension& x) const override {
+    return c_[MU] == 0.0 ? 0.0 : c_[MU] * unstretched_length(t, x).first;
+  }
+  double span_mass_rate() const override { return c_[MU]; }
   const char* drawn_as() const override { return "rope"; }
   /// l_u and l̇_u at t (m, m/s): the winch's l_u(t) or the length, plus what a drum has paid out, s and ṡ.
   std::pair<double, double> unstretched_length(double t, const Extension& x) const {

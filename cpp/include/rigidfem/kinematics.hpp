@@ -45,17 +45,22 @@ struct AppliedLoad {
 AppliedLoad applied_load(const Data& d, const Load& L);
 /// A force element (force_elements.hpp) at the current state: its points r_A, r_B (global, m),
 /// their velocities, the unit vector e = (r_B − r_A)/l, the length l (m), its rate l̇ = e·(v_B − v_A)
-/// (m/s) and the axial force F (N, > 0 pushing). The velocities come from the spatial velocities
-/// v_p of the recursive algorithms (`spatial`) or from Ṫ_p (kinematics with rates). A
-/// SimulationError at t if the points coincide (l = 0: no line of action).
+/// (m/s) and the axial force F (N, > 0 pushing). A heavy rope's span of mass m (ElementLaw::span_mass, μ l_u) hangs
+/// ½ λ m g on each point, and the rope its drums have paid out, μ s, is taken from their mass at A where it leaves
+/// them: w_B = ½ λ m g, w_A = λ (½ m − μ s) g, the gradient of V = −½ m g·(r_A + r_B) + μ s g·r_A. Wound on drums or
+/// sheaves, it pulls them by P = P_law + ½ λ μ g·(r_B − r_A) (N; ElementLaw::pull, μ = ∂m/∂s, λ the load factor). The velocities come from the spatial velocities v_p of the recursive
+/// algorithms (`spatial`) or from Ṫ_p (kinematics with rates). A SimulationError at t if the points coincide
+/// (l = 0: no line of action).
 struct ElementState {
   Vec3 xa, xb, va, vb, e;
   double l, ld, F;
   double s = 0.0, sd = 0.0;  ///< wound on drums or sheaves: the length paid out, Σ r q (m), and its rate (m/s)
+  Vec3 wa = Vec3::Zero(), wb = Vec3::Zero();  ///< the weights on A and B (N)
+  double P = 0.0;            ///< the pull on its drums and sheaves (N)
   Extension extension() const { return {l, ld, s, sd}; }
 };
-ElementState element_state(const Data& d, const ForceElement& element, bool spatial);
-/// The element's loads: F e on body b at r_B and −F e on body a at r_A (none on the ground).
+ElementState element_state(const System& sys, const Data& d, const ForceElement& element, bool spatial);
+/// The element's loads: F e + w_B on body b at r_B and −F e + w_A on body a at r_A (none on the ground).
 std::pair<AppliedLoad, AppliedLoad> element_loads(const ElementState& s);
 
 /// Links of varying length (flows.hpp) at d.t: L, v, v̇ into d.flow (the rates zero `at_rest`),
@@ -92,7 +97,7 @@ template <class Visit>
 void for_each_body_load(const System& sys, const Data& d, bool spatial, Visit&& visit) {
   for (const Load& L : sys.loads) visit(L.body, applied_load(d, L), L.follower);
   for (const ForceElement& E : sys.elements) {
-    const auto [on_b, on_a] = element_loads(element_state(d, E, spatial));
+    const auto [on_b, on_a] = element_loads(element_state(sys, d, E, spatial));
     if (E.body_b >= 0) visit(E.body_b, on_b, false);
     if (E.body_a >= 0) visit(E.body_a, on_a, false);
   }

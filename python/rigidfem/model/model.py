@@ -433,12 +433,20 @@ class Model(_core._Model):
 
     @recorded
     def add_rope(self, name: str, a, b, *, EA: float, length, DA: float = 0.0, drum=None,
-                 radius: float | None = None) -> handles.Element:
-        """A massless rope between the points ``a`` and ``b`` (book ch. 7.1: a hoisting rope): it
+                 radius: float | None = None, mass_per_length: float = 0.0) -> handles.Element:
+        """A rope between the points ``a`` and ``b`` (book ch. 7.1: a hoisting rope): it
         only pulls, with the tension T = (EA (l − l_u) + DA (l̇ − l̇_u))/l_u while positive, 0 when
         slack. ``EA`` (N) is its axial stiffness, ``DA`` (N·s) its axial damping, and ``length`` its unstretched
         length l_u (m): a number or a ``rigidfem.motion`` profile l_u(t) paid out by a winch
         (``rf.laws.Rope``). Returns its handle; ``System.element_states`` gives its force F = −T (N).
+
+        ``mass_per_length`` μ (kg per m of unstretched rope; 0, massless, by default) gives its free span the weight
+        μ l_u g, half on each point, taken as a straight span: its potential −½ μ l_u g·(r_a + r_b). Wound on a drum,
+        the rope the drum pays out, μ r φ, is taken from the drum's weight at the point ``a`` where it leaves (give
+        the drum's body the mass it has at φ = 0), and the drum takes the span's pull ½ μ g·(r_b − r_a) besides the
+        rope's: a load hanging on l_u of rope holds the drum with r (m + μ l_u) g, as the continuum does. The span's
+        kinetic energy is not modelled (its weight is): the whole rope moving at the drum's surface speed adds μ L r²
+        to the drum's inertia, which its body may hold.
 
         ``drum`` winds it on a drum of ``radius`` r (m): a body whose joint's rotation φ (rad; its only coordinate,
         or ``(body, "ry")`` to name one) pays it out, l_u = ``length`` + r φ. (A translation x pays out r x: a
@@ -464,7 +472,7 @@ class Model(_core._Model):
                 raise _checks.refuse(f"length: expected a number l0 in m for a rope wound on a drum (the drum pays it "
                                      f"out: l_u = l0 + r phi), got {length!r}")
             wound = (body.index, k, r)
-        law = laws.Rope(EA=EA, DA=DA, **force_elements.unstretched(length))
+        law = laws.Rope(EA=EA, DA=DA, mass_per_length=mass_per_length, **force_elements.unstretched(length))
         handle = force_elements.add_force_element(self, name, a, b, law)
         if wound is not None:
             self._wind(handle.index, *wound)
