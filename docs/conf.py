@@ -6,6 +6,11 @@ Build: ``pip install ".[docs]" && sphinx-build -W -b html docs docs/_build/html`
 The notebooks are rendered with the outputs they were committed with (myst-nb, no execution); the API
 reference is generated from the docstrings (autosummary, numpydoc style through napoleon); the table of
 simulate's options is written from ``rigidfem.options`` at build time.
+
+The site works offline: MathJax is served from its own ``_static/mathjax`` (the ``sphinx-mathjax-offline``
+package, MathJax 3) and the animations' buttons (matplotlib's ``to_jshtml``, which links Font Awesome from a
+CDN) use Font Awesome's CSS and fonts copied into ``_static/fontawesome`` (the ``fontawesomefree`` package).
+``tests/test_docs.py`` fails on any script, stylesheet or font the built pages would fetch from outside.
 """
 
 from __future__ import annotations
@@ -19,6 +24,8 @@ from pathlib import Path
 import rigidfem
 from rigidfem import options
 
+import fontawesomefree
+
 # rf.animation is imported on first use (matplotlib.animation costs 0.1 s); its page needs its short path too
 sys.modules.setdefault("rigidfem.animation", importlib.import_module("rigidfem.viz.animation"))
 
@@ -31,11 +38,26 @@ copyright = "2026, the rigidfem developers"  # noqa: A001 (Sphinx's name)
 release = rigidfem.__version__
 
 extensions = ["myst_nb", "sphinx.ext.autodoc", "sphinx.ext.autosummary", "sphinx.ext.napoleon",
-              "sphinx.ext.mathjax"]
+              "sphinx.ext.mathjax", "sphinx-mathjax-offline"]
+mathjax_path = "mathjax/tex-chtml.js"  # in _static, copied there by sphinx-mathjax-offline (no CDN)
 source_suffix = {".rst": "restructuredtext", ".md": "myst-nb", ".ipynb": "myst-nb"}
 exclude_patterns = ["_build", "**.ipynb_checkpoints"]
 html_theme = "furo"
 html_title = f"rigidfem {release}"
+REPOSITORY = "https://github.com/rigidfem/rigidfem"
+html_theme_options = {
+    # the repository, linked from every page's footer (furo's GitHub mark)
+    "footer_icons": [{
+        "name": "GitHub", "url": REPOSITORY, "class": "",
+        "html": '<svg stroke="currentColor" fill="currentColor" stroke-width="0" viewBox="0 0 16 16">'
+                '<path fill-rule="evenodd" d="M8 0C3.58 0 0 3.58 0 8c0 3.54 2.29 6.53 5.47 7.59.4.07.55-.17.55-.38 '
+                '0-.19-.01-.82-.01-1.49-2.01.37-2.53-.49-2.69-.94-.09-.23-.48-.94-.82-1.13-.28-.15-.68-.52-.01-.53.63-.01 '
+                '1.08.58 1.23.82.72 1.21 1.87.87 2.33.66.07-.52.28-.87.51-1.07-1.78-.2-3.64-.89-3.64-3.95 0-.87.31-1.59.82-2.15'
+                '-.08-.2-.36-1.02.08-2.12 0 0 .67-.21 2.2.82.64-.18 1.32-.27 2-.27.68 0 1.36.09 2 .27 1.53-1.04 2.2-.82 2.2-.82'
+                '.44 1.1.16 1.92.08 2.12.51.56.82 1.27.82 2.15 0 3.07-1.87 3.75-3.65 3.95.29.25.54.73.54 1.48 0 1.07-.01 1.93'
+                '-.01 2.2 0 .21.15.46.55.38A8.013 8.013 0 0 0 16 8c0-4.42-3.58-8-8-8z"></path></svg>',
+    }],
+}
 
 myst_enable_extensions = ["dollarmath", "amsmath"]
 myst_heading_anchors = 3
@@ -105,5 +127,30 @@ def _escape_bars(app, what, name, obj, opts, lines) -> None:
         lines[k] = "".join(p if p.startswith("``") else p.replace("|", r"\|") for p in parts)
 
 
+# matplotlib's to_jshtml animations link Font Awesome 4 from a CDN for their buttons; the link is pointed at
+# Font Awesome 6's CSS (which keeps the v4 names the buttons use) and fonts, copied into the site.
+_FONT_AWESOME = Path(fontawesomefree.__file__).resolve().parent / "static" / "fontawesomefree"
+_FONT_AWESOME_CDN = re.compile(r"<link\b[^>]*\bhref=[\"']?(?:https?:)?//[^\"'>\s]*font-?awesome[^>]*>", re.I)
+
+
+def _local_font_awesome(app, pagename, templatename, context, doctree) -> None:
+    body = context.get("body")
+    if body and _FONT_AWESOME_CDN.search(body):
+        href = context["pathto"]("_static/fontawesome/css/all.min.css", 1)
+        context["body"] = _FONT_AWESOME_CDN.sub(f'<link rel="stylesheet" href="{href}">', body)
+
+
+def _copy_font_awesome(app, exc) -> None:
+    if exc is not None or app.builder.format != "html":
+        return
+    out = Path(app.outdir) / "_static" / "fontawesome"
+    for rel in ["LICENSE.txt", "css/all.min.css"] + [f"webfonts/{f.name}" for f in
+                                                      sorted((_FONT_AWESOME / "webfonts").iterdir())]:
+        (out / rel).parent.mkdir(parents=True, exist_ok=True)
+        shutil.copyfile(_FONT_AWESOME / rel, out / rel)
+
+
 def setup(app):
     app.connect("autodoc-process-docstring", _escape_bars)
+    app.connect("html-page-context", _local_font_awesome)
+    app.connect("build-finished", _copy_font_awesome)

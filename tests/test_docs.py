@@ -1,7 +1,9 @@
 """The documentation site builds with Sphinx, warnings as errors (``docs/``; the README's link).
 
 Checks what a reader opens: a page for every public name (from its docstring), the notebooks with
-the figures they were committed with, and the table of simulate's options written from its one source.
+the figures they were committed with, the table of simulate's options written from its one source, a site
+that loads nothing from outside (it works offline), an install page that names every extra, and pages that
+speak of the package rather than of its development.
 """
 
 import html
@@ -79,3 +81,91 @@ def test_the_examples_in_the_modules_docstrings_print_what_they_say():
         result = doctest.testmod(module, optionflags=doctest.ELLIPSIS | doctest.NORMALIZE_WHITESPACE, verbose=False)
         failed, tried = failed + result.failed, tried + result.attempted
     assert tried > 0 and failed == 0, f"{failed} of {tried} examples failed"
+
+
+#: A script, a stylesheet, an @import or a font fetched from another host: http://, https:// or //.
+EXTERNAL = r"""(?:https?:)?//"""
+SCRIPT_SRC = re.compile(r"""<script\b[^>]*?\bsrc\s*=\s*["']?([^"'\s>]+)""", re.I)
+LINK = re.compile(r"<link\b[^>]*>", re.I)
+STYLESHEET_HREF = re.compile(r"""\bhref\s*=\s*["']?([^"'\s>]+)""", re.I)
+CSS_URL = re.compile(r"""@import\s+(?:url\(\s*)?["']?\s*([^"')\s;]+)|\burl\(\s*["']?\s*([^"')\s]+)""", re.I)
+
+
+def _loaded(page: str) -> list[tuple[str, str]]:
+    """(kind, address) of what a page or a stylesheet makes the browser fetch by itself."""
+    found = [("script", m.group(1)) for m in SCRIPT_SRC.finditer(page)]
+    for tag in LINK.findall(page):
+        rel = re.search(r"""\brel\s*=\s*["']?([^"'>]*)""", tag, re.I)
+        href = STYLESHEET_HREF.search(tag)
+        if rel and "stylesheet" in rel.group(1).lower() and href:
+            found.append(("stylesheet", href.group(1)))
+    found += [("@import" if m.group(1) else "url()", m.group(1) or m.group(2)) for m in CSS_URL.finditer(page)]
+    return found
+
+
+def test_the_site_loads_nothing_from_outside(site):
+    """Every page works offline: no script, stylesheet, @import or font from another host (MathJax and the
+    animations' Font Awesome are served from _static), and every local one it names is in the site. Links
+    (<a href>) to outside are fine."""
+    pages = sorted(site.rglob("*.html"))
+    assert len(pages) >= len(rf.__all__) + len(list((ROOT / "notebooks").glob("*.ipynb")))
+    external, missing = [], []
+    for path in pages + sorted(site.glob("_static/**/*.css")):
+        for kind, address in _loaded(path.read_text(encoding="utf-8")):
+            where = f"{path.relative_to(site)}: {kind} {address}"
+            if re.match(EXTERNAL, address, re.I):
+                external.append(where)
+            elif path.suffix == ".html" and not address.startswith(("data:", "#")):
+                if not (path.parent / address.split("?")[0].split("#")[0]).exists():
+                    missing.append(where)
+    assert not external, f"{len(external)} external resources:\n" + "\n".join(external[:20])
+    assert not missing, f"{len(missing)} local resources missing:\n" + "\n".join(missing[:20])
+    assert (site / "_static" / "mathjax" / "tex-chtml.js").exists()
+    assert (site / "_static" / "fontawesome" / "webfonts" / "fa-solid-900.woff2").exists()
+    assert "github.com/rigidfem/rigidfem" in (site / "api" / "rigidfem.Model.html").read_text(encoding="utf-8")
+    assert "Changelog" in text(site / "changelog.html")
+
+
+#: The development's narrative, which the pages a user reads leave to the CHANGELOG and the history: an
+#: issue's number, "the issue's ...", a "Before: ..." or "(... before)" / "now ..." of what the package did,
+#: a previous run compared with this one.
+NARRATIVE = [re.compile(r"\bissues?\s*#?\d", re.I), re.compile(r"\bthe issue's", re.I), re.compile(r"\bBefore:"),
+             re.compile(r"[;(,]\s*before[,:)]|\d\S* before\)|\bnow \d|\bprevious run\b|\bfixed in this run\b")]
+
+
+def _user_pages() -> list[tuple[str, list[str]]]:
+    """(where, lines) of the README, the site's pages (docs/**/*.md, not the generated _folders) and the
+    notebooks' markdown cells."""
+    pages = [ROOT / "README.md"] + sorted(p for p in (ROOT / "docs").rglob("*.md")
+                                          if not any(part.startswith("_") for part in p.relative_to(ROOT).parts))
+    out = [(p.relative_to(ROOT).as_posix(), p.read_text(encoding="utf-8").splitlines()) for p in pages]
+    for nb in sorted((ROOT / "notebooks").glob("*.ipynb")):
+        for k, cell in enumerate(json.loads(nb.read_text(encoding="utf-8"))["cells"]):
+            if cell["cell_type"] == "markdown":
+                out.append((f"notebooks/{nb.name}, cell {k}", "".join(cell["source"]).splitlines()))
+    return out
+
+
+def test_the_pages_speak_of_the_package_not_of_its_development():
+    found = [f"{where}:{n}: {line.strip()[:120]}" for where, lines in _user_pages()
+             for n, line in enumerate(lines, 1) if any(p.search(line) for p in NARRATIVE)]
+    assert not found, "development narrative on a user's page:\n" + "\n".join(found)
+
+
+def test_the_install_page_names_every_extra_and_the_project_its_addresses():
+    tomllib = pytest.importorskip("tomllib")
+    project = tomllib.loads((ROOT / "pyproject.toml").read_text(encoding="utf-8"))["project"]
+    page = (ROOT / "docs" / "install.md").read_text(encoding="utf-8")
+    extras = project["optional-dependencies"]
+    assert [e for e in extras if f'".[{e}]"' not in page] == []
+    assert set(extras["docs"]) <= set(extras["test"])  # the test extra builds the site as the docs extra does
+    assert {"Homepage", "Documentation", "Repository", "Changelog"} <= set(project["urls"])
+
+
+def test_the_citation_file_names_the_package_and_the_book():
+    yaml = pytest.importorskip("yaml")
+    cff = yaml.safe_load((ROOT / "CITATION.cff").read_text(encoding="utf-8"))
+    assert cff["cff-version"] == "1.2.0" and cff["title"] == "rigidfem" and cff["version"] == rf.__version__
+    assert cff["authors"] == [{"name": "rigidfem developers"}]
+    (book,) = cff["references"]
+    assert book["type"] == "book" and book["year"] == 2006 and "Rigid Finite Element Method" in book["title"]

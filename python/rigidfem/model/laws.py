@@ -12,7 +12,7 @@ marked as parameters become named parameters ``"<name>.<constant>"`` of the comp
 >>> import rigidfem as rf
 >>> rope = rf.laws.Rope(EA=2e8, length=12.0)
 >>> [(c.name, c.unit, c.value) for c in rope.constants]
-[('EA', 'N', 200000000.0), ('DA', 'N s', 0.0), ('length', 'm', 12.0)]
+[('EA', 'N', 200000000.0), ('DA', 'N s', 0.0), ('length', 'm', 12.0), ('mass_per_length', 'kg/m', 0.0)]
 >>> sorted(rf.laws.kinds())
 ['Buffer', 'Contact', 'ForceFunction', 'Friction', 'Rope', 'SlidingFriction', 'SpringDamper', 'SpringDamping']
 """

@@ -364,7 +364,7 @@ def sweep(function: Callable, cases: Sequence[Mapping] | None = None, *, grid: M
         ``"threads"`` (default: a thread pool; the C++ integrators run without the GIL),
         ``"processes"`` (a process pool; the function and its arguments must pickle),
         ``"serial"``, any ``concurrent.futures.Executor`` (e.g. ``mpi4py.futures.MPIPoolExecutor``),
-        or a Dask ``Client`` (``pip install "rigidfem[dask]"``; Dask pickles with cloudpickle, so
+        or a Dask ``Client`` (``pip install ".[dask]"``; Dask pickles with cloudpickle, so
         functions defined in a notebook travel too). Processes, executors and Dask get the cases
         in batches, ``BATCHES_PER_WORKER`` (4) tasks per worker, so that short runs do not pay a
         task's cost each (~3 ms on Dask); threads one case a task.
