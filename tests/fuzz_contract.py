@@ -2414,6 +2414,8 @@ class Gen:
                 kw["stiffness"] = A(self.choice(["-1.0", "nan", "'k'"]), bad=True)
             fn = "model.add_spring_damper" if kind == "spring" else "model.add_rope"
             if kind == "rope":
+                if kw["length"]["e"] == fl(0.0):  # a rope needs l_u > 0
+                    kw["length"] = A("0.0", bad=True)
                 kw["EA"] = kw.pop("stiffness")
                 if "damping" in kw:
                     kw["DA"] = kw.pop("damping")

@@ -28,7 +28,7 @@ def falling(gravity=G):
     return model.compile(), body
 
 
-@pytest.mark.parametrize("method", ["dopri5", "radau5", "esdirk43", "bs23"])
+@pytest.mark.parametrize("method", ["dopri5", "radau5", "esdirk43", "bs23", "dop853"])
 def test_a_terminal_event_ends_a_fall_where_free_fall_says(method):
     """A coordinate, a point and a Python function crossing a level: t* = √(2 (z0 − h)/g), the run ends there."""
     system, body = falling()

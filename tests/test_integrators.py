@@ -39,14 +39,14 @@ def test_observed_order_of_accuracy(pendulum2, method, dts, order, kw):
     assert np.all(observed > order - 0.3), observed
 
 
-@pytest.mark.parametrize("method", ["dopri5", "rkf45", "bs23", "rk4", "generalized_alpha"])
+@pytest.mark.parametrize("method", ["dopri5", "rkf45", "bs23", "dop853", "rk4", "generalized_alpha"])
 def test_output_at_t_eval_is_dense_output_not_nearest_steps(pendulum2, method):
     system, ref = pendulum2
     t = np.linspace(0, 1.0, 37)  # not on the step grid
-    kw = {"rtol": 1e-10, "atol": 1e-12} if method in ("dopri5", "rkf45", "bs23") else {"dt": 1e-3}
+    kw = {"rtol": 1e-10, "atol": 1e-12} if method in ("dopri5", "rkf45", "bs23", "dop853") else {"dt": 1e-3}
     r = rf.simulate(system, 1.0, method=method, q0=Y0[:2], t_eval=t, **kw)
     np.testing.assert_array_equal(r.t, t)
-    bound = {"dopri5": 1e-8, "rkf45": 1e-8, "bs23": 1e-8, "rk4": 1e-9, "generalized_alpha": 2e-5}[method]
+    bound = {"dopri5": 1e-8, "rkf45": 1e-8, "bs23": 1e-8, "dop853": 1e-8, "rk4": 1e-9, "generalized_alpha": 2e-5}[method]
     assert np.max(np.abs(r.q - ref.sol(t)[:2].T)) < bound
     assert np.max(np.abs(r.qd - ref.sol(t)[2:].T)) < 20 * bound
     # A quantity derived at the outputs: q̈ is the forward dynamics at the interpolated state.

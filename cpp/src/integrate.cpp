@@ -520,7 +520,7 @@ const std::vector<OptionInfo>& integrator_options() {
   static const std::vector<OptionInfo> table = {
       {"dt", OptionType::Real, "s", "a positive finite step in s",
        "Step of the fixed-step methods: steps end on t0 + k·dt exactly, the last on t_end. Given to an adaptive "
-       "method (dopri5, rkf45, bs23, esdirk43, radau5, auto) it sets only the first step, with a UserWarning saying so "
+       "method (dopri5, dop853, rkf45, bs23, esdirk43, radau5, auto) it sets only the first step, with a UserWarning saying so "
        "(``adaptive=False`` runs those at fixed steps of dt).",
        true, [](const O& o) { return step_or_none(o.dt); },
        [](O& o, V v) { o.dt = std::holds_alternative<double>(v) ? positive_step(v, "dt") : 0.0; }},
@@ -540,7 +540,7 @@ const std::vector<OptionInfo>& integrator_options() {
        "force, N) and loop names (their multipliers, N or N·m), each error mapped from the state's through the "
        "output's Jacobian, a velocity's held as the displacement it makes over the step. None (the default): "
        "'bodies' — every body's displacement, the RMS over its material √(|δc|² + δθᵀ I_C δθ/m) — for radau5, the "
-       "adaptive Newmark family and auto's radau5; 'state' for dopri5, rkf45, bs23, esdirk43 and auto's dopri5 phase. "
+       "adaptive Newmark family and auto's radau5; 'state' for dopri5, dop853, rkf45, bs23, esdirk43 and auto's dopri5 phase. "
        "A mode that no output sees is not resolved: the L-stable radau5 damps it (the released strip of 1 m, m = 32: "
        "2,800 steps to 1e-6 m instead of 177,000).",
        true, [](const O&) { return OptionValue(); }, nullptr},
@@ -556,13 +556,14 @@ const std::vector<OptionInfo>& integrator_options() {
        false, [](const O& o) { return OptionValue(o.max_steps); },
        [](O& o, V v) { o.max_steps = std::get<long>(v); }},
       {"adaptive", OptionType::Flag, "", "None, True or False",
-       "Step-size control: on by default for dopri5, rkf45, bs23, esdirk43 and radau5 (False runs them at the fixed "
+       "Step-size control: on by default for dopri5, dop853, rkf45, bs23, esdirk43 and radau5 (False runs them at the fixed "
        "step dt), off by default for the Newmark family (True switches on its local error estimate); auto takes None "
        "or True.",
        true, [](const O& o) { return o.adaptive < 0 ? OptionValue() : OptionValue(o.adaptive == 1); },
        [](O& o, V v) { o.adaptive = std::holds_alternative<bool>(v) ? int(std::get<bool>(v)) : -1; }},
       {"stiffness_warning", OptionType::Flag, "", "True or False",
-       "dopri5 and rkf45 run Hairer's stiffness test (h ρ > 3.25, rkf45 2.95, over 15 accepted steps): the step is "
+       "dopri5, dop853 and rkf45 run Hairer's stiffness test (h ρ > 3.25, dop853 6.0, rkf45 2.95, over 15 accepted "
+       "steps): the step is "
        "then bounded by stability, so it costs ~t ω_max/3.3 steps, and at loose tolerances the stiff modes keep "
        "errors ~rtol ω_max/ω, or grow. It warns (RuntimeWarning) and records the time in ``stats['stiff_at']``; "
        "False keeps the record and drops the warning.",

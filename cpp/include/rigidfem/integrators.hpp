@@ -27,6 +27,7 @@ enum class Method {
   Dopri5,            ///< Dormand–Prince 5(4), adaptive
   RKF45,             ///< Runge–Kutta–Fehlberg 4(5), adaptive
   BS23,              ///< Bogacki–Shampine 3(2), adaptive
+  Dop853,            ///< Dormand–Prince 8(5,3), adaptive
   Newmark,           ///< Newmark β, γ, Newton
   HHT,               ///< Hilber–Hughes–Taylor α
   GeneralizedAlpha,  ///< Chung–Hulbert generalised-α with ρ∞
