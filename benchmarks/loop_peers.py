@@ -598,7 +598,8 @@ def settings(scene: Scene, quick: bool = False) -> dict:
     if quick:
         rtols = rtols[::3]
     rigid = [("auto", "rtol", rtols), ("radau5", "rtol", rtols), ("esdirk43", "rtol", rtols),
-             ("dopri5", "rtol", rtols), ("rk4", "dt", steps(2.785)), ("generalized_alpha", "dt", steps()),
+             ("dopri5", "rtol", rtols), ("dop853", "rtol", rtols), ("rk4", "dt", steps(2.785)),
+             ("generalized_alpha", "dt", steps()),
              ("generalized_alpha", "dt", steps(), {"newton_tol": TIGHT_NEWTON_TOL})]
     return {
         "rigidfem": rigid,

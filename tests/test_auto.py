@@ -1,5 +1,5 @@
-"""method="auto" (the default): dopri5 on non-stiff problems (bit for bit), its stiff method where a
-counted trial finds it faster, the choice reported in Result.stats and repr, deterministic (work is
+"""method="auto" (the default): dopri5, or dop853 at rtol <= 1e-7, on non-stiff problems (bit for bit), its stiff
+method where a counted trial finds it faster, the choice reported in Result.stats and repr, deterministic (work is
 counted, not timed), and the delivered error against independent references."""
 
 import concurrent.futures
@@ -28,13 +28,15 @@ def spring_chain(n=8, k=1e6, m=1.0):
     return model.compile()
 
 
-def test_non_stiff_runs_dopri5_bit_for_bit():
+@pytest.mark.parametrize("rtol,explicit", [(2e-7, "dopri5"), (1e-8, "dop853")])
+def test_non_stiff_runs_its_explicit_method_bit_for_bit(rtol, explicit):
+    """Not stiff: dopri5, or dop853 at rtol <= 1e-7, exactly as asked for by name."""
     system = pendulum()
-    auto = rf.simulate(system, 5.0, q0=[1.0], rtol=1e-8, atol=1e-10)
-    dopri = rf.simulate(system, 5.0, method="dopri5", q0=[1.0], rtol=1e-8, atol=1e-10)
-    assert auto.stats["method"] == "dopri5" and auto.stats["auto_trials"] == 0
-    assert np.array_equal(auto.q, dopri.q) and np.array_equal(auto.t, dopri.t)
-    assert "auto (dopri5)" in repr(auto) and auto.method == "auto"
+    auto = rf.simulate(system, 5.0, q0=[1.0], rtol=rtol, atol=1e-2 * rtol)
+    alone = rf.simulate(system, 5.0, method=explicit, q0=[1.0], rtol=rtol, atol=1e-2 * rtol)
+    assert auto.stats["method"] == explicit and auto.stats["auto_trials"] == 0
+    assert np.array_equal(auto.q, alone.q) and np.array_equal(auto.t, alone.t)
+    assert f"auto ({explicit})" in repr(auto) and auto.method == "auto"
 
 
 def test_stiff_hands_over_and_is_cheaper_than_dopri5():

@@ -18,19 +18,23 @@ Method auto_stiff_method(const System& sys, const IntegratorOptions& o) {
   return sys.nz == 0 && o.iteration_matrix != IterationMatrix::Spring ? Method::Radau5 : Method::Esdirk43;
 }
 
-std::string auto_description(Method stiff_method, const IntegratorStats& st, double t0) {
-  const std::string stiff = method_name(stiff_method);
+Method auto_explicit_method(const IntegratorOptions& o) {
+  return o.rtol.size() && o.rtol.minCoeff() <= 1e-7 ? Method::Dop853 : Method::Dopri5;
+}
+
+std::string auto_description(Method stiff_method, Method explicit_method, const IntegratorStats& st, double t0) {
+  const std::string stiff = method_name(stiff_method), dopri5 = method_name(explicit_method);
   const bool switched = std::isfinite(st.switched_at);
   const long lost = st.auto_trials - (switched ? 1 : 0);
   const std::string tried =
       lost ? "; " + std::to_string(lost) + " trial" + (lost != 1 ? "s" : "") + " of " + stiff + " lost" : "";
-  if (!switched) return "dopri5" + tried;
+  if (!switched) return dopri5 + tried;
   if (st.switched_at == t0 && st.probe_steps > 0)
-    return stiff + " from the start (a dopri5 probe of " + std::to_string(st.probe_steps) +
+    return stiff + " from the start (a " + dopri5 + " probe of " + std::to_string(st.probe_steps) +
            " steps found the problem stiff)" + tried;
   if (st.switched_at == t0)
-    return stiff + " from the start (omega_max = " + num(st.omega_max, 3) + " rad/s: stiff for dopri5)" + tried;
-  return "dopri5, then " + stiff + " from t = " + num(st.switched_at, 6) + " s" + tried;
+    return stiff + " from the start (omega_max = " + num(st.omega_max, 3) + " rad/s: stiff for " + dopri5 + ")" + tried;
+  return dopri5 + ", then " + stiff + " from t = " + num(st.switched_at, 6) + " s" + tried;
 }
 
 /// The spectral radius ρ of the Jacobian J = [[0, I], [∂q̈/∂q, ∂q̈/∂q̇]] of y' = (q̇, q̈) at (t, q, q̇, s):
@@ -77,7 +81,10 @@ double spectral_radius(const System& sys, double t, const VecX& q, const VecX& v
   return rho;
 }
 
-// method="auto": which of dopri5 and its stiff method runs. Three ways to the stiff method:
+// method="auto": which of its explicit method and its stiff method runs. The explicit method is dopri5, or dop853 at
+// rtol <= 1e-7 (auto_explicit_method; below, "dopri5" stands for either: dop853's work per unit of time at its
+// stability boundary, 6/12 evaluations, is dopri5's 3.3/6, so the rules are the same, its steps counted near the
+// boundary from h ρ > 3.6 instead of 2). Three ways to the stiff method:
 //  - from t0 at once, when dopri5 would need `direct_steps` or more for stability alone, span ρ/3.3
 //    with ρ the Jacobian's spectral radius at t0 (spectral_radius);
 //  - from t0 after a probe: dopri5's first window of `window` accepted steps holds a fifth at the
@@ -104,8 +111,9 @@ double spectral_radius(const System& sys, double t, const VecX& q, const VecX& v
 // until it does. The stiff method holds the tolerances as asked (on outputs where asked).
 AutoChoice::AutoChoice(const System& sys, const IntegratorOptions& o, const Tolerances& asked, double t0,
                        const VecX& y0, IntegratorStats& stats)
-    : sys_(sys), o_(o), asked_(asked), t0_(t0), span_(asked.span), y0_(y0) {
+    : sys_(sys), o_(o), asked_(asked), explicit_(auto_explicit_method(o)), t0_(t0), span_(asked.span), y0_(y0) {
   o_.stiff_method = auto_stiff_method(sys, o);
+  near_ = explicit_ == Method::Dop853 ? 3.6 : 2.0;
   const int n = sys.nq;
   const double loosest = asked.rtol.size() ? asked.rtol.maxCoeff() : 0.0;  // nq = 0: no tolerance to tighten
   const double tighten = loosest > loosest_explicit ? loosest_explicit / loosest : 1.0;
@@ -123,7 +131,10 @@ AutoChoice::AutoChoice(const System& sys, const IntegratorOptions& o, const Tole
 
 IntegratorOptions AutoChoice::first(IntegratorStats& stats) {
   // on a stiff problem its stiff method from t0 for the whole run (h = 0: no dopri5 step to go back to)
-  return direct_ ? switched(t0_, 0.0, stats) : o_;
+  if (direct_) return switched(t0_, 0.0, stats);
+  IntegratorOptions explicit_options = o_;
+  explicit_options.method = explicit_;
+  return explicit_options;
 }
 
 bool AutoChoice::after_step(double t, double h_rho, const IntegratorStats& stats) {
@@ -134,7 +145,7 @@ bool AutoChoice::after_step(double t, double h_rho, const IntegratorStats& stats
     if (!kept) backoff_ *= 2;
     return !kept;
   }
-  if (h_rho > 2.0) ++near_boundary_;
+  if (h_rho > near_) ++near_boundary_;
   if (++steps_ < window) return false;
   // The first window: its start-up rejections say nothing, its steps at the stability boundary do.
   const bool near = near_boundary_ * 5 >= window, rejecting = (stats.rejected - rejected_mark_) * 6 >= window;
@@ -167,7 +178,7 @@ IntegratorOptions AutoChoice::switched(double t, double h, IntegratorStats& stat
   stiff_running_ = !stiff_running_;
   IntegratorOptions next = o_;
   next.adaptive = 1;
-  next.method = stiff_running_ ? o_.stiff_method : Method::Dopri5;
+  next.method = stiff_running_ ? o_.stiff_method : explicit_;
   if (stiff_running_) {
     ++stats.auto_trials;
     h_explicit_ = h;

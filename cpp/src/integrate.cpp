@@ -57,7 +57,8 @@ const std::vector<MethodInfo>& method_table() {
     rows.push_back({Method::Auto, "auto", "auto", 5, true, true, true, false, method_options(true, true),
                     "radau5 (esdirk43 with Maxwell arms or the spring matrix) from the start where the highest "
                     "frequency at t0 (stats['omega_max'], by power iteration) would hold dopri5 to 200 steps or more "
-                    "for stability alone; otherwise dopri5, handing over for good where its steps sit at the stability "
+                    "for stability alone; otherwise dopri5 (dop853 at rtol <= 1e-7), handing over for good where its steps sit at "
+                    "the stability "
                     "limit (from the start if that is in its first window, kept if it beats dopri5's probe by a count "
                     "of work); stats['method'] says what ran",
                     make_runge_kutta, check_auto});
@@ -689,7 +690,8 @@ Trajectory integrate(const System& sys, double t0, double t_end, const VecX& q0,
   } catch (...) {
     traj.error = std::current_exception();  // from a callback: the caller decides (Ctrl-C: partial result)
   }
-  traj.stats.method = o.method == Method::Auto ? auto_description(auto_stiff_method(sys, o), traj.stats, t0)
+  traj.stats.method = o.method == Method::Auto ? auto_description(auto_stiff_method(sys, o), auto_explicit_method(o),
+                                                                    traj.stats, t0)
                                                : method_name(o.method);
   traj.stats.wall_time = std::chrono::duration<double>(Clock::now() - start).count();
   return traj;

@@ -78,7 +78,10 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
     ----------
     method : str
         "auto" (default): dopri5 while it is the cheaper, a stiff method where it is not: radau5, or
-        esdirk43 with Maxwell arms or with ``iteration_matrix="spring"`` (radau5 takes neither). dopri5
+        esdirk43 with Maxwell arms or with ``iteration_matrix="spring"`` (radau5 takes neither). At
+        rtol <= 1e-7 dop853 takes dopri5's place (its order 8 takes fewer evaluations there: 1.2-2 times
+        as fast on a double pendulum, a four-bar and the Bricard linkage), by the same rules with its
+        stability boundary (h ρ > 3.6 counted near it, where dopri5's is h ρ > 2). dopri5
         holds the state (its stability rests on its error control); radau5 measures its error on the
         outputs (``error_on``: the bodies' displacements by default), esdirk43 holds the state. First auto estimates the
         spectral radius ρ of the Jacobian of (q̇, q̈) at t0 (``stats["omega_max"]``, rad/s: the highest
