@@ -7,10 +7,19 @@
 
 namespace rigidfem {
 
+void spatial_inertia(double m, const Vec3& c, const Mat3& Ic, Mat6& I) {
+  // [[I_C + m C Cᵀ, m C], [m Cᵀ, m 1]], C = [c]×, C Cᵀ = |c|² 1 − c cᵀ
+  const Vec3 mc = m * c;
+  I.topLeftCorner<3, 3>() = Ic - mc * c.transpose();
+  I.topLeftCorner<3, 3>().diagonal().array() += mc.dot(c);
+  I.topRightCorner<3, 3>() << 0.0, -mc.z(), mc.y(), mc.z(), 0.0, -mc.x(), -mc.y(), mc.x(), 0.0;
+  I.bottomLeftCorner<3, 3>() = I.topRightCorner<3, 3>().transpose();
+  I.bottomRightCorner<3, 3>() = m * Mat3::Identity();
+}
+
 Mat6 spatial_inertia(double m, const Vec3& c, const Mat3& Ic) {
-  const Mat3 C = skew(c);
   Mat6 I;
-  I << Ic + m * C * C.transpose(), m * C, m * C.transpose(), m * Mat3::Identity();
+  spatial_inertia(m, c, Ic, I);
   return I;
 }
 
@@ -43,8 +52,8 @@ void spatial_kinematics(const System& sys, Data& d) {
     d.v[p] = v;
     d.c[p] = c;
     const Mat3 R = d.T[p].topLeftCorner<3, 3>();
-    d.I[p] = spatial_inertia(d.mass[p], R * d.com[p] + d.T[p].topRightCorner<3, 1>(),
-                             R * d.inertia[p] * R.transpose());
+    const Mat3 RI = R * d.inertia[p];
+    spatial_inertia(d.mass[p], R * d.com[p] + d.T[p].topRightCorner<3, 1>(), RI * R.transpose(), d.I[p]);
     d.fext[p].setZero();
   }
   for_each_body_load(sys, d, true, [&](int body, const AppliedLoad& a, bool) {
@@ -121,8 +130,29 @@ bool invert_spd(const SmallMat& D, SmallMat& Dinv) {
   return true;
 }
 
+// D⁻¹ of a symmetric 3 × 3 D by its cofactors (cheaper than a factorisation at this size); false unless D is
+// positive definite (its leading minors positive).
+bool invert_spd3(const Mat3& D, Mat3& Dinv) {
+  const double c00 = D(1, 1) * D(2, 2) - D(1, 2) * D(1, 2), c01 = D(0, 2) * D(1, 2) - D(0, 1) * D(2, 2),
+               c02 = D(0, 1) * D(1, 2) - D(0, 2) * D(1, 1);
+  const double det = D(0, 0) * c00 + D(0, 1) * c01 + D(0, 2) * c02;
+  if (!(D(0, 0) > 0.0 && D(0, 0) * D(1, 1) - D(0, 1) * D(0, 1) > 0.0 && det > 0.0)) return false;
+  const double r = 1.0 / det;
+  Dinv(0, 0) = c00 * r, Dinv(0, 1) = Dinv(1, 0) = c01 * r, Dinv(0, 2) = Dinv(2, 0) = c02 * r;
+  Dinv(1, 1) = (D(0, 0) * D(2, 2) - D(0, 2) * D(0, 2)) * r;
+  Dinv(1, 2) = Dinv(2, 1) = (D(0, 2) * D(0, 1) - D(0, 0) * D(1, 2)) * r;
+  Dinv(2, 2) = (D(0, 0) * D(1, 1) - D(0, 1) * D(0, 1)) * r;
+  return true;
+}
+
+[[noreturn]] void singular_articulated_inertia(const System& sys, const Data& d, int p) {
+  throw SimulationError(d.t, "articulated inertia of body '" + sys.body_names[p] +
+                                 "' is singular (a massless chain or a singular configuration)");
+}
+
 // ABA pass 2, inertia part (leaves to root): S the free axes, U = I^A S, D = Sᵀ U + diag(δ), and
 // the parent gets I^a = I^A − U D⁻¹ Uᵀ, kept in d.IA[p] for the bias pass. δ = 0 without an armature.
+// One and three free coordinates (a revolute joint, an sde's three rotations) take fixed-size paths.
 void articulated_inertias(const System& sys, Data& d, const VecX* armature) {
   d.IA = d.I;
   for (int p = sys.nbodies - 1; p >= 0; --p) {
@@ -130,14 +160,29 @@ void articulated_inertias(const System& sys, Data& d, const VecX* armature) {
     Subspace& S = d.S[p];
     S.resize(6, nf);
     for (int k = 0; k < nf; ++k) S.col(k) = d.axes[sys.q_use[k0 + k]];
-    d.U6[p].noalias() = d.IA[p] * S;
-    if (nf > 0) {
-      SmallMat D = S.transpose() * d.U6[p];
-      if (armature) D.diagonal() += armature->segment(k0, nf);
-      if (!invert_spd(D, d.Dinv[p]))
-        throw SimulationError(d.t, "articulated inertia of body '" + sys.body_names[p] +
-                                       "' is singular (a massless chain or a singular configuration)");
-      d.IA[p] -= d.U6[p] * d.Dinv[p] * d.U6[p].transpose();
+    if (nf == 1) {
+      const Vec6 U = d.IA[p] * S.col(0);
+      const double D = S.col(0).dot(U) + (armature ? (*armature)(k0) : 0.0);
+      if (!(D > 0.0)) singular_articulated_inertia(sys, d, p);
+      d.U6[p] = U;
+      d.Dinv[p].setConstant(1, 1, 1.0 / D);
+      d.IA[p].noalias() -= (U / D) * U.transpose();
+    } else if (nf == 3) {
+      const Eigen::Matrix<double, 6, 3> U = d.IA[p] * S.leftCols<3>();
+      Mat3 D = S.leftCols<3>().transpose() * U, Dinv;
+      if (armature) D.diagonal() += armature->segment<3>(k0);
+      if (!invert_spd3(D, Dinv)) singular_articulated_inertia(sys, d, p);
+      d.U6[p] = U;
+      d.Dinv[p] = Dinv;
+      d.IA[p].noalias() -= (U * Dinv) * U.transpose();
+    } else {
+      d.U6[p].noalias() = d.IA[p] * S;
+      if (nf > 0) {
+        SmallMat D = S.transpose() * d.U6[p];
+        if (armature) D.diagonal() += armature->segment(k0, nf);
+        if (!invert_spd(D, d.Dinv[p])) singular_articulated_inertia(sys, d, p);
+        d.IA[p] -= d.U6[p] * d.Dinv[p] * d.U6[p].transpose();
+      }
     }
     if (sys.parent[p] >= 0) d.IA[sys.parent[p]] += d.IA[p];
   }
@@ -151,18 +196,28 @@ void articulated_inertias(const System& sys, Data& d, const VecX* armature) {
 void articulated_accelerations(const System& sys, Data& d, const VecX& tau, const Vec6& a0, VecX& x) {
   for (int p = sys.nbodies - 1; p >= 0; --p) {
     Vec6 pa = d.pA[p] + d.IA[p] * d.c[p];
-    if (sys.nq_of[p] > 0) {
-      d.u[p] = tau.segment(sys.q_index[p], sys.nq_of[p]) - d.S[p].transpose() * d.pA[p];
+    const int k0 = sys.q_index[p], nf = sys.nq_of[p];
+    if (nf == 3) {  // the fixed-size path of articulated_inertias
+      const Vec3 u = tau.segment<3>(k0) - d.S[p].leftCols<3>().transpose() * d.pA[p];
+      d.u[p] = u;
+      pa.noalias() += d.U6[p].leftCols<3>() * (d.Dinv[p].topLeftCorner<3, 3>() * u);
+    } else if (nf > 0) {
+      d.u[p] = tau.segment(k0, nf) - d.S[p].transpose() * d.pA[p];
       pa += d.U6[p] * (d.Dinv[p] * d.u[p]);
     }
     if (sys.parent[p] >= 0) d.pA[sys.parent[p]] += pa;
   }
   for (int p = 0; p < sys.nbodies; ++p) {
     Vec6 a = parent_value(sys, d.a, p, a0) + d.c[p];
-    if (sys.nq_of[p] > 0) {
+    const int k0 = sys.q_index[p], nf = sys.nq_of[p];
+    if (nf == 3) {
+      const Vec3 qdd = d.Dinv[p].topLeftCorner<3, 3>() * (d.u[p].head<3>() - d.U6[p].leftCols<3>().transpose() * a);
+      x.segment<3>(k0) = qdd;
+      a.noalias() += d.S[p].leftCols<3>() * qdd;
+    } else if (nf > 0) {
       const SmallVec qdd = d.Dinv[p] * (d.u[p] - d.U6[p].transpose() * a);
-      x.segment(sys.q_index[p], sys.nq_of[p]) = qdd;
-      for (int k = 0; k < sys.nq_of[p]; ++k) a += d.S[p].col(k) * qdd(k);
+      x.segment(k0, nf) = qdd;
+      for (int k = 0; k < nf; ++k) a += d.S[p].col(k) * qdd(k);
     }
     d.a[p] = a;
   }

@@ -19,6 +19,7 @@ namespace rigidfem {
 /// Spatial inertia at the global origin of mass m with centre c and inertia I_c about it (global axes):
 /// [[I_c + m S(c) S(c)ᵀ, m S(c)], [m S(c)ᵀ, m 1]].
 Mat6 spatial_inertia(double m, const Vec3& c, const Mat3& Ic);
+void spatial_inertia(double m, const Vec3& c, const Mat3& Ic, Mat6& I);  ///< the same, into I
 /// a_0 = (0, −g): gravity as an upward acceleration of the base.
 Vec6 gravity_acceleration(const System& sys, const Data& d);
 /// (T, axes, q̇) => velocities v_p, joint bias accelerations c_p = Σ ṡ_k q̇_k, spatial
