@@ -1,4 +1,4 @@
-"""``python -m benchmarks {scaling,peers,scale,loops,implicit_step,sweep,kane_peers,loop_peers,sweep_peers,strip_peers,crane_peers,size_peers,orders,tolerance,accuracy,viewer,sensitivities,contact} [--quick] [--output DIR]``, from the root of a checkout."""
+"""``python -m benchmarks {scaling,peers,scale,loops,implicit_step,sweep,kane_peers,loop_peers,sweep_peers,strip_peers,crane_peers,size_peers,evaluations,orders,tolerance,accuracy,viewer,sensitivities,contact} [--quick] [--output DIR]``, from the root of a checkout."""
 
 from __future__ import annotations
 
@@ -20,6 +20,7 @@ COMMANDS = {
     "strip_peers": "a whippy strip released from rest (m = 16, 32, 64): CPU time to a tip error against Exudyn (KinematicTree, ANCF cable) and MuJoCo (chain, flex rod) (needs: pip install exudyn mujoco)",
     "crane_peers": "an offshore crane with a hoisting rope on a moving base: CPU time to a payload error against Exudyn (KinematicTree, rope by a symbolic spring law, base by coordinate constraints) and MuJoCo (tendon rope, servoed base) (needs: pip install exudyn mujoco)",
     "size_peers": "size: one second of a whippy strip of 10^3 and 10^4 rfes, CPU time to a tip error against Exudyn (the chain in redundant coordinates, sparse solver) and MuJoCo (the chain by MjSpec) (needs: pip install exudyn mujoco)",
+    "evaluations": "one evaluation of each kind per model (forward dynamics, rk4 step, implicit Newton iteration) on the peers pages' models (slider-crank, Bricard, strip, crane) against MuJoCo's mj_forward and mj_step and Pinocchio's ABA, and where rigidfem's forward dynamics goes (needs: pip install mujoco; pin optional)",
     "orders": "speed against error on Kane's beam: esdirk43, radau5, generalised-α and dopri5",
     "tolerance": "Kane's beam (m = 20): tip error delivered against rtol asked, every adaptive method; fixed-step failures",
     "accuracy": "the default asked for a tip error against the best of every method: strips, tapes, the bench's scenes",

@@ -4,6 +4,7 @@ test_study.py with the studies (formerly ``rigidfem.study.dynamics_scaling`` and
 ``rigidfem.study.implicit_step_scaling``)."""
 
 import csv
+import importlib.util
 import sys
 from pathlib import Path
 
@@ -224,6 +225,44 @@ def test_size_peers_models_agree():
     assert runners["MuJoCo"].residual(q, qd, xml.data.qacc[xml.address]) < 1e-12
     checks = zp.verify(s, runners).rows
     assert [r["code"] for r in checks] == ["Exudyn", "MuJoCo"] and all(r["difference"] < r["allowed"] for r in checks)
+
+
+def test_evaluations_quick(tmp_path, capsys):
+    """python -m benchmarks evaluations --quick: per model (slider-crank, Bricard, strip m = 16, crane) the
+    per-call table's and the forward-dynamics table's columns, positive finite times and shares in [0, 1]
+    (the timings are the benchmark's to print, not the test's to compare); Pinocchio's column on the
+    strip only, when it is installed."""
+    pytest.importorskip("mujoco")
+    from benchmarks import evaluations
+
+    assert main(["evaluations", "--quick", "--output", str(tmp_path)]) == 0
+    models = ["slider-crank m=4", "Bricard", "strip m=16", "crane m=6"]
+    with open(tmp_path / "evaluations_per_call.csv") as f:
+        reader = csv.DictReader(f)
+        assert tuple(reader.fieldnames) == evaluations.PER_CALL_COLUMNS
+        rows = list(reader)
+    assert [r["model"] for r in rows] == models and [int(r["nl"]) for r in rows] == [5, 5, 0, 0]
+    times = ("rigidfem_fd_us", "rigidfem_rk4_step_us", "newton_iteration_us", "residual_us", "lu_solve_us",
+             "tangent_us", "lu_factor_us", "mujoco_forward_us", "mujoco_rk4_step_us", "fd/mujoco_forward",
+             "rk4_step/mujoco_rk4_step", "dt_s")
+    for r in rows:
+        assert all(np.isfinite(float(r[k])) and float(r[k]) > 0 for k in times), r
+        assert float(r["rk4_rhs_per_step"]) >= 4 and "unstable" not in r["note"]
+        with_pinocchio = r["model"].startswith("strip") and importlib.util.find_spec("pinocchio") is not None
+        for k in ("pinocchio_aba_us", "fd/pinocchio_aba"):
+            assert (float(r[k]) > 0) if with_pinocchio else r[k] == "-", (k, r)
+    with open(tmp_path / "evaluations_forward_dynamics.csv") as f:
+        reader = csv.DictReader(f)
+        assert tuple(reader.fieldnames) == evaluations.FORWARD_COLUMNS
+        split = list(reader)
+    assert [r["model"] for r in split] == models
+    for r in split:
+        assert all(float(r[k]) > 0 for k in ("fd_cpp_us", "fd_python_us", "mass_matrix_python_us",
+                                             "generalized_forces_python_us"))
+        assert all(0.0 <= float(r[k]) <= 1.0 for k in ("tree_share", "loops_share"))
+        assert (float(r["tree_fd_cpp_us"]) > 0) if int(r["nl"]) else r["tree_fd_cpp_us"] == "-"
+    out = capsys.readouterr().out
+    assert "| model | nq | nl | rigidfem_fd_us |" in out and "| model | nq | nl | fd_cpp_us |" in out
 
 
 def test_orders_study_table():

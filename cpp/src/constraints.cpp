@@ -190,15 +190,23 @@ VecX least_norm(const MatX& A, const VecX& b) {
   return svd.matrixV() * c;
 }
 
-VecX least_norm_symmetric(const MatX& A, const VecX& b) {
+void least_norm_symmetric(const MatX& A, const VecX& b, Eigen::SelfAdjointEigenSolver<MatX>& eigen, VecX& c,
+                          VecX& x) {
   // x = V Λ⁺ Vᵀ b, A = V Λ Vᵀ (the lower triangle read), λ_i⁺ = 1/λ_i for λ_i > 1e-10 λ_max, else 0
   // (a negative λ_i is round-off of a zero one).
-  Eigen::SelfAdjointEigenSolver<MatX> eigen(A);
+  eigen.compute(A);
   const VecX& s = eigen.eigenvalues();  // ascending
   const double floor = s.size() > 0 ? 1e-10 * s(s.size() - 1) : 0.0;
-  VecX c = eigen.eigenvectors().transpose() * b;
+  c.noalias() = eigen.eigenvectors().transpose() * b;
   for (Eigen::Index i = 0; i < s.size(); ++i) c(i) = s(i) > floor ? c(i) / s(i) : 0.0;
-  return eigen.eigenvectors() * c;
+  x.noalias() = eigen.eigenvectors() * c;
+}
+
+VecX least_norm_symmetric(const MatX& A, const VecX& b) {
+  Eigen::SelfAdjointEigenSolver<MatX> eigen(A.rows());
+  VecX c, x;
+  least_norm_symmetric(A, b, eigen, c, x);
+  return x;
 }
 
 MatX free_jacobian(const System& sys, const Data& d) { return d.G(Eigen::all, sys.free_coords); }

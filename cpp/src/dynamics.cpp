@@ -153,10 +153,22 @@ std::string worst_loop(const System& sys, const Data& d) {
 }  // namespace
 
 void close_loops(const System& sys, Data& d) {
-  const MatX G = free_jacobian(sys, d);
-  const MatX Y = solve_armature(sys, d, G.transpose());  // M⁻¹ Gᵀ with the tree's factorisation
-  d.lambda = least_norm_symmetric(G * Y, d.gamma - G * d.qdd);
-  d.qdd += Y * d.lambda;
+  // λ = (G M⁻¹ Gᵀ)⁺ (γ − G q̈), q̈ += M⁻¹ Gᵀ λ, in d's workspace (no allocation on the recursive path)
+  d.Gfree = d.G(Eigen::all, sys.free_coords);
+  if (recursive(sys)) {
+    for (Eigen::Index j = 0; j < d.Gfree.rows(); ++j) {  // Y = M⁻¹ Gᵀ with the tree's factorisation
+      d.loop_col = d.Gfree.row(j).transpose();
+      aba_solve(sys, d, d.loop_col, d.loop_col);
+      d.Y.col(j) = d.loop_col;
+    }
+  } else {
+    d.Y = d.llt.solve(d.Gfree.transpose());
+  }
+  d.GY.noalias() = d.Gfree * d.Y;
+  d.loop_rhs = d.gamma;
+  d.loop_rhs.noalias() -= d.Gfree * d.qdd;
+  least_norm_symmetric(d.GY, d.loop_rhs, d.loop_eigen, d.loop_c, d.lambda);
+  d.qdd.noalias() += d.Y * d.lambda;
   set_accelerations(sys, d, d.qdd);
   if (!d.qdd.allFinite()) throw SimulationError(d.t, "accelerations of the closed loops are NaN or inf");
 }
@@ -176,12 +188,30 @@ double project_onto_loops(const System& sys, Data& d, double t, VecX& q, VecX& q
   if (sys.nl == 0) return 0.0;
   constexpr double eps = std::numeric_limits<double>::epsilon();
   double residual = 0.0, previous = 0.0;
-  MatX G, Y;
-  // Y = M⁻¹ Gᵀ (nq, nl) at the state of d, for the mass-weighted corrections.
-  auto weighted = [&] {
-    G = free_jacobian(sys, d);
-    factor_mass(sys, d);
-    Y = solve_armature(sys, d, G.transpose());
+  bool factored = false;  // M factorised in this call (at a configuration Gauss-Newton has since moved by Δq)
+  MatX& G = d.Gfree;
+  MatX& Y = d.Y;
+  // Y = M⁻¹ Gᵀ (nq, nl) for the mass-weighted corrections, G at the state of d and M factorised there, or for
+  // the velocity's projection at the last Gauss-Newton iterate (the weight need only be positive definite: the
+  // projection lands on G q̇ = −∂g/∂t with the current G whatever it is)
+  auto weighted = [&](bool refactor) {
+    G = d.G(Eigen::all, sys.free_coords);
+    if (refactor || !factored) factor_mass(sys, d), factored = true;
+    if (!recursive(sys)) {
+      Y = d.llt.solve(G.transpose());
+      return;
+    }
+    for (Eigen::Index j = 0; j < G.rows(); ++j) {
+      d.loop_col = G.row(j).transpose();
+      aba_solve(sys, d, d.loop_col, d.loop_col);
+      Y.col(j) = d.loop_col;
+    }
+  };
+  auto corrected = [&](const VecX& residuals) -> const VecX& {  // Y (G Y)⁺ residuals, into d.loop_col
+    d.GY.noalias() = G * Y;
+    least_norm_symmetric(d.GY, residuals, d.loop_eigen, d.loop_c, d.loop_rhs);
+    d.loop_col.noalias() = Y * d.loop_rhs;
+    return d.loop_col;
   };
   for (int it = 0;; ++it) {
     loop_equations(sys, d, t, q, qd);
@@ -195,9 +225,8 @@ double project_onto_loops(const System& sys, Data& d, double t, VecX& q, VecX& q
     // |g| q̇/σ². It stops where it no longer gains (round-off, or the residual lies along a row
     // that least_norm counts as dependent) or after max_iterations; linear convergence there is fine.
     if ((it > 0 && residual > 0.9 * previous) || it == max_iterations) break;
-    weighted();
-    const VecX dq = Y * least_norm_symmetric(G * Y, d.g);  // Δq = M⁻¹Gᵀ (G M⁻¹ Gᵀ)⁺ g
-    q -= dq;
+    weighted(true);
+    q -= corrected(d.g);  // Δq = M⁻¹Gᵀ (G M⁻¹ Gᵀ)⁺ g
     previous = residual;
   }
   if (!(residual <= std::max(tol, 1e-9)) || sys.nq == 0)
@@ -208,8 +237,8 @@ double project_onto_loops(const System& sys, Data& d, double t, VecX& q, VecX& q
   // q̇ ← q̇ − M⁻¹Gᵀ (G M⁻¹ Gᵀ)⁺ ġ, ġ = G q̇ + ∂g/∂t: the correction is M-orthogonal to every motion
   // the loops allow, so it never raises the kinetic energy and takes none from the admissible motion
   // (the Euclidean Gᵀ(GGᵀ)⁺ġ does, where G loses rank).
-  weighted();
-  qd -= Y * least_norm_symmetric(G * Y, d.gd);
+  weighted(false);
+  qd -= corrected(d.gd);
   return residual;
 }
 

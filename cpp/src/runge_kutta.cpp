@@ -46,6 +46,7 @@ class FirstOrder {
     for (int j = 0; sens_ && j < sens_->count(); ++j) sens_->project(j, t, q, qd, y.segment(state_size() + 2 * n * j, 2 * n));
   }
   int controlled() const { return 2 * sys_.nq; }  ///< the error is controlled on y's first 2 nq: [q, q̇]
+  bool loops() const { return sys_.nl > 0; }     ///< every accepted step is projected onto the loops (project)
   int state_size() const { return 2 * sys_.nq + sys_.nz; }  ///< [q, q̇, s]; the sensitivities follow
   /// The sensitivities' blocks, each [S_q, S_q̇] (symplectic Euler's rule treats them as [q, q̇]).
   int sensitivity_count() const { return sens_ ? sens_->count() : 0; }
@@ -186,9 +187,11 @@ class RungeKutta final : public Stepper {
     y1_ = y0_;
     for (int i = 0; i < s; ++i)
       if (tab_.b[i] != 0.0) y1_ += (h * tab_.b[i]) * k_[i];
+    // f(t + h, y1), the next step's first stage and the dense output's end slope; a fixed-step method on loops
+    // takes it at the projected state instead (project), saving an evaluation a step
     if (tab_.fsal)
       f1_ = k_[s - 1];
-    else
+    else if (!(ode_.loops() && tab_.e.empty()))
       ode_.eval(t + h, y1_, f1_);
     // Hairer's estimate of h ρ (ρ the dominant eigenvalue) from two evaluations at t + h: dopri5's
     // stages 6 and 7, rkf45's stage 5 (c₅ = 1) and f(t + h, y1).
@@ -228,6 +231,7 @@ class RungeKutta final : public Stepper {
   void project(double t) override {
     ode_.project(t, y_);
     ode_.eval(t, y_, f_);  // the next step starts from the projected state
+    if (tab_.e.empty()) f1_ = f_;  // the dense output's end slope (attempt left it to here)
   }
 
   VecX dense(double t) const override {

@@ -35,6 +35,9 @@ VecX least_norm(const MatX& A, const VecX& b);
 /// The same for a symmetric positive semi-definite A (G M⁻¹ Gᵀ, M symmetric): by its eigenvalues,
 /// which are its singular values (the same rank decision), without the Jacobi SVD's sweeps.
 VecX least_norm_symmetric(const MatX& A, const VecX& b);
+/// The same into x, with the caller's eigensolver and scratch c (no allocation once they are sized).
+void least_norm_symmetric(const MatX& A, const VecX& b, Eigen::SelfAdjointEigenSolver<MatX>& eigen, VecX& c,
+                          VecX& x);
 
 /// The wrench each loop joint applies to its body B, in frame A's axes: (force N, torque N·m about
 /// B's frame origin) per loop, from the multipliers λ (nl); for a Distance loop the force along the

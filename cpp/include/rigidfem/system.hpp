@@ -145,6 +145,11 @@ struct Data {
   VecX g, gd, gamma;           // (nl) g(q, t), ġ, and γ with G q̈ = γ
   MatX G;                      // (nl, nc) ∂g/∂q over all coordinates
   VecX lambda;                 // (nl) multipliers of the last constrained forward dynamics
+  // close_loops' workspace (no allocation per call): G over the free coordinates, Y = M⁻¹ Gᵀ, G Y, the
+  // right-hand side γ − G q̈, a column, and the eigensolver of G Y, sized at construction
+  MatX Gfree, Y, GY;
+  VecX loop_rhs, loop_col, loop_c;
+  Eigen::SelfAdjointEigenSolver<MatX> loop_eigen;
   // Recursive algorithms (ground coordinates, at the global origin):
   std::vector<Vec6> axes;      // (nuses) coordinate axes s = (ω, v_O)
   std::vector<Vec6> v, c, a;   // (nbodies) spatial velocity, joint bias acceleration, acceleration
