@@ -150,7 +150,28 @@ def _copy_font_awesome(app, exc) -> None:
         shutil.copyfile(_FONT_AWESOME / rel, out / rel)
 
 
+def _download_link(app, pagename, templatename, context, doctree) -> None:
+    """A notebook's page opens with a link to download it (the .ipynb itself, copied beside the page)."""
+    if pagename.startswith("notebooks/") and context.get("body") and (HERE / f"{pagename}.ipynb").exists():
+        name = pagename.split("/", 1)[1]
+        link = (f'<p class="rigidfem-download"><a class="reference download" href="{name}.ipynb" download>'
+                f'Download this notebook ({name}.ipynb)</a>, run it with <code>pip install ".[notebooks]"</code> '
+                f'and <code>jupyter lab</code> from a checkout.</p>')
+        context["body"] = link + context["body"]
+
+
+def _copy_notebook_files(app, exc) -> None:
+    if exc is not None or app.builder.format != "html":
+        return
+    out = Path(app.outdir) / "notebooks"
+    out.mkdir(parents=True, exist_ok=True)
+    for nb in sorted((HERE / "notebooks").glob("*.ipynb")):
+        shutil.copyfile(nb, out / nb.name)
+
+
 def setup(app):
     app.connect("autodoc-process-docstring", _escape_bars)
+    app.connect("html-page-context", _download_link)
+    app.connect("build-finished", _copy_notebook_files)
     app.connect("html-page-context", _local_font_awesome)
     app.connect("build-finished", _copy_font_awesome)

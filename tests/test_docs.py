@@ -55,6 +55,9 @@ def test_the_notebooks_are_pages_with_their_figures(site):
     for nb in sorted((ROOT / "notebooks").glob("*.ipynb")):
         page = site / "notebooks" / f"{nb.stem}.html"
         assert page.exists(), nb.name
+        # each page links its notebook for download, and the file is there, the repository's own
+        assert f'href="{nb.name}" download' in page.read_text(encoding="utf-8"), nb.name
+        assert (site / "notebooks" / nb.name).read_bytes() == nb.read_bytes(), nb.name
         figures = sum("image/png" in out.get("data", {}) for cell in json.loads(nb.read_text())["cells"]
                       if cell["cell_type"] == "code" for out in cell.get("outputs", []))
         assert page.read_text(encoding="utf-8").count("<img") >= figures, nb.name

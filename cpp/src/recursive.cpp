@@ -1,5 +1,6 @@
 #include "rigidfem/recursive.hpp"
 
+#include <cmath>
 #include <stdexcept>
 #include <string>
 
@@ -130,18 +131,25 @@ bool invert_spd(const SmallMat& D, SmallMat& Dinv) {
   return true;
 }
 
-// D⁻¹ of a symmetric 3 × 3 D by its cofactors (cheaper than a factorisation at this size); false unless D is
-// positive definite (its leading minors positive).
+// D⁻¹ of a symmetric 3 × 3 D through its Cholesky factor, written out (as accurate as a factorisation, without
+// its loops): D = L Lᵀ, M = L⁻¹ (lower), D⁻¹ = Mᵀ M; false unless D is positive definite.
 bool invert_spd3(const Mat3& D, Mat3& Dinv) {
-  const double c00 = D(1, 1) * D(2, 2) - D(1, 2) * D(1, 2), c01 = D(0, 2) * D(1, 2) - D(0, 1) * D(2, 2),
-               c02 = D(0, 1) * D(1, 2) - D(0, 2) * D(1, 1);
-  const double det = D(0, 0) * c00 + D(0, 1) * c01 + D(0, 2) * c02;
-  if (!(D(0, 0) > 0.0 && D(0, 0) * D(1, 1) - D(0, 1) * D(0, 1) > 0.0 && det > 0.0)) return false;
-  const double r = 1.0 / det;
-  Dinv(0, 0) = c00 * r, Dinv(0, 1) = Dinv(1, 0) = c01 * r, Dinv(0, 2) = Dinv(2, 0) = c02 * r;
-  Dinv(1, 1) = (D(0, 0) * D(2, 2) - D(0, 2) * D(0, 2)) * r;
-  Dinv(1, 2) = Dinv(2, 1) = (D(0, 2) * D(0, 1) - D(0, 0) * D(1, 2)) * r;
-  Dinv(2, 2) = (D(0, 0) * D(1, 1) - D(0, 1) * D(0, 1)) * r;
+  // m_ii = 1/l_ii first: one division per pivot
+  if (!(D(0, 0) > 0.0)) return false;
+  const double m00 = 1.0 / std::sqrt(D(0, 0)), l10 = D(1, 0) * m00, l20 = D(2, 0) * m00;
+  const double r1 = D(1, 1) - l10 * l10;
+  if (!(r1 > 0.0)) return false;
+  const double m11 = 1.0 / std::sqrt(r1), l21 = (D(2, 1) - l20 * l10) * m11;
+  const double r2 = D(2, 2) - l20 * l20 - l21 * l21;
+  if (!(r2 > 0.0)) return false;
+  const double m22 = 1.0 / std::sqrt(r2);
+  const double m10 = -l10 * m00 * m11, m21 = -l21 * m11 * m22, m20 = -(l20 * m00 + l21 * m10) * m22;
+  Dinv(0, 0) = m00 * m00 + m10 * m10 + m20 * m20;
+  Dinv(1, 0) = Dinv(0, 1) = m11 * m10 + m21 * m20;
+  Dinv(2, 0) = Dinv(0, 2) = m22 * m20;
+  Dinv(1, 1) = m11 * m11 + m21 * m21;
+  Dinv(2, 1) = Dinv(1, 2) = m22 * m21;
+  Dinv(2, 2) = m22 * m22;
   return true;
 }
 
