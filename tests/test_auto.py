@@ -3,6 +3,8 @@ method where a counted trial finds it faster, the choice reported in Result.stat
 counted, not timed), and the delivered error against independent references."""
 
 import concurrent.futures
+import sys
+from pathlib import Path
 
 import numpy as np
 import pytest
@@ -77,6 +79,24 @@ def test_short_stiff_run_is_found_by_a_probe():
     auto = rf.simulate(system, 1.0, rtol=1e-5, atol=1e-7, t_eval=t)
     assert auto.stats["method"] == "radau5 from the start (a dopri5 probe of 20 steps found the problem stiff)"
     alone = rf.simulate(system, 1.0, method="radau5", rtol=1e-5, atol=1e-7, t_eval=t)
+    np.testing.assert_array_equal(auto.q, alone.q)
+
+
+def test_dop853_hands_over_where_its_steps_reach_the_stability_boundary_not_where_they_are_rejected():
+    """At rtol <= 1e-7 auto's explicit method is dop853, held to the same rules by its own stability boundary
+    (h ρ > 3.6 counted near it): on Kane's beam over 1 s its steps grow to the boundary and the run goes to radau5;
+    on the Bricard linkage, rigid and not stiff, a window of dop853's steps through the singular configuration at
+    t = 4 s rejects 7 of 20, which is no hand-over (radau5 took 7 times dop853's time there)."""
+    model, _ = samples.kane_beam(omega=6.0, duration=15.0, elements=10)
+    kane = rf.simulate(model.compile(), 1.0, rtol=1e-8, atol=1e-10)
+    assert kane.stats["method"].startswith("dop853, then radau5 from t = ")
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))
+    from benchmarks import loop_peers
+
+    scene = loop_peers.bricard()
+    auto = rf.simulate(scene.system, scene.t_end, q0=scene.q0, t_eval=scene.t_eval, rtol=1e-7, atol=1e-9)
+    alone = rf.simulate(scene.system, scene.t_end, "dop853", q0=scene.q0, t_eval=scene.t_eval, rtol=1e-7, atol=1e-9)
+    assert auto.stats["method"] == "dop853" and alone.stats["rejected_steps"] >= 7
     np.testing.assert_array_equal(auto.q, alone.q)
 
 

@@ -95,7 +95,7 @@ double spectral_radius(const System& sys, double t, const VecX& q, const VecX& v
 //    method starts again from the initial state. When it reaches the time the probe reached it must have
 //    advanced `margin` times as far per unit of work as the probe did, or dopri5 goes on from there;
 //  - from the state reached, when a later window of dopri5 looks stiff (a fifth of its steps near
-//    the stability boundary or a sixth as many rejections as steps), after waiting `backoff` windows
+//    the stability boundary or, for dopri5, a sixth as many rejections as steps), after waiting `backoff` windows
 //    (doubled by a lost probe trial).
 // A hand-over is final. (Judging it too — over its first 26 steps against dopri5's last window or, from
 // t0, against dopri5's best rate 3.3/ρ per 6 evaluations, and every 100 steps after — was measured on
@@ -148,7 +148,11 @@ bool AutoChoice::after_step(double t, double h_rho, const IntegratorStats& stats
   if (h_rho > near_) ++near_boundary_;
   if (++steps_ < window) return false;
   // The first window: its start-up rejections say nothing, its steps at the stability boundary do.
-  const bool near = near_boundary_ * 5 >= window, rejecting = (stats.rejected - rejected_mark_) * 6 >= window;
+  // dop853's rejections are no sign of stiffness: its long steps are cut where the motion turns sharply (the Bricard
+  // linkage through its singular configuration at t = 4 s: a window of 20 steps with 7 rejected, which handed the
+  // run to radau5 at 7 times dop853's cost); only its steps at the stability boundary count
+  const bool near = near_boundary_ * 5 >= window;
+  const bool rejecting = explicit_ == Method::Dopri5 && (stats.rejected - rejected_mark_) * 6 >= window;
   const bool trial = (near && first_window_) || ((near || rejecting) && ++windows_since_trial_ >= backoff_);
   first_window_ = false;
   mark(t, stats);

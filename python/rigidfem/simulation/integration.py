@@ -96,7 +96,7 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
         unit of work as the probe — counted, not timed (right-hand sides, nq per tangent, (nq/50)²
         per dense factorisation), so the choice is the same on every machine and thread — else
         dopri5 goes on. A later window that looks bounded by stability (a fifth of its steps at
-        h ρ > 2, or a sixth as many rejections) hands the run over to the stiff method from the
+        h ρ > 2, or, for dopri5, a sixth as many rejections) hands the run over to the stiff method from the
         state reached, after waiting twice as many windows if the probe's trial was lost. A
         hand-over is final. On a non-stiff problem run for long the rule by ρ can misjudge: a
         pendulum over 1000 s (over 500 periods) runs radau5, 1.5 times dopri5's time at rtol = 1e-3,
