@@ -115,12 +115,24 @@ def test_contacts_onsets_and_separations_are_located_and_keep_the_error_bar_hone
 
 
 def test_a_terminal_runs_error_estimate_runs_to_its_end():
-    """The error bar of a run ended by an event: its second run goes to the same end, with the event located."""
+    """The error bar of a run ended by an event: its second run goes to the same end, at the same outputs, its events
+    ending nothing, and the bar is within 10 times the true error (z = cos 2t) where that error is above round-off.
+    A terminal event only the second run would see (the first run's coarser steps passed it) ends neither: the
+    second run keeps the first's end (found by the fuzzer: the two runs' outputs had different lengths)."""
     system, _ = oscillator()
     event = rf.Event("zero", "mass.z", direction=1, terminal=True)
     r = rf.simulate(system, 9.0, "dopri5", q0=[1.0], events=[event], rtol=1e-6, error_estimate=True)
     assert r.t[-1] == pytest.approx(3 * math.pi / 4, abs=1e-6)
-    assert r.estimate is not None and np.isfinite(r.estimate.of(lambda x: x.q[:, 0])).all()
+    second = r.estimate.reference
+    assert np.array_equal(second.t, r.t)  # the same outputs, to the same end (the root is that end)
+    bar, true = r.estimate.of(lambda x: x.q[:, 0]), np.abs(r.q[:, 0] - np.cos(2.0 * r.t))
+    big = true > 1e-9
+    assert big.sum() > 10 and np.all(bar[big] < 10 * true[big]) and np.all(bar[big] > true[big] / 10)
+    # a level the coarse run steps over: the terminal event would end only the second run
+    low = rf.Event("low", "mass.z", value=-0.9999, direction=-1, terminal=True)  # dt = 0.025 s sees it at 1.564 s
+    coarse = rf.simulate(system, 2.0, "newmark", q0=[1.0], dt=0.05, events=[low])
+    assert coarse.t[-1] == 2.0 and not coarse.events  # stepped over
+    assert np.array_equal(coarse.error_estimate.reference.t, coarse.t)  # the second run does not stop at it
 
 
 def test_bad_events_are_refused_by_name():

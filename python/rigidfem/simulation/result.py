@@ -284,9 +284,11 @@ def _estimate_error(result: Result):
                          f"t = {result.t[-1] if len(result.t) else run['t0']:g} s")
     kw = {k: v for k, v in run.items() if k not in ("outputs", "fixed")}
     kw["t_eval"], kw["stiffness_warning"] = result.t, False
-    if ended:  # the second run to the same end, its events located but none ending it
+    if ended:  # the second run to the same end
         kw["t_end"] = result.events[-1].t
-        kw["events"] = [dataclasses.replace(e, terminal=False) for e in run["events"]]
+    if terminal:  # its events located but none ending it: the first run's end is the second's, a root there or not
+        kw["events"] = [dataclasses.replace(e, terminal=False) if isinstance(e, events_.Event) else e
+                        for e in run["events"]]
     if run["fixed"]:
         kw["dt"] = run["dt"] / 2.0
         order = options_.method(run["method"]).order  # Richardson's factor 2^p/(2^p − 1)
