@@ -320,3 +320,340 @@ def test_the_shapes_of_contacts_are_drawn_in_their_bodies_frames(tmp_path):
     state = _open(viewer.to_html(tmp_path / "contact.html"), "slide=10&probe=1")
     assert "error" not in state, state.get("error")
     assert state.get("ready") == "1" and int(state["ink"]) > 500
+
+
+# -- what the picture shows: framing, the grid and scale, deformation, modes, overlays, colours, arrows -------------
+#
+# The pages are opened together, each in an iframe of one host page in one Chromium (a launch costs 2-4 s), and
+# each records the snapshots asked for in its fragment (#shots=0,-1: the PNGs of the first and the last frame,
+# what the snapshot button saves); #helpers=0 leaves out the grid and the global triad, so that the pixels that
+# are not background are the model's.
+
+def _open_pages(pages, tmp_path):
+    """The body data attributes of each (path, fragment) page after it ran, all in one Chromium."""
+    import json
+
+    if BROWSER is None:
+        if os.environ.get("RIGIDFEM_REQUIRE_BROWSER"):
+            pytest.fail("RIGIDFEM_REQUIRE_BROWSER is set but no chromium was found")
+        pytest.skip("no chromium on this machine (.ci/run installs Debian's)")
+    host = tmp_path / "host.html"
+    frames = "".join(f'<iframe style="width: 800px; height: 470px; border: 0; display: block" src="{p.as_uri()}#{f}">'
+                     f'</iframe>' for p, f in pages)
+    host.write_text(f"""<!DOCTYPE html><html><body>{frames}<script>
+function copy() {{
+  const all = [...document.querySelectorAll("iframe")].map((f) => f.contentDocument && f.contentDocument.body
+                                                          ? {{...f.contentDocument.body.dataset}} : {{}});
+  if (all.every((d) => d.ready === "1" || d.error)) document.body.dataset.pages = JSON.stringify(all);
+  else setTimeout(copy, 100);
+}}
+window.addEventListener("load", copy);
+</script></body></html>""", encoding="utf-8")
+    run = subprocess.run([BROWSER, "--headless", "--no-sandbox", "--use-gl=angle", "--use-angle=swiftshader",
+                          "--enable-unsafe-swiftshader", "--allow-file-access-from-files",
+                          f"--virtual-time-budget={4000 + 2000 * len(pages)}", "--window-size=800,600",
+                          "--dump-dom", host.as_uri()], capture_output=True, text=True, timeout=300, check=False)
+    found = re.search(r'<body data-pages="([^"]*)"', run.stdout)
+    assert found, run.stderr[-2000:]
+    import html as html_
+    return json.loads(html_.unescape(found.group(1)))
+
+
+def _image(data_url):
+    """The PNG of a data URL as an (h, w, 3) uint8 array."""
+    import base64
+    import io
+
+    from PIL import Image
+
+    assert data_url.startswith("data:image/png;base64,"), data_url[:40]
+    return np.asarray(Image.open(io.BytesIO(base64.b64decode(data_url.split(",", 1)[1]))).convert("RGB"))
+
+
+def _ink(img):
+    """The pixels that are not the white background."""
+    return np.any(img < 245, axis=2)
+
+
+def _box(mask):
+    """(top, bottom, left, right) of the True pixels."""
+    rows, cols = np.flatnonzero(mask.any(axis=1)), np.flatnonzero(mask.any(axis=0))
+    return rows[0], rows[-1], cols[0], cols[-1]
+
+
+def _strip():
+    """The README's quick start: a steel strip clamped at the ground, gravity along -y, released from rest."""
+    E, rho, b, h, L = 2.1e11, 7850.0, 0.02, 0.005, 1.0
+    model = rf.Model(gravity=(0.0, -9.81, 0.0))
+    beam = model.add_beam("strip", model.ground, L, rf.Material(E=E, rho=rho), rf.Section.rectangle(h, b), 20,
+                          deform="bend_z")
+    system = model.compile()
+    return system, rf.simulate(system, 2.0, t_eval=np.linspace(0.0, 2.0, 101)), [beam.tip]
+
+
+def _four_bar():
+    model, h = rf.samples.four_bar()
+    system = model.compile()
+    q0, _ = system.assemble([0.4, -1.9, 4.6])
+    return system, rf.simulate(system, 3.0, q0=q0, t_eval=np.linspace(0.0, 3.0, 61)), [h["coupler"].point((0.4, 0, 0))]
+
+
+def _kane(linear=False):
+    model, h = rf.samples.kane_beam(omega=6.0, duration=15.0, elements=10, linear=linear)
+    system = model.compile()
+    return system, rf.simulate(system, 20.0, t_eval=np.linspace(0.0, 20.0, 101)), [h["beam"].tip]
+
+
+def _crane():
+    """Notebook 06's crane at sea's rest: a column slewing 30° in 3 s, a 24 m boom of 6 rfes luffed by an actuator,
+    a 5 t payload on a 14 m rope (z up)."""
+    g, crane, h_col, pin, L, lug_at, th = 9.81, (0.0, 8.0, 4.0), 12.0, 1.0, 24.0, 7.0, np.radians(45.0)
+    anchor, m_pay, lu, EA = (-0.5, 0.0, 4.0), 5000.0, 14.0, 1.0e8
+    lug = lug_at * np.array([np.cos(th), 0.0, np.sin(th)])
+    tip = np.array(crane) + [pin + L * np.cos(th), 0.0, h_col + L * np.sin(th)]
+    model = rf.Model(gravity=(0.0, 0.0, -g))
+    vessel = model.add_moving_base("vessel", {})
+    column = model.add_body("column", vessel, rf.Joint.revolute("z"), mass=8000.0, inertia=(1e5, 1e5, 5e3),
+                            com=(0.0, 0.0, h_col / 2), placement=rf.transform(crane))
+    times = np.linspace(0.0, 3.0, 31)
+    model.prescribe(column, rf.motion.spline(times, np.radians(30.0) * (times / 3.0) ** 2))
+    boom = model.add_beam("boom", column, L, rf.Material(E=210e9, rho=7850.0, nu=0.3, retardation=2e-3),
+                          rf.Section.tube(0.8, 0.75), 6, deform=("bend_y", "bend_z", "torsion"),
+                          joint=rf.Joint.revolute("y"), placement=rf.transform((pin, 0.0, h_col), (0.0, -th, 0.0)))
+    model.add_actuator("luff", column.point(anchor), boom.point(lug_at),
+                       np.linalg.norm(lug - (np.array(anchor) - [pin, 0.0, h_col])))
+    payload = model.add_body("payload", model.ground, rf.Joint.custom(["x", "y", "z"]), mass=m_pay,
+                             inertia=(1.0, 1.0, 1.0), placement=rf.transform(tip - [0.0, 0.0, lu * (1 + m_pay * g / EA)]))
+    rope = model.add_rope("rope", boom.tip, payload, EA=EA, length=lu, DA=0.05 * 2 * np.sqrt(EA / lu * m_pay) * lu)
+    system = model.compile()
+    q0 = rf.static_equilibrium(system, q0=np.zeros(system.nq), load_steps=2, t=0.0).q
+    result = rf.simulate(system, 3.0, method="generalized_alpha", dt=0.01, q0=q0, t_eval=np.linspace(0.0, 3.0, 31))
+    return system, result, [payload], rope
+
+
+@pytest.fixture(scope="module")
+def four_models():
+    return {"README strip": _strip(), "four-bar": _four_bar(), "Kane's beam": _kane(), "crane": _crane()[:3]}
+
+
+def test_the_camera_is_set_from_gravity_and_the_drawn_geometry(four_models):
+    """The up axis is -gravity (z without gravity, or up=); the camera stands above the model; the scene's box holds
+    the trails (the strip's sagging tip, below every body's origin at some frame) and the beam's tip."""
+    for name, (system, result, trails) in four_models.items():
+        d = rf.view(system, result, trails=trails).data
+        g = np.asarray(system.gravity)
+        up = -g / np.linalg.norm(g) if np.linalg.norm(g) else np.array([0.0, 0.0, 1.0])
+        np.testing.assert_allclose(d["up"], up, atol=1e-12, err_msg=name)
+        assert np.dot(d["camera"]["dir"], up) > 0.2, name  # from above
+        lo, hi = np.asarray(d["camera"]["lo"]), np.asarray(d["camera"]["hi"])
+        path = result.position(trails[0])
+        assert np.all(path >= lo - 1e-6) and np.all(path <= hi + 1e-6), name
+    system, result, trails = four_models["README strip"]
+    assert rf.view(system, result, up=(0, 0, 1)).data["up"] == [0.0, 0.0, 1.0]
+    grid = rf.view(system, result).data["grid"]
+    assert grid["step"] == 0.1 and np.dot(grid["origin"], [0, 1, 0]) < result.position(trails[0])[:, 1].min()
+
+
+def test_every_model_is_drawn_whole_inside_the_picture_and_fills_it(four_models, tmp_path):
+    """The README's strip and the four-bar (gravity along -y), Kane's beam (no gravity) and the crane (z up), each
+    at its first, middle and last frame (the last with the whole trail): the model's pixels lie inside the
+    picture with a margin of 4 px, and together they span at least half its width or height."""
+    pages = []
+    for k, (name, (system, result, trails)) in enumerate(four_models.items()):
+        path = rf.view(system, result, trails=trails, title=name).to_html(tmp_path / f"model{k}.html")
+        pages.append((path, f"helpers=0&shots=0,{len(result.t) // 2},-1"))
+    pages.append((pages[0][0], "shots=-1"))  # with the grid, as users see it
+    states = _open_pages(pages, tmp_path)
+    fills = {}
+    for name, state in zip(four_models, states):
+        assert "error" not in state, (name, state.get("error"))
+        union = None
+        for shot in ("shot0", "shot1", "shot2"):
+            ink = _ink(_image(state[shot]))
+            h, w = ink.shape
+            assert ink.sum() > 300, (name, shot)
+            top, bottom, left, right = _box(ink)
+            assert top >= 4 and left >= 4 and bottom <= h - 5 and right <= w - 5, (name, shot, _box(ink), (h, w))
+            union = ink if union is None else union | ink
+        top, bottom, left, right = _box(union)
+        fills[name] = max((right - left + 1) / w, (bottom - top + 1) / h)
+    assert all(f >= 0.5 for f in fills.values()), fills
+    grid = _image(states[-1]["shot0"])
+    assert _ink(grid).sum() > 2 * _ink(_image(states[0]["shot2"])).sum()  # the grid is drawn
+
+
+def _values(b64):
+    import base64
+    return np.frombuffer(base64.b64decode(b64), dtype="<f4")
+
+
+@pytest.fixture(scope="module")
+def stiff():
+    """A stiff steel cantilever (20 mm along y, bending about z) at rest under gravity -y: a 1.4 mm sag over 1 m."""
+    model, h = rf.samples.cantilever(elements=20, gravity=(0.0, -9.81, 0.0))
+    system = model.compile()
+    return system, h["beam"], rf.static_equilibrium(system).q
+
+
+def test_the_deformation_scale_magnifies_each_rfes_pose_relative_to_the_rigid_beam(stiff):
+    """At scale s the rfes' origins are the rigid beam's plus s times their displacements (exactly: the beam is
+    clamped, so its first rfe does not move), and the tip's sag is s times the computed one to the second order
+    in the tip's rotation s θ (here 0.2 rad: 1 %)."""
+    system, beam, q = stiff
+    rfes = [b.index for b in beam.rfes]
+    base, big = (_poses(rf.view(system, q=q, scale=s)).astype(float)[0] for s in (1.0, 100.0))
+    rigid = np.c_[beam.frames, np.zeros((len(rfes), 2))]
+    np.testing.assert_allclose(big[rfes, 9:], rigid + 100.0 * (base[rfes, 9:] - rigid), atol=1e-5)
+    tip = big[rfes[-1], :9].reshape(3, 3) @ [beam.length - beam.frames[-1], 0, 0] + big[rfes[-1], 9:]
+    sag = system.position(beam.tip, 0.0, q)[1]
+    assert sag < -1e-3 and tip[1] == pytest.approx(100.0 * sag, rel=0.01)
+    with pytest.raises(ValueError, match=r"^scale: expected a positive"):
+        rf.view(system, q=q, scale=0.0)
+
+
+def test_the_sdes_are_coloured_by_their_bending_moment_from_their_laws(stiff):
+    """The values are the sdes' c φ: at rest under its own weight w the moment at an sde at s is w (L - s)^2 / 2
+    (the weight beyond it times its arm), to float32's round-off; the colour bar spans them."""
+    system, beam, q = stiff
+    d = rf.view(system, q=q, color="bending_moment").data
+    w = 7850.0 * 0.02 * 0.005 * 9.81
+    s = beam.frames[1:]
+    np.testing.assert_allclose(_values(d["beams"][0]["values"]), w * (1.0 - s) ** 2 / 2, rtol=1e-5)
+    bar = d["colour_bars"][0]
+    assert bar["label"].startswith("bending moment") and bar["hi"] == pytest.approx(w * (1 - s[0]) ** 2 / 2, rel=1e-6)
+    curvature = _values(rf.view(system, q=q, color="curvature").data["beams"][0]["values"])
+    np.testing.assert_allclose(curvature, w * (1.0 - s) ** 2 / 2 / (2.1e11 * 0.005 * 0.02**3 / 12), rtol=1e-4)
+    with pytest.raises(ValueError, match=r"^color: expected None or one of \['axial_force'"):
+        rf.view(system, q=q, color="stress")
+    with pytest.raises(ValueError, match=r"^color: expected beams with the deformations 'axial_force' reads"):
+        rf.view(system, q=q, color="axial_force")
+
+
+def test_mode_shapes_are_animated_over_a_period():
+    """rf.view(modes): q0 + a sin(2 pi phase) shape at 48 phases, a such that the largest displacement of a body's
+    origin along the shape (to first order) is 10 % of the model's size (1 m); several modes side by side, each
+    labelled by its frequency."""
+    model, _ = rf.samples.cantilever(elements=10)
+    system = model.compile()
+    modes = rf.modal_analysis(system)
+    v = rf.view(modes)
+    assert v.frames == 48 and v.data["clock"] == "phase" and v.data["loop"] and v.data["t"][12] == 0.25
+    shape, eps = modes.shapes[:, 0], 1e-7
+    rate = max(np.linalg.norm(system.transform(i, 0.0, modes.q + eps * shape)[:3, 3]
+                              - system.transform(i, 0.0, modes.q)[:3, 3]) / eps for i in range(system.nbodies))
+    a = v.data["amplitudes"][0]
+    assert a * rate == pytest.approx(0.1, rel=1e-4)
+    poses = _poses(v).astype(float)
+    for k in (12, 30):  # a quarter period, and a phase where the sine is negative
+        T = system.transform(system.nbodies - 1, 0.0, modes.q + a * np.sin(2 * np.pi * k / 48) * shape)
+        np.testing.assert_allclose(poses[k, -1, 9:], T[:3, 3], atol=1e-6)
+    three = rf.view(system, modes, mode=(0, 1, 2))
+    assert [x["label"] for x in three.data["legend"]] == [f"mode {m + 1}: {modes.frequencies_hz[m]:.4g} Hz"
+                                                          for m in range(3)]
+    offsets = [three.data["offset"]] + [x["offset"] for x in three.data["layers"]]
+    assert offsets[0] != offsets[1] != offsets[2]
+    with pytest.raises(ValueError, match=r"^mode: expected an integer in \[0, 9\], got 10"):
+        rf.view(modes, mode=10)
+    with pytest.raises(ValueError, match=r"^scale: expected 1 with modes"):
+        rf.view(modes, scale=10.0)
+
+
+def test_two_results_are_overlaid_at_the_first_ones_times():
+    """A nonlinear and a linear model of Kane's beam (two systems) in one scene: each with its own bodies and poses,
+    the second at its outputs nearest the first's times; named in the legend."""
+    a, b = _kane_pair()
+    v = rf.view([a, b], labels=["nonlinear", "linear"], frames=11)
+    assert v.frames == 11 and len(v.data["layers"]) == 1
+    assert [x["label"] for x in v.data["legend"]] == ["nonlinear", "linear"]
+    second = np.frombuffer(__import__("base64").b64decode(v.data["layers"][0]["poses"]), "<f4").reshape(11, -1, 12)
+    k = np.searchsorted(b.t, v.data["t"][5])
+    T = b.system.transform(b.system.nbodies - 1, b.t[k], b.q[k])
+    np.testing.assert_allclose(second[5, -1, 9:], T[:3, 3], rtol=1e-5, atol=1e-5)
+    side = rf.view(a.system, [a, b], layout="side")
+    assert side.data["offset"] != side.data["layers"][0]["offset"]
+    with pytest.raises(ValueError, match=r"^labels: expected a sequence of 2 names"):
+        rf.view([a, b], labels=["one"])
+
+
+def _kane_pair():
+    runs = []
+    for linear in (False, True):
+        model, _ = rf.samples.kane_beam(omega=2.0, duration=15.0, elements=6, linear=linear)
+        system = model.compile()
+        runs.append(rf.simulate(system, 10.0, t_eval=np.linspace(0.0, 10.0, 51)))
+    return runs
+
+
+def test_ropes_are_coloured_by_their_tension_and_forces_drawn_as_arrows():
+    """The crane's rope carries -element_forces (its tension, N) at each frame; with forces=True its pull on the
+    boom's tip and on the payload are arrows of that size, opposite, along the rope."""
+    system, result, _, _ = _crane()
+    v = rf.view(system, result, forces=True)
+    seg = next(s for s in v.data["segments"] if s["kind"] == "rope")
+    T = -result.element_forces[:, 0]
+    np.testing.assert_allclose(_values(seg["values"]), T, rtol=1e-6)
+    assert v.data["colour_bars"][-1]["label"] == "rope tension T (N)" and v.data["colour_bars"][-1]["hi"] == \
+        pytest.approx(T.max(), rel=1e-6)
+    on = [_values(a["vectors"]).reshape(-1, 3) for a in v.data["arrows"] if a["kind"] == "element"][:2]
+    np.testing.assert_allclose(np.linalg.norm(on[0], axis=1), T, rtol=1e-5)
+    np.testing.assert_allclose(on[0], -on[1], rtol=1e-6)
+    assert v.data["arrow_scale"]["largest"] == pytest.approx(T.max(), rel=1e-6)
+
+
+def test_what_cannot_be_shown_is_named_not_drawn_blank(pendulum_run, tmp_path):
+    """A result with NaN coordinates, one loaded without its system, modes without their system: a ValueError saying
+    which output and coordinate, or what to pass, where the page was blank."""
+    _, system, result = pendulum_run
+    bad = rf.Result(system, result.t, result.q.copy(), result.qd, {}, "rk4")
+    bad.q[4, 0] = np.nan
+    with pytest.raises(ValueError, match=r"^result: expected finite coordinates to show, got nan in 'link\.ry' at "
+                                         r"t = 0\.04 s \(output 4\)"):
+        rf.view(system, bad)
+    with pytest.raises(ValueError, match=r"^result\[1\]: expected finite coordinates"):
+        rf.view([result, bad])
+    with pytest.raises(ValueError, match=r"^q: expected finite coordinates to show, got inf in .link\.ry."):
+        rf.view(system, q=[np.inf])
+    result.to_npz(tmp_path / "run.npz")
+    with pytest.raises(ValueError, match=r"^result: expected a Result with its System for the 3D view"):
+        rf.view(rf.load_npz(tmp_path / "run.npz"))
+    import pickle
+    modes = pickle.loads(pickle.dumps(rf.modal_analysis(system)))
+    with pytest.raises(ValueError, match=r"^system: expected the System the modes are of \(rf\.view\(system, modes\)\)"):
+        rf.view(modes)
+    assert rf.view(system, modes).frames == 48
+    with pytest.raises(ValueError, match=r"^result: expected a Result or a non-empty sequence"):
+        rf.view(system, [])
+
+
+def test_the_picture_shows_deformation_colours_modes_overlays_and_arrows(stiff, tmp_path):
+    """In Chromium: the stiff cantilever at scale 100 spans many more pixel rows than at 1 (its sag shows); coloured
+    by bending moment, its clamped end's colour differs from its free end's; a mode's quarter period differs from
+    its start; two overlaid runs show both palettes; the crane's arrows draw; the snapshot button saves a PNG of the
+    picture."""
+    system, _, q = stiff
+    runs = _kane_pair()
+    crane = _crane()
+    pages = [(rf.view(system, q=q).to_html(tmp_path / "one.html"), "helpers=0&shots=0"),
+             (rf.view(system, q=q, scale=100, color="bending_moment").to_html(tmp_path / "hundred.html"),
+              "helpers=0&shots=0"),
+             (rf.view(rf.modal_analysis(system, q=q), mode=(0, 1)).to_html(tmp_path / "modes.html"),
+              "helpers=0&shots=0,12"),
+             (rf.view(runs, labels=["nonlinear", "linear"]).to_html(tmp_path / "both.html"), "helpers=0&shots=25"),
+             (rf.view(*crane[:2], forces=True, color="bending_moment", scale=20).to_html(tmp_path / "crane.html"),
+              "shots=-1&click=snapshot")]
+    one, hundred, modes, both, crane_state = _open_pages(pages, tmp_path)
+    for state in (one, hundred, modes, both, crane_state):
+        assert "error" not in state, state.get("error")
+    rows = [np.ptp(_box(_ink(_image(s["shot0"])))[:2]) + 1 for s in (one, hundred)]
+    assert rows[1] > 4 * rows[0], rows
+    img = _image(hundred["shot0"])
+    ink = _ink(img)
+    *_, left, right = _box(ink)
+    ends = [img[:, c0:c1][ink[:, c0:c1]].mean(axis=0) for c0, c1 in ((left, left + 12), (right - 12, right + 1))]
+    assert np.linalg.norm(ends[0] - ends[1]) > 100, ends  # yellow (high |M|) at the clamp, purple at the tip
+    assert not np.array_equal(_image(modes["shot0"]), _image(modes["shot1"]))
+    img = _image(both["shot0"]).astype(int)
+    orange = (img[..., 0] > img[..., 1] + 40) & (img[..., 1] > img[..., 2] + 20)
+    teal = (img[..., 1] > img[..., 0] + 40) & (img[..., 2] > img[..., 0] + 30)
+    assert orange.sum() > 20 and teal.sum() > 20, (orange.sum(), teal.sum())
+    assert crane_state.get("snapshots") == "1" and _ink(_image(crane_state["shot0"])).sum() > 1000

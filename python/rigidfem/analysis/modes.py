@@ -196,6 +196,7 @@ def modal_analysis(system, q=None, qd=None, *, t: float = 0.0, sensitivities=Non
         qd = np.zeros(n) if qd is None else _checks.array(qd, (n,), "qd")
         modes.sensitivities = analysis_sensitivities.modal(
             system, names, lambda s: _modal_matrices(s, modes.q, qd, _checks.scalar(t, "t"), modes.basis), _undamped)
+    modes._system = system  # for rf.view(modes) (not a field: not pickled)
     return modes
 
 
