@@ -635,6 +635,81 @@ class Model(_core._Model):
         self._beams.append(beam)
         return beam
 
+    @classmethod
+    def from_urdf(cls, path, flexible: dict | None = None, *, base: str = "fixed",
+                  gravity=(0.0, 0.0, -9.81)) -> Model:
+        """A robot from its URDF file: links as bodies, joints as joints, and the links named in ``flexible`` as
+        beams (``rigidfem.model.urdf`` says how each element of the file is read).
+
+        Parameters
+        ----------
+        path : str or os.PathLike
+            The URDF file (XML; an xacro file must be expanded first). Mesh files are not read.
+        flexible : dict, optional
+            Link name -> a dict of ``add_beam``'s arguments for the beam that replaces it: ``elements``,
+            ``material``, ``section`` (required), ``formulation``, ``deform``, ``linear``, ``tip_mass``,
+            ``tip_inertia``, ``tip_offset``; ``to`` (the child joint at the beam's end; default the farthest)
+            and ``match_mass`` (True: the density set so the beam has the link's mass in the file). The beam
+            runs from the link's joint frame to that joint's origin, its x axis along the link and its z axis
+            along the joint's axis (``bend_z`` bends it in the plane the joint turns in). Its mass and inertia
+            are the material's and section's: the file's inertial of that link is dropped.
+        base : "fixed" or "free"
+            The root link fixed to the ground (default; as Pinocchio's ``buildModelFromUrdf`` without a root
+            joint), or joined to it by ``Joint.free()`` (six coordinates: x, y, z in m, ZYX angles in rad).
+        gravity : (3,) array or None
+            m/s², global frame, as ``Model(gravity=...)``.
+
+        Returns
+        -------
+        Model
+            Bodies named after their links (a flexible link's rfes ``<link>.rfe0 ...``), coordinates in the
+            file's depth-first order of links; ``model.urdf`` (``rigidfem.model.urdf.UrdfModel``) maps the file's
+            links and joints to bodies, frames and coordinate names and lists what was not used (joint limits
+            are not enforced).
+
+        Examples
+        --------
+        >>> import pathlib, tempfile
+        >>> import rigidfem as rf
+        >>> urdf = '''<robot name="arm">
+        ...   <link name="base"/>
+        ...   <joint name="shoulder" type="revolute"><parent link="base"/><child link="arm"/>
+        ...     <axis xyz="0 0 1"/></joint>
+        ...   <link name="arm"><inertial><origin xyz="0.5 0 0"/><mass value="2"/>
+        ...     <inertia ixx="0.01" iyy="0.2" izz="0.2" ixy="0" ixz="0" iyz="0"/></inertial></link>
+        ...   <joint name="elbow" type="revolute"><parent link="arm"/><child link="hand"/>
+        ...     <origin xyz="1 0 0"/><axis xyz="0 0 1"/></joint>
+        ...   <link name="hand"><inertial><mass value="0.5"/>
+        ...     <inertia ixx="1e-3" iyy="1e-3" izz="1e-3" ixy="0" ixz="0" iyz="0"/></inertial></link>
+        ... </robot>'''
+        >>> path = pathlib.Path(tempfile.mkdtemp()) / "arm.urdf"
+        >>> _ = path.write_text(urdf)
+        >>> steel = rf.Material(E=2.1e11, rho=7850.0)
+        >>> model = rf.Model.from_urdf(path, flexible={"arm": dict(elements=4, material=steel,
+        ...                                                        section=rf.Section.tube(0.05, 0.04))})
+        >>> model.urdf.coordinates
+        {'shoulder': ('arm.rfe0.rz',), 'elbow': ('hand.rz',)}
+        >>> model.compile().nq
+        14
+        """
+        from . import urdf
+
+        model = cls(gravity=gravity)
+        model._keep_urdf(urdf.from_urdf(model, path, flexible, base))
+        return model
+
+    @recorded
+    def _keep_urdf(self, description) -> None:
+        """Keep what ``from_urdf`` made of the file (recorded, so a pickled model keeps it)."""
+        self._urdf = description
+
+    @property
+    def urdf(self):
+        """What ``Model.from_urdf`` made of its file (``rigidfem.model.urdf.UrdfModel``: the links' bodies and
+        frames, the joints' coordinates, the flexible links' beams, the visuals, notes); None for a model built
+        in code."""
+        return getattr(self, "_urdf", None)
+
     def compile(self, algorithm: str = "recursive") -> System:
         """Freeze the model into an immutable ``System``.
 
