@@ -62,6 +62,8 @@ html_theme_options = {
 myst_enable_extensions = ["dollarmath", "amsmath"]
 myst_heading_anchors = 3
 nb_execution_mode = "off"  # the notebooks' outputs as committed
+# A widget's HTML fallback before its view: the site runs no widget manager (rf.view(...).widget() shows its page)
+nb_mime_priority_overrides = [("html", "text/html", 5)]
 
 autosummary_generate = True
 autodoc_default_options = {"members": True, "undoc-members": False}
@@ -169,7 +171,20 @@ def _copy_notebook_files(app, exc) -> None:
         shutil.copyfile(nb, out / nb.name)
 
 
+def _write_viewer_pages(app, exc) -> None:
+    """The gallery's 3D pages (docs/viewer_gallery.py) into the site's viewer/ folder."""
+    if exc is not None or app.builder.format != "html":
+        return
+    sys.path.insert(0, str(HERE))
+    try:
+        import viewer_gallery
+    finally:
+        sys.path.remove(str(HERE))
+    viewer_gallery.write(Path(app.outdir) / "viewer")
+
+
 def setup(app):
+    app.connect("build-finished", _write_viewer_pages)
     app.connect("autodoc-process-docstring", _escape_bars)
     app.connect("html-page-context", _download_link)
     app.connect("build-finished", _copy_notebook_files)

@@ -172,3 +172,16 @@ def test_the_citation_file_names_the_package_and_the_book():
     assert cff["authors"] == [{"name": "rigidfem developers"}]
     (book,) = cff["references"]
     assert book["type"] == "book" and book["year"] == 2006 and "Rigid Finite Element Method" in book["title"]
+
+
+def test_the_gallery_embeds_the_viewers_standalone_pages(site):
+    """The site's gallery shows pages of rf.view (written by the build from docs/viewer_gallery.py) in iframes, each
+    page in the site, self-contained (its three.js inline), and the notebooks that show the viewer carry its page."""
+    gallery = (site / "gallery.html").read_text(encoding="utf-8")
+    shown = re.findall(r'<iframe src="(viewer/\w+\.html)"', gallery)
+    assert len(shown) == 4, shown
+    for page in shown:
+        body = (site / page).read_text(encoding="utf-8")
+        assert "window.RIGIDFEM" in body and "REVISION" in body, page
+    for nb in ("06_offshore_crane", "09_cantilever_frequencies", "11_kane", "12_whippy_beam"):
+        assert "<iframe srcdoc=" in (site / "notebooks" / f"{nb}.html").read_text(encoding="utf-8"), nb

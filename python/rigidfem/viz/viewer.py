@@ -788,9 +788,6 @@ def _scene(layers, trails, title, up, scale, color, forces, layout, kind) -> dic
         up = -g / np.linalg.norm(g) if np.linalg.norm(g) > 0 else np.array([0.0, 0.0, 1.0])
     shown = [_layer_scene(layer, None, scale) for layer in layers]
     size0 = _extent(layers[0]["system"], shown[0]["poses"][0].astype(float))
-    for s in shown:  # tubes and triads at the first layer's size
-        for beam, b in zip(s["beams"], getattr(layers[0]["system"], "_beams", ())):
-            beam["radius"] = _radius(layers[0]["system"], beam["bodies"], size0)
     trail_rows = [dict(zip(("body", "r"), _point(p))) for p in trails]
     arrows = [_arrows(layer, s["poses"], s["segments"]) if forces else [] for layer, s in zip(layers, shown)]
     biggest = max([float(np.max(np.linalg.norm(a["vectors"], axis=1), initial=0.0)) for arr in arrows for a in arr],
@@ -808,14 +805,18 @@ def _scene(layers, trails, title, up, scale, color, forces, layout, kind) -> dic
             offsets[k] = r * (x - float((p @ r).min()))
             x += widths[k] + gap
     every = np.concatenate([p + o for p, o in zip(points, offsets)])
-    framing = _framing(every, up) if len(shown) > 1 else framing
-    if layout == "side" and len(shown) > 1:  # the same view, the extents of all the layers
-        framing = _reframed(every, framing)
+    framing = _framing(every, up) if len(shown) > 1 and layout != "side" else framing
+    triad = np.vstack([np.zeros((1, 3)), 0.1 * size0 * np.eye(3)])  # the global triad (viewer.js): seen, not aimed at
+    every = np.vstack([every, triad])
+    framing = _reframed(every, framing)
     grid = _grid(every, framing)
     corners = [np.asarray(grid["origin"]) + x * np.asarray(grid["a"]) + y * np.asarray(grid["b"])
                for x in grid["range"][:2] for y in grid["range"][2:]]
     framing = _reframed(np.vstack([every, corners]), framing)  # the grid in the picture too
     size = float(np.linalg.norm(np.asarray(framing["hi"]) - np.asarray(framing["lo"]))) or 1e-3
+    for layer, s in zip(layers, shown):  # tubes visible at the size of the whole scene
+        for beam in s["beams"]:
+            beam["radius"] = _radius(layer["system"], beam["bodies"], 0.5 * size)
     data = {"title": title, "t": [float(x) for x in (layers[0].get("phase", layers[0]["t"]))],
             "clock": "phase" if kind == "modes" else "t", "loop": kind == "modes",
             "rate": 0.5 if kind == "modes" else 1.0, "size": size, "scene_size": size0,

@@ -342,10 +342,12 @@
     const a = document.createElement("a");
     a.href = snapshot();
     a.download = (D.title || "rigidfem").replace(/[^\w.-]+/g, "_") + "_" + frame + ".png";
+    status.snapshots = (+status.snapshots || 0) + 1;
+    status.snapshot = a.download + " " + a.href.slice(0, 22);
+    if (hash.get("download") === "0") return;  // #download=0: the file prepared, not saved (tests)
     document.body.appendChild(a);
     a.click();
     a.remove();
-    status.snapshots = (+status.snapshots || 0) + 1;
   });
 
   // the pixels of the picture: how many differ from the background, and a hash of them (tests)
@@ -372,7 +374,8 @@
   });
 
   // #frame=K or #t=T picks the frame shown first (links, tests); #probe=1 records the pixels; #shots=0,10,-1
-  // records the snapshots of those frames (-1: the last) in data-shot0, data-shot1, ...
+  // records the snapshots of those frames (-1: the last) in data-shot0, data-shot1, ...; #click=snapshot presses
+  // the snapshot button
   resize();
   let first = 0;
   if (hash.has("frame")) first = +hash.get("frame");
