@@ -233,3 +233,19 @@ def test_a_chirp_sweeps_its_frequency_with_exact_rates():
         motion.chirp(A, 1.0, -1.0, T)
     with pytest.raises(ValueError, match="^duration: expected a positive time in s"):
         motion.chirp(A, 1.0, 2.0, 0.0)
+
+
+def test_sample_evaluates_many_times_in_one_call():
+    # a spline's (q, q̇, q̈) at many times, against the same profile called at each time, and the spin-up's closed form
+    knots = np.linspace(0.0, 2.0, 9)
+    profiles = [motion.spline(knots, np.sin(3.0 * knots)), motion.spin_up(6.0, 15.0)]
+    times = np.linspace(-0.5, 3.0, 37)
+    for p in profiles:
+        rows = p.sample(times)
+        assert rows.shape == (len(times), 3)
+        np.testing.assert_array_equal(rows, np.array([p(t) for t in times]))
+    W, T, t = 6.0, 15.0, times[times > 0.0]
+    theta = W / T * (t**2 / 2 + (T / (2 * math.pi)) ** 2 * (np.cos(2 * math.pi * t / T) - 1))
+    np.testing.assert_allclose(profiles[1].sample(t)[:, 0], theta, rtol=1e-12, atol=1e-15)
+    with pytest.raises(ValueError, match="times"):
+        profiles[0].sample(np.array([0.0, np.nan]))

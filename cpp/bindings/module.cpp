@@ -162,6 +162,18 @@ void bind_profiles(py::module_& m) {
             return py::make_tuple(s.q, s.qd, s.qdd);
           },
           py::arg("t"), "(q, qd, qdd) at time t (s).")
+      .def(
+          "sample",
+          [](const Profile& p, const Eigen::Ref<const VecX>& times) {
+            MatX out(times.size(), 3);
+            for (Eigen::Index k = 0; k < times.size(); ++k) {
+              if (!std::isfinite(times(k))) bad("times", "finite times in s", num(times(k)));
+              const MotionState s = p.at(times(k));
+              out.row(k) << s.q, s.qd, s.qdd;
+            }
+            return out;
+          },
+          py::arg("times"), "(q, qd, qdd) at each of the times (s): an array (len(times), 3), one call for many.")
       .def("__repr__", [](const Profile& p) { return "<rigidfem motion " + p.describe() + ">"; })
       .def(
           "__reduce__",

@@ -33,17 +33,51 @@ std::vector<double> grid(double t0, double t_end, double dt) {
   return t;
 }
 
+/// The reverse mode's products r(z_i) of the vectors z_i a GMRES solve applied its operator to: its solution is
+/// x = Σ y_i z_i (Gmres::combination), so r(x) = Σ y_i r(z_i) costs no further product.
+class KeptProducts {
+ public:
+  void clear() { count_ = 0; }
+  void keep(const ResidualVjp& r) {
+    if (count_ == kept_.size()) kept_.push_back(r);
+    else kept_[count_] = r;  // the vectors keep their storage
+    ++count_;
+  }
+  /// sum() = Σ y_i r(z_i); false when y is not one coefficient per product kept.
+  bool combine(const VecX& y) {
+    if (static_cast<std::size_t>(y.size()) != count_ || count_ == 0) return false;
+    sum_ = kept_[0];
+    for (VecX* v : {&sum_.q, &sum_.qd, &sum_.qdd, &sum_.pq, &sum_.pqd, &sum_.pqdd}) v->setZero();
+    for (std::size_t i = 0; i < count_; ++i) {
+      const ResidualVjp& r = kept_[i];
+      sum_.q += y(i) * r.q, sum_.qd += y(i) * r.qd, sum_.qdd += y(i) * r.qdd;
+      sum_.pq += y(i) * r.pq, sum_.pqd += y(i) * r.pqd, sum_.pqdd += y(i) * r.pqdd;
+    }
+    return true;
+  }
+  const ResidualVjp& sum() const { return sum_; }
+
+ private:
+  std::vector<ResidualVjp> kept_;
+  std::size_t count_ = 0;
+  ResidualVjp sum_;
+};
+
 /// What both methods' transposes share: the reverse mode at a state, and GMRES on a transposed Newton matrix
 /// with a preconditioner kept while it converges in a few iterations.
 class Transposes : public AdjointSteps {
  public:
   Transposes(const System& sys, const IntegratorOptions& o, ParameterVjp& params)
-      : sys_(sys), params_(params), d_(sys), e_(sys), matrix_(NewtonMatrix::make(sys, o, istats_)) {}
+      : sys_(sys), params_(params), d_(sys), e_(sys), transpose_(sys), matrix_(NewtonMatrix::make(sys, o, istats_)) {}
 
   void start(double t0, const VecX& q0, const VecX& qd0) override {
     VecX y0(2 * sys_.nq);
     y0 << q0, qd0;
     stepper().start(t0, y0);
+  }
+  const Data& at_end(const StepRecord& end) override {
+    at(end.t, end.q, end.v, end.qdd);
+    return d_;
   }
   void step(double t, double h) override {
     double err = 0.0;
@@ -77,7 +111,8 @@ class Transposes : public AdjointSteps {
   ResidualVjp vjp(double t, const Eigen::Ref<const VecX>& q, const Eigen::Ref<const VecX>& v,
                   const Eigen::Ref<const VecX>& a, const VecX& mu) {
     at(t, q, v, a);
-    return rnea_vector_jacobian_product(sys_, d_, mu);
+    transpose_.prepare(d_);
+    return transpose_.apply(d_, mu);
   }
   /// x with S x = b by GMRES to 1e-11 (S, P as Gmres takes them), the preconditioner refreshed by `refresh` first
   /// when the last solve took more iterations than refresh_above_.
@@ -98,6 +133,9 @@ class Transposes : public AdjointSteps {
   const System& sys_;
   ParameterVjp& params_;
   Data d_, e_;  // the state's, and the loops' equations'
+  ResidualTranspose transpose_;  // the reverse mode at d_'s state, prepared once per state
+  KeptProducts kept_;            // the reverse mode's products of one GMRES solve
+  VecX y_;                       // its combination
   IntegratorStats istats_;
   std::unique_ptr<NewtonMatrix> matrix_;
   Gmres<double> gmres_;
@@ -130,12 +168,15 @@ class NewmarkSteps final : public Transposes {
     const double h = s.h, z = (1.0 - k_.af) / (1.0 - k_.am), c1 = k_.gamma * z * h, c2 = k_.beta * z * h * h;
     auto qb = bars.segment(0, n), vb = bars.segment(n, n), ab = bars.segment(2 * n, n), zb = bars.segment(3 * n, n);
     const VecX g = zb + z * (ab + (k_.beta * h * h) * qb + (k_.gamma * h) * vb);
-    // Sᵀ μ = g, Sᵀv = M v + c₁ Cᵀ v + c₂ Kᵀ v by the reverse mode at the step's end
-    at(s.t, s.q, s.v, s.qdd);
+    // Sᵀ μ = g, Sᵀv = M v + c₁ Cᵀ v + c₂ Kᵀ v by the reverse mode at the step's end (d_: at_end)
+    transpose_.prepare(d_);
     const bool loops = sys_.nl > 0;
     // A₁₁ᵀv = M v + c₁ Cᵀ v + c₂ (Kᵀ v − H v), H = ∂(Gᵀλ)/∂q (symmetric) with loops
+    bool keep = !loops;  // the products of μ's own solve, whose combination is r(μ) (no loops: μ is that solve's)
+    kept_.clear();
     auto S = [&](const VecX& v, VecX& out) {
-      const ResidualVjp r = rnea_vector_jacobian_product(sys_, d_, v);
+      const ResidualVjp& r = transpose_.apply(d_, v);
+      if (keep) kept_.keep(r);
       out = r.qdd + c1 * r.qd + c2 * r.q;
       if (loops) out -= c2 * hessian(s.t, s.q, s.v, s.lambda, v);
     };
@@ -146,6 +187,7 @@ class NewmarkSteps final : public Transposes {
         throw SimulationError(s.t, "the adjoint's Newton matrix M + γh C + βh² K is singular");
     };
     VecX mu = gmres(S, P, g, refresh, s.t);
+    keep = false;
     VecX nu, loop_q;
     if (loops) {  // the saddle system by its Schur complement: μ = x − Y ν, Y = A₁₁⁻ᵀ (c₂ Gᵀ), (G Y) ν = G x
       loop_equations(sys_, e_, s.t, s.q, s.v);
@@ -156,7 +198,8 @@ class NewmarkSteps final : public Transposes {
       mu -= Y * nu;
       loop_q = G.transpose() * nu - hessian(s.t, s.q, s.v, s.lambda, mu);
     }
-    const ResidualVjp r = rnea_vector_jacobian_product(sys_, d_, mu);  // d_ still at the step's end (GMRES's products)
+    // r(μ) = Σ y_i r(z_i) of GMRES's products, or one more product (d_ still at the step's end)
+    const ResidualVjp& r = !loops && gmres_.combination(y_) && kept_.combine(y_) ? kept_.sum() : transpose_.apply(d_, mu);
     const VecX qh = loops ? VecX(qb - r.q - loop_q) : VecX(qb - r.q), vh = vb - r.qd;
     const VecX A = ab + (k_.beta * h * h) * qh + (k_.gamma * h) * vh;
     qb = qh;
@@ -507,13 +550,11 @@ void Adjoint::replay(long first, long last, std::vector<StepRecord>& states) {
   }
 }
 
-void Adjoint::output_vjp(const StepRecord& s, const VecX& ybar, Eigen::Ref<VecX> qbar, VecX& grad) {
+void Adjoint::output_vjp(const Data& d, const VecX& ybar, Eigen::Ref<VecX> qbar, VecX& grad) {
   const System& sys = *sys_;
-  set_state(sys, d_, s.t, s.q, s.v);
-  tree_kinematics(sys, d_);
   VecX pbar = VecX::Zero(sys.np);
-  objective_outputs_vjp(sys, d_, outputs_, ybar, qbar, pbar);
-  if (sys.np > 0) params_->add_prescribed(s.t, pbar, grad);
+  objective_outputs_vjp(sys, d, outputs_, ybar, qbar, pbar);
+  if (sys.np > 0) params_->add_prescribed(d.t, pbar, grad);
 }
 
 VecX Adjoint::backward(const Eigen::Ref<const RowMatX>& ybar) {
@@ -535,13 +576,14 @@ VecX Adjoint::backward(const Eigen::Ref<const RowMatX>& ybar) {
     for (long m = last; m > first; --m) {
       interruption_point();
       const StepRecord& s = states[m - first];
-      output_vjp(s, ybar.row(m).transpose(), bars.head(n), grad);  // the objective at t_m
-      steps_->transpose(s, bars, grad);                               // the step m−1 → m
+      const Data& d = steps_->at_end(s);
+      output_vjp(d, ybar.row(m).transpose(), bars.head(n), grad);  // the objective at t_m
+      steps_->transpose(s, bars, grad);                            // the step m−1 → m
     }
     last = first;
   }
   const StepRecord& s0 = checkpoints_[0];
-  output_vjp(s0, ybar.row(0).transpose(), bars.head(n), grad);
+  output_vjp(steps_->at_end(s0), ybar.row(0).transpose(), bars.head(n), grad);
   steps_->transpose_start(s0, bars, grad);
   q0bar_ = bars.head(n), qd0bar_ = bars.segment(n, n);
   for (int j = 0; j < P; ++j) grad(j) += initial_.col(j).head(n).dot(q0bar_) + initial_.col(j).tail(n).dot(qd0bar_);

@@ -58,7 +58,8 @@ void objective_outputs_vjp(const System& sys, const Data& d, const std::vector<O
 
 ParameterVjp::ParameterVjp(const System& sys, const std::vector<SensitivityParameter>& parameters)
     : sys_(sys), parameters_(parameters), touched_(parameters.size()), whole_(parameters.size(), false),
-      V_(sys.nbodies),
+      V_(sys.nbodies), inertia_rates_(parameters.size()), rated_(sys.nbodies, 0), Vl_(sys.nbodies), al_(sys.nbodies),
+      vl_(sys.nbodies), yl_(sys.nbodies),
       base_{std::vector<double>(sys.nbodies), std::vector<double>(sys.nc), std::vector<double>(sys.elements.size()),
             std::vector<double>(sys.loads.size()), std::vector<double>()} {
   for (std::size_t j = 0; j < parameters_.size(); ++j) {
@@ -97,6 +98,21 @@ ParameterVjp::ParameterVjp(const System& sys, const std::vector<SensitivityParam
         for (const Component& c : touched)
           if (c.kind == Component::Body && c.index >= F.first && c.index <= F.first + F.elements) whole_[j] = true;
       }
+    }
+    for (Component& c : touched_[j])
+      if (c.kind == Component::Drive) c.slot = static_cast<int>(rates_.size()), rates_.emplace_back();
+    rated_at_t_.assign(rates_.size(), 0);
+    if (whole_[j]) continue;
+    // the bodies' inertias moved by p_j: İ = (I(p + h) − I(p ∓ h)) / (2h or h) in each body's frame
+    const SensitivityParameter& p = parameters_[j];
+    for (const Component& c : touched_[j]) {
+      if (c.kind != Component::Body) continue;
+      const int b = c.index;
+      auto inertia = [b](const System& X) { return spatial_inertia(X.mass[b], X.com[b], X.inertia[b]); };
+      const Mat6 rate = p.minus ? Mat6((inertia(*p.plus) - inertia(*p.minus)) / (2.0 * p.h))
+                                : Mat6((inertia(*p.plus) - inertia(sys)) / p.h);
+      inertia_rates_[j].push_back({b, rate});
+      rated_[b] = 1;
     }
   }
 }
@@ -150,6 +166,15 @@ MotionState ParameterVjp::drive_derivative(int j, int coord, double t) const {
   return {(up.q - down.q) / h, (up.qd - down.qd) / h, (up.qdd - down.qdd) / h};
 }
 
+const MotionState& ParameterVjp::drive_rate(int j, const Component& c, double t) {
+  if (!(t == rates_t_)) {
+    rates_t_ = t;
+    std::fill(rated_at_t_.begin(), rated_at_t_.end(), 0);
+  }
+  if (!rated_at_t_[c.slot]) rates_[c.slot] = drive_derivative(j, c.index, t), rated_at_t_[c.slot] = 1;
+  return rates_[c.slot];
+}
+
 double ParameterVjp::residual_power(const System& X, const Data& d, const VecX& mu) {
   if (!e_) e_ = std::make_unique<Data>(sys_);
   VecX q(sys_.nq), qd(sys_.nq), qdd(sys_.nq);
@@ -170,6 +195,19 @@ void ParameterVjp::add(const Data& d, const VecX& mu, const ResidualVjp& r, doub
     for (int u = sys_.use_start[b]; u < sys_.use_start[b + 1]; ++u)
       if (sys_.use_q[u] >= 0) V_[b] += d.axes[u] * mu(sys_.use_q[u]);
   }
+  // V̂, â, v̂ and ŷ = −v̂ ×m V̂ in each rated body's frame: (ω, v_O) ↦ (Rᵀω, Rᵀ(v_O + ω × o)), o its origin
+  for (int b = 0; b < sys_.nbodies; ++b) {
+    if (!rated_[b]) continue;
+    const Mat3 Rt = d.T[b].topLeftCorner<3, 3>().transpose();
+    const Vec3 o = d.T[b].topRightCorner<3, 1>();
+    auto local = [&](const Vec6& m) {
+      Vec6 x;
+      x << Rt * m.head<3>(), Rt * (m.tail<3>() + m.head<3>().cross(o));
+      return x;
+    };
+    Vl_[b] = local(V_[b]), al_[b] = local(d.a[b]), vl_[b] = local(d.v[b]);
+    yl_[b] = -crossm(vl_[b], Vl_[b]);
+  }
   const double t = d.t;
   for (auto& cache : base_) std::fill(cache.begin(), cache.end(), std::numeric_limits<double>::quiet_NaN());
   double base = std::numeric_limits<double>::quiet_NaN();  // μᵀr of the run's system, for whole differences
@@ -183,11 +221,13 @@ void ParameterVjp::add(const Data& d, const VecX& mu, const ResidualVjp& r, doub
       continue;
     }
     double sum = 0.0;
+    for (const InertiaRate& r : inertia_rates_[j])
+      sum += Vl_[r.body].dot(r.rate * al_[r.body]) + yl_[r.body].dot(r.rate * vl_[r.body]);
     for (const Component& c : touched_[j]) {
-      if (c.kind == Component::Actuator) continue;
+      if (c.kind == Component::Actuator || c.kind == Component::Body) continue;
       if (c.kind == Component::Drive) {  // the reverse mode's ∂(μᵀr)/∂ of the prescribed coordinate's motion
         const int k = sys_.coords[c.index].drive_index;
-        const MotionState dp = drive_derivative(static_cast<int>(j), c.index, t);
+        const MotionState& dp = drive_rate(static_cast<int>(j), c, t);
         sum += r.pq(k) * dp.q + r.pqd(k) * dp.qd + r.pqdd(k) * dp.qdd;
       } else if (p.minus) {
         sum += (power(*p.plus, d, c, mu) - power(*p.minus, d, c, mu)) / (2.0 * p.h);
@@ -224,11 +264,11 @@ void ParameterVjp::add_projection(double t, const VecX& q, const VecX& qd, const
   }, grad);
 }
 
-void ParameterVjp::add_prescribed(double t, const VecX& pbar, Eigen::Ref<VecX> grad) const {
+void ParameterVjp::add_prescribed(double t, const VecX& pbar, Eigen::Ref<VecX> grad) {
   for (std::size_t j = 0; j < parameters_.size(); ++j)
     for (const Component& c : touched_[j])
       if (c.kind == Component::Drive)
-        grad(j) += pbar(sys_.coords[c.index].drive_index) * drive_derivative(static_cast<int>(j), c.index, t).q;
+        grad(j) += pbar(sys_.coords[c.index].drive_index) * drive_rate(static_cast<int>(j), c, t).q;
 }
 
 }  // namespace rigidfem

@@ -147,7 +147,11 @@ struct LoadTerms {
   std::vector<FlowTerm> flows;
   std::vector<ContactForce> contacts;
   std::vector<Eigen::Matrix<double, 6, 24>> contact_J;
-  LoadTerms(const System& sys, const Data& d) {
+  LoadTerms() = default;
+  LoadTerms(const System& sys, const Data& d) { at(sys, d); }
+  /// The terms at the state of d (the vectors keep their capacity).
+  void at(const System& sys, const Data& d) {
+    loads.clear(), elements.clear(), flows.clear(), contacts.clear(), contact_J.clear();
     for_each_body_load(sys, d, true, [&](int body, const AppliedLoad& a, bool follower) {
       loads.push_back({body, follower, a});
     });
@@ -272,40 +276,91 @@ VecX rnea_directional_derivative(const System& sys, Data& d, const VecX& dq, con
   return out;
 }
 
-ResidualVjp rnea_vector_jacobian_product(const System& sys, Data& d, const VecX& mu) {
+// What the reverse mode reads of a state, whatever μ: the loads' and elements' states and their laws'
+// derivatives, each free coordinate's own stiffness and damping and its axis's moment s_u ×* f̄_b, each use's
+// velocity before it and v ×m s_u, each body's I v and I a.
+struct ResidualTranspose::Prepared {
+  struct Law {
+    ExtensionDerivatives F, P;  // the element's law and, for a wound rope, its pull
+    Vec3 g_half;                // ½ λ μ g of a heavy rope
+  };
+  LoadTerms terms;
+  std::vector<Law> laws;            // per element
+  VecX k_own, c_own;                // (nq) ∂Q/∂q, ∂Q/∂q̇ of each free coordinate's own laws
+  std::vector<Vec6> s_f;            // (nq) s_u ×* f̄_b of the coordinate's use
+  std::vector<Vec6> v_before, v_s;  // (nuses) the velocity before each use, and v ×m s_u
+  std::vector<Vec6> Iv, Ia;         // (nbodies)
+  std::vector<Vec6> G, Wu, H, Wb, vb, ab;  // the sweeps' adjoints (buffers)
+};
+
+ResidualTranspose::ResidualTranspose(const System& sys) : sys_(sys), p_(std::make_unique<Prepared>()) {
+  Prepared& p = *p_;
+  const int nb = sys.nbodies;
+  p.laws.resize(sys.elements.size());
+  p.k_own.resize(sys.nq), p.c_own.resize(sys.nq), p.s_f.resize(sys.nq);
+  p.v_before.resize(sys.nuses), p.v_s.resize(sys.nuses), p.Wu.resize(sys.nuses);
+  for (auto* x : {&p.Iv, &p.Ia, &p.G, &p.H, &p.Wb, &p.vb, &p.ab}) x->resize(nb);
+  out_ = {VecX(sys.nq), VecX(sys.nq), VecX(sys.nq), VecX(sys.np), VecX(sys.np), VecX(sys.np)};
+}
+
+ResidualTranspose::~ResidualTranspose() = default;
+
+void ResidualTranspose::prepare(Data& d) {
+  const System& sys = sys_;
+  Prepared& p = *p_;
   spatial_kinematics(sys, d);
   rnea_pass(sys, d);
-  const LoadTerms terms(sys, d);
-  ResidualVjp out{VecX::Zero(sys.nq), VecX::Zero(sys.nq), VecX::Zero(sys.nq),
-                  VecX::Zero(sys.np), VecX::Zero(sys.np), VecX::Zero(sys.np)};
-  const int nb = sys.nbodies;
-  // the velocity before each use (the forward pass's state)
-  std::vector<Vec6> v_before(sys.nuses);
-  for (int p = 0; p < nb; ++p) {
-    Vec6 v = sys.parent[p] >= 0 ? d.v[sys.parent[p]] : Vec6::Zero();
-    for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) v_before[u] = v, v += d.axes[u] * d.qda(sys.use_coord[u]);
+  p.terms.at(sys, d);
+  for (std::size_t k = 0; k < sys.elements.size(); ++k) {
+    const ForceElement& E = sys.elements[k];
+    const ElementState& st = p.terms.elements[k];
+    p.laws[k].F = E.law->derivatives(d.t, st.extension(), d.load_factor);
+    if (!E.windings.empty()) p.laws[k].P = E.law->pull_derivatives(d.t, st.extension());
+    p.laws[k].g_half = 0.5 * d.load_factor * E.law->span_mass_rate() * sys.gravity;
   }
-  // δr_k = s_uᵀ δf̄_b + (W_before ×m s_u)ᵀ f̄_b + passive: the adjoint G of each subtree sum and of each W_before
-  std::vector<Vec6> G(nb, Vec6::Zero()), Wu(sys.nuses, Vec6::Zero());
   for (int k = 0; k < sys.nq; ++k) {
     const int i = sys.free_coords[k], b = sys.coords[i].body, u = sys.q_use[k];
     const Coordinate& c = sys.coords[i];
-    G[b] += d.axes[u] * mu(k);
-    Wu[u] += mu(k) * crossf(d.axes[u], d.sf[b]);  // (W ×m s)·f = W·(s ×* f)
-    const auto [k_own, c_own] = c.spring.derivatives(d.spring_scale(i));
-    out.q(k) -= k_own * mu(k);
-    out.qd(k) -= c_own * mu(k);
+    std::tie(p.k_own(k), p.c_own(k)) = c.spring.derivatives(d.spring_scale(i));
     if (!c.laws.empty()) {
       const auto [dQ_dq, dQ_dqd] = coordinate_derivatives(sys, d, i);
-      out.q(k) -= dQ_dq * mu(k);
-      out.qd(k) -= dQ_dqd * mu(k);
+      p.k_own(k) += dQ_dq, p.c_own(k) += dQ_dqd;
     }
+    p.s_f[k] = crossf(d.axes[u], d.sf[b]);  // (W ×m s)·f = W·(s ×* f)
+  }
+  for (int b = 0; b < sys.nbodies; ++b) {
+    Vec6 v = sys.parent[b] >= 0 ? d.v[sys.parent[b]] : Vec6::Zero();
+    for (int u = sys.use_start[b]; u < sys.use_start[b + 1]; ++u) {
+      p.v_before[u] = v, p.v_s[u] = crossm(v, d.axes[u]);
+      v += d.axes[u] * d.qda(sys.use_coord[u]);
+    }
+    p.Iv[b] = d.I[b] * d.v[b], p.Ia[b] = d.I[b] * d.a[b];
+  }
+}
+
+const ResidualVjp& ResidualTranspose::apply(const Data& d, const VecX& mu) {
+  const System& sys = sys_;
+  Prepared& p = *p_;
+  ResidualVjp& out = out_;
+  for (VecX* x : {&out.q, &out.qd, &out.qdd, &out.pq, &out.pqd, &out.pqdd}) x->setZero();
+  const int nb = sys.nbodies;
+  // δr_k = s_uᵀ δf̄_b + (W_before ×m s_u)ᵀ f̄_b + passive: the adjoint G of each subtree sum and of each W_before
+  std::fill(p.G.begin(), p.G.end(), Vec6::Zero());
+  std::fill(p.Wu.begin(), p.Wu.end(), Vec6::Zero());
+  for (int k = 0; k < sys.nq; ++k) {
+    const int b = sys.coords[sys.free_coords[k]].body, u = sys.q_use[k];
+    p.G[b] += d.axes[u] * mu(k);
+    p.Wu[u] += mu(k) * p.s_f[k];
+    out.q(k) -= p.k_own(k) * mu(k);
+    out.qd(k) -= p.c_own(k) * mu(k);
   }
   // subtree sums transposed: each body's δf meets the adjoints of its own and its ancestors' sums
-  std::vector<Vec6> H(nb);
-  for (int p = 0; p < nb; ++p) H[p] = G[p] + (sys.parent[p] >= 0 ? H[sys.parent[p]] : Vec6::Zero());
+  std::vector<Vec6>&H = p.H, &Wb = p.Wb, &vb = p.vb, &ab = p.ab;
+  for (int b = 0; b < nb; ++b) H[b] = p.G[b] + (sys.parent[b] >= 0 ? H[sys.parent[b]] : Vec6::Zero());
   // adjoints of each body's W, δv and δa at the end of its joint
-  std::vector<Vec6> Wb(nb, Vec6::Zero()), vb(nb, Vec6::Zero()), ab(nb, Vec6::Zero());
+  std::fill(Wb.begin(), Wb.end(), Vec6::Zero());
+  std::fill(vb.begin(), vb.end(), Vec6::Zero());
+  std::fill(ab.begin(), ab.end(), Vec6::Zero());
   auto point_adjoint = [&](int b, const Vec3& x, const Vec3& dx_bar, const Vec3& dvel_bar) {
     if (b < 0) return;
     // dvel = δv_O + δω × x + ω × dx, dx = W_v + W_ω × x
@@ -315,24 +370,25 @@ ResidualVjp rnea_vector_jacobian_product(const System& sys, Data& d, const VecX&
     Wb[b].tail<3>() += dx;
     Wb[b].head<3>() += x.cross(dx);
   };
+  const LoadTerms& terms = p.terms;
   for (std::size_t k = 0; k < terms.elements.size(); ++k) {
     const ForceElement& E = sys.elements[k];
     const ElementState& st = terms.elements[k];
+    const Prepared::Law& law = p.laws[k];
+    const ExtensionDerivatives& F = law.F;
     // δf_b −= (x_b × df, df), δf_a += (x_a × df, df)
     Vec3 df = Vec3::Zero();
     if (E.body_b >= 0) df += st.xb.cross(H[E.body_b].head<3>()) - H[E.body_b].tail<3>();
     if (E.body_a >= 0) df -= st.xa.cross(H[E.body_a].head<3>()) - H[E.body_a].tail<3>();
-    const ExtensionDerivatives F = E.law->derivatives(d.t, st.extension(), d.load_factor);
     // df = (F_l δl + F_l̇ δl̇ + F_s δs + F_ṡ δṡ) e + F δe; δl̇ = δe·(v_b − v_a) + e·δḋ; δl = e·δd;
     // δe = (1 − e eᵀ) δd / l; each free winding's row −r_k (c_k δP + P c_k' δq̇_k) adds −μ_k r_k c_k (P_l, P_l̇, P_s,
     // P_ṡ) to (δl̄, δl̇̄, δs̄, δṡ̄), and δs = Σ r_k δq_k
     const double ed = st.e.dot(df);
     // a heavy rope's weights δw_B = −δw_A = ½ λ μ δs g, and its pull's ½ λ μ g·δd
-    const Vec3 g_half = 0.5 * d.load_factor * E.law->span_mass_rate() * sys.gravity;
-    double dl_bar = F.l * ed, dld_bar = F.ld * ed, s_bar = F.s * ed + g_half.dot(df), sd_bar = F.sd * ed;
+    double dl_bar = F.l * ed, dld_bar = F.ld * ed, s_bar = F.s * ed + law.g_half.dot(df), sd_bar = F.sd * ed;
     double pull_bar = 0.0;  // Σ μ_k r_k c_k
     if (!E.windings.empty()) {
-      const ExtensionDerivatives P = E.law->pull_derivatives(d.t, st.extension());
+      const ExtensionDerivatives& P = law.P;
       for (const Winding& wi : E.windings)
         if (const int k = sys.coords[wi.coord].free_index; k >= 0) {
           const auto [c, dc] = wi.factor(d.qda(wi.coord));
@@ -347,7 +403,7 @@ ResidualVjp rnea_vector_jacobian_product(const System& sys, Data& d, const VecX&
     }
     const Vec3 de_bar = st.F * df + (st.vb - st.va) * dld_bar;
     const Vec3 ddd_bar = st.e * dld_bar;
-    const Vec3 dd_bar = st.e * dl_bar + (de_bar - st.e * st.e.dot(de_bar)) / st.l - pull_bar * g_half;
+    const Vec3 dd_bar = st.e * dl_bar + (de_bar - st.e * st.e.dot(de_bar)) / st.l - pull_bar * law.g_half;
     point_adjoint(E.body_b, st.xb, dd_bar, ddd_bar);
     point_adjoint(E.body_a, st.xa, -dd_bar, -ddd_bar);
   }
@@ -387,36 +443,42 @@ ResidualVjp rnea_vector_jacobian_product(const System& sys, Data& d, const VecX&
     }
   }
   // δf_p = I δa + δv ×* I v + v ×* I δv + δI a + v ×* δI v, δI x = W ×* I x − I (W ×m x), transposed
-  for (int p = 0; p < nb; ++p) {
-    const Mat6& I = d.I[p];
-    const Vec6& h = H[p];
-    const Vec6& v = d.v[p];
-    const Vec6 z = crossm(v, h);
-    ab[p] += I * h;
-    vb[p] += -crossf(h, I * v) - I * z;
-    Wb[p] += -crossf(h, I * d.a[p]) - crossf(d.a[p], I * h) + crossf(z, I * v) + crossf(v, I * z);
+  for (int b = 0; b < nb; ++b) {
+    const Mat6& I = d.I[b];
+    const Vec6& h = H[b];
+    const Vec6& v = d.v[b];
+    const Vec6 z = crossm(v, h), Ih = I * h, Iz = I * z;
+    ab[b] += Ih;
+    vb[b] += -crossf(h, p.Iv[b]) - Iz;
+    Wb[b] += -crossf(h, p.Ia[b]) - crossf(d.a[b], Ih) + crossf(z, p.Iv[b]) + crossf(v, Iz);
   }
   // the forward sweep transposed, leaves to root, each body's uses last to first
-  for (int p = nb - 1; p >= 0; --p) {
-    Vec6 W = Wb[p], dv = vb[p], da = ab[p];
-    for (int u = sys.use_start[p + 1] - 1; u >= sys.use_start[p]; --u) {
+  for (int b = nb - 1; b >= 0; --b) {
+    Vec6 W = Wb[b], dv = vb[b], da = ab[b];
+    for (int u = sys.use_start[b + 1] - 1; u >= sys.use_start[b]; --u) {
       const int i = sys.use_coord[u], k = sys.use_q[u], j = sys.use_drive[u];
       const Vec6& s = d.axes[u];
-      const Vec6& v = v_before[u];
+      const Vec6& v = p.v_before[u];
       const double qd = d.qda(i), qdd = d.qdda(i);
       // W += s δq, δv += δs q̇ + s δq̇, δa += (δv ×m s + v ×m δs) q̇ + δs q̈ + (v ×m s) δq̇ + s δq̈: the adjoints
       // of a free coordinate's (δq, δq̇, δq̈), or of a prescribed one's motion
-      const double wq = s.dot(W), wqd = s.dot(dv) + crossm(v, s).dot(da), wqdd = s.dot(da);
+      const double wq = s.dot(W), wqd = s.dot(dv) + p.v_s[u].dot(da), wqdd = s.dot(da);
       if (k >= 0) out.q(k) += wq, out.qd(k) += wqd, out.qdd(k) += wqdd;
       if (j >= 0) out.pq(j) += wq, out.pqd(j) += wqd, out.pqdd(j) += wqdd;
       Vec6 ds = qd * dv;
       dv += qd * crossf(s, da);
       ds += -qd * crossf(v, da) + qdd * da;
-      W += crossf(s, ds) + Wu[u];                // δs = W ×m s
+      W += crossf(s, ds) + p.Wu[u];  // δs = W ×m s
     }
-    if (sys.parent[p] >= 0) Wb[sys.parent[p]] += W, vb[sys.parent[p]] += dv, ab[sys.parent[p]] += da;
+    if (sys.parent[b] >= 0) Wb[sys.parent[b]] += W, vb[sys.parent[b]] += dv, ab[sys.parent[b]] += da;
   }
   return out;
+}
+
+ResidualVjp rnea_vector_jacobian_product(const System& sys, Data& d, const VecX& mu) {
+  ResidualTranspose transpose(sys);
+  transpose.prepare(d);
+  return transpose.apply(d, mu);
 }
 
 std::pair<MatX, MatX> rnea_derivatives(const System& sys, Data& d) {

@@ -40,6 +40,8 @@
 /// states, one extra forward run's work.
 #pragma once
 
+#include <limits>
+
 #include <memory>
 #include <vector>
 
@@ -74,7 +76,7 @@ class ParameterVjp {
   /// coordinates' motion: a drive's numbers).
   void add(const Data& d, const VecX& mu, const ResidualVjp& r, double w, Eigen::Ref<VecX> grad);
   /// grad_j += pbarᵀ ∂q_p(t)/∂p_j: the prescribed coordinates' values moved by a drive's numbers.
-  void add_prescribed(double t, const VecX& pbar, Eigen::Ref<VecX> grad) const;
+  void add_prescribed(double t, const VecX& pbar, Eigen::Ref<VecX> grad);
   /// Closed loops: grad_j −= [μᵀ ∂(−Gᵀλ)/∂p_j + νᵀ ∂c/∂p_j] for the parameters that move a drive (the loops' terms
   /// see the prescribed coordinates), c = g(q, t) (`acceleration` false) or G q̈ − γ (true), by central differences
   /// of the systems at p ± h at (t, q, q̇, q̈, λ).
@@ -91,7 +93,8 @@ class ParameterVjp {
  private:
   struct Component {
     enum Kind { Body, Coordinate, Element, Load, Drive, Actuator } kind;
-    int index;  // body, coordinate (in coords), element, load, loop (an actuator's: only in g, G, γ)
+    int index;      // body, coordinate (in coords), element, load, loop (an actuator's: only in g, G, γ)
+    int slot = -1;  // a Drive's: its place among all parameters' Drive components (drive_rate)
   };
   double power(const System& X, const Data& d, const Component& c, const VecX& mu) const;
   double residual_power(const System& X, const Data& d, const VecX& mu);  // μᵀ r of X at the state of d
@@ -110,12 +113,28 @@ class ParameterVjp {
   }
   double base_power(const Data& d, const Component& c, const VecX& mu);
   MotionState drive_derivative(int j, int coord, double t) const;
+  /// drive_derivative of a Drive component at t, kept while t stays (the objective's outputs and the step's end ask
+  /// at the same t).
+  const MotionState& drive_rate(int j, const Component& c, double t);
   const System& sys_;
   std::vector<SensitivityParameter> parameters_;
   std::vector<std::vector<Component>> touched_;  // per parameter
   std::vector<bool> whole_;                       // per parameter: μᵀr differenced whole (links of varying length)
   std::vector<Vec6> V_;                           // (nbodies) V_b = Σ s_u μ_u along the path
   std::vector<double> base_[5];                   // per kind of component in r: its power on the run's system, or NaN
+  /// A body's part of μᵀr, V_bᵀ(I_b a_b + v_b ×* I_b v_b) = V̂ᵀ I a + ŷᵀ I v with ŷ = −v ×m V, is linear in its spatial
+  /// inertia I_b, constant in the body's own frame (^: about its origin, in its axes): a parameter's part is
+  /// V̂ᵀ İ â + ŷᵀ İ v̂ with İ = ∂I_b/∂p_j, differenced once when the parameters are set.
+  struct InertiaRate {
+    int body;
+    Mat6 rate;  // İ in the body's frame
+  };
+  std::vector<std::vector<InertiaRate>> inertia_rates_;  // per parameter
+  std::vector<char> rated_;                              // per body: some parameter moves its inertia
+  std::vector<Vec6> Vl_, al_, vl_, yl_;                  // per rated body: V̂, â, v̂, ŷ at the state
+  double rates_t_ = std::numeric_limits<double>::quiet_NaN();  // the time of the drive rates kept
+  std::vector<MotionState> rates_;                             // per Drive component (its slot)
+  std::vector<char> rated_at_t_;                               // per slot: kept at rates_t_
   std::unique_ptr<Data> e_;                       // the loops' terms on the systems at p ± h (same sizes)
 };
 
@@ -147,7 +166,11 @@ class AdjointSteps {
   virtual StepRecord record(double t, double h) const = 0;
   virtual void restore(const StepRecord& r) = 0;
   virtual int adjoint_size() const = 0;
-  /// The adjoint state at a step's end (its record `end`) into the one at its start; grad += its parameters' part.
+  /// The state at a step's end (q, q̇, q̈ and the frames), on the Data it returns: what the objective's outputs and
+  /// transpose read.
+  virtual const Data& at_end(const StepRecord& end) = 0;
+  /// The adjoint state at a step's end (its record `end`, after at_end(end)) into the one at its start; grad += its
+  /// parameters' part.
   virtual void transpose(const StepRecord& end, VecX& bars, VecX& grad) = 0;
   /// At t0: what the start (q̈_0 from the dynamics) adds; bars keeps (q̄_0, q̇̄_0) in front.
   virtual void transpose_start(const StepRecord& start, VecX& bars, VecX& grad) = 0;
@@ -174,7 +197,7 @@ class Adjoint {
 
  private:
   void replay(long first, long last, std::vector<StepRecord>& states);
-  void output_vjp(const StepRecord& s, const VecX& ybar, Eigen::Ref<VecX> qbar, VecX& grad);
+  void output_vjp(const Data& d, const VecX& ybar, Eigen::Ref<VecX> qbar, VecX& grad);  // at d's state
 
   std::shared_ptr<const System> sys_;
   IntegratorOptions o_;

@@ -12,6 +12,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <memory>
 #include <utility>
 
 #include "rigidfem/recursive.hpp"
@@ -49,5 +50,23 @@ struct ResidualVjp {
   VecX pq, pqd, pqdd;  ///< (np) ∂(μᵀr)/∂ of the prescribed coordinates' q, q̇, q̈
 };
 ResidualVjp rnea_vector_jacobian_product(const System& sys, Data& d, const VecX& mu);
+
+/// The reverse mode at one state for many μ (an adjoint's transposed solves): prepare(d) computes once what does
+/// not depend on μ (the spatial kinematics, the RNEA pass, the loads' and elements' states and their laws'
+/// derivatives, the velocities before each use, I v and I a), apply(d, μ) runs only the sweeps, into a buffer it
+/// keeps (valid until the next apply). Needs what rnea_derivatives needs; d must not change in between.
+class ResidualTranspose {
+ public:
+  explicit ResidualTranspose(const System& sys);
+  ~ResidualTranspose();
+  void prepare(Data& d);
+  const ResidualVjp& apply(const Data& d, const VecX& mu);
+
+ private:
+  struct Prepared;
+  const System& sys_;
+  std::unique_ptr<Prepared> p_;
+  ResidualVjp out_;
+};
 
 }  // namespace rigidfem

@@ -28,6 +28,7 @@ class Gmres {
     V_.resize(n, restart + 1), H_.setZero(restart + 1, restart), g_.resize(restart + 1), cs_.resize(restart),
         sn_.resize(restart);
     x.setZero(n);
+    first_cycle_ = true, y_.resize(0);
     const double bnorm = b.norm();
     if (bnorm == 0.0) return 0;
     r_ = b;
@@ -75,10 +76,24 @@ class Gmres {
       const VecS y = H_.topLeftCorner(j, j).template triangularView<Eigen::Upper>().solve(g_.head(j));
       Pinv(VecS(V_.leftCols(j) * y), z_);
       x += z_;
-      if (converged || iterations >= max_iterations || !x.allFinite()) return iterations;
+      if (converged && first_cycle_) y_ = y;
+      if (converged || iterations >= max_iterations || !x.allFinite()) {
+        first_cycle_ = first_cycle_ && converged;
+        return iterations;
+      }
+      first_cycle_ = false;
       S(x, w_);
       r_ = b - w_;
     }
+  }
+
+  /// After a solve that converged in its first cycle: y with x = Σ_i y_i z_i over the vectors z_i the operator was
+  /// applied to, in the order it was (z_i = P⁻¹ v_i), so a linear map of x is the same combination of the maps of the
+  /// z_i; empty when x = 0 (b = 0). False after a restart or a solve that did not converge.
+  bool combination(VecS& y) const {
+    if (!first_cycle_) return false;
+    y = y_;
+    return true;
   }
 
  private:
@@ -90,8 +105,9 @@ class Gmres {
     y = -conj(sn_(i)) * xi + cs_(i) * y;
   }
 
+  bool first_cycle_ = true;
   MatS V_, H_;
-  VecS g_, sn_, r_, z_, w_;
+  VecS g_, sn_, r_, z_, w_, y_;
   Eigen::VectorXd cs_;
 };
 

@@ -39,16 +39,28 @@ Mat4 inverse(const Mat4& T);
 /// [[M⁻¹, −M⁻¹ r], [0, 1]].
 Mat4 affine_inverse(const Mat4& T);
 
-/// m ×m s, the motion cross product (Featherstone's crm).
+/// m ×m s, the motion cross product (Featherstone's crm): (ω × s_ω, ω × s_v + v × s_ω) for m = (ω, v), written
+/// out by components so that the compiler inlines it (Eigen's comma initialiser kept GCC from doing so).
 inline Vec6 crossm(const Vec6& m, const Vec6& s) {
   Vec6 r;
-  r << m.head<3>().cross(s.head<3>()), m.head<3>().cross(s.tail<3>()) + m.tail<3>().cross(s.head<3>());
+  r(0) = m(1) * s(2) - m(2) * s(1);
+  r(1) = m(2) * s(0) - m(0) * s(2);
+  r(2) = m(0) * s(1) - m(1) * s(0);
+  r(3) = m(1) * s(5) - m(2) * s(4) + m(4) * s(2) - m(5) * s(1);
+  r(4) = m(2) * s(3) - m(0) * s(5) + m(5) * s(0) - m(3) * s(2);
+  r(5) = m(0) * s(4) - m(1) * s(3) + m(3) * s(1) - m(4) * s(0);
   return r;
 }
-/// v ×* f, the force cross product (Featherstone's crf).
+/// v ×* f, the force cross product (Featherstone's crf): (ω × f_τ + v × f_F, ω × f_F) for v = (ω, v), f = (τ, F),
+/// by components as crossm.
 inline Vec6 crossf(const Vec6& v, const Vec6& f) {
   Vec6 r;
-  r << v.head<3>().cross(f.head<3>()) + v.tail<3>().cross(f.tail<3>()), v.head<3>().cross(f.tail<3>());
+  r(0) = v(1) * f(2) - v(2) * f(1) + v(4) * f(5) - v(5) * f(4);
+  r(1) = v(2) * f(0) - v(0) * f(2) + v(5) * f(3) - v(3) * f(5);
+  r(2) = v(0) * f(1) - v(1) * f(0) + v(3) * f(4) - v(4) * f(3);
+  r(3) = v(1) * f(5) - v(2) * f(4);
+  r(4) = v(2) * f(3) - v(0) * f(5);
+  r(5) = v(0) * f(4) - v(1) * f(3);
   return r;
 }
 

@@ -44,6 +44,10 @@ class Profile:
         ...
     def __truediv__(self, arg0: typing.Any) -> typing.Any:
         ...
+    def sample(self, times: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
+        """
+        (q, qd, qdd) at each of the times (s): an array (len(times), 3), one call for many.
+        """
     def shifted(self, delay: typing.Any) -> typing.Any:
         """
         The same motion `delay` s later: q(t − delay), with its rates.

@@ -400,7 +400,7 @@ class Parameters:
         key = (prefix, float(t0), float(t1))
         if key not in self._cache:  # the profile at its current values, once for all its numbers
             base = remade(group.profile, changed)
-            self._cache[key] = np.array([base(t)[0] for t in times])
+            self._cache[key] = base.sample(times)[:, 0]
         q = self._cache[key]
         p = self.values[name]
         delta = 1e-6 * max(abs(p), 1.0)
@@ -408,7 +408,7 @@ class Parameters:
             moved = remade(group.profile, {**changed, short: p + delta})
         except ValueError:  # p at the upper edge of the values its profile takes: the trial step below it
             moved = remade(group.profile, {**changed, short: p - delta})
-        change = np.max(np.abs(np.array([moved(t)[0] for t in times]) - q))
+        change = np.max(np.abs(moved.sample(times)[:, 0] - q))
         # at most δ · 1e3: a number the profile hardly depends on over [t0, t1] (a ramp's fraction over 1 ms)
         # would otherwise get a step far beyond its values
         return min(delta * 1e-6 * max(1.0, float(np.max(np.abs(q)))) / change, 1e3 * delta) if change > 0.0 \
