@@ -1,6 +1,7 @@
 // The discrete adjoints of the Newmark family and of radau5, with checkpointing (adjoint.hpp).
 #include "rigidfem/adjoint.hpp"
 
+#include <algorithm>
 #include <chrono>
 #include <cmath>
 #include <stdexcept>
@@ -115,10 +116,11 @@ class Transposes : public AdjointSteps {
     return transpose_.apply(d_, mu);
   }
   /// x with S x = b by GMRES to 1e-11 (S, P as Gmres takes them), the preconditioner refreshed by `refresh` first
-  /// when the last solve took more iterations than refresh_above_.
+  /// when none is ready (`ready`: one the caller has; else the sweep's own, once made) or the last solve took more
+  /// iterations than refresh_above_.
   template <class Op, class Prec, class Refresh>
-  VecX gmres(const Op& S, const Prec& P, const VecX& b, Refresh&& refresh, double t) {
-    if (!fresh_ || last_iterations_ > refresh_above_) {
+  VecX gmres(const Op& S, const Prec& P, const VecX& b, Refresh&& refresh, double t, bool ready = false) {
+    if (!(ready || fresh_) || last_iterations_ > refresh_above_) {
       refresh();
       fresh_ = true;
       ++stats->preconditioner_refreshes;
@@ -149,14 +151,35 @@ class Transposes : public AdjointSteps {
 /// The Newmark family (adjoint.hpp): the adjoint state (q̄, q̇̄, ā, q̈̄).
 class NewmarkSteps final : public Transposes {
  public:
-  NewmarkSteps(const System& sys, const IntegratorOptions& o, ParameterVjp& params)
-      : Transposes(sys, o, params), stepper_(make_newmark_stepper(sys, o, istats_)), k_(stepper_->coefficients()) {}
+  NewmarkSteps(const System& sys, const IntegratorOptions& o, ParameterVjp& params, double memory)
+      : Transposes(sys, o, params), memory_(memory), stepper_(make_newmark_stepper(sys, o, istats_)), k_(stepper_->coefficients()) {}
 
+  void start(double t0, const VecX& q0, const VecX& qd0) override {
+    Transposes::start(t0, q0, qd0);
+    factors_.clear(), made_at_.clear();
+    keeping_ = true;
+  }
+  /// A step of the forward run keeps the stepper's dense factorisation when it made a new one (in a replay the
+  /// stepper makes them again: not kept), while they fit into an eighth of the adjoint's memory.
+  void step(double t, double h) override {
+    Transposes::step(t, h);
+    if (!keeping_) return;
+    auto f = stepper_->dense_factor();
+    if (!f || (!factors_.empty() && f == factors_.back())) return;
+    const double bytes = 8.0 * sys_.nq * sys_.nq * static_cast<double>(factors_.size() + 1);
+    if (bytes > memory_ / 8.0) {
+      keeping_ = false;
+      return;
+    }
+    factors_.push_back(std::move(f));
+    made_at_.push_back(t + h);
+  }
   StepRecord record(double t, double h) const override {
     const NewmarkState& s = stepper_->current();
     return {t, h, s.q, s.v, s.qdd, s.a, s.lambda, {}, {}, {}, {}};
   }
   void restore(const StepRecord& r) override {
+    keeping_ = false;  // a replay's
     NewmarkState s;
     s.q = r.q, s.v = r.v, s.qdd = r.qdd, s.a = r.a, s.s = VecX(0), s.lambda = r.lambda;
     stepper_->restore(r.t, s);
@@ -180,20 +203,31 @@ class NewmarkSteps final : public Transposes {
       out = r.qdd + c1 * r.qd + c2 * r.q;
       if (loops) out -= c2 * hessian(s.t, s.q, s.v, s.lambda, v);
     };
-    auto P = [&](const VecX& v, VecX& out) { matrix_->precondition_transposed(v, out); };
+    // the preconditioner: the forward run's factorisation of this step's Newton matrix (the latest made by t: the
+    // step's own), or the sweep's own where that one took more than refresh_above_ iterations, until the sweep
+    // reaches the steps of an earlier forward factorisation
+    const auto it = std::upper_bound(made_at_.begin(), made_at_.end(), s.t);
+    const Eigen::PartialPivLU<MatX>* forward = it == made_at_.begin() ? nullptr : factors_[it - made_at_.begin() - 1].get();
+    if (forward != forward_) forward_ = forward, own_ = false, last_iterations_ = 0;
+    auto P = [&](const VecX& v, VecX& out) {
+      if (forward_ && !own_) out.noalias() = forward_->transpose().solve(v);
+      else matrix_->precondition_transposed(v, out);
+    };
     auto refresh = [&] {
       matrix_->linearize(s.t, s.q, s.v, s.qdd, VecX());
       if (!(matrix_->factor(c1, c2, VecX()) > 1e-15))
         throw SimulationError(s.t, "the adjoint's Newton matrix M + γh C + βh² K is singular");
+      own_ = forward_ != nullptr;
     };
-    VecX mu = gmres(S, P, g, refresh, s.t);
+    VecX mu = gmres(S, P, g, refresh, s.t, forward_ && !own_);
     keep = false;
     VecX nu, loop_q;
     if (loops) {  // the saddle system by its Schur complement: μ = x − Y ν, Y = A₁₁⁻ᵀ (c₂ Gᵀ), (G Y) ν = G x
       loop_equations(sys_, e_, s.t, s.q, s.v);
       const MatX G = free_jacobian(sys_, e_);
       MatX Y(sys_.nq, sys_.nl);
-      for (int k = 0; k < sys_.nl; ++k) Y.col(k) = gmres(S, P, VecX(c2 * G.row(k).transpose()), refresh, s.t);
+      for (int k = 0; k < sys_.nl; ++k)
+        Y.col(k) = gmres(S, P, VecX(c2 * G.row(k).transpose()), refresh, s.t, forward_ && !own_);
       nu = least_norm(G * Y, G * mu);
       mu -= Y * nu;
       loop_q = G.transpose() * nu - hessian(s.t, s.q, s.v, s.lambda, mu);
@@ -257,8 +291,14 @@ class NewmarkSteps final : public Transposes {
  private:
   Stepper& stepper() override { return *stepper_; }
 
+  double memory_;  // the adjoint's bytes: an eighth of it for the forward factorisations
   std::unique_ptr<NewmarkStepper> stepper_;
   NewmarkCoefficients k_;
+  std::vector<std::shared_ptr<const Eigen::PartialPivLU<MatX>>> factors_;  // the forward run's, in order
+  std::vector<double> made_at_;  // the end of the step that made each
+  bool keeping_ = false;         // in the forward run (not a replay) and within memory
+  const Eigen::PartialPivLU<MatX>* forward_ = nullptr;  // the forward factorisation in use
+  bool own_ = false;             // the sweep's own factorisation preferred to forward_
 };
 
 /// radau5 (adjoint.hpp): the adjoint state (q̄, q̇̄).
@@ -458,7 +498,7 @@ Adjoint::Adjoint(std::shared_ptr<const System> sys, const IntegratorOptions& o, 
     steps_ = std::make_unique<RadauSteps>(s, o_, *params_);
   else if (o.method == Method::Newmark || o.method == Method::HHT || o.method == Method::GeneralizedAlpha ||
            o.method == Method::ImplicitSpring)
-    steps_ = std::make_unique<NewmarkSteps>(s, o_, *params_);
+    steps_ = std::make_unique<NewmarkSteps>(s, o_, *params_, memory_);
   else
     bad("method", "generalized_alpha, newmark, hht, implicit_spring or radau5 (the methods with an adjoint)",
         method_name(o.method));

@@ -56,9 +56,10 @@ class DenseNewtonMatrix final : public NewtonMatrix {
   double factor(double c1, double c2, const VecX& e) override {
     S_ = M_ + c1 * C_ + c2 * K_;
     if (e.size()) S_.diagonal() += e;
-    lu_.compute(S_);
+    auto lu = std::make_shared<Eigen::PartialPivLU<MatX>>(S_);
+    lu_ = lu;
     ++stats_.factorizations;
-    return lu_.rcond();
+    return lu_->rcond();
   }
 
   double factor(cplx c1, cplx c2) override {
@@ -68,11 +69,12 @@ class DenseNewtonMatrix final : public NewtonMatrix {
     return luc_.rcond();
   }
 
-  void solve(const VecX& b, VecX& x) override { x.noalias() = lu_.solve(b); }
+  void solve(const VecX& b, VecX& x) override { x.noalias() = lu_->solve(b); }
   void solve(const VecXc& b, VecXc& x) override { x.noalias() = luc_.solve(b); }
-  void precondition_transposed(const VecX& b, VecX& x) override { x.noalias() = lu_.transpose().solve(b); }
+  void precondition_transposed(const VecX& b, VecX& x) override { x.noalias() = lu_->transpose().solve(b); }
   void precondition_transposed(const VecXc& b, VecXc& x) override { x.noalias() = luc_.transpose().solve(b); }
   bool krylov() const override { return false; }
+  std::shared_ptr<const Eigen::PartialPivLU<MatX>> dense_factor() const override { return lu_; }
 
  private:
   const System& sys_;
@@ -80,7 +82,7 @@ class DenseNewtonMatrix final : public NewtonMatrix {
   IntegratorStats& stats_;
   MatX K_, C_, M_, S_;
   Eigen::MatrixXcd Sc_;
-  Eigen::PartialPivLU<MatX> lu_;
+  std::shared_ptr<Eigen::PartialPivLU<MatX>> lu_;
   Eigen::PartialPivLU<Eigen::MatrixXcd> luc_;
 };
 

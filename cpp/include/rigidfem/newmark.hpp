@@ -28,6 +28,8 @@ class NewmarkStepper : public Stepper {
   /// Makes s, at time t, the current state (a checkpoint's: the steps from it repeat the run's).
   virtual void restore(double t, const NewmarkState& s) = 0;
   virtual NewmarkCoefficients coefficients() const = 0;
+  /// Its Newton matrix's dense factorisation now (NewtonMatrix::dense_factor), or none.
+  virtual std::shared_ptr<const Eigen::PartialPivLU<MatX>> dense_factor() const = 0;
 };
 
 /// newmark, hht, generalized_alpha or implicit_spring by o.method.

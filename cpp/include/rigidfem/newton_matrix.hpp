@@ -75,6 +75,9 @@ class NewtonMatrix {
   MatX solve(const MatX& B);
   /// Whether the tangent is matrix-free.
   virtual bool krylov() const = 0;
+  /// Slot 0's dense LU, shared (a new one at each factorisation: an old one stays valid for whoever keeps it), or
+  /// none (Krylov): what the adjoint keeps of the forward run's Newton matrices to precondition its transposes.
+  virtual std::shared_ptr<const Eigen::PartialPivLU<MatX>> dense_factor() const { return nullptr; }
 };
 
 }  // namespace rigidfem
