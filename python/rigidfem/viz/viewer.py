@@ -49,7 +49,7 @@ import numpy as np
 
 from ..base import _checks
 import rigidfem._core as _core  # the compiled core, by its absolute name
-from .._core import Body, Point
+from .._core import Body, Point, SimulationError
 
 ASSETS = Path(__file__).resolve().parent / "viewer_assets"
 
@@ -266,6 +266,8 @@ def _layers(system, result, q, t, mode, frames, amplitude):
     if result is None:
         qs = np.zeros(system.nq) if q is None else _checks.reals(q, (system.nq,), "q")
         t = _checks.scalar(t, "t")
+        if frames is not None:  # judged, though one state is one frame
+            _checks.integer(frames, "frames", minimum=1)
         return system, [{"system": system, "t": np.array([t]), "q": qs[None, :], "qd": None, "label": "state",
                          "what": "q"}], "state"
     if q is not None:
@@ -537,8 +539,11 @@ def _layer_scene(layer, size_hint: float | None, scale: float) -> dict:
     poses = _poses(system, times, states)
     if not np.all(np.isfinite(poses)):
         k = int(np.argwhere(~np.isfinite(poses))[0][0])
+        if np.all(np.isfinite(states[k])):  # finite coordinates the kinematics overflowed at (a drive at t = 1e300)
+            raise SimulationError(f"t = {times[k]:g} s: the body poses to show are NaN or inf at finite coordinates "
+                                  "(the drives' or the kinematics' values overflow there)")
         raise _checks.refuse(f"{layer['what']}: expected finite body poses to show, got NaN or inf at t = "
-                             f"{times[k]:g} s (the drives or the coordinates there)")
+                             f"{times[k]:g} s (the coordinates there)")
     if scale != 1.0:
         poses = _magnified(system, times, states, poses, scale)
     size = size_hint or _extent(system, poses[0].astype(float))
