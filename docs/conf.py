@@ -8,8 +8,9 @@ reference is generated from the docstrings (autosummary, numpydoc style through 
 simulate's options is written from ``rigidfem.options`` at build time.
 
 The site works offline: MathJax is served from its own ``_static/mathjax`` (the ``sphinx-mathjax-offline``
-package, MathJax 3) and the animations' buttons (matplotlib's ``to_jshtml``, which links Font Awesome from a
-CDN) use Font Awesome's CSS and fonts copied into ``_static/fontawesome`` (the ``fontawesomefree`` package).
+package, MathJax 3), the code blocks' copy buttons (``sphinx-copybutton``) from ``_static`` too, and the
+animations' buttons (matplotlib's ``to_jshtml``, which links Font Awesome from a CDN) use Font Awesome's CSS and
+fonts copied into ``_static/fontawesome`` (the ``fontawesomefree`` package).
 ``tests/test_docs.py`` fails on any script, stylesheet or font the built pages would fetch from outside.
 """
 
@@ -38,8 +39,12 @@ copyright = "2026, the rigidfem developers"  # noqa: A001 (Sphinx's name)
 release = rigidfem.__version__
 
 extensions = ["myst_nb", "sphinx.ext.autodoc", "sphinx.ext.autosummary", "sphinx.ext.napoleon",
-              "sphinx.ext.mathjax", "sphinx-mathjax-offline"]
+              "sphinx.ext.mathjax", "sphinx-mathjax-offline", "sphinx_copybutton"]
 mathjax_path = "mathjax/tex-chtml.js"  # in _static, copied there by sphinx-mathjax-offline (no CDN)
+# A copy button on every code block (its script and icons in _static); prompts and doctest outputs are not copied
+copybutton_prompt_text = r">>> |\.\.\. |\$ "
+copybutton_prompt_is_regexp = True
+copybutton_exclude = ".linenos, .gp, .go"
 source_suffix = {".rst": "restructuredtext", ".md": "myst-nb", ".ipynb": "myst-nb"}
 exclude_patterns = ["_build", "**.ipynb_checkpoints"]
 html_theme = "furo"

@@ -185,3 +185,15 @@ def test_the_gallery_embeds_the_viewers_standalone_pages(site):
         assert "window.RIGIDFEM" in body and "REVISION" in body, page
     for nb in ("06_offshore_crane", "09_cantilever_frequencies", "11_kane", "12_whippy_beam"):
         assert "<iframe srcdoc=" in (site / "notebooks" / f"{nb}.html").read_text(encoding="utf-8"), nb
+
+
+def test_code_blocks_have_copy_buttons_served_from_the_site(site):
+    """sphinx-copybutton's script, with its clipboard library, is in the site's _static and loaded by the pages
+    that show code (the copied text leaves out the >>> prompts and the outputs)."""
+    for name in ("copybutton.js", "clipboard.min.js", "copybutton.css"):
+        assert (site / "_static" / name).exists(), name
+    for page in ("tour.html", "simulation.html", "api/rigidfem.simulate.html"):
+        body = (site / page).read_text(encoding="utf-8")
+        assert "_static/copybutton.js" in body and "highlight" in body, page
+    script = (site / "_static" / "copybutton.js").read_text(encoding="utf-8")
+    assert ">>> " in script.replace("\\\\", "\\") or "&gt;&gt;&gt;" in script
