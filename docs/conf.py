@@ -5,7 +5,8 @@ Build: ``pip install ".[docs]" && sphinx-build -W -b html docs docs/_build/html`
 
 The notebooks are rendered with the outputs they were committed with (myst-nb, no execution); the API
 reference is generated from the docstrings (autosummary, numpydoc style through napoleon); the table of
-simulate's options is written from ``rigidfem.options`` at build time.
+simulate's options is written from ``rigidfem.options`` at build time, and the drawings (``docs/figures.py``) are
+drawn by it.
 
 The site works offline: MathJax is served from its own ``_static/mathjax`` (the ``sphinx-mathjax-offline``
 package, MathJax 3), the code blocks' copy buttons (``sphinx-copybutton``) from ``_static`` too, and the
@@ -118,9 +119,20 @@ def _write_api_page() -> None:
         path.write_text(text)
 
 
+def _draw_figures() -> None:
+    """The pages' drawings (docs/figures.py) into docs/_generated/figures, made at each build."""
+    sys.path.insert(0, str(HERE))
+    try:
+        import figures
+    finally:
+        sys.path.remove(str(HERE))
+    figures.write(HERE / "_generated" / "figures")
+
+
 _copy_notebooks()
 _write_options_table()
 _write_api_page()
+_draw_figures()
 exclude_patterns.append("_generated")
 
 # The docstrings write |x| for norms and absolute values, as mathematics reads in help(); reST would take

@@ -197,3 +197,16 @@ def test_code_blocks_have_copy_buttons_served_from_the_site(site):
         assert "_static/copybutton.js" in body and "highlight" in body, page
     script = (site / "_static" / "copybutton.js").read_text(encoding="utf-8")
     assert ">>> " in script.replace("\\\\", "\\") or "&gt;&gt;&gt;" in script
+
+
+def test_the_method_page_shows_the_rfe_figure_drawn_by_the_build(site):
+    """The figure of two rfes, their frames and the sde between them is drawn by docs/figures.py at each build
+    (conf.py calls it); no picture of the site is committed."""
+    page = (site / "method.html").read_text(encoding="utf-8")
+    assert re.search(r'<img[^>]*src="_images/rfe_sde\.png"', page)
+    png = (site / "_images" / "rfe_sde.png").read_bytes()
+    assert png[:8] == b"\x89PNG\r\n\x1a\n"
+    width, height = int.from_bytes(png[16:20], "big"), int.from_bytes(png[20:24], "big")
+    assert width > 900 and 0.2 < height / width < 0.6, (width, height)
+    committed = subprocess.run(["git", "ls-files", "docs"], cwd=ROOT, capture_output=True, text=True).stdout.split()
+    assert not [f for f in committed if f.endswith((".png", ".jpg", ".svg", ".gif"))]
