@@ -150,20 +150,26 @@ std::string worst_loop(const System& sys, const Data& d) {
   return "loop '" + sys.loops[k].name + "' (" + loop_kind_name(sys.loops[k].kind) + ", residual " + num(worst) + ")";
 }
 
+/// d.Y = M⁻¹ Gᵀ of the loops' free columns d.Gfree with the factorisation of M in d: the tree's, a column at a
+/// time in place (no allocation), or the Lagrange engine's LLT.
+void mass_weighted_rows(const System& sys, Data& d) {
+  if (!recursive(sys)) {
+    d.Y = d.llt.solve(d.Gfree.transpose());
+    return;
+  }
+  for (Eigen::Index j = 0; j < d.Gfree.rows(); ++j) {
+    d.loop_col = d.Gfree.row(j).transpose();
+    aba_solve(sys, d, d.loop_col, d.loop_col);
+    d.Y.col(j) = d.loop_col;
+  }
+}
+
 }  // namespace
 
 void close_loops(const System& sys, Data& d) {
   // λ = (G M⁻¹ Gᵀ)⁺ (γ − G q̈), q̈ += M⁻¹ Gᵀ λ, in d's workspace (no allocation on the recursive path)
   d.Gfree = d.G(Eigen::all, sys.free_coords);
-  if (recursive(sys)) {
-    for (Eigen::Index j = 0; j < d.Gfree.rows(); ++j) {  // Y = M⁻¹ Gᵀ with the tree's factorisation
-      d.loop_col = d.Gfree.row(j).transpose();
-      aba_solve(sys, d, d.loop_col, d.loop_col);
-      d.Y.col(j) = d.loop_col;
-    }
-  } else {
-    d.Y = d.llt.solve(d.Gfree.transpose());
-  }
+  mass_weighted_rows(sys, d);
   d.GY.noalias() = d.Gfree * d.Y;
   d.loop_rhs = d.gamma;
   d.loop_rhs.noalias() -= d.Gfree * d.qdd;
@@ -197,15 +203,7 @@ double project_onto_loops(const System& sys, Data& d, double t, VecX& q, VecX& q
   auto weighted = [&](bool refactor) {
     G = d.G(Eigen::all, sys.free_coords);
     if (refactor || !factored) factor_mass(sys, d), factored = true;
-    if (!recursive(sys)) {
-      Y = d.llt.solve(G.transpose());
-      return;
-    }
-    for (Eigen::Index j = 0; j < G.rows(); ++j) {
-      d.loop_col = G.row(j).transpose();
-      aba_solve(sys, d, d.loop_col, d.loop_col);
-      Y.col(j) = d.loop_col;
-    }
+    mass_weighted_rows(sys, d);
   };
   auto corrected = [&](const VecX& residuals) -> const VecX& {  // Y (G Y)⁺ residuals, into d.loop_col
     d.GY.noalias() = G * Y;

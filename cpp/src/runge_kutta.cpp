@@ -58,6 +58,28 @@ class FirstOrder {
   std::unique_ptr<SensitivityEquations> sens_;
 };
 
+/// Hairer's starting step for a method of order p from (t0, y0), f0 = f(t0, y0) (Hairer, Nørsett & Wanner I,
+/// II.4): h0 = 0.01 d0/d1, then h1 = (0.01 / max(d1, d2))^(1/(p+1)) with d2 the change of f over h0, all norms
+/// scaled by the tolerances; the whole span when nothing moves (nq = 0).
+double hairer_initial_step(FirstOrder& ode, int p, double t0, const VecX& y0, const VecX& f0, double span,
+                           const Tolerances& tol, double max_step) {
+  if (y0.size() == 0) return std::min(span, max_step);
+  const int m = ode.controlled();
+  const VecX sc = tol.atol.array() + tol.rtol.array() * y0.head(m).cwiseAbs().array();
+  const double d0 = scaled_rms(y0.head(m), sc), d1 = scaled_rms(f0.head(m), sc);
+  // 1e-6 s where either is negligible, or where a component of zero weight moves (d1 infinite: atol = 0)
+  double h0 = (d0 < 1e-5 || d1 < 1e-5 || !std::isfinite(d1)) ? 1e-6 : 0.01 * d0 / d1;
+  h0 = std::min({h0, max_step, span});
+  VecX f1;
+  ode.eval(t0 + h0, y0 + h0 * f0, f1);
+  const double dm = std::max(d1, scaled_rms(f1.head(m) - f0.head(m), sc) / h0);
+  // dm is infinite when a component with zero weight (atol = 0, starting at zero) moves: start small.
+  const double h1 = dm <= 1e-15         ? std::max(1e-6, 1e-3 * h0)
+                    : std::isfinite(dm) ? std::pow(0.01 / dm, 1.0 / (p + 1))
+                                        : 1e-3 * h0;
+  return std::min({100.0 * h0, h1, max_step, span});
+}
+
 struct Tableau {
   std::vector<double> c;
   std::vector<std::vector<double>> a;  // a[i][j], j < i
@@ -135,25 +157,8 @@ class RungeKutta final : public Stepper {
     ode_.eval(t0, y_, f_);
   }
 
-  /// Hairer's starting step for a method of order p (the whole span when nothing moves, nq = 0).
   double initial_step(double span, const Tolerances& tol, double max_step) override {
-    if (y_.size() == 0) return std::min(span, max_step);
-    const int p = tab_.order;
-    const int m = ode_.controlled();
-    const VecX sc = tol.atol.array() + tol.rtol.array() * y_.head(m).cwiseAbs().array();
-    const double d0 = scaled_rms(y_.head(m), sc), d1 = scaled_rms(f_.head(m), sc);
-    // 1e-6 s where either is negligible, or where a component of zero weight moves (d1 infinite: atol = 0)
-    double h0 = (d0 < 1e-5 || d1 < 1e-5 || !std::isfinite(d1)) ? 1e-6 : 0.01 * d0 / d1;
-    h0 = std::min({h0, max_step, span});
-    VecX f1;
-    ode_.eval(t_start_ + h0, y_ + h0 * f_, f1);
-    const double d2 = scaled_rms(f1.head(m) - f_.head(m), sc) / h0;
-    const double dm = std::max(d1, d2);
-    // dm is infinite when a component with zero weight (atol = 0, starting at zero) moves: start small.
-    const double h1 = dm <= 1e-15         ? std::max(1e-6, 1e-3 * h0)
-                      : std::isfinite(dm) ? std::pow(0.01 / dm, 1.0 / (p + 1))
-                                          : 1e-3 * h0;
-    return std::min({100.0 * h0, h1, max_step, span});
+    return hairer_initial_step(ode_, tab_.order, t_start_, y_, f_, span, tol, max_step);
   }
 
   bool attempt(double t, double h, const Tolerances* tol, double& err) override {
@@ -330,20 +335,8 @@ class Dop853 final : public Stepper {
     t_start_ = t0;
   }
 
-  /// Hairer's starting step for order 8, as the other explicit pairs' (RungeKutta::initial_step).
   double initial_step(double span, const Tolerances& tol, double max_step) override {
-    if (y_.size() == 0) return std::min(span, max_step);
-    const int m = ode_.controlled();
-    const VecX sc = tol.atol.array() + tol.rtol.array() * y_.head(m).cwiseAbs().array();
-    const double d0 = scaled_rms(y_.head(m), sc), d1 = scaled_rms(f_.head(m), sc);
-    double h0 = (d0 < 1e-5 || d1 < 1e-5 || !std::isfinite(d1)) ? 1e-6 : 0.01 * d0 / d1;
-    h0 = std::min({h0, max_step, span});
-    VecX f1;
-    ode_.eval(t_start_ + h0, y_ + h0 * f_, f1);
-    const double dm = std::max(d1, scaled_rms(f1.head(m) - f_.head(m), sc) / h0);
-    const double h1 = dm <= 1e-15 ? std::max(1e-6, 1e-3 * h0) : std::isfinite(dm) ? std::pow(0.01 / dm, 1.0 / 9.0)
-                                                                                    : 1e-3 * h0;
-    return std::min({100.0 * h0, h1, max_step, span});
+    return hairer_initial_step(ode_, 8, t_start_, y_, f_, span, tol, max_step);
   }
 
   /// An adaptive step whose stages cannot be evaluated (a stage's state singular or not finite: its long steps reach

@@ -92,7 +92,8 @@ def gradient(system, t_end: float, parameters=None, *, outputs, running=None, te
         "generalized_alpha" (default), "newmark", "hht", "implicit_spring" or "radau5", at fixed steps ``dt`` (s).
     memory : float
         Bytes for the states the backward sweep needs (default 256 MiB): all of them if they fit, else
-        checkpoints every ⌈√N⌉ steps and each segment run again.
+        checkpoints every ⌈√N⌉ steps and each segment run again; the forward run's dense Newton
+        factorisations, which precondition the sweep, are kept within an eighth of it besides.
     **options
         The method's options as in ``rigidfem.simulate`` (``rho_inf``, ``alpha``, ``beta``, ``gamma``,
         ``newton_tol``, ``newton_max_iterations``, ``iteration_matrix``: ``rigidfem.integrator_options(method)``);
