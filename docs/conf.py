@@ -33,6 +33,7 @@ sys.modules.setdefault("rigidfem.animation", importlib.import_module("rigidfem.v
 
 HERE = Path(__file__).resolve().parent
 ROOT = HERE.parent
+sys.path.insert(0, str(HERE))  # the site's own extension: apilinks (inline code naming an object links to its page)
 
 project = "rigidfem"
 author = "the rigidfem developers"
@@ -40,7 +41,7 @@ copyright = "2026, the rigidfem developers"  # noqa: A001 (Sphinx's name)
 release = rigidfem.__version__
 
 extensions = ["myst_nb", "sphinx.ext.autodoc", "sphinx.ext.autosummary", "sphinx.ext.napoleon",
-              "sphinx.ext.mathjax", "sphinx-mathjax-offline", "sphinx_copybutton"]
+              "sphinx.ext.mathjax", "sphinx-mathjax-offline", "sphinx_copybutton", "apilinks"]
 mathjax_path = "mathjax/tex-chtml.js"  # in _static, copied there by sphinx-mathjax-offline (no CDN)
 # A copy button on every code block (its script and icons in _static); prompts and doctest outputs are not copied
 copybutton_prompt_text = r">>> |\.\.\. |\$ "
@@ -72,7 +73,11 @@ nb_execution_mode = "off"  # the notebooks' outputs as committed
 nb_mime_priority_overrides = [("html", "text/html", 5)]
 
 autosummary_generate = True
-autodoc_default_options = {"members": True, "undoc-members": False}
+# A class's page documents the methods it inherits from its compiled base (System's mass_matrix, ...), not those of
+# object or the exceptions' bases; a public module's page documents the functions and classes of the module it
+# stands for (rigidfem.study is rigidfem.studies.study), which autodoc would take for imported ones
+autodoc_default_options = {"members": True, "undoc-members": False, "imported-members": True,
+                           "inherited-members": "pybind11_object,BaseException,object"}
 autodoc_member_order = "bysource"
 napoleon_numpy_docstring = True
 napoleon_google_docstring = False
@@ -200,7 +205,29 @@ def _write_viewer_pages(app, exc) -> None:
     viewer_gallery.write(Path(app.outdir) / "viewer")
 
 
+_documented_module: list[str] = [""]
+
+
+def _note_module(app, what, name, obj, opts, lines) -> None:
+    if what == "module":
+        _documented_module[0] = obj.__name__
+
+
+def _only_the_modules_own(app, what, name, obj, skip, opts):
+    """On a module's page, the functions and classes defined in the module it stands for, not what it imports
+    nor the public names with a page of their own; on a class's page, no member inherited from outside the
+    package (matplotlib's Animation)."""
+    where = getattr(obj, "__module__", None)
+    if what == "module" and isinstance(where, str) and (callable(obj) or isinstance(obj, type)):
+        return skip or where != _documented_module[0] or getattr(rigidfem, name, None) is obj
+    if what == "class" and isinstance(where, str) and not where.startswith("rigidfem"):
+        return True
+    return None
+
+
 def setup(app):
+    app.connect("autodoc-process-docstring", _note_module)
+    app.connect("autodoc-skip-member", _only_the_modules_own)
     app.connect("build-finished", _write_viewer_pages)
     app.connect("autodoc-process-docstring", _escape_bars)
     app.connect("html-page-context", _download_link)

@@ -210,3 +210,39 @@ def test_the_method_page_shows_the_rfe_figure_drawn_by_the_build(site):
     assert width > 900 and 0.2 < height / width < 0.6, (width, height)
     committed = subprocess.run(["git", "ls-files", "docs"], cwd=ROOT, capture_output=True, text=True).stdout.split()
     assert not [f for f in committed if f.endswith((".png", ".jpg", ".svg", ".gif"))]
+
+
+def _article(path: Path) -> str:
+    page = path.read_text(encoding="utf-8")
+    return page[page.find("<article"):page.find("</article>")]
+
+
+APILINK = re.compile(r'<a class="rigidfem-apilink[^"]*" href="([^"]*)"')
+
+
+def test_api_names_and_notebooks_in_the_text_are_links(site):
+    """docs/apilinks.py turns inline code naming a public object (``rf.simulate``, ``Result.sensitivity``,
+    ``system.mass_matrix(t, q)``) into a link to its entry on its API page, and every ``notebooks/NN_name.ipynb``
+    into a link to the notebook's page; every such link reaches an anchor that exists."""
+    simulation = _article(site / "simulation.html")
+    links = APILINK.findall(simulation)
+    assert len([h for h in links if h.startswith("api/")]) >= 50, len(links)
+    assert 'href="api/rigidfem.simulate.html#rigidfem.simulate"' in simulation
+    assert 'href="api/rigidfem.Result.html#rigidfem.Result.sensitivity"' in simulation or \
+        "Result.sensitivity" not in (ROOT / "docs" / "simulation.md").read_text(encoding="utf-8")
+    anchors: dict[Path, set[str]] = {}
+    pages = sorted(site.glob("*.html")) + sorted(site.glob("chapters/*.html")) + sorted(site.glob("notebooks/*.html"))
+    for path in pages + sorted(site.glob("api/*.html")):
+        article = _article(path)
+        for href in APILINK.findall(article):
+            target, _, anchor = href.partition("#")
+            file = (path.parent / target).resolve() if target else path
+            if file not in anchors:
+                anchors[file] = set(re.findall(r'\bid="([^"]+)"', file.read_text(encoding="utf-8")))
+            assert not anchor or anchor in anchors[file], (path.name, href)
+        outside_links = re.sub(r"<a\b[^>]*>.*?</a>", "", article, flags=re.S)
+        unlinked = re.findall(r"notebooks/\d\d_\w+\.ipynb", outside_links)
+        assert not unlinked, (path.relative_to(site).as_posix(), unlinked)
+    # a page of the guide and a notebook link both ways
+    assert 'href="notebooks/08_sweeps.html"' in simulation
+    assert APILINK.search(_article(site / "notebooks" / "02_cantilever.html"))
