@@ -27,9 +27,8 @@ struct Track {
 /// Jacobian ∂x/∂q_i = Σ_u U_u x̃ over the uses u on the path from p to the ground (x̃ = (x, 1)
 /// for the origin, (x, 0) for an axis): the Lagrange formulation's kinematics (T, Ṫ, T̈, U), which
 /// also holds the linear joints. The ground (p = −1): F itself, at rest.
-Track homogeneous_track(const System& sys, const Data& d, int p, const Mat4& F, int h) {
-  Track tr;
-  tr.J = Mat3X::Zero(3, sys.nc);
+void homogeneous_track(const System& sys, const Data& d, int p, const Mat4& F, int h, Track& tr) {
+  tr.J.setZero(3, sys.nc);
   const Eigen::Vector4d c = F.col(h);
   tr.x = (d.T[p] * c).head<3>();
   tr.xd = (d.Td[p] * c).head<3>();
@@ -38,7 +37,6 @@ Track homogeneous_track(const System& sys, const Data& d, int p, const Mat4& F, 
   for (int k = p; k >= 0; k = sys.parent[k])
     for (int u = sys.use_start[k]; u < sys.use_start[k + 1]; ++u)
       tr.J.col(sys.use_coord[u]) += (d.U[u] * xh).head<3>();
-  return tr;
 }
 
 /// The spatial velocity v_p and the acceleration a_p at q̈_free = 0 (the prescribed q̈ in, no
@@ -62,10 +60,9 @@ std::pair<Vec6, Vec6> body_motion(const System& sys, const Data& d, int p) {
 /// body's motion (ω, v_O), (α, a_O) from body_motion:
 ///   origin x: ẋ = v_O + ω × x, ẍ = a_O + α × x + ω × ẋ, ∂x/∂q_u = ω_u × x + v_u;
 ///   axis e:   ė = ω × e,       ë = α × e + ω × ė,       ∂e/∂q_u = ω_u × e.
-Track spatial_track(const System& sys, const Data& d, int p, const std::pair<Vec6, Vec6>& motion, const Mat4& F,
-                    int h) {
-  Track tr;
-  tr.J = Mat3X::Zero(3, sys.nc);
+void spatial_track(const System& sys, const Data& d, int p, const std::pair<Vec6, Vec6>& motion, const Mat4& F,
+                   int h, Track& tr) {
+  tr.J.setZero(3, sys.nc);
   const bool point = h == 3;
   tr.x = (d.T[p] * F.col(h)).head<3>();
   const auto& [v, a] = motion;
@@ -76,24 +73,31 @@ Track spatial_track(const System& sys, const Data& d, int p, const std::pair<Vec
       const Vec6& s = d.axes[u];
       tr.J.col(sys.use_coord[u]) += s.head<3>().cross(tr.x) + (point ? Vec3(s.tail<3>()) : Vec3::Zero());
     }
-  return tr;
 }
 
 /// The columns h = 0..3 of frame F in body p as tracks, from the spatial kinematics or the 4x4 ones.
-std::array<Track, 4> frame_tracks(const System& sys, const Data& d, int p, const Mat4& F, int columns, bool spatial) {
-  std::array<Track, 4> tr;
+/// Into tr, whose Jacobians keep their storage from call to call (the loops' rows allocate nothing once sized).
+void frame_tracks(const System& sys, const Data& d, int p, const Mat4& F, int columns, bool spatial,
+                  std::array<Track, 4>& tr) {
   if (p < 0) {  // the ground: F itself, at rest
-    for (int h = 0; h < 4; ++h) tr[h] = {F.block<3, 1>(0, h), Vec3::Zero(), Vec3::Zero(), Mat3X::Zero(3, sys.nc)};
-    return tr;
+    for (int h = 0; h < 4; ++h) {
+      tr[h].x = F.block<3, 1>(0, h), tr[h].xd.setZero(), tr[h].xdd.setZero();
+      tr[h].J.setZero(3, sys.nc);
+    }
+    return;
   }
   const auto motion = spatial ? body_motion(sys, d, p) : std::pair<Vec6, Vec6>{};
-  for (int h = 4 - columns; h < 4; ++h)
-    tr[h] = spatial ? spatial_track(sys, d, p, motion, F, h) : homogeneous_track(sys, d, p, F, h);
-  return tr;
+  for (int h = 4 - columns; h < 4; ++h) {
+    if (spatial) spatial_track(sys, d, p, motion, F, h, tr[h]);
+    else homogeneous_track(sys, d, p, F, h, tr[h]);
+  }
 }
 
-/// d = r_B − r_A as a track.
-Track difference(const Track& b, const Track& a) { return {b.x - a.x, b.xd - a.xd, b.xdd - a.xdd, b.J - a.J}; }
+/// d = r_B − r_A as a track, into out.
+void difference(const Track& b, const Track& a, Track& out) {
+  out.x = b.x - a.x, out.xd = b.xd - a.xd, out.xdd = b.xdd - a.xdd;
+  out.J = b.J - a.J;
+}
 
 enum { X, Y, Z };
 
@@ -128,18 +132,18 @@ const KindRow& layout(LoopKind kind) {
   return row;
 }
 
-/// Row r of the constraints: value, rate, −(second rate at q̈_free = 0), Jacobian.
-void put(Data& d, int r, double g, double gd, double bias, const Eigen::Ref<const Eigen::RowVectorXd>& G) {
+/// Row r of the constraints: value, rate, −(second rate at q̈_free = 0); its Jacobian the caller writes into d.G.
+void put(Data& d, int r, double g, double gd, double bias) {
   d.g(r) = g;
   d.gd(r) = gd;
   d.gamma(r) = -bias;
-  d.G.row(r) = G;
 }
 
 /// g = x·y: ġ = ẋ·y + x·ẏ, g̈ = ẍ·y + 2 ẋ·ẏ + x·ÿ, ∂g/∂q = yᵀ ∂x/∂q + xᵀ ∂y/∂q.
 void dot_row(Data& d, int r, const Track& x, const Track& y) {
-  put(d, r, x.x.dot(y.x), x.xd.dot(y.x) + x.x.dot(y.xd), x.xdd.dot(y.x) + 2.0 * x.xd.dot(y.xd) + x.x.dot(y.xdd),
-      y.x.transpose() * x.J + x.x.transpose() * y.J);
+  put(d, r, x.x.dot(y.x), x.xd.dot(y.x) + x.x.dot(y.xd), x.xdd.dot(y.x) + 2.0 * x.xd.dot(y.xd) + x.x.dot(y.xdd));
+  d.G.row(r).noalias() = y.x.transpose() * x.J;
+  d.G.row(r).noalias() += x.x.transpose() * y.J;
 }
 
 /// g = |x| − l(t): ġ = x·ẋ/|x| − l̇, g̈ = (ẋ·ẋ + x·ẍ)/|x| − (x·ẋ)²/|x|³ − l̈, ∂g/∂q = xᵀ ∂x/∂q / |x|.
@@ -148,8 +152,8 @@ void distance_row(Data& d, int r, const Track& x, const MotionState& l, const st
   if (!(n > 1e-12 * std::max(1.0, std::abs(l.q))))
     throw SimulationError(d.t, "the distance of loop '" + name + "' is zero, where its direction is undefined");
   const double s = x.x.dot(x.xd);
-  put(d, r, n - l.q, s / n - l.qd, (x.xd.squaredNorm() + x.x.dot(x.xdd)) / n - s * s / (n * n * n) - l.qdd,
-      x.x.transpose() * x.J / n);
+  put(d, r, n - l.q, s / n - l.qd, (x.xd.squaredNorm() + x.x.dot(x.xdd)) / n - s * s / (n * n * n) - l.qdd);
+  d.G.row(r).noalias() = (x.x / n).transpose() * x.J;
 }
 
 }  // namespace
@@ -160,9 +164,12 @@ void constraint_equations(const System& sys, Data& d, bool spatial) {
     int r = sys.loop_row[k];
     // The origins (columns 3) and, for the joints, the axes (columns 0..2) of frames A and B.
     const int columns = L.kind == LoopKind::Distance ? 1 : 4;
-    const std::array<Track, 4> a = frame_tracks(sys, d, L.body_a, L.frame_a, columns, spatial),
-                               b = frame_tracks(sys, d, L.body_b, L.frame_b, columns, spatial);
-    const Track dr = difference(b[3], a[3]);
+    // the frames' tracks in a workspace of this thread, sized once for the system's coordinates
+    thread_local std::array<Track, 4> a, b;
+    thread_local Track dr;
+    frame_tracks(sys, d, L.body_a, L.frame_a, columns, spatial, a);
+    frame_tracks(sys, d, L.body_b, L.frame_b, columns, spatial, b);
+    difference(b[3], a[3], dr);
     if (L.kind == LoopKind::Distance) {
       const MotionState l = L.drive ? L.drive->at(d.t) : MotionState{L.length, 0.0, 0.0};
       if (!std::isfinite(l.q) || !std::isfinite(l.qd) || !std::isfinite(l.qdd))
