@@ -51,6 +51,16 @@ class Gradient:
     ``value`` is J; ``gradient`` {name: dJ/dp} in units of J per unit of p; ``q0`` and ``qd0`` dJ/dq₀ and
     dJ/dq̇₀ (nq); ``t`` the steps (s); ``outputs`` {name: (len t, 3) or (len t,)}; ``stats`` the run's
     counts and times (s).
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> model, h = rf.samples.spring_mass()
+    >>> system = model.compile()
+    >>> g = rf.gradient(system, 1.0, ["q0[block.x]"], outputs={"x": "block.x"},
+    ...                terminal=lambda y: y["x"], dt=1e-3, q0=[0.1])
+    >>> type(g).__name__, sorted(g.gradient)
+    ('Gradient', ['q0[block.x]'])
     """
 
     value: float
@@ -105,6 +115,16 @@ def gradient(system, t_end: float, parameters=None, *, outputs, running=None, te
         ``value`` J, ``gradient`` {name: dJ/dp}, ``q0``/``qd0`` dJ/dq₀, dJ/dq̇₀, ``stats``. With loop closures
         ``q0``/``qd0`` are the partial derivatives by each coordinate; an initial value named in ``parameters``
         moves along the loops (as ``System.assemble`` would close them).
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> model, h = rf.samples.spring_mass()
+    >>> system = model.compile()
+    >>> g = rf.gradient(system, 1.0, ["q0[block.x]"], outputs={"x": "block.x"},
+    ...                terminal=lambda y: y["x"], dt=1e-3, q0=[0.1])
+    >>> round(g.value, 4), round(g.gradient["q0[block.x]"], 4)
+    (0.0409, 0.4087)
     """
     system = _checks.system(system)
 

@@ -29,7 +29,16 @@ from .operating_point import (_compiled, _describe_null_space, _EPS, _frame, _lo
 @dataclass
 class Modes(Versioned):
     """Result of ``modal_analysis``: one entry per mode (k = nq, or nq − rank G with loops), sorted
-    by natural frequency."""
+    by natural frequency.
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> model, h = rf.samples.cantilever(elements=4)
+    >>> modes = rf.modal_analysis(model.compile())
+    >>> len(modes.omega), round(float(modes.frequencies_hz[0]), 2)
+    (4, 16.95)
+    """
 
     omega: np.ndarray           #: (k,) undamped natural circular frequencies, rad/s (a divergence: √(−ω²))
     frequencies_hz: np.ndarray  #: (k,) omega / 2π, Hz
@@ -187,6 +196,14 @@ def modal_analysis(system, q=None, qd=None, *, t: float = 0.0, sensitivities=Non
     ``sensitivities``: named parameters (``System.parameters``) whose derivatives (dω/dp, dζ/dp) at
     this (q, q̇) come with the modes (``Modes.sensitivity(name)``; symmetric problems: no gyroscopic or
     circulatory terms; ``rigidfem.analysis.analysis_sensitivities``).
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> model, h = rf.samples.spring_mass()
+    >>> modes = rf.modal_analysis(model.compile())
+    >>> modes.omega.round(3)
+    array([20.])
     """
     system = _checks.system(system)
     names = analysis_sensitivities.check_names(system, sensitivities)

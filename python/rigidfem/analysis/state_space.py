@@ -58,7 +58,19 @@ EQUILIBRIUM_TOL = 1e-6
 
 class NotAnEquilibriumWarning(UserWarning):
     """``rf.linearize`` about a state that is not an equilibrium (q̈ ≠ 0): the linear model holds
-    for small deviations along the trajectory through that state only."""
+    for small deviations along the trajectory through that state only.
+
+    Examples
+    --------
+    >>> import warnings
+    >>> import rigidfem as rf
+    >>> model, h = rf.samples.pendulum()
+    >>> with warnings.catch_warnings(record=True) as caught:
+    ...     warnings.simplefilter("always")
+    ...     ss = rf.linearize(model.compile(), [0.5])
+    >>> [w.category.__name__ for w in caught]
+    ['NotAnEquilibriumWarning']
+    """
 def linearize(system, q, qd=None, *, t: float = 0.0, inputs=(), outputs=None, dt: float | None = None):
     """The system linearised about (q, q̇) at t: a ``scipy.signal.StateSpace`` (A, B, C, D).
 
@@ -102,6 +114,14 @@ def linearize(system, q, qd=None, *, t: float = 0.0, inputs=(), outputs=None, dt
     model then holds along the trajectory through the state only. Raises ``ValueError`` naming the
     argument for bad input (unknown coordinate names list the valid ones; points of another model;
     dt <= 0; shapes).
+
+    Examples
+    --------
+    >>> import numpy as np, rigidfem as rf
+    >>> model, h = rf.samples.pendulum()
+    >>> ss = rf.linearize(model.compile(), [0.0])
+    >>> ss.A.shape, np.sort(np.linalg.eigvals(ss.A).imag).round(3)
+    ((2, 2), array([-3.836,  3.836]))
     """
     system = _checks.system(system)
     n = system.nq

@@ -46,7 +46,16 @@ from .operating_point import (_close_loops, _compiled, _constraint_stiffness, _C
 
 @dataclass
 class Equilibrium(Versioned):
-    """Result of ``static_equilibrium``."""
+    """Result of ``static_equilibrium``.
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> model, h = rf.samples.spring_mass()
+    >>> eq = rf.static_equilibrium(model.compile())
+    >>> eq.converged, eq.q.round(6)
+    (True, array([0.]))
+    """
 
     q: np.ndarray            #: (nq,) equilibrium coordinates, m and rad
     converged: bool          #: always True: a load step that does not converge raises SimulationError
@@ -120,6 +129,14 @@ def static_equilibrium(system, q0=None, *, t: float = 0.0, load_steps: int = 10,
     ``sensitivities``: named parameters (``System.parameters``) whose derivatives dq/dp of the
     equilibrium come with it, K_t dq/dp = ∂f/∂p (``Equilibrium.sensitivity(name)``;
     ``rigidfem.analysis.analysis_sensitivities``).
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> model, h = rf.samples.cantilever(elements=4)
+    >>> eq = rf.static_equilibrium(model.compile())
+    >>> eq.converged, eq.q.shape
+    (True, (4,))
     """
     system = _checks.system(system)
     names = analysis_sensitivities.check_names(system, sensitivities)

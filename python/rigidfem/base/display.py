@@ -3,6 +3,15 @@
 Every name is escaped with ``html.escape``; long tables show their first ``MAX_ROWS`` rows and
 a last row "… n more". The functions only read their object (a Model is compiled into a
 System to list its coordinates; a Model that does not compile shows its bodies and the error).
+
+Examples
+--------
+>>> import rigidfem as rf
+>>> model, h = rf.samples.pendulum()
+>>> system = model.compile()
+>>> html = rf.display.system_html(system)
+>>> "link.ry" in html
+True
 """
 
 from __future__ import annotations

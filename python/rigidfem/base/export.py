@@ -11,6 +11,16 @@ Column names of a Result's table (``Result.to_dataframe``, ``Result.to_csv``):
 
 The modes' table (``Modes.table``, ``Modes.to_dataframe``) has the columns ``mode`` (1, 2, ...),
 ``omega (rad/s)``, ``f (Hz)`` and ``zeta`` (the modal damping ratio, dimensionless).
+
+Examples
+--------
+>>> import rigidfem as rf
+>>> model, h = rf.samples.pendulum()
+>>> system = model.compile()
+>>> res = rf.simulate(system, 0.5, q0=[0.5], t_eval=[0.0, 0.5])
+>>> names, table = rf.export.result_columns(res, points={"tip": h["tip"]})
+>>> names, table.shape
+(['link.ry', 'link.ry.dot', 'tip.x', 'tip.y', 'tip.z'], (2, 5))
 """
 
 from __future__ import annotations

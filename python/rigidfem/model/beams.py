@@ -180,6 +180,13 @@ def rfe_parameters(material, section, start: float, end: float, origin: float | 
     With x measured from the frame: m = ∫ρA ds, m x_C = ∫ρA x ds, ∫x² dm = ∫ρA x² ds and
     the section's rotary inertia ∫y² dm = ∫ρ Iz ds, ∫z² dm = ∫ρ Iy ds (book ch. 3.6).
     ``material``/``section`` may be functions of s.
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> p = rf.rfe_parameters(rf.Material(E=2.1e11, rho=7850.0), rf.Section.rectangle(0.02, 0.005), 0.0, 0.1)
+    >>> round(float(p.mass), 6)
+    0.0785
     """
     mat = _as_property(material, Material, "material")
     sec = _as_property(section, Section, "section")
@@ -241,6 +248,13 @@ def sde_parameters(material, section, start: float, end: float) -> SdeParameters
     c_x = EA/Δ, c_y = κ_y GA/Δ, c_z = κ_z GA/Δ, c_φ1 = GJ/Δ, c_φ2 = E Iy/Δ, c_φ3 = E Iz/Δ,
     b_k = μ c_k. For a varying section each c is the segment's integrated compliance,
     1/c = ∫ ds/(EI)(s), which for a uniform one is Δ/(EI).
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> p = rf.sde_parameters(rf.Material(E=2.1e11, rho=7850.0), rf.Section.rectangle(0.02, 0.005), 0.0, 0.1)
+    >>> round(float(p.stiffness["bend_z"]), 1)
+    7000.0
     """
     mat = _as_property(material, Material, "material")
     sec = _as_property(section, Section, "section")
@@ -274,7 +288,16 @@ class _Rows(Sequence):
 
 @dataclass
 class Beam:
-    """Handle of a beam added by ``Model.add_beam``."""
+    """Handle of a beam added by ``Model.add_beam``.
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> model, h = rf.samples.cantilever(elements=4)
+    >>> beam = h["beam"]
+    >>> beam.elements, len(beam.rfes), beam.deform
+    (4, 5, ('bend_z',))
+    """
 
     name: str
     length: float

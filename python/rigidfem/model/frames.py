@@ -16,6 +16,15 @@ def transform(translation=(0.0, 0.0, 0.0), euler_zyx=(0.0, 0.0, 0.0)) -> np.ndar
     """Homogeneous transform Trans(translation) · R3(φ3) R2(φ2) R1(φ1) (4, 4).
 
     ``translation`` in m, ``euler_zyx = (φ3, φ2, φ1)`` in rad (yaw, pitch, roll).
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> rf.transform(translation=(1.0, 0.0, 0.0)).round(3)
+    array([[1., 0., 0., 1.],
+           [0., 1., 0., 0.],
+           [0., 0., 1., 0.],
+           [0., 0., 0., 1.]])
     """
     r = _checks.vec3(translation, "translation")
     phi = _checks.vec3(euler_zyx, "euler_zyx")

@@ -39,7 +39,16 @@ def _make(kind: str, coordinates: Sequence[str], stiffness=0.0, damping=0.0, res
 
 
 class Joint:
-    """Factory of joints: ``Joint.revolute("z", stiffness=10.0)`` etc."""
+    """Factory of joints: ``Joint.revolute("z", stiffness=10.0)`` etc.
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> rf.Joint.revolute("z", stiffness=10.0).coordinates
+    ['rz']
+    >>> rf.Joint.free().coordinates
+    ['x', 'y', 'z', 'rz', 'ry', 'rx']
+    """
 
     @staticmethod
     def fixed() -> JointSpec:

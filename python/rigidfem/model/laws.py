@@ -15,6 +15,12 @@ marked as parameters become named parameters ``"<name>.<constant>"`` of the comp
 [('EA', 'N', 200000000.0), ('DA', 'N s', 0.0), ('length', 'm', 12.0), ('mass_per_length', 'kg/m', 0.0)]
 >>> sorted(rf.laws.kinds())
 ['Buffer', 'Contact', 'ForceFunction', 'Friction', 'Rope', 'SlidingFriction', 'SpringDamper', 'SpringDamping']
+
+Examples
+--------
+>>> import rigidfem as rf
+>>> rf.laws.Rope(EA=2e8, length=12.0, DA=1e6)
+Rope(EA=200000000.0, DA=1000000.0, length=12.0, mass_per_length=0.0)
 """
 
 from __future__ import annotations

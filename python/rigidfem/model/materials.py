@@ -36,6 +36,13 @@ class Material:
         stiffness c_k gets one arm per term, k_j = (E_j/E) c_k with τ_j
         (``Model.add_maxwell_arm``: its force is an internal variable of the state). Empty by
         default. ``Material.zener`` and ``Material.from_relaxation`` build it.
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> steel = rf.Material(E=2.1e11, rho=7850.0, nu=0.3)
+    >>> round(steel.G / 1e9, 2)
+    80.77
     """
 
     E: float
@@ -146,6 +153,13 @@ class Section:
         Torsion constant (Saint-Venant), m⁴; equals Iy + Iz only for circles and tubes.
     kappa_y, kappa_z : float
         Shear coefficients (shear stiffness κ G A) for shear along y and z.
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> s = rf.Section.rectangle(0.02, 0.005)
+    >>> round(s.A * 1e6, 3), s.Iz > s.Iy
+    (100.0, True)
     """
 
     A: float

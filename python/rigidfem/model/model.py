@@ -80,6 +80,15 @@ class Model(_core._Model):
         Default ``(0, 0, -9.81)``.
 
     Bodies are added after their parents, so the compiled system has parent[p] < p.
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> model = rf.Model()
+    >>> link = model.add_body("link", model.ground, rf.Joint.revolute("y"), mass=1.0,
+    ...                       inertia=(0.1, 0.1, 0.1), com=(0.0, 0.0, -0.5))
+    >>> model.compile().coordinate_names
+    ['link.ry']
     """
 
     def __init__(self, gravity=(0.0, 0.0, -9.81)):
@@ -113,7 +122,17 @@ class Model(_core._Model):
         return Body()
 
     def body(self, name: str) -> Body:
-        """The handle of the body called ``name``."""
+        """The handle of the body called ``name``.
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model = rf.Model()
+        >>> link = model.add_body("link", model.ground, rf.Joint.revolute("y"), mass=1.0,
+        ...                       inertia=(0.1, 0.1, 0.1), com=(0.0, 0.0, -0.5))
+        >>> model.body("link").index == link.index
+        True
+        """
         if not isinstance(name, str):
             raise _checks.refuse(f"name: expected the name (str) of a body of this model or 'ground', got {name!r}")
         try:
@@ -174,6 +193,17 @@ class Model(_core._Model):
         placement : (4, 4) array, optional
             Pose of the joint frame in the parent's frame (``rigidfem.transform``);
             identity by default. The body frame is the joint frame moved by the joint.
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model = rf.Model()
+        >>> link = model.add_body("link", model.ground, rf.Joint.revolute("y"), mass=1.0,
+        ...                       inertia=(0.1, 0.1, 0.1), com=(0.0, 0.0, -0.5))
+        >>> link
+        <rigidfem Body 'link' #0>
+        >>> model.compile().nq
+        1
         """
         name = self._new_name(name)
         if not isinstance(joint, JointSpec):
@@ -210,6 +240,17 @@ class Model(_core._Model):
         ("x", ..., "rx") when the joint has more than one. A coordinate takes one motion:
         prescribing it again is a ValueError. Returns the coordinate's handle ("<body>.<axis>", kind "drive"); the
         drive's numbers are the parameters ``"<body>.<axis>.drive.<path>"``.
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model = rf.Model()
+        >>> link = model.add_body("link", model.ground, rf.Joint.revolute("y"), mass=1.0,
+        ...                       inertia=(0.1, 0.1, 0.1), com=(0.0, 0.0, -0.5))
+        >>> _ = model.prescribe(link, rf.motion.ramp(1.0, 0.0, 1.0))
+        >>> system = model.compile()
+        >>> system.nq, system.prescribed_names
+        (0, ['link.ry'])
         """
         if not isinstance(motion, Profile):
             raise _checks.refuse(f"motion: expected a profile from rigidfem.motion, got {motion!r}")
@@ -246,6 +287,14 @@ class Model(_core._Model):
         placement : (4, 4) array, optional
             Pose of the frame in which the motion is given (the base's rest pose), in the global
             frame; identity by default.
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model = rf.Model()
+        >>> ship = model.add_moving_base("ship", {"heave": rf.motion.harmonic(0.5, 0.1)})
+        >>> model.compile().prescribed_names
+        ['ship.x', 'ship.y', 'ship.z', 'ship.rz', 'ship.ry', 'ship.rx']
         """
         profiles = _base_profiles(motion)
         base = self.add_body(name, self.ground, joints.Joint.free(), mass=mass, inertia=inertia, com=com,
@@ -267,6 +316,16 @@ class Model(_core._Model):
         inf) raises a ValueError naming the law, the coordinate, the value and the time where
         a System method calls it, and ``rigidfem.SimulationError`` at that time in a simulation
         (both are ``rigidfem._core.ForceLawError``). Exceptions the function raises propagate.
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model = rf.Model()
+        >>> link = model.add_body("link", model.ground, rf.Joint.revolute("y"), mass=1.0,
+        ...                       inertia=(0.1, 0.1, 0.1), com=(0.0, 0.0, -0.5))
+        >>> _ = model.add_generalized_force(link, 1.0)
+        >>> round(float(model.compile().forward_dynamics(0.0, [0.0], [0.0])[0]), 4)
+        2.8571
         """
         k = self._coordinate(body, coordinate)
         if callable(force):
@@ -293,6 +352,17 @@ class Model(_core._Model):
         ``rigidfem.simulate`` integrates s (initial value ``s0``, zero by default) and returns it
         as ``Result.arm_forces``; ``rigidfem.Material(prony=...)`` puts arms in every sde of a beam. Returns the
         coordinate's handle ("<body>.<axis>", kind "arm").
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model = rf.Model(gravity=None)
+        >>> block = model.add_body("block", model.ground, rf.Joint.prismatic("x", stiffness=100.0), mass=1.0,
+        ...                        inertia=(1e-3,) * 3)
+        >>> _ = model.add_maxwell_arm(block, 50.0, 0.1)
+        >>> res = rf.simulate(model.compile(), 0.1, q0=[0.01])
+        >>> res.arm_forces.shape[1]
+        1
         """
         k = self._coordinate(body, coordinate)
         stiffness = _checks.real(stiffness, "stiffness", "an arm stiffness in N/m or N·m/rad")
@@ -309,6 +379,17 @@ class Model(_core._Model):
         when ``follower=True``. ``scale`` (a ``rigidfem.motion`` profile) multiplies
         it by its value q(t). ``name`` (new among the model's names) names its parameter
         ``"<name>.force"``, its magnitude (``System.parameters``). Returns its handle.
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model = rf.Model()
+        >>> link = model.add_body("link", model.ground, rf.Joint.revolute("y"), mass=1.0,
+        ...                       inertia=(0.1, 0.1, 0.1), com=(0.0, 0.0, -0.5))
+        >>> load = model.add_force("push", link.point((0.0, 0.0, -1.0)), (1.0, 0.0, 0.0))
+        >>> system = model.compile()
+        >>> round(float(system.forward_dynamics(0.0, [0.0], [0.0])[0]), 4)
+        -2.8571
         """
         name = self._new_name(name)
         p = self._point(point)
@@ -319,7 +400,18 @@ class Model(_core._Model):
     def add_torque(self, name: str, body: Body, torque, *, follower: bool = False,
                    scale: Profile | None = None) -> handles.Load:
         """Apply a torque (N·m) on ``body``: global components, or body ones if ``follower``. ``name`` names its
-        parameter ``"<name>.torque"``, its magnitude. Returns its handle."""
+        parameter ``"<name>.torque"``, its magnitude. Returns its handle.
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model = rf.Model()
+        >>> link = model.add_body("link", model.ground, rf.Joint.revolute("y"), mass=1.0,
+        ...                       inertia=(0.1, 0.1, 0.1), com=(0.0, 0.0, -0.5))
+        >>> _ = model.add_torque("motor", link, (0.0, 2.0, 0.0))
+        >>> round(float(model.compile().forward_dynamics(0.0, [0.0], [0.0])[0]), 4)
+        5.7143
+        """
         name = self._new_name(name)
         p = self._point(body)
         return self._load(name, "torque", p.body, np.zeros(3), np.zeros(3), _checks.reals(torque, (3,), "torque"), follower,
@@ -381,6 +473,14 @@ class Model(_core._Model):
 
         Returns the loop's handle. The initial coordinates of a simulation must close every loop:
         ``System.assemble`` finds them from a guess.
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.four_bar()
+        >>> system = model.compile()
+        >>> system.loop_names, system.nq
+        (['C'], 3)
         """
         name = loops.add_loop_joint(self, self._new_name(name), kind, a, b, frame_a=frame_a, frame_b=frame_b,
                                     length=length)
@@ -392,7 +492,19 @@ class Model(_core._Model):
         and ``b`` (Point or Body): their distance is held at ``length`` (m), a number or a
         ``rigidfem.motion`` profile l(t). Its force (N, positive pushing the points apart) is the
         loop's reaction, column 0 of ``System.loop_reactions``; ``name`` names it in ``System.loop_names``. Returns its
-        handle."""
+        handle.
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model = rf.Model(gravity=None)
+        >>> arm = model.add_body("arm", model.ground, rf.Joint.revolute("y"), mass=1.0, inertia=(0.1,) * 3,
+        ...                      com=(0.5, 0.0, 0.0))
+        >>> _ = model.add_actuator("jack", model.ground.point((0.0, 0.0, -0.5)), arm.point((0.5, 0.0, 0.0)), 0.7)
+        >>> system = model.compile()
+        >>> system.loop_names
+        ['jack']
+        """
         return handles.Loop(loops.add_actuator(self, self._new_name(name), a, b, length), "actuator", self._nloops - 1)
 
     @recorded
@@ -401,7 +513,17 @@ class Model(_core._Model):
         and ``b`` (Point, Body or ``model.ground``; rigid bodies or rfes of a beam), acting along the line between
         them with the law's axial force F(t, l, l̇) (N, > 0 pushing the points apart). No constraint: it acts on
         trees and closed chains alike (``rigidfem.model.force_elements``). Its constants marked as parameters become
-        ``"<name>.<constant>"`` (``System.parameters``); ``System.element_names`` lists ``name``. Returns its handle."""
+        ``"<name>.<constant>"`` (``System.parameters``); ``System.element_names`` lists ``name``. Returns its handle.
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model = rf.Model(gravity=None)
+        >>> block = model.add_body("block", model.ground, rf.Joint.prismatic("x"), mass=2.0, inertia=(1e-3,) * 3)
+        >>> _ = model.add_force_element("s", model.ground, block, rf.laws.SpringDamper(stiffness=50.0, length=0.0))
+        >>> round(float(model.compile().forward_dynamics(0.0, [0.1], [0.0])[0]), 4)
+        -2.5
+        """
         return force_elements.add_force_element(self, self._new_name(name), a, b, law)
 
     @recorded
@@ -412,7 +534,18 @@ class Model(_core._Model):
         F = −k (l − l₀) − c l̇ (N, > 0 pushing the points apart) with ``stiffness`` k (N/m),
         rest ``length`` l₀ (m) and ``damping`` c (N·s/m): ``add_force_element(name, a, b,
         rf.laws.SpringDamper(stiffness=k, length=l₀, damping=c))``. ``System.element_names`` lists ``name``. Returns
-        its handle."""
+        its handle.
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model = rf.Model(gravity=None)
+        >>> block = model.add_body("block", model.ground, rf.Joint.prismatic("x"), mass=2.0, inertia=(1e-3,) * 3)
+        >>> _ = model.add_spring_damper("s", model.ground, block, stiffness=50.0, length=0.0, damping=1.0)
+        >>> modes = rf.modal_analysis(model.compile(), [0.1])
+        >>> modes.omega.round(3)
+        array([5.])
+        """
         name = self._new_name(name)
         force_elements.points(self, a, b)  # named before the law's constants
         law = laws.SpringDamper(stiffness=stiffness, length=length, damping=damping)
@@ -425,7 +558,17 @@ class Model(_core._Model):
         F(t) or a Python function ``force(t, l, ld)`` of time (s), length (m) and its rate (m/s)
         (the slow path: called under the GIL at every evaluation) — less its ``damping`` c l̇
         (N·s/m): a ``rf.laws.SpringDamper`` without a spring. Position control is ``add_actuator``. Returns its
-        handle; ``System.element_states`` and ``Result.element_forces`` give its force."""
+        handle; ``System.element_states`` and ``Result.element_forces`` give its force.
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model = rf.Model(gravity=None)
+        >>> block = model.add_body("block", model.ground, rf.Joint.prismatic("x"), mass=2.0, inertia=(1e-3,) * 3)
+        >>> _ = model.add_cylinder("jack", model.ground, block, 10.0)
+        >>> round(float(model.compile().forward_dynamics(0.0, [0.5], [0.0])[0]), 4)
+        5.0
+        """
         name = self._new_name(name)
         force_elements.points(self, a, b)  # named before the law's constants
         law = laws.SpringDamper(damping=damping, **force_elements.cylinder_force(force))
@@ -454,7 +597,18 @@ class Model(_core._Model):
         inertia, driven by a torque or a law of the state: ``add_torque``, ``add_joint_law``) or prescribed (a speed:
         ``prescribe``). The drum takes the generalised force r P, P = T + ½ EA ε² while taut (ε = (l − l_u)/l_u):
         −∂/∂(r φ) of the energy the rope stores and dissipates, so that the energy balance holds to the last term.
-        The point ``a`` is where the rope leaves the drum (or a sheave it runs over), fixed on ``a``'s body."""
+        The point ``a`` is where the rope leaves the drum (or a sheave it runs over), fixed on ``a``'s body.
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model = rf.Model()
+        >>> load = model.add_body("load", model.ground, rf.Joint.prismatic("z"), mass=10.0, inertia=(1e-3,) * 3)
+        >>> _ = model.add_rope("rope", model.ground.point((0.0, 0.0, 2.0)), load, EA=1e5, length=2.0)
+        >>> eq = rf.static_equilibrium(model.compile(), [-0.01])
+        >>> round(float(eq.q[0]), 6)
+        -0.001962
+        """
         name = self._new_name(name)
         force_elements.points(self, a, b)  # named before the law's constants
         wound = None
@@ -490,7 +644,22 @@ class Model(_core._Model):
         ``mass`` (kg) is the rope's mass that slips, the slip's inertia (a small one keeps u an ordinary coordinate:
         ``"<name>"`` is a point mass 1 m from an axis along gravity, turning about it: u in rad = m of rope, and
         gravity does no work on it; its named parameter ``"<name>.mass"`` sets that inertia). The friction's power is
-        in ``dissipated_power``. Returns the body."""
+        in ``dissipated_power``. Returns the body.
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model = rf.Model()
+        >>> heavy = model.add_body("heavy", model.ground, rf.Joint.prismatic("z"), 30.0, (1.0, 1.0, 1.0),
+        ...                        placement=rf.transform((-0.5, 0.0, 0.0)))
+        >>> light = model.add_body("light", model.ground, rf.Joint.prismatic("z"), 10.0, (1.0, 1.0, 1.0),
+        ...                        placement=rf.transform((0.5, 0.0, 0.0)))
+        >>> left = model.add_rope("left", model.ground.point((-0.5, 0.0, 5.0)), heavy, EA=1e8, length=5.0)
+        >>> right = model.add_rope("right", model.ground.point((0.5, 0.0, 5.0)), light, EA=1e8, length=5.0)
+        >>> _ = model.add_sheave("sheave", left, right, mu=0.3, wrap=3.14, mass=0.1)
+        >>> model.compile().coordinate_names
+        ['heavy.z', 'light.z', 'sheave.rz']
+        """
         name = self._new_name(name)
         ropes = []
         for argument, rope in (("into", into), ("out_of", out_of)):
@@ -536,7 +705,17 @@ class Model(_core._Model):
         """Fix a shape (``rigidfem.shapes``: ``Sphere``, ``Capsule``, ``Box``, ``HalfSpace``) on ``body`` (a Body or
         ``model.ground``), or one capsule on each rigid finite element of a beam (``body`` a ``Beam``, ``shape``
         ``rigidfem.shapes.Capsules()``: the shapes ``"<name>[k]"``). Lengths in m, in the body's frame. Shapes touch
-        only through ``add_contact``. Returns the shape's handle (``.shapes``: the indices of its shapes)."""
+        only through ``add_contact``. Returns the shape's handle (``.shapes``: the indices of its shapes).
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model = rf.Model()
+        >>> ball = model.add_body("ball", model.ground, rf.Joint.prismatic("z"), mass=0.1, inertia=(1e-5,) * 3)
+        >>> shape = model.add_shape("sphere", ball, rf.shapes.Sphere(0.05))
+        >>> shape.shapes
+        (0,)
+        """
         handle = shapes.add_shape(self, self._new_name(name), body, shape)
         self._names.add(handle.name)
         return handle
@@ -549,7 +728,19 @@ class Model(_core._Model):
         Stribeck fall). Every shape of ``a`` meets every shape of ``b`` (none on one body): spheres and capsules each
         other and half-spaces, boxes half-spaces only. A half-space against n shapes costs O(n) an evaluation; a
         model without contacts pays nothing. The law's stiffness, restitution, mu_s and mu_k become the named parameters
-        ``"<name>.stiffness"``, ... (``System.parameters``). Returns the contact's handle."""
+        ``"<name>.stiffness"``, ... (``System.parameters``). Returns the contact's handle.
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model = rf.Model()
+        >>> ball = model.add_body("ball", model.ground, rf.Joint.prismatic("z"), mass=0.1, inertia=(1e-5,) * 3)
+        >>> b = model.add_shape("sphere", ball, rf.shapes.Sphere(0.05))
+        >>> floor = model.add_shape("floor", model.ground, rf.shapes.HalfSpace())
+        >>> _ = model.add_contact("hit", b, floor, rf.laws.Contact(stiffness=1e5, restitution=0.8))
+        >>> model.compile().contact_names
+        ['hit']
+        """
         name = self._new_name(name)
         if not isinstance(law, laws.Law) or law.info["acts_on"] != "contact":
             raise _checks.refuse(f"law: expected a contact law (Contact from rigidfem.laws), got {law!r}")
@@ -565,7 +756,17 @@ class Model(_core._Model):
         ``coordinate`` ("x", ..., "rx"; None: the joint's only one) of ``body``'s joint, adding its generalised
         force Q(t, q, q̇) (N or N·m) to the coordinate's own spring-damping law. Its constants marked as parameters
         become ``"<name>.<constant>"`` (``System.parameters``, in the coordinate's units: N or N·m for a rotation's
-        forces). Returns its handle."""
+        forces). Returns its handle.
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model = rf.Model(gravity=None)
+        >>> block = model.add_body("block", model.ground, rf.Joint.prismatic("x"), mass=2.0, inertia=(1e-3,) * 3)
+        >>> _ = model.add_joint_law("friction", block, rf.laws.Friction(breakaway=3.0, coulomb=2.0))
+        >>> model.compile().nq
+        1
+        """
         name = self._new_name(name)
         if not isinstance(law, laws.Law) or law.info["acts_on"] != "coordinate" or not law.info["addable"]:
             kinds = [k for k, i in laws.kinds().items() if i["acts_on"] == "coordinate" and i["addable"]]
@@ -629,6 +830,15 @@ class Model(_core._Model):
         Beam
             Handle with ``tip``, ``point(s)``, ``rfes``, ``centerline(system, q)``, and
             the rfe/sde parameters ``rfe`` and ``sde``.
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model = rf.Model()
+        >>> beam = model.add_beam("beam", model.ground, 1.0, rf.Material(E=2.1e11, rho=7850.0),
+        ...                       rf.Section.rectangle(0.02, 0.005), 4, deform="bend_z")
+        >>> model.compile().coordinate_names
+        ['beam.rfe1.rz', 'beam.rfe2.rz', 'beam.rfe3.rz', 'beam.rfe4.rz']
         """
         beam = add_beam(self, name, parent, length, material, section, elements, formulation, deform, linear,
                         joint, placement, tip_mass, tip_inertia, tip_offset)
@@ -717,6 +927,18 @@ class Model(_core._Model):
         algorithm, RNEA and CRBA for the right-hand side and mass matrix) or "lagrange" (the
         book's formulation, kept as the reference). Systems with linear joints (the linear
         beam model) always use Lagrange.
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model = rf.Model()
+        >>> link = model.add_body("link", model.ground, rf.Joint.revolute("y"), mass=1.0,
+        ...                       inertia=(0.1, 0.1, 0.1), com=(0.0, 0.0, -0.5))
+        >>> system = model.compile()
+        >>> system
+        <rigidfem System: 1 bodies, nq=1, 0 prescribed>
+        >>> model.compile("lagrange").algorithm
+        'lagrange'
         """
         return System(self, algorithm)
 
@@ -732,6 +954,16 @@ class System(_core._System):
     body in the order the bodies were added, within a joint in the order x, y, z,
     rz, ry, rx. Prescribed coordinates are not part of q; their drives are
     evaluated at time t (s), which is why some methods take ``t``.
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> model, h = rf.samples.pendulum()
+    >>> system = model.compile()
+    >>> system
+    <rigidfem System: 1 bodies, nq=1, 0 prescribed>
+    >>> system.nq, system.coordinate_names
+    (1, ['link.ry'])
     """
 
     def __init__(self, model, algorithm: str = "recursive"):
@@ -753,7 +985,17 @@ class System(_core._System):
     def with_parameters(self, values: dict) -> System:
         """This system with the named parameters ``values`` ({name: value}, units of ``System.parameters``)
         changed: a new System (O(n), the model is not compiled again) that simulates exactly as the model
-        built with those values. ValueError naming an unknown parameter or a value out of its range."""
+        built with those values. ValueError naming an unknown parameter or a value out of its range.
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.spring_mass()
+        >>> system = model.compile()
+        >>> heavy = system.with_parameters({"block.mass": 4.0})
+        >>> round(float(rf.modal_analysis(system).omega[0] / rf.modal_analysis(heavy).omega[0]), 6)
+        1.414214
+        """
         values = self._parameters.checked(values)
         new = System.__new__(System)
         changes = self._parameters.changes(values)
@@ -771,19 +1013,49 @@ class System(_core._System):
 
     def position(self, point, t, q) -> np.ndarray:
         """Global position (3,) in m of a ``Point`` (or a ``Body``'s origin) of this system's model at
-        time ``t`` (s) and coordinates ``q`` (m, rad)."""
+        time ``t`` (s) and coordinates ``q`` (m, rad).
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.pendulum()
+        >>> system = model.compile()
+        >>> system.position(h["tip"], 0.0, [0.0])
+        array([ 0.,  0., -1.])
+        """
         _checks.same_model(point, self, "point")
         return self._position(point, t, q)
 
     def velocity(self, point, t, q, qd) -> np.ndarray:
         """Global velocity (3,) in m/s of a ``Point`` (or a ``Body``'s origin) at time ``t`` (s),
-        coordinates ``q`` and rates ``qd`` (m/s, rad/s)."""
+        coordinates ``q`` and rates ``qd`` (m/s, rad/s).
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.pendulum()
+        >>> system = model.compile()
+        >>> system.velocity(h["tip"], 0.0, [0.0], [2.0]).round(3)
+        array([-2.,  0.,  0.])
+        """
         _checks.same_model(point, self, "point")
         return self._velocity(point, t, q, qd)
 
     def transform(self, body, t, q) -> np.ndarray:
         """Pose T_p (4, 4) in the global frame of a body (a ``Body`` handle or its index) at time ``t``
-        (s) and coordinates ``q``."""
+        (s) and coordinates ``q``.
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.pendulum()
+        >>> system = model.compile()
+        >>> system.transform(h["link"], 0.0, [0.0]).round(3)
+        array([[1., 0., 0., 0.],
+               [0., 1., 0., 0.],
+               [0., 0., 1., 0.],
+               [0., 0., 0., 1.]])
+        """
         if isinstance(body, Body):
             _checks.same_model(body, self, "body", "a Body of the model this system was compiled from")
         return _core._System.transform(self, body, t, q)
@@ -794,11 +1066,30 @@ class System(_core._System):
         required, m or the cosine of direction rows; up to 1e-9 accepted where G has lost rank), then
         the velocities projected onto G q̇ + ∂g/∂t = 0 in the mass metric (the kinetic energy never rises). Raises ``SimulationError`` naming the
         loop that cannot be closed from this guess. ``t`` (s, keyword) for prescribed motions; q in m
-        and rad, qd per s (zero by default)."""
+        and rad, qd per s (zero by default).
+
+        Examples
+        --------
+        >>> import numpy as np, rigidfem as rf
+        >>> model, h = rf.samples.four_bar()
+        >>> system = model.compile()
+        >>> q, qd = system.assemble([0.4, -1.9, 4.6])
+        >>> g, gd, G = system.loop_constraints(0.0, q, qd)
+        >>> bool(np.abs(g).max() < 1e-10), G.shape
+        (True, (5, 3))
+        """
         return loops.assemble(self, q, qd, t=t, tol=tol, max_iterations=max_iterations)
 
     def coordinate_index(self, name: str) -> int:
-        """Index in q of the coordinate called ``name`` (e.g. ``"link1.rz"``)."""
+        """Index in q of the coordinate called ``name`` (e.g. ``"link1.rz"``).
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.double_pendulum()
+        >>> model.compile().coordinate_index("link2.ry")
+        1
+        """
         names = self.coordinate_names
         if name not in names:
             raise _checks.refuse(f"name: expected one of {names}, got {name!r}")

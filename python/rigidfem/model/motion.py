@@ -8,6 +8,15 @@ Profiles compose, in C++ with their exact rates: ``p + r``, ``p - r``, ``p + c``
 same motion ``delay`` s later) and ``piecewise([p0, p1, ...], breaks)`` (one after the other,
 checked to join continuously). Rest-to-rest moves (``rest_to_rest``) and smooth ramps of the rate
 (``ramp``) stop and start where they say, unlike a polynomial, which keeps growing after its end.
+
+Examples
+--------
+>>> import rigidfem as rf
+>>> p = rf.motion.rest_to_rest(0.0, 1.0, 0.0, 2.0)
+>>> [round(x, 6) for x in p(1.0)]
+[0.5, 0.9375, 0.0]
+>>> [round(x, 6) for x in p(3.0)]
+[1.0, 0.0, 0.0]
 """
 
 from __future__ import annotations

@@ -30,6 +30,17 @@ Every constant they set but one enters the equations of motion linearly (inertia
 forces), which is what makes the sensitivities' derivatives by them exact to round-off
 (``cpp/include/rigidfem/sensitivities.hpp``); a contact's restitution does not (``Parameter.linear`` False), and
 is differenced centrally, as a profile's numbers are.
+
+Examples
+--------
+>>> import rigidfem as rf
+>>> model, h = rf.samples.cantilever(elements=4)
+>>> system = model.compile()
+>>> sorted(system.parameters)[:3]
+['beam.A', 'beam.E', 'beam.G']
+>>> stiffer = system.with_parameters({"beam.E": 4.2e11})
+>>> round(float(rf.modal_analysis(stiffer).omega[0] / rf.modal_analysis(system).omega[0]), 6)
+1.414214
 """
 
 from __future__ import annotations
@@ -47,7 +58,16 @@ from ..base import _checks
 
 @dataclass(frozen=True)
 class Parameter:
-    """A named parameter of a system: its current ``value`` in ``unit``, and what it sets."""
+    """A named parameter of a system: its current ``value`` in ``unit``, and what it sets.
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> model, h = rf.samples.spring_mass()
+    >>> p = model.compile().parameters["block.mass"]
+    >>> p.value, p.unit
+    (2.0, 'kg')
+    """
 
     name: str
     value: float

@@ -4,6 +4,13 @@ Each returns ``(model, handles)``: the Model (not yet compiled, so it can be
 changed) and a dict of its bodies and points. Gravity is −9.81 m/s² along Z.
 Bodies are slender rods unless said otherwise: mass m, length l, centre of mass at
 the middle, inertia m l²/12 about the transverse axes and a small axial one.
+
+Examples
+--------
+>>> import rigidfem as rf
+>>> model, h = rf.samples.double_pendulum()
+>>> sorted(h), model.compile().nq
+(['link1', 'link2', 'tip'], 2)
 """
 
 from __future__ import annotations

@@ -16,6 +16,13 @@ For example (``model`` a ``rigidfem.Model``)::
     waves = rf.sea.jonswap_waves(hs=2.0, tp=8.0, n=200, seed=1)
     deck = model.add_moving_base("deck", waves.motion({"heave": rf.sea.RAO.oscillator(6.0, 0.1),
                                                          "roll": np.radians(2.0)}))
+
+Examples
+--------
+>>> import rigidfem as rf
+>>> waves = rf.sea.jonswap_waves(hs=2.0, tp=8.0, n=50, seed=1)
+>>> type(waves).__name__, len(waves.amplitude), round(4 * waves.m0 ** 0.5, 2)
+('Waves', 50, 2.0)
 """
 
 from __future__ import annotations

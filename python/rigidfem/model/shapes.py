@@ -10,6 +10,12 @@ corners), half-spaces everything but half-spaces.
 >>> import rigidfem as rf
 >>> rf.shapes.Sphere(0.1)
 Sphere(radius=0.1, center=(0.0, 0.0, 0.0))
+
+Examples
+--------
+>>> import rigidfem as rf
+>>> rf.shapes.Capsule(0.02, (0.0, 0.0, 0.0), (0.1, 0.0, 0.0))
+Capsule(radius=0.02, a=(0.0, 0.0, 0.0), b=(0.1, 0.0, 0.0))
 """
 
 from __future__ import annotations

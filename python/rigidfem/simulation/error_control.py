@@ -113,6 +113,18 @@ class ErrorEstimate(Versioned):
     displacement (m), a coordinate (m or rad), an element's axial force (N), a loop's multipliers
     (N or N·m); "bodies" is the largest displacement of any body's origin or centre of mass (m).
     ``of(quantity)`` gives the estimate of any other quantity of the run.
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> model, h = rf.samples.pendulum()
+    >>> system = model.compile()
+    >>> res = rf.simulate(system, 1.0, q0=[0.5], rtol=1e-6, error_estimate=True)
+    >>> est = res.error_estimate
+    >>> type(est).__name__, est.names
+    ('ErrorEstimate', ['bodies'])
+    >>> bool(est.max[0] < 1e-4)
+    True
     """
 
     t: np.ndarray

@@ -55,6 +55,16 @@ class Event:
         For a point: the global direction its position is measured along.
     rate : bool
         For a coordinate: its rate q̇ (m/s or rad/s) crosses ``value``.
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> model, h = rf.samples.pendulum()
+    >>> system = model.compile()
+    >>> low = rf.Event("low", "link.ry", value=0.0, direction=-1, terminal=True)
+    >>> res = rf.simulate(system, 5.0, q0=[0.5], events=[low])
+    >>> round(float(res.t[-1]), 3)
+    0.416
     """
 
     name: str

@@ -181,6 +181,15 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
 
     Ctrl-C in the main thread — in the C++ loop, in a Python drive or force law, or in a
     ``scipy:`` method — returns the partial result with a RuntimeWarning (``result.interrupted``).
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> model, h = rf.samples.pendulum()
+    >>> system = model.compile()
+    >>> res = rf.simulate(system, 1.0, q0=[0.5])
+    >>> res.stats["method"], round(float(res.q[-1, 0]), 4)
+    ('dopri5', -0.4034)
     """
     o = options_.resolve(options)
     dt, rtol, atol, error_on, first_step = o["dt"], o["rtol"], o["atol"], o["error_on"], o["first_step"]

@@ -90,7 +90,15 @@ _BY_NAME = {o.name: o for o in OPTIONS}
 
 
 def methods() -> dict[str, Method]:
-    """The integration methods (name -> ``Method``): the C++ method table, with SciPy's solvers."""
+    """The integration methods (name -> ``Method``): the C++ method table, with SciPy's solvers.
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> m = rf.methods()
+    >>> "dopri5" in m, "radau5" in m
+    (True, True)
+    """
     return {name: _METHODS[name] for name in METHODS}
 
 
@@ -103,7 +111,14 @@ def method(name) -> Method:
 
 def integrator_options(method: str | None = None) -> dict[str, Option]:
     """The options (name -> ``Option``) that ``method`` reads, or every option for None. ValueError for
-    an unknown method."""
+    an unknown method.
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> sorted(rf.integrator_options("rk4"))
+    ['dt', 'max_steps']
+    """
     if method is None:
         return dict(_BY_NAME)
     readers = globals()["method"](method).options

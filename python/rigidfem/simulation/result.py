@@ -40,6 +40,17 @@ class Result(Versioned):
     multipliers ``loop_reactions`` are).
     ``error_estimate`` is the error bar of the time integration (computed on first use: a second run);
     ``run`` keeps the arguments of the call that made the result.
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> model, h = rf.samples.pendulum()
+    >>> system = model.compile()
+    >>> res = rf.simulate(system, 1.0, q0=[0.5], t_eval=[0.0, 0.5, 1.0])
+    >>> res.t, res.q.shape
+    (array([0. , 0.5, 1. ]), (3, 1))
+    >>> res.q[:, 0].round(3)
+    array([ 0.5  , -0.157, -0.403])
     """
 
     system: object = field(repr=False)
@@ -162,7 +173,19 @@ class Result(Versioned):
 
     def position(self, point, frame: Body | None = None) -> np.ndarray:
         """Positions (len(t), 3) in m of a ``Point`` (or a ``Body``'s origin), in the global
-        frame or in the frame of the body ``frame``."""
+        frame or in the frame of the body ``frame``.
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.pendulum()
+        >>> system = model.compile()
+        >>> res = rf.simulate(system, 1.0, q0=[0.5], t_eval=[0.0, 0.5, 1.0])
+        >>> res.position(h["tip"]).shape
+        (3, 3)
+        >>> res.position(h["tip"])[0].round(4)
+        array([-0.4794,  0.    , -0.8776])
+        """
         _checks.result(self, "result", needs="positions")
         if isinstance(point, Body):
             point = point.origin
@@ -178,7 +201,17 @@ class Result(Versioned):
 
     def sensitivity(self, name: str) -> tuple[np.ndarray, np.ndarray]:
         """(∂q/∂p, ∂q̇/∂p), each (len(t), nq), by the parameter or initial value ``name`` the run was asked
-        for (``simulate(sensitivities=...)``; units of q and q̇ per unit of the parameter)."""
+        for (``simulate(sensitivities=...)``; units of q and q̇ per unit of the parameter).
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.spring_mass()
+        >>> res = rf.simulate(model.compile(), 1.0, "rk4", dt=1e-3, q0=[0.1], sensitivities=["q0[block.x]"])
+        >>> dq, dqd = res.sensitivity("q0[block.x]")
+        >>> round(float(dq[0, 0]), 6), dq.shape
+        (1.0, (1001, 1))
+        """
         if not isinstance(name, str) or name not in self.sensitivities:
             raise _checks.refuse(f"name: expected one of the sensitivities of this run {list(self.sensitivities)}, "
                              f"got {name!r}")
@@ -191,7 +224,18 @@ class Result(Versioned):
         ``name``: (∂x/∂q) ∂q/∂p, by a central difference of x along ∂q/∂p at each output (about 1e-10
         relative; m per unit of the parameter), plus, for a profile's number, ∂x/∂p at fixed q: a drive's
         number moves its prescribed coordinate, and the point with it (a central difference of x on the
-        systems at p ± h)."""
+        systems at p ± h).
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.pendulum()
+        >>> system = model.compile()
+        >>> res = rf.simulate(system, 1.0, "rk4", dt=1e-3, q0=[0.5], t_eval=[0.0, 1.0],
+        ...                   sensitivities=["q0[link.ry]"])
+        >>> res.position_sensitivity(h["tip"], "q0[link.ry]")[0].round(4)
+        array([-0.8776,  0.    ,  0.4794])
+        """
         _checks.result(self, "result", needs="positions")
         dq, _ = self.sensitivity(name)
         size = np.max(np.abs(dq), axis=1, initial=0.0) / np.maximum(1.0, np.max(np.abs(self.q), axis=1, initial=0.0))
@@ -208,7 +252,18 @@ class Result(Versioned):
 
     def event_times(self, name: str) -> np.ndarray:
         """The times (s) of the roots of the event called ``name`` (``simulate(events=...)``, or a contact's name: its
-        onsets and separations), in order; ValueError for a name the run had no event of."""
+        onsets and separations), in order; ValueError for a name the run had no event of.
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.pendulum()
+        >>> system = model.compile()
+        >>> up = rf.Event("up", "link.ry", direction=1)
+        >>> res = rf.simulate(system, 3.0, q0=[0.5], events=[up])
+        >>> res.event_times("up").round(3)
+        array([1.248, 2.912])
+        """
         known = {e[1] for e in self._event_specs()} if self.system is not None and self.run else set()
         if not isinstance(name, str) or name not in known | {f.event for f in self.events}:
             raise _checks.refuse(f"name: expected the name of one of the run's events ({sorted(known) or 'none'}), "
@@ -238,18 +293,55 @@ class Result(Versioned):
         """pandas DataFrame indexed by ``t`` (s): a column per coordinate (q, m or rad, named as in
         ``system.coordinate_names``), ``<name>.dot`` per coordinate (q̇, m/s or rad/s) and, for
         ``points={"tip": beam.tip}`` (Points or Bodies), ``tip.x``, ``tip.y``, ``tip.z`` (global
-        position, m). ImportError when pandas is not installed (``to_csv`` needs none)."""
+        position, m). ImportError when pandas is not installed (``to_csv`` needs none).
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.pendulum()
+        >>> system = model.compile()
+        >>> res = rf.simulate(system, 1.0, q0=[0.5], t_eval=[0.0, 0.5, 1.0])
+        >>> list(res.to_dataframe(points={"tip": h["tip"]}).columns)
+        ['link.ry', 'link.ry.dot', 'tip.x', 'tip.y', 'tip.z']
+        """
         return export.to_dataframe(self, points)
 
     def to_csv(self, path, points=None):
         """Write the table of ``to_dataframe`` as CSV with a header line ``t,<columns>`` (numpy only;
-        17 significant digits) to ``path`` (a str or ``os.PathLike``). Returns ``path``."""
+        17 significant digits) to ``path`` (a str or ``os.PathLike``). Returns ``path``.
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.pendulum()
+        >>> system = model.compile()
+        >>> res = rf.simulate(system, 1.0, q0=[0.5], t_eval=[0.0, 0.5, 1.0])
+        >>> import pathlib, tempfile
+        >>> path = pathlib.Path(tempfile.mkdtemp()) / "run.csv"
+        >>> _ = res.to_csv(path, points={"tip": h["tip"]})
+        >>> path.read_text().splitlines()[0]
+        't,link.ry,link.ry.dot,tip.x,tip.y,tip.z'
+        """
         return export.to_csv(self, _checks.path(path), points)
 
     def to_npz(self, path):
         """Save t, q, qd, the forward sensitivities (if any), coordinate_names, method, stats and interrupted in a
         NumPy archive at ``path`` (a str or ``os.PathLike``); ``rigidfem.load_npz(path, system)`` reads it back.
-        The run's events (``events``) are not saved. Returns ``path``."""
+        The run's events (``events``) are not saved. Returns ``path``.
+
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.pendulum()
+        >>> system = model.compile()
+        >>> import pathlib, tempfile
+        >>> res = rf.simulate(system, 0.5, q0=[0.5])
+        >>> path = pathlib.Path(tempfile.mkdtemp()) / "run.npz"
+        >>> _ = res.to_npz(path)
+        >>> back = rf.load_npz(path, system)
+        >>> bool((back.q == res.q).all())
+        True
+        """
         return export.to_npz(self, _checks.path(path))
 
 
@@ -258,7 +350,21 @@ def load_npz(path, system=None) -> Result:
     computed with (its coordinate names must match; ValueError otherwise) to use the outputs that need it:
     positions, energies. Without it, ``t``, ``q``, ``qd``, ``stats``, the sensitivities, ``to_npz`` and the table of
     coordinates (``to_dataframe``, ``to_csv`` without points) work; what needs the system says so (ValueError).
-    A file that is not such an archive is a ValueError naming ``path``; a missing one a FileNotFoundError."""
+    A file that is not such an archive is a ValueError naming ``path``; a missing one a FileNotFoundError.
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> model, h = rf.samples.pendulum()
+    >>> system = model.compile()
+    >>> import pathlib, tempfile
+    >>> res = rf.simulate(system, 0.5, q0=[0.5])
+    >>> path = pathlib.Path(tempfile.mkdtemp()) / "run.npz"
+    >>> _ = res.to_npz(path)
+    >>> back = rf.load_npz(path, system)
+    >>> bool((back.q == res.q).all())
+    True
+    """
     return Result(system, **read_result(path, system))
 
 

@@ -25,6 +25,15 @@ closes them. A drive's or an actuator's numbers move the loops' g(q, t; p) too: 
 
 ``Result.sensitivity(name)`` returns (∂q/∂p, ∂q̇/∂p), each (len t, nq); ``Result.position_sensitivity(point,
 name)`` the derivative (len t, 3) of a point's position. Not yet: Maxwell arms (refused).
+
+Examples
+--------
+>>> import rigidfem as rf
+>>> model, h = rf.samples.spring_mass()
+>>> res = rf.simulate(model.compile(), 1.0, "rk4", dt=1e-3, q0=[0.1], sensitivities=["q0[block.x]"])
+>>> dq, dqd = res.sensitivity("q0[block.x]")
+>>> round(float(dq[0, 0]), 6), dq.shape
+(1.0, (1001, 1))
 """
 
 from __future__ import annotations

@@ -67,7 +67,14 @@ PACE_MARGIN = 100.0
 
 class ResolveError(ValueError):
     """``rf.resolve`` could not meet its task: ``runs`` holds every analysis made, ``best`` the plan of
-    the finest level reached (or None)."""
+    the finest level reached (or None).
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> issubclass(rf.ResolveError, ValueError)
+    True
+    """
 
     def __init__(self, message, runs=None, best=None):
         super().__init__(message)
@@ -76,7 +83,19 @@ class ResolveError(ValueError):
 
 @dataclass
 class Plan:
-    """What ``rf.resolve`` chose, why, and the estimated errors (in the outputs' units: m for points)."""
+    """What ``rf.resolve`` chose, why, and the estimated errors (in the outputs' units: m for points).
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> def build(elements, deform):
+    ...     model, h = rf.samples.cantilever(elements=elements, deform=deform)
+    ...     model.add_force("load", h["beam"].tip, (0.0, -1.0, 0.0))
+    ...     return model, {"tip": h["beam"].tip}
+    >>> plan = rf.resolve(build, "tip", 1e-5, deform=("bend_z",))
+    >>> type(plan).__name__, plan.elements >= 4
+    ('Plan', True)
+    """
 
     elements: int                 #: the elements passed to the builder
     deform: tuple                 #: the deformations kept
@@ -173,6 +192,17 @@ def resolve(build, outputs, tol: float, *, t_end: float | None = None, elements:
         before t_end, ...): simulate's or static_equilibrium's error, naming the time and the cause,
         with the analysis (elements, deform) in its message and the analyses made before it in
         ``runs``.
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> def build(elements, deform):
+    ...     model, h = rf.samples.cantilever(elements=elements, deform=deform)
+    ...     model.add_force("load", h["beam"].tip, (0.0, -1.0, 0.0))
+    ...     return model, {"tip": h["beam"].tip}
+    >>> plan = rf.resolve(build, "tip", 1e-5, deform=("bend_z",))
+    >>> plan.elements >= 4, plan.deform
+    (True, ('bend_z',))
     """
     if not callable(build):
         raise ResolveError(f"build: expected a function build(elements, deform) -> (model, handles), got {build!r}")

@@ -12,6 +12,13 @@ Errors are measured against a reference solved much more tightly (Dormand–Prin
 rtol = 1e-12 by default) at the same output times: the tip position (m) at the final time
 and as an RMS over the run, and the same for the joint coordinates. Wall time is the
 minimum of several warm runs.
+
+Examples
+--------
+>>> import rigidfem as rf
+>>> scene = rf.study.scenes.cantilever(elements=4)
+>>> type(scene).__name__
+'Scene'
 """
 
 from __future__ import annotations

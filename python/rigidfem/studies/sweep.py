@@ -388,6 +388,16 @@ def sweep(function: Callable, cases: Sequence[Mapping] | None = None, *, grid: M
         One row per case in the order of the cases: the parameters, ``seed`` (when the function
         takes one), the returned values, ``error`` (None when it ran) and ``wall_time_s`` (s,
         the case's own time in its worker).
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> def run(length):
+    ...     model, h = rf.samples.pendulum(length=length)
+    ...     return {"omega": float(rf.modal_analysis(model.compile()).omega[0])}
+    >>> table = rf.sweep(run, grid={"length": [1.0, 4.0]}, executor="serial")
+    >>> [round(w, 3) for w in table["omega"]]
+    [3.836, 1.918]
     """
     if not callable(function):
         raise _checks.refuse(f"function: expected a callable function(**parameters), got {function!r}")

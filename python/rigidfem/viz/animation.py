@@ -4,6 +4,12 @@
 ``rigidfem.plots.shape``, the time as text and trails of chosen points. In a notebook show it
 with ``IPython.display.HTML(anim.to_jshtml())``; write a movie with ``save(anim, "movie.gif")``
 (pillow, installed with matplotlib) or ``.mp4`` (needs ffmpeg).
+
+Examples
+--------
+>>> import rigidfem as rf
+>>> sorted(rf.animation.WRITERS)[:2]
+['.avi', '.gif']
 """
 
 from __future__ import annotations
@@ -91,6 +97,19 @@ def animate(result, *, plane: str | None = None, beams=(), segments=(), trails=(
     -------
     matplotlib.animation.FuncAnimation
         ``anim.to_jshtml()`` shows it in a notebook, ``save(anim, "movie.gif")`` writes it to a file.
+
+    Examples
+    --------
+    >>> import matplotlib
+    >>> matplotlib.use("Agg")
+    >>> import matplotlib.pyplot as plt
+    >>> import rigidfem as rf
+    >>> model, h = rf.samples.pendulum()
+    >>> res = rf.simulate(model.compile(), 0.5, q0=[0.5], t_eval=[0.0, 0.25, 0.5])
+    >>> anim = rf.animate(res, plane="xz", frames=2)
+    >>> "<script" in anim.to_jshtml()
+    True
+    >>> plt.close("all")
     """
     result = _checks.result(result, needs="an animation")
     plane = plots._plane(plane)

@@ -9,6 +9,19 @@ in J, forces in N and torques in N·m.
 - mode shapes of ``rigidfem.modal_analysis``: ``modes``.
 
 ``rigidfem.animation`` animates a Result with the same drawing code as ``shape``.
+
+Examples
+--------
+>>> import matplotlib
+>>> matplotlib.use("Agg")
+>>> import matplotlib.pyplot as plt
+>>> import rigidfem as rf
+>>> model, h = rf.samples.pendulum()
+>>> res = rf.simulate(model.compile(), 0.5, q0=[0.5])
+>>> ax = rf.plots.coordinates(res)
+>>> ax.get_xlabel()
+'t (s)'
+>>> plt.close("all")
 """
 
 from __future__ import annotations

@@ -81,7 +81,19 @@ _BOX_SAMPLES = 400_000
 
 class Viewer:
     """A scene and its frames (``rf.view``): shows itself in a notebook (``_repr_html_``: an iframe, no
-    network) and writes a self-contained HTML file (``to_html``)."""
+    network) and writes a self-contained HTML file (``to_html``).
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> model, h = rf.samples.pendulum()
+    >>> system = model.compile()
+    >>> viewer = rf.view(system, q=[0.5])
+    >>> type(viewer).__name__
+    'Viewer'
+    >>> "<iframe" in viewer._repr_html_()
+    True
+    """
 
     def __init__(self, data: dict, height: int):
         self.data = data
@@ -206,10 +218,23 @@ def view(system, result=None, *, trails=(), frames: int | None = None, q=None, t
         With several results or modes: "overlay" (in the same place, in different colours; the default
         for results) or "side" (side by side along the picture's horizontal; the default for modes).
 
+    Notes
+    -----
     Ropes are coloured by their tension (N) whenever a run is shown, with their own colour bar.
     Raises ``ValueError`` naming the argument: a result without its system, without outputs or whose
     coordinates are not finite (NaN or inf: it names the first output and coordinate), an unknown
     quantity, a bad scale.
+
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> model, h = rf.samples.pendulum()
+    >>> system = model.compile()
+    >>> viewer = rf.view(system, q=[0.5])
+    >>> type(viewer).__name__
+    'Viewer'
+    >>> "<iframe" in viewer._repr_html_()
+    True
     """
     system, layers, kind = _layers(system, result, q, t, mode, frames, amplitude)
     if scale is not None:
