@@ -50,6 +50,9 @@ copybutton_exclude = ".linenos, .gp, .go"
 source_suffix = {".rst": "restructuredtext", ".md": "myst-nb", ".ipynb": "myst-nb"}
 exclude_patterns = ["_build", "**.ipynb_checkpoints"]
 html_theme = "furo"
+# the site's own stylesheet (the gallery's cards) and the thumbnails the build makes (_generated/static/thumbnails)
+html_static_path = ["_static", "_generated/static"]
+html_css_files = ["gallery.css"]
 html_title = f"rigidfem {release}"
 REPOSITORY = "https://github.com/rigidfem/rigidfem"
 html_theme_options = {
@@ -134,10 +137,18 @@ def _draw_figures() -> None:
     figures.write(HERE / "_generated" / "figures")
 
 
+def _write_gallery() -> None:
+    """The gallery's thumbnails (each notebook's first figure) and cards (docs/notebook_gallery.py)."""
+    import notebook_gallery
+
+    notebook_gallery.write(HERE / "notebooks", HERE / "_generated")
+
+
 _copy_notebooks()
 _write_options_table()
 _write_api_page()
 _draw_figures()
+_write_gallery()
 exclude_patterns.append("_generated")
 
 # The docstrings write |x| for norms and absolute values, as mathematics reads in help(); reST would take

@@ -305,3 +305,18 @@ def test_the_public_examples_run_and_print_what_they_show():
     result = runner.summarize(verbose=False)
     assert result.failed == 0, "".join(report)[-4000:]
     assert names_run >= len(_public_objects()) - len(EXAMPLES_IN_CPP), (result, names_run)
+
+
+def test_the_gallery_shows_a_card_with_a_thumbnail_per_notebook(site):
+    """docs/notebook_gallery.py makes, at each build, a thumbnail of each notebook's first figure (from its committed
+    outputs) and a card linking the notebook's page; the cards are plain HTML and CSS served by the site."""
+    gallery = (site / "gallery.html").read_text(encoding="utf-8")
+    cards = re.findall(r'<a class="rigidfem-card" href="(notebooks/\w+\.html)"><img src="(_static/thumbnails/\w+\.png)"',
+                       gallery)
+    notebooks = sorted(p.stem for p in (ROOT / "notebooks").glob("*.ipynb"))
+    assert [Path(href).stem for href, _ in cards] == notebooks
+    for href, thumbnail in cards:
+        assert (site / href).exists(), href
+        png = (site / thumbnail).read_bytes()
+        assert png[:8] == b"\x89PNG\r\n\x1a\n" and 100 <= int.from_bytes(png[16:20], "big") <= 480, thumbnail
+    assert '_static/gallery.css' in gallery and (site / "_static" / "gallery.css").exists()
