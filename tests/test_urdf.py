@@ -543,3 +543,223 @@ def test_a_flexible_links_other_children_hang_from_the_rfe_nearest_their_origin(
             np.testing.assert_allclose(flexible.position(u.point(link, (0.1, 0.2, -0.3)), 0.0, qf),
                                        rigid.position(rigid_model.urdf.point(link, (0.1, 0.2, -0.3)), 0.0, q),
                                        atol=1e-14)
+
+
+# --- visual geometry: primitives and meshes the viewer draws ---------------------------------------------------
+
+#: A cube's 8 corners (m) and its 12 triangles, outward.
+CUBE = np.array([[x, y, z] for x in (0.0, 0.2) for y in (0.0, 0.2) for z in (0.0, 0.2)]) - 0.1
+CUBE_FACES = np.array([[0, 2, 3], [0, 3, 1], [4, 5, 7], [4, 7, 6], [0, 1, 5], [0, 5, 4], [2, 6, 7], [2, 7, 3],
+                       [0, 4, 6], [0, 6, 2], [1, 3, 7], [1, 7, 5]])
+
+
+def write_stl(path, vertices, faces, binary=True):
+    """An STL file of the triangles ``faces`` (k, 3) of ``vertices`` (n, 3), binary or ASCII."""
+    tri = np.asarray(vertices, dtype=float)[faces]
+    if binary:
+        facets = np.zeros(len(tri), dtype=[("n", "<f4", 3), ("v", "<f4", (3, 3)), ("a", "<u2")])
+        facets["v"] = tri
+        path.write_bytes(b"solid made by the test".ljust(80, b" ") + np.uint32(len(tri)).tobytes() + facets.tobytes())
+    else:
+        rows = "".join("facet normal 0 0 0\n outer loop\n" + "".join(f"  vertex {x:.17g} {y:.17g} {z:.17g}\n" for x, y, z in t)
+                       + " endloop\nendfacet\n" for t in tri)
+        path.write_text(f"solid cube\n{rows}endsolid cube\n")
+    return path
+
+
+#: The visuals of write_meshed_robot: the cube on "fore" (binary STL) and on "hand" (ASCII), origins and scales.
+FORE_MESH = {"xyz": (0.25, 0.0, 0.02), "rpy": (0.0, 0.0, 0.4), "scale": (1.5, 1.0, 0.8)}
+HAND_MESH = {"xyz": (0.05, 0.0, 0.0), "rpy": (0.3, 0.0, 0.0), "scale": (0.5, 0.5, 0.5)}
+
+
+def write_meshed_robot(folder, mesh_dir=None):
+    """A three-link arm (z up) in ``folder/meshpkg/urdf/arm.urdf`` whose visuals are a yellow box (the base, on the
+    ground), a cylinder along the upper arm (no colour), a magenta cube of a binary STL on the forearm, and on the
+    hand (fixed to the forearm) a cyan cube of an ASCII STL (a material of the robot named) and a mesh whose file
+    is not there. The STL files are in ``meshpkg/meshes`` (or ``mesh_dir``), named ``package://meshpkg/meshes/...``."""
+    package = Path(folder) / "meshpkg"
+    (package / "urdf").mkdir(parents=True, exist_ok=True)
+    meshes = Path(mesh_dir) if mesh_dir is not None else package / "meshes"
+    meshes.mkdir(parents=True, exist_ok=True)
+    write_stl(meshes / "cube.stl", CUBE, CUBE_FACES)
+    write_stl(meshes / "cube_ascii.stl", CUBE, CUBE_FACES, binary=False)
+    inertia = '<inertia ixx="0.01" iyy="0.05" izz="0.05" ixy="0" ixz="0" iyz="0"/>'
+
+    def mesh(name, m, colour=""):
+        return (f'<visual><origin xyz="{" ".join(map(str, m["xyz"]))}" rpy="{" ".join(map(str, m["rpy"]))}"/>'
+                f'<geometry><mesh filename="package://meshpkg/meshes/{name}" scale="{" ".join(map(str, m["scale"]))}"/>'
+                f'</geometry>{colour}</visual>')
+
+    text = f"""<robot name="meshed">
+  <material name="cyan"><color rgba="0.1 0.8 0.8 1"/></material>
+  <link name="base"><visual><origin xyz="0 0 0.05"/><geometry><box size="0.3 0.3 0.1"/></geometry>
+    <material name="yellow"><color rgba="0.9 0.8 0.1 1"/></material></visual></link>
+  <joint name="shoulder" type="revolute"><parent link="base"/><child link="upper"/><origin xyz="0 0 0.1"/>
+    <axis xyz="0 0 1"/></joint>
+  <link name="upper"><inertial><origin xyz="0.25 0 0"/><mass value="2"/>{inertia}</inertial>
+    <visual><origin xyz="0.25 0 0" rpy="0 1.5707963267948966 0"/><geometry><cylinder radius="0.04" length="0.5"/>
+    </geometry></visual></link>
+  <joint name="elbow" type="revolute"><parent link="upper"/><child link="fore"/><origin xyz="0.5 0 0"/>
+    <axis xyz="0 0 1"/></joint>
+  <link name="fore"><inertial><origin xyz="0.25 0 0"/><mass value="1"/>{inertia}</inertial>
+    {mesh("cube.stl", FORE_MESH, '<material name="magenta"><color rgba="0.8 0.1 0.8 1"/></material>')}</link>
+  <joint name="wrist" type="fixed"><parent link="fore"/><child link="hand"/><origin xyz="0.5 0 0"/></joint>
+  <link name="hand"><inertial><mass value="0.2"/>{inertia}</inertial>
+    {mesh("cube_ascii.stl", HAND_MESH, '<material name="cyan"/>')}
+    <visual><geometry><mesh filename="package://meshpkg/meshes/gone.dae"/></geometry></visual></link>
+</robot>"""
+    return write(package / "urdf", text, "arm.urdf")
+
+
+def test_visuals_are_read_and_their_mesh_files_found_by_package_or_folder(tmp_path):
+    """The box, the cylinder and the two cubes are kept with their colours (the cyan one a material of the robot);
+    ``package://meshpkg/...`` is found above the URDF's folder, or through ``package_dirs`` (a folder holding the
+    package, or a dict); the binary and the ASCII STL give the same cube; the missing file is one note."""
+    path = write_meshed_robot(tmp_path / "one")
+    model = rf.Model.from_urdf(path)
+    u = model.urdf
+    box, = u.visuals["base"]
+    cylinder, = u.visuals["upper"]
+    assert (box.kind, box.size, box.colour) == ("box", (0.3, 0.3, 0.1), (0.9, 0.8, 0.1, 1.0))
+    assert (cylinder.kind, cylinder.size, cylinder.colour) == ("cylinder", (0.04, 0.5), None)
+    fore, = u.visuals["fore"]
+    hand, gone = u.visuals["hand"]
+    assert fore.path == str(tmp_path / "one" / "meshpkg" / "meshes" / "cube.stl") and fore.colour == (0.8, 0.1, 0.8, 1.0)
+    assert hand.colour == (0.1, 0.8, 0.8, 1.0) and gone.path is None and gone.mesh is None
+    for v in (fore, hand):  # 8 corners, 12 triangles: identical vertices merged
+        assert v.mesh.vertices.shape == (8, 3) and v.mesh.triangles.shape == (12, 3)
+        np.testing.assert_allclose(np.sort(v.mesh.vertices, axis=0), np.sort(CUBE, axis=0), atol=1e-7)
+    np.testing.assert_array_equal(fore.mesh.vertices, hand.mesh.vertices)
+    np.testing.assert_array_equal(fore.mesh.triangles, hand.mesh.triangles)
+    missing = [n for n in u.notes if n.startswith("mesh files not found")]
+    assert missing == [("mesh files not found (not drawn; a body with no other visual shows its inertia's box): "
+                        "package://meshpkg/meshes/gone.dae")]
+    # the package elsewhere: found through package_dirs only
+    elsewhere = write_meshed_robot(tmp_path / "a", mesh_dir=tmp_path / "b" / "meshpkg" / "meshes")
+    assert rf.Model.from_urdf(elsewhere).urdf.visuals["fore"][0].mesh is None
+    for dirs in (tmp_path / "b", [str(tmp_path / "b")], {"meshpkg": tmp_path / "b" / "meshpkg"}):
+        found = rf.Model.from_urdf(elsewhere, package_dirs=dirs).urdf.visuals["fore"][0]
+        assert found.path == str(tmp_path / "b" / "meshpkg" / "meshes" / "cube.stl") and found.mesh.size == 12
+    with pytest.raises(ValueError, match=r"^package_dirs: expected a folder .* that exists.*, got .*nowhere"):
+        rf.Model.from_urdf(path, package_dirs=[tmp_path / "nowhere"])
+    assert pickle.loads(pickle.dumps(model)).urdf.visuals["fore"][0].mesh.size == 12
+
+
+def test_the_viewer_gets_each_mesh_in_its_bodys_frame_and_primitives_by_their_matrices(tmp_path):
+    """In the page's scene, a mesh's vertices are the file's times its scale, turned and moved by its origin into
+    its link's frame, and by the link's frame in its body's (the hand is fixed to the forearm 0.5 m on): float32
+    in base64, three uint32 indices a triangle; the base's box is on the ground (body -1), the cylinder's matrix is
+    its origin; a body with visuals has no inertia's box."""
+    import base64
+
+    model = rf.Model.from_urdf(write_meshed_robot(tmp_path))
+    system = model.compile()
+    data = rf.view(system).data
+    shown = {v["link"]: v for v in data["visuals"]}
+    assert [(v["link"], v["kind"], v["body"]) for v in data["visuals"]] == [
+        ("base", "box", -1), ("upper", "cylinder", model.urdf.bodies["upper"].index),
+        ("fore", "mesh", model.urdf.bodies["fore"].index), ("hand", "mesh", model.urdf.bodies["fore"].index)]
+    for link, m, frame in (("fore", FORE_MESH, np.eye(4)), ("hand", HAND_MESH, rf.transform((0.5, 0.0, 0.0)))):
+        T = frame @ rf.transform(m["xyz"], m["rpy"][::-1])  # rf.transform's angles are ZYX: (yaw, pitch, roll)
+        expected = (CUBE * m["scale"]) @ T[:3, :3].T + T[:3, 3]
+        vertices = np.frombuffer(base64.b64decode(shown[link]["vertices"]), dtype="<f4").reshape(-1, 3)
+        indices = np.frombuffer(base64.b64decode(shown[link]["indices"]), dtype="<u4").reshape(-1, 3)
+        assert vertices.shape == (8, 3) and indices.shape == (12, 3) and shown[link]["triangles"] == 12
+        distance = np.linalg.norm(expected[:, None, :] - vertices[None, :, :], axis=2)
+        assert distance.min(axis=1).max() < 1e-6  # every corner of the file's cube where its origin puts it
+        # the triangles are the file's: twice a face's area each pair, 2 (ab + bc + ca) in all
+        a, b, c = (vertices[indices[:, k]].astype(float) for k in range(3))
+        area = 0.5 * np.linalg.norm(np.cross(b - a, c - a), axis=1).sum()
+        sx, sy, sz = 0.2 * np.asarray(m["scale"])
+        assert area == pytest.approx(2 * (sx * sy + sy * sz + sz * sx), rel=1e-5)
+    assert shown["fore"]["colour"] == 0xCC1ACC and shown["upper"]["colour"] is None
+    np.testing.assert_allclose(np.reshape(shown["base"]["matrix"], (4, 4)), rf.transform((0.0, 0.0, 0.05)))
+    np.testing.assert_allclose(np.reshape(shown["upper"]["matrix"], (4, 4)),
+                               rf.transform((0.25, 0.0, 0.0), (0.0, math.pi / 2, 0.0)), atol=1e-15)
+    assert shown["upper"]["size"] == [0.04, 0.5] and all(b["box"] is None for b in data["bodies"])
+
+
+def test_a_flexible_links_visuals_are_not_drawn_and_a_broken_mesh_is_a_note(tmp_path):
+    """The forearm as a beam: its cube is left out of the scene (the tube is drawn) and said so in a note; a mesh
+    file that is not STL, or a broken one, is a note and no error, and its body shows its inertia's box."""
+    path = write_meshed_robot(tmp_path)
+    model = rf.Model.from_urdf(path, flexible={"fore": {"elements": 4, "material": ALUMINIUM, "section": TUBE}})
+    assert "visuals of flexible links not drawn (their beams' tubes are): fore" in model.urdf.notes
+    data = rf.view(model.compile()).data
+    assert [v["link"] for v in data["visuals"]] == ["base", "upper", "hand"] and len(data["beams"]) == 1
+    (tmp_path / "meshpkg" / "meshes" / "cube.stl").write_bytes(b"not a mesh")
+    (tmp_path / "meshpkg" / "meshes" / "cube_ascii.stl").write_text("solid x\n vertex 1 2\nendsolid\n")
+    model = rf.Model.from_urdf(path)
+    unread, = [n for n in model.urdf.notes if n.startswith("mesh files not read")]
+    assert "package://meshpkg/meshes/cube.stl (not an STL file" in unread and "cube_ascii.stl (" in unread
+    data = rf.view(model.compile()).data
+    assert [v["link"] for v in data["visuals"]] == ["base", "upper"]
+    assert data["bodies"][model.urdf.bodies["fore"].index]["box"] is not None
+
+
+COLLADA = """<?xml version="1.0" encoding="utf-8"?>
+<COLLADA xmlns="http://www.collada.org/2005/11/COLLADASchema" version="1.4.1">
+  <asset><unit name="millimeter" meter="0.001"/><up_axis>Z_UP</up_axis></asset>
+  <library_effects><effect id="paint"><profile_COMMON><technique sid="common"><phong>
+    <diffuse><color sid="diffuse">0.2 0.4 0.6 1</color></diffuse></phong></technique></profile_COMMON></effect>
+  </library_effects>
+  <library_geometries><geometry id="quad"><mesh>
+    <source id="quad-pos"><float_array id="quad-pos-array" count="15">0 0 0 100 0 0 100 100 0 0 100 0 50 50 80</float_array>
+      <technique_common><accessor source="#quad-pos-array" count="5" stride="3"/></technique_common></source>
+    <source id="quad-n"><float_array id="quad-n-array" count="3">0 0 1</float_array></source>
+    <vertices id="quad-v"><input semantic="POSITION" source="#quad-pos"/></vertices>
+    <polylist count="1"><input semantic="VERTEX" source="#quad-v" offset="0"/>
+      <input semantic="NORMAL" source="#quad-n" offset="1"/><vcount>4</vcount><p>0 0 1 0 2 0 3 0</p></polylist>
+    <triangles count="2"><input semantic="VERTEX" source="#quad-v" offset="0"/><p>0 1 4 1 2 4</p></triangles>
+  </mesh></geometry></library_geometries>
+  <library_visual_scenes><visual_scene id="scene"><node id="a"><translate>0 0 10</translate>
+    <node id="b"><rotate>0 0 1 90</rotate><instance_geometry url="#quad"/></node></node></visual_scene>
+  </library_visual_scenes>
+  <scene><instance_visual_scene url="#scene"/></scene>
+</COLLADA>"""
+
+
+def test_a_collada_files_triangles_are_read_in_metres_where_its_nodes_put_them():
+    """<polylist> fanned into triangles, <triangles> as they are (NORMAL indices interleaved and skipped), the nodes'
+    <translate> and <rotate> (degrees) applied, millimetres to metres, the first diffuse colour kept."""
+    import tempfile
+
+    from rigidfem.model import meshes
+
+    with tempfile.TemporaryDirectory() as folder:
+        path = Path(folder) / "quad.dae"
+        path.write_text(COLLADA)
+        mesh = meshes.read(path)
+    p = 1e-3 * np.array([[0, 0, 0], [100, 0, 0], [100, 100, 0], [0, 100, 0], [50, 50, 80]], dtype=float)
+    p = p @ np.array([[0, -1, 0], [1, 0, 0], [0, 0, 1.0]]).T + [0, 0, 0.01]  # rotate 90° about z, then up 10 mm
+    tri = np.array([[0, 1, 2], [0, 2, 3], [0, 1, 4], [1, 2, 4]])
+    got = {tuple(sorted(map(tuple, np.round(mesh.vertices[t].astype(float), 6)))) for t in mesh.triangles}
+    assert got == {tuple(sorted(map(tuple, np.round(p[t], 6)))) for t in tri}
+    assert mesh.colour == (0.2, 0.4, 0.6, 1.0)
+
+
+def test_fine_meshes_are_decimated_to_the_pages_triangles(tmp_path, monkeypatch):
+    """Vertex clustering: a sphere of 20,000 triangles kept within 2,000 (and at least half of them), its vertices
+    still on the sphere to within a cell; in the viewer, all the meshes of all the layers within MAX_TRIANGLES."""
+    from rigidfem.model import meshes
+    from rigidfem.viz import viewer
+
+    n = 100
+    theta, phi = np.meshgrid(np.linspace(0, np.pi, n + 1), np.linspace(0, 2 * np.pi, n + 1), indexing="ij")
+    v = 0.1 * np.c_[(np.sin(theta) * np.cos(phi)).ravel(), (np.sin(theta) * np.sin(phi)).ravel(), np.cos(theta).ravel()]
+    k = np.arange(n * (n + 1)).reshape(n, n + 1)[:, :n].ravel()
+    t = np.r_[np.c_[k, k + n + 1, k + 1], np.c_[k + 1, k + n + 1, k + n + 2]]
+    fine = meshes._merged(v, t)
+    coarse = meshes.decimated(fine, 2000)
+    assert fine.size > 19000 and 1000 <= coarse.size <= 2000
+    assert np.abs(np.linalg.norm(coarse.vertices, axis=1) - 0.1).max() < 0.01
+    path = write_meshed_robot(tmp_path)
+    write_stl(tmp_path / "meshpkg" / "meshes" / "cube.stl", fine.vertices, fine.triangles)  # the forearm's a sphere
+    system = rf.Model.from_urdf(path).compile()
+    monkeypatch.setattr(viewer, "MAX_TRIANGLES", 2000)
+    one = rf.view(system).data["visuals"]
+    assert [v.get("triangles") for v in one][::3] == [None, 12] and 1000 < one[2]["triangles"] <= 1988
+    run = rf.Result(system, [0.0, 1.0], np.zeros((2, system.nq)), np.zeros((2, system.nq)), {}, "none")
+    both = rf.view([run, run]).data
+    drawn = [v["triangles"] for v in both["visuals"] + both["layers"][0]["visuals"] if v["kind"] == "mesh"]
+    assert sum(drawn) <= 2000 and min(drawn) > 0

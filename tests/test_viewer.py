@@ -629,10 +629,15 @@ def test_the_picture_shows_deformation_colours_modes_overlays_and_arrows(stiff, 
     """In Chromium: the stiff cantilever's tip is drawn level with its clamp at scale 1 and far below it at 100; coloured
     by bending moment, its clamped end's colour differs from its free end's; a mode's quarter period differs from
     its start; two overlaid runs show both palettes; the crane's arrows draw; the snapshot button saves a PNG of the
-    picture."""
+    picture; a URDF arm's yellow base box, magenta STL cube and cyan STL cube show in their colours from left to right
+    (x runs to the right), and without its mesh files the cubes are gone and the forearm's inertia box is drawn."""
+    from test_urdf import write_meshed_robot
+
     system, _, q = stiff
     runs = _kane_pair()
     crane = _crane()
+    arms = [rf.Model.from_urdf(write_meshed_robot(tmp_path / name, mesh_dir=meshes)).compile()
+            for name, meshes in (("arm", None), ("lost", tmp_path / "elsewhere" / "meshpkg" / "meshes"))]
     pages = [(rf.view(system, q=q).to_html(tmp_path / "one.html"), "helpers=0&shots=0"),
              (rf.view(system, q=q, scale=100, color="bending_moment").to_html(tmp_path / "hundred.html"),
               "helpers=0&shots=0"),
@@ -641,8 +646,9 @@ def test_the_picture_shows_deformation_colours_modes_overlays_and_arrows(stiff, 
              (rf.view(runs, labels=["nonlinear", "linear"]).to_html(tmp_path / "both.html"), "helpers=0&shots=25"),
              (rf.view(*crane[:2], forces=True, color="bending_moment", scale=20).to_html(tmp_path / "crane.html"),
               "shots=-1&click=snapshot&download=0")]
-    one, hundred, modes, both, crane_state = _open_pages(pages, tmp_path)
-    for state in (one, hundred, modes, both, crane_state):
+    pages += [(rf.view(arm).to_html(tmp_path / f"arm{k}.html"), "helpers=0&shots=0") for k, arm in enumerate(arms)]
+    one, hundred, modes, both, crane_state, arm, lost = _open_pages(pages, tmp_path)
+    for state in (one, hundred, modes, both, crane_state, arm, lost):
         assert "error" not in state, state.get("error")
     drops = []  # how far the tip's end of the picture's beam is below its clamped end (pixel rows)
     for s in (one, hundred):
@@ -663,6 +669,19 @@ def test_the_picture_shows_deformation_colours_modes_overlays_and_arrows(stiff, 
     assert orange.sum() > 20 and teal.sum() > 20, (orange.sum(), teal.sum())
     assert crane_state.get("snapshots") == "1" and _ink(_image(crane_state["shot0"])).sum() > 1000
     assert crane_state["snapshot"] == "rigidfem_30.png data:image/png;base64,"  # the button's file: title_frame.png
+    regions = []
+    for state in (arm, lost):
+        img = _image(state["shot0"]).astype(int)
+        r, g, b = img[..., 0], img[..., 1], img[..., 2]
+        regions.append({"yellow": (r > b + 50) & (g > b + 50), "magenta": (r > g + 50) & (b > g + 50),
+                        "cyan": (g > r + 60) & (b > r + 60) & (abs(g - b) < 30), "blue": (b > g + 40) & (b > r + 80)})
+    shown, missing = regions
+    counts = {k: int(v.sum()) for k, v in shown.items()}
+    assert min(counts.values()) > 200, counts
+    columns = [np.flatnonzero(shown[k].any(axis=0)).mean() for k in ("yellow", "magenta", "cyan")]
+    assert columns == sorted(columns), columns
+    assert missing["magenta"].sum() == 0 and missing["cyan"].sum() == 0 and missing["yellow"].sum() > 200
+    assert missing["blue"].sum() > counts["blue"] + 200, (int(missing["blue"].sum()), counts)  # the forearm's box
 
 
 def test_the_widget_shows_as_the_page_where_no_widget_runs(kane, tmp_path):

@@ -847,14 +847,14 @@ class Model(_core._Model):
 
     @classmethod
     def from_urdf(cls, path, flexible: dict | None = None, *, base: str = "fixed",
-                  gravity=(0.0, 0.0, -9.81)) -> Model:
+                  gravity=(0.0, 0.0, -9.81), package_dirs=None) -> Model:
         """A robot from its URDF file: links as bodies, joints as joints, and the links named in ``flexible`` as
         beams (``rigidfem.model.urdf`` says how each element of the file is read).
 
         Parameters
         ----------
         path : str or os.PathLike
-            The URDF file (XML; an xacro file must be expanded first). Mesh files are not read.
+            The URDF file (XML; an xacro file must be expanded first).
         flexible : dict, optional
             Link name -> a dict of ``add_beam``'s arguments for the beam that replaces it: ``elements``,
             ``material``, ``section`` (required), ``formulation``, ``deform``, ``linear``, ``tip_mass``,
@@ -868,6 +868,11 @@ class Model(_core._Model):
             joint), or joined to it by ``Joint.free()`` (six coordinates: x, y, z in m, ZYX angles in rad).
         gravity : (3,) array or None
             m/s², global frame, as ``Model(gravity=...)``.
+        package_dirs : str, os.PathLike, a sequence of them, or a dict, optional
+            Where ``package://pkg/...`` mesh files are looked for: folders holding packages (``<folder>/pkg/...``,
+            or ``<folder>/...`` for a folder named pkg), or a dict of package name -> its folder; then the URDF's
+            folder and those above it. The viewer draws the meshes found (STL and Collada .dae) and the visuals'
+            boxes, cylinders and spheres; a mesh file not found or not read is a note in ``model.urdf.notes``.
 
         Returns
         -------
@@ -905,7 +910,7 @@ class Model(_core._Model):
         from . import urdf
 
         model = cls(gravity=gravity)
-        model._keep_urdf(urdf.from_urdf(model, path, flexible, base))
+        model._keep_urdf(urdf.from_urdf(model, path, flexible, base, package_dirs))
         return model
 
     @recorded

@@ -21,9 +21,18 @@ How the tree becomes bodies and joints:
   free joint (``base="free"``).
 - Joint limits, efforts and velocities are kept in ``UrdfModel.joints`` but not enforced (the coordinates
   are unbounded); ``<dynamics damping>`` becomes the joint's viscous damping (N·m·s/rad or N·s/m);
-  ``friction`` is kept, not modelled; collision geometry, transmissions and Gazebo tags are ignored. Each
-  link's visual geometry (a mesh's file name as written, its origin and scale, or a primitive's size) is kept
-  in ``UrdfModel.visuals``; the files are not read. ``UrdfModel.notes`` lists what was ignored.
+  ``friction`` is kept, not modelled; collision geometry, transmissions and Gazebo tags are ignored.
+  ``UrdfModel.notes`` lists what was ignored.
+- Each link's visual geometry is kept in ``UrdfModel.visuals`` (the viewer draws it): a primitive's size,
+  a mesh's file name as written, its origin, scale and colour (``<material><color rgba>``, or a material of
+  the robot named there), and for a mesh file that is found and read (STL, binary or ASCII, or Collada
+  .dae: ``rigidfem.model.meshes``) its triangles. ``package://pkg/rest`` is looked for in the folders of
+  ``package_dirs`` (``<folder>/pkg/rest``, or ``<folder>/rest`` for a folder named pkg; a dict maps a
+  package to its folder), then in the URDF's folder and the folders above it alike, then as
+  ``<URDF's folder>/rest``; ``file://`` names a path, and a plain name is relative to the URDF's folder.
+  A mesh file not found, or not read (another format, or a broken file), is one note in
+  ``UrdfModel.notes``, never an error: its body is drawn by its other visuals, or as its inertia's box.
+  The visuals of a flexible link are not drawn (its beam's tube is) and their files are not read.
 - A link named in ``flexible`` becomes a beam (``Model.add_beam``) from its joint frame to the origin of its
   child joint (``to``: the farthest one by default), divided into ``elements`` sdes. Its frame's x axis runs
   along the link, its z axis along the joint's axis (in-plane bending of the joint's own motion is
@@ -47,10 +56,13 @@ import math
 import os
 import xml.etree.ElementTree as ET
 from dataclasses import dataclass, field, replace
+from pathlib import Path
+from urllib.parse import unquote, urlparse
 
 import numpy as np
 
 from ..base import _checks
+from . import meshes
 from .frames import transform
 from .joints import Joint
 from .materials import Material, Section
@@ -69,15 +81,22 @@ _AXES = np.eye(3)
 
 @dataclass(frozen=True)
 class Visual:
-    """A link's visual geometry as the file gives it: ``kind`` "mesh", "box", "cylinder" or "sphere";
-    ``filename`` (a mesh's, as written: ``package://...`` not resolved), ``scale`` (3,), ``size`` (a box's
-    sides, or (radius, length) of a cylinder, (radius,) of a sphere; m) and ``origin`` (4, 4) in the link frame."""
+    """A link's visual geometry: ``kind`` "mesh", "box", "cylinder" (along the visual frame's z) or "sphere";
+    ``filename`` (a mesh's, as written: ``package://...``), ``scale`` (3,) of a mesh, ``size`` (a box's sides,
+    or (radius, length) of a cylinder, (radius,) of a sphere; m), ``origin`` (4, 4) the visual frame in the
+    link frame, ``colour`` (r, g, b, a) in [0, 1] of its material or None. Once loaded (``UrdfModel.visuals``):
+    ``path`` the mesh file found (None: not found) and ``mesh`` its ``meshes.Mesh`` (vertices in m in the
+    visual frame before ``scale``; None: not read). A mesh's point v is at ``origin · diag(scale) · v`` in the
+    link frame."""
 
     kind: str
     origin: np.ndarray
     filename: str | None = None
     scale: tuple = (1.0, 1.0, 1.0)
     size: tuple = ()
+    colour: tuple | None = None
+    path: str | None = None
+    mesh: object = None
 
 
 @dataclass(frozen=True)
@@ -148,7 +167,7 @@ def _origin(element, where: str) -> np.ndarray:
     return transform(xyz, (yaw, pitch, roll))
 
 
-def _link(element) -> Link:
+def _link(element, materials: dict) -> Link:
     name = element.get("name")
     where = f"link {name!r}"
     inertial = element.find("inertial")
@@ -160,21 +179,35 @@ def _link(element) -> Link:
         I = np.array([[ixx, ixy, ixz], [ixy, iyy, iyz], [ixz, iyz, izz]])
     if mass < 0.0:
         raise _checks.refuse(f"path: expected a mass >= 0 kg of {where}, got {mass}")
-    return Link(name, mass, _origin(inertial, where), I, tuple(_visual(v, where) for v in element.findall("visual")))
+    visuals = tuple(_visual(v, where, materials) for v in element.findall("visual"))
+    return Link(name, mass, _origin(inertial, where), I, visuals)
 
 
-def _visual(element, where: str) -> Visual:
+def _colour(material, where: str):
+    """(r, g, b, a) of a ``<material>``'s ``<color rgba>``, or None."""
+    colour = material.find("color") if material is not None else None
+    if colour is None:
+        return None
+    return tuple(float(x) for x in np.clip(_floats(colour, "rgba", 4, (0.5, 0.5, 0.5, 1.0), where), 0.0, 1.0))
+
+
+def _visual(element, where: str, materials: dict) -> Visual:
     origin = _origin(element, where)
+    material = element.find("material")
+    colour = _colour(material, where)
+    if colour is None and material is not None:
+        colour = materials.get(material.get("name"))
     geometry = element.find("geometry")
     shape = next(iter(geometry), None) if geometry is not None else None
     if shape is None:
-        return Visual("none", origin)
+        return Visual("none", origin, colour=colour)
     if shape.tag == "mesh":
-        return Visual("mesh", origin, shape.get("filename"), tuple(_floats(shape, "scale", 3, (1, 1, 1), where)))
+        scale = tuple(float(x) for x in _floats(shape, "scale", 3, (1, 1, 1), where))
+        return Visual("mesh", origin, shape.get("filename"), scale, colour=colour)
     sizes = {"box": lambda: tuple(_floats(shape, "size", 3, (0, 0, 0), where)),
              "cylinder": lambda: (_number(shape, "radius", where), _number(shape, "length", where)),
              "sphere": lambda: (_number(shape, "radius", where),)}
-    return Visual(shape.tag, origin, size=sizes[shape.tag]() if shape.tag in sizes else ())
+    return Visual(shape.tag, origin, size=sizes[shape.tag]() if shape.tag in sizes else (), colour=colour)
 
 
 def _joint(element, links) -> UrdfJoint:
@@ -219,11 +252,12 @@ def parse(path) -> Robot:
         raise _checks.refuse(f"path: expected a URDF file whose root element is <robot>, got <{root.tag}>")
     if any(e.tag.startswith(f"{{{_XACRO}}}") for e in root.iter()) or "${" in ET.tostring(root, encoding="unicode"):
         raise _checks.refuse("path: expected a URDF file, got a xacro file (expand it with xacro first)")
+    materials = {e.get("name"): _colour(e, f"material {e.get('name')!r}") for e in root.findall("material")}
     links = {}
     for e in root.findall("link"):
         if not e.get("name") or e.get("name") in links:
             raise _checks.refuse(f"path: expected links of unique non-empty names, got {e.get('name')!r} twice or empty")
-        links[e.get("name")] = _link(e)
+        links[e.get("name")] = _link(e, materials)
     joints = {}
     for e in root.findall("joint"):
         if not e.get("name") or e.get("name") in joints:
@@ -280,9 +314,11 @@ class UrdfModel:
     beams : dict
         Flexible link name -> its ``Beam`` handle.
     visuals : dict
-        Link name -> its ``Visual`` tuple, origins in the link frame.
+        Link name -> its ``Visual`` tuple, origins in the link frame, meshes found and read (those of a
+        flexible link as written: not drawn, not read).
     notes : tuple of str
-        What the file holds that the model does not use (limits, friction, masses replaced by beams).
+        What the file holds that the model does not use (limits, friction, masses replaced by beams) and the
+        visual geometry that cannot be drawn (mesh files not found or not read, a flexible link's).
     """
 
     robot: Robot
@@ -570,10 +606,95 @@ def _flexible(flexible, robot: Robot) -> dict:
     return out
 
 
-def from_urdf(model, path, flexible=None, base: str = "fixed") -> UrdfModel:
+def _package_dirs(package_dirs):
+    """``package_dirs`` checked: [(package or None, folder)] of a folder, a sequence of folders or a dict of
+    package names to folders (each a str or os.PathLike that exists)."""
+    if package_dirs is None:
+        return []
+    if isinstance(package_dirs, dict):
+        items = list(package_dirs.items())
+    elif isinstance(package_dirs, (list, tuple)):
+        items = [(None, d) for d in package_dirs]
+    else:
+        items = [(None, package_dirs)]
+    out = []
+    for key, folder in items:
+        if not (isinstance(folder, os.PathLike) or isinstance(folder, str) and folder) or \
+                not (key is None or isinstance(key, str) and key) or not os.path.isdir(folder):
+            raise _checks.refuse(f"package_dirs: expected a folder (str or os.PathLike) that exists, a sequence of "
+                                 f"them or a dict of package names to them, got {_checks._short(folder)}"
+                                 f"{'' if key is None else f' for {key!r}'}")
+        out.append((key, Path(folder)))
+    return out
+
+
+def _resolve(filename: str, folder: Path, package_dirs: list):
+    """The mesh file ``filename`` names (see the module's docstring), or None when no candidate is a file."""
+    if filename.startswith("package://"):
+        package, _, rest = filename[len("package://"):].partition("/")
+        candidates = []
+        for key, d in package_dirs:
+            if key is None:
+                candidates += [d / package / rest] + ([d / rest] if d.name == package else [])
+            elif key == package:
+                candidates.append(d / rest)
+        for d in (folder, *folder.parents):
+            candidates += [d / package / rest] + ([d / rest] if d.name == package else [])
+        candidates.append(folder / rest)
+    elif filename.startswith("file://"):
+        candidates = [Path(unquote(urlparse(filename).path))]
+    else:
+        candidates = [folder / filename]
+    return next((c for c in candidates if c.is_file()), None)
+
+
+def _load_visuals(robot: Robot, folder: Path, package_dirs: list, flexible) -> tuple[dict, list]:
+    """(link name -> its visuals with their mesh files found and read, notes): each file read once; the
+    visuals of the links in ``flexible`` as written."""
+    visuals, missing, unread, skipped, read = {}, [], [], [], {}
+    for name, link in robot.links.items():
+        if name in flexible:
+            visuals[name] = link.visuals
+            if link.visuals:
+                skipped.append(name)
+            continue
+        loaded = []
+        for v in link.visuals:
+            if v.kind == "mesh" and v.filename:
+                found = _resolve(v.filename, folder, package_dirs)
+                if found is None:
+                    missing.append(v.filename)
+                else:
+                    if found not in read:
+                        try:
+                            read[found] = meshes.read(found)
+                        except (ValueError, OSError) as error:
+                            read[found] = None
+                            unread.append(f"{v.filename} ({error})")
+                    colour = v.colour or (read[found].colour if read[found] is not None else None)
+                    v = replace(v, path=str(found), mesh=read[found], colour=colour)
+            loaded.append(v)
+        visuals[name] = tuple(loaded)
+    notes = []
+    if missing:
+        notes.append(f"mesh files not found (not drawn; a body with no other visual shows its inertia's box): "
+                     f"{', '.join(dict.fromkeys(missing))}")
+    if unread:
+        notes.append(f"mesh files not read (not drawn): {'; '.join(dict.fromkeys(unread))}")
+    if skipped:
+        notes.append(f"visuals of flexible links not drawn (their beams' tubes are): {', '.join(skipped)}")
+    return visuals, notes
+
+
+def from_urdf(model, path, flexible=None, base: str = "fixed", package_dirs=None) -> UrdfModel:
     """Add the robot of the URDF file ``path`` to the empty ``model`` (see ``Model.from_urdf``)."""
     robot = parse(path)
     if base not in ("fixed", "free"):
         raise _checks.refuse(f"base: expected 'fixed' (the root link fixed to the ground) or 'free' (a free joint), "
                              f"got {base!r}")
-    return _Builder(model, robot, _flexible(flexible, robot), base).build()
+    folders = _package_dirs(package_dirs)
+    flexible = _flexible(flexible, robot)
+    built = _Builder(model, robot, flexible, base).build()
+    visuals, notes = _load_visuals(robot, Path(os.fspath(path)).resolve().parent, folders, flexible)
+    built.visuals, built.notes = visuals, built.notes + tuple(notes)
+    return built

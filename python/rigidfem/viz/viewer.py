@@ -1,7 +1,8 @@
 """A 3D viewer for a teacher's browser: ``rf.view(system, result)`` in a notebook, ``.to_html(path)`` to mail.
 
 The scene is drawn by three.js (r111, MIT, shipped in ``viewer_assets``: nothing is fetched from the
-network): bodies as boxes of their equivalent inertia with their triads, beams as tubes through their
+network): bodies as boxes of their equivalent inertia with their triads (a robot of ``Model.from_urdf``'s
+by its links' visual geometry: boxes, cylinders, spheres and the meshes found), beams as tubes through their
 rigid finite elements' origins and tips, spring-dampers, cylinders, ropes and actuators as lines, loop
 joints as a marker and a line between their two frames, and the paths of chosen points; a ground grid
 whose square is named (the scale), a legend, and optionally the sdes coloured by a quantity with its
@@ -33,7 +34,8 @@ For example::
     path = viewer.to_html("kane.html")          # a self-contained page, about 1.2 MB (10 bodies)
 
 The file holds every frame's pose of every body as float32: 48 bytes × frames × bodies before base64
-(4/3), plus 0.9 MB of three.js; a 20 s Kane run (m = 20, 401 frames, 22 bodies) is about 1.5 MB.
+(4/3), plus 0.9 MB of three.js; a 20 s Kane run (m = 20, 401 frames, 22 bodies) is about 1.5 MB. A URDF
+robot's meshes add about 24 bytes a triangle, at most ``MAX_TRIANGLES`` = 200,000 of them (about 4.8 MB).
 """
 
 from __future__ import annotations
@@ -48,6 +50,7 @@ from pathlib import Path
 import numpy as np
 
 from ..base import _checks
+from ..model import meshes
 import rigidfem._core as _core  # the compiled core, by its absolute name
 from .._core import Body, Point, SimulationError
 
@@ -77,6 +80,11 @@ MODE_FRAMES = 48
 
 #: At most this many body poses are sampled for the scene's box (frames thinned evenly beyond it).
 _BOX_SAMPLES = 400_000
+
+#: The most triangles of URDF meshes a page holds, all layers together (beyond it the smaller meshes are kept
+#: whole and each larger one decimated by vertex clustering to the same number): 12 bytes a vertex and 12 a
+#: triangle, about 4.8 MB as base64.
+MAX_TRIANGLES = 200_000
 
 
 class Viewer:
@@ -220,7 +228,9 @@ def view(system, result=None, *, trails=(), frames: int | None = None, q=None, t
 
     Notes
     -----
-    Ropes are coloured by their tension (N) whenever a run is shown, with their own colour bar.
+    Ropes are coloured by their tension (N) whenever a run is shown, with their own colour bar. A model of
+    ``Model.from_urdf`` is drawn by its links' visual geometry (boxes, cylinders, spheres and the meshes read,
+    in their materials' colours with one result; ``rigidfem.model.urdf``), its flexible links by their tubes.
     Raises ``ValueError`` naming the argument: a result without its system, without outputs or whose
     coordinates are not finite (NaN or inf: it names the first output and coordinate), an unknown
     quantity, a bad scale.
@@ -594,8 +604,10 @@ def _layer_scene(layer, size_hint: float | None, scale: float) -> dict:
                "rotation": np.asarray(R, float).ravel().tolist(), "radius": float(r)}
               for kind, body, a, b, n, h, R, r in system._shapes]
     bodies, masses, inertias, centres = [], system.masses, system.inertias, system.centres_of_mass
+    visuals = _urdf_visuals(system)
+    drawn = {sh["body"] for sh in shapes} | {v["body"] for v in visuals}  # bodies shown by their shapes or visuals
     for i, n in enumerate(names):
-        shaped = any(sh["body"] == i for sh in shapes)  # a body with shapes is shown by them
+        shaped = i in drawn
         box = None if i in in_beam or shaped else _equivalent_box(float(masses[i]), np.asarray(inertias[i]))
         if i in base or (box is not None and max(box) > 2 * size):
             box = [0.08 * size] * 3
@@ -604,7 +616,83 @@ def _layer_scene(layer, size_hint: float | None, scale: float) -> dict:
         bodies.append({"name": n, "box": box, "com": [float(x) for x in centres[i]],
                        "triad": 0.0 if i in in_beam else 0.06 * size, "base": i in base})
     return {"label": layer["label"], "bodies": bodies, "beams": beams, "segments": segments, "shapes": shapes,
-            "poses": poses}
+            "visuals": visuals, "poses": poses}
+
+
+def _urdf_visuals(system) -> list:
+    """The visual geometry of a robot from ``Model.from_urdf`` ([] for another model), each in its body's frame
+    (the ground's: global): {body, link, kind, colour, corners (8, 3) of its box} and, for a mesh that was read,
+    ``mesh`` (a ``meshes.Mesh``) and ``T`` (4, 4) = T_body_link · origin · diag(scale) taking its vertices into
+    the body's frame; for a primitive ``size`` (m) and ``T`` = T_body_link · origin. The visuals of flexible
+    links are left out: their beams' tubes are drawn."""
+    urdf = next((a["description"] for name, a in _calls(system) if name == "_keep_urdf"), None)
+    if urdf is None:
+        return []
+    out = []
+    unit_box = np.array([[x, y, z] for x in (-0.5, 0.5) for y in (-0.5, 0.5) for z in (-0.5, 0.5)])
+    for link, visuals in urdf.visuals.items():
+        if link in urdf.beams or link not in urdf.bodies:
+            continue
+        for v in visuals:
+            T = urdf.frames[link] @ v.origin
+            size = [float(x) for x in v.size]
+            if v.kind == "mesh" and v.mesh is not None and v.mesh.size:
+                T = T @ np.diag([*(float(x) for x in v.scale), 1.0])
+                local = v.mesh.vertices.astype(float) @ T[:3, :3].T + T[:3, 3]
+                lo, hi = local.min(axis=0), local.max(axis=0)
+                corners = 0.5 * (lo + hi) + unit_box * (hi - lo)
+            elif v.kind == "box" and len(size) == 3 and min(size) > 0:
+                corners = (unit_box * size) @ T[:3, :3].T + T[:3, 3]
+            elif v.kind == "cylinder" and len(size) == 2 and min(size) > 0:
+                corners = (unit_box * [2 * size[0], 2 * size[0], size[1]]) @ T[:3, :3].T + T[:3, 3]
+            elif v.kind == "sphere" and len(size) == 1 and size[0] > 0:
+                corners = (unit_box * 2 * size[0]) @ T[:3, :3].T + T[:3, 3]
+            else:  # a mesh not found or not read (model.urdf.notes says which), or no geometry
+                continue
+            out.append({"body": int(urdf.bodies[link].index), "link": link, "kind": v.kind, "size": size,
+                        "colour": v.colour, "mesh": v.mesh if v.kind == "mesh" else None, "T": T,
+                        "corners": corners.tolist()})
+    return out
+
+
+def _visuals_json(shown: list, colours: bool) -> None:
+    """The visuals of the layers as the page holds them: a mesh's ``vertices`` (float32, body frame, m) and
+    ``indices`` (uint32, three a triangle) in base64, decimated so that all the layers' meshes together have at
+    most ``MAX_TRIANGLES`` (the smaller meshes whole, each larger one to the same number); a primitive's ``size``
+    (m) and ``matrix`` (16, row by row, the visual frame in the body frame). ``colour`` (0xRRGGBB) and ``opacity``
+    of the file's material with ``colours`` (one layer), else None: the layer's body colour."""
+    sizes = sorted(v["mesh"].size for s in shown for v in s["visuals"] if v["mesh"] is not None)
+    cap, left = None, MAX_TRIANGLES  # each mesh's most triangles: the small ones whole, the others alike
+    for k, n in enumerate(sizes):
+        if n * (len(sizes) - k) > left:
+            cap = left // (len(sizes) - k)
+            break
+        left -= n
+    thinned = {}
+    for s in shown:
+        rows = []
+        for v in s["visuals"]:
+            rgba = v["colour"] if colours else None
+            row = {"body": v["body"], "link": v["link"], "kind": v["kind"],
+                   "colour": None if rgba is None else int(sum(round(255 * c) << (16 - 8 * k)
+                                                              for k, c in enumerate(rgba[:3]))),
+                   "opacity": 1.0 if rgba is None else float(rgba[3])}
+            if v["mesh"] is not None:
+                mesh = v["mesh"]
+                if cap is not None and mesh.size > cap:
+                    if id(mesh) not in thinned:
+                        thinned[id(mesh)] = meshes.decimated(mesh, cap)
+                    mesh = thinned[id(mesh)]
+                T = v["T"]
+                row["vertices"] = _b64(mesh.vertices.astype(float) @ T[:3, :3].T + T[:3, 3])
+                row["indices"] = base64.b64encode(np.ascontiguousarray(mesh.triangles, dtype="<u4").tobytes()
+                                                  ).decode("ascii")
+                row["triangles"] = int(mesh.size)
+            else:
+                row["size"] = v["size"]
+                row["matrix"] = [float(x) for x in v["T"].ravel()]
+            rows.append(row)
+        s["visuals"] = rows
 
 
 def _sde_values(layer, quantity: str, shown_beams: list) -> list:
@@ -701,6 +789,9 @@ def _drawn_points(scene: dict, poses: np.ndarray, trails: list, arrows: list, ar
             local[i].extend(np.asarray(body["com"]) + corners * body["box"])
         if body["triad"] > 0:
             local[i].extend(body["triad"] * np.eye(3))
+    for v in scene["visuals"]:  # the corners of each visual's box in its body's frame
+        if v["body"] >= 0:
+            local[v["body"]].extend(v["corners"])
     for beam in scene["beams"]:
         local[beam["bodies"][-1]].extend([beam["tip"]] + beam.get("tips", [])[-1:])
     for seg in scene["segments"]:
@@ -727,6 +818,7 @@ def _drawn_points(scene: dict, poses: np.ndarray, trails: list, arrows: list, ar
     for tr in trails:
         if tr["body"] < 0:
             out.append(np.asarray(tr["r"], float)[None, :])
+    out += [np.asarray(v["corners"], float) for v in scene["visuals"] if v["body"] < 0]
     for a in arrows:  # the arrows' tips at their drawn length
         if "points" in a:
             base = a["points"][frames]
@@ -879,6 +971,7 @@ def _scene(layers, trails, title, up, scale, color, forces, layout, kind) -> dic
         colour_bars.append({"what": "ropes", "label": "rope tension T (N)", "lo": float(min(0.0, *[x.min() for x in tensions])),
                             "hi": float(max(x.max() for x in tensions))})
     data["colour_bars"] = colour_bars
+    _visuals_json(shown, colours=len(shown) == 1)
     if forces:
         data["arrow_scale"] = {"m_per_N": arrow_scale, "largest": biggest}
     rows = []

@@ -1,5 +1,6 @@
 // rigidfem's 3D viewer: plays the poses that rigidfem.view wrote into window.RIGIDFEM (no network).
-// Bodies are boxes of their equivalent inertia and triads, beams tubes through their rfes' origins
+// Bodies are boxes of their equivalent inertia and triads (a URDF robot's by its links' visual geometry),
+// beams tubes through their rfes' origins
 // and tips (coloured by an sde quantity when one is given), force elements and loop joints lines and
 // markers (ropes coloured by their tension), trails the paths of chosen points, force arrows; a ground
 // grid whose square the legend names. Several layers (results or modes) each have their own poses.
@@ -13,12 +14,14 @@
   const consoleError = console.error.bind(console);
   console.error = (...args) => { status.error = args.map(String).join(" "); consoleError(...args); };
 
-  // little-endian float32 arrays written by Python as base64
-  function floats(b64) {
-    const raw = atob(b64), bytes = new Uint8Array(raw.length);
-    for (let i = 0; i < raw.length; ++i) bytes[i] = raw.charCodeAt(i);
-    return new Float32Array(bytes.buffer);
+  // little-endian float32 (and uint32) arrays written by Python as base64
+  function bytes(b64) {
+    const raw = atob(b64), out = new Uint8Array(raw.length);
+    for (let i = 0; i < raw.length; ++i) out[i] = raw.charCodeAt(i);
+    return out.buffer;
   }
+  function floats(b64) { return new Float32Array(bytes(b64)); }
+  function uints(b64) { return new Uint32Array(bytes(b64)); }
   const hash = new URLSearchParams(window.location.hash.slice(1));
   const helpers = hash.get("helpers") !== "0";  // #helpers=0: the model alone (tests measure its pixels)
   const nf = D.t.length, L = D.scene_size || D.size;
@@ -122,6 +125,38 @@
       if (b.triad > 0) g.add(new THREE.AxesHelper(b.triad));
       scene.add(g);
       return g;
+    });
+    // a URDF robot's visual geometry, fixed in its bodies' frames (the ground's at the layer's offset): meshes
+    // (vertices already in the body's frame, shaded flat, both sides lit), boxes, cylinders (along z) and spheres
+    // placed by their matrices; the file's colour, or the layer's body colour
+    const ground = new THREE.Group();
+    ground.position.copy(off);
+    scene.add(ground);
+    (Y.visuals || []).forEach((v) => {
+      const material = new THREE.MeshLambertMaterial({ color: v.colour == null ? palette[1] : v.colour,
+                                                       side: THREE.DoubleSide, transparent: v.opacity < 1,
+                                                       opacity: v.opacity });
+      let geometry;
+      if (v.kind === "mesh") {
+        const indexed = new THREE.BufferGeometry();
+        indexed.setAttribute("position", new THREE.BufferAttribute(floats(v.vertices), 3));
+        indexed.setIndex(new THREE.BufferAttribute(uints(v.indices), 1));
+        geometry = indexed.toNonIndexed();  // a normal per face: CAD edges stay sharp
+        indexed.dispose();
+        geometry.computeVertexNormals();
+      } else if (v.kind === "box") {
+        geometry = new THREE.BoxBufferGeometry(v.size[0], v.size[1], v.size[2]);
+      } else if (v.kind === "cylinder") {
+        geometry = new THREE.CylinderBufferGeometry(v.size[0], v.size[0], v.size[1], 32).rotateX(Math.PI / 2);
+      } else {
+        geometry = new THREE.SphereBufferGeometry(v.size[0], 24, 16);
+      }
+      const mesh = new THREE.Mesh(geometry, material);
+      if (v.matrix) {
+        mesh.matrixAutoUpdate = false;
+        mesh.matrix.set(...v.matrix);
+      }
+      (v.body >= 0 ? bodyObjects[v.body] : ground).add(mesh);
     });
     // shapes of the contacts, fixed in their bodies' frames (the ground's in the scene): translucent, a
     // half-space as a square of the scene's size on its plane
