@@ -28,6 +28,11 @@ FORMATS = {".stl": "STL", ".dae": "Collada"}
 MAX_TRIANGLES = 200_000
 
 
+class UnreadableMesh(Exception):
+    """A mesh file this module cannot read (its format, or its contents): ``Model.from_urdf`` turns it into a note in
+    ``model.urdf.notes`` and draws the body's inertia box instead; it never reaches the user as an error."""
+
+
 @dataclass(frozen=True, eq=False)
 class Mesh:
     """A triangle mesh: ``vertices`` (n, 3) float32 in m, ``triangles`` (k, 3) uint32 indices into them, and
@@ -45,7 +50,7 @@ class Mesh:
 
 def read(path) -> Mesh:
     """The mesh of the STL or Collada file ``path`` (by its ending, ``FORMATS``), decimated to at most
-    ``MAX_TRIANGLES``. A file that cannot be read as its format is a ValueError saying why."""
+    ``MAX_TRIANGLES``. A file that cannot be read as its format is an UnreadableMesh saying why."""
     name = str(path).lower()
     if name.endswith(".stl"):
         with open(path, "rb") as f:
@@ -53,9 +58,9 @@ def read(path) -> Mesh:
     elif name.endswith(".dae"):
         mesh = _collada(path)
     else:
-        raise ValueError(f"not a format read here ({', '.join(FORMATS)})")
+        raise UnreadableMesh(f"not a format read here ({', '.join(FORMATS)})")
     if mesh.size == 0:
-        raise ValueError("no triangles in it")
+        raise UnreadableMesh("no triangles in it")
     return decimated(mesh, MAX_TRIANGLES)
 
 
@@ -63,7 +68,7 @@ def _merged(vertices: np.ndarray, triangles: np.ndarray, colour=None) -> Mesh:
     """The mesh with identical vertices merged and triangles with a repeated vertex dropped."""
     vertices = np.asarray(vertices, dtype=np.float32).reshape(-1, 3)
     if not np.all(np.isfinite(vertices)):
-        raise ValueError("vertices that are not finite numbers")
+        raise UnreadableMesh("vertices that are not finite numbers")
     unique, inverse = np.unique(vertices, axis=0, return_inverse=True)
     t = inverse.reshape(-1)[np.asarray(triangles, dtype=np.int64)]
     t = t[(t[:, 0] != t[:, 1]) & (t[:, 1] != t[:, 2]) & (t[:, 0] != t[:, 2])]
@@ -85,13 +90,13 @@ def _stl(raw: bytes) -> Mesh:
             v = np.frombuffer(raw, _FACET, k, 84)["vertices"].reshape(-1, 3)
             return _merged(v, np.arange(3 * k).reshape(-1, 3))
     if not raw.lstrip()[:5].lower() == b"solid":
-        raise ValueError(f"not an STL file (neither 84 + 50 k bytes nor text beginning with 'solid', {len(raw)} bytes)")
+        raise UnreadableMesh(f"not an STL file (neither 84 + 50 k bytes nor text beginning with 'solid', {len(raw)} bytes)")
     try:
         v = np.array(_VERTEX.findall(raw.decode("latin-1")), dtype=float)
     except ValueError:
-        raise ValueError("an ASCII STL file with a vertex that is not three numbers") from None
+        raise UnreadableMesh("an ASCII STL file with a vertex that is not three numbers") from None
     if len(v) % 3:
-        raise ValueError(f"an ASCII STL file of {len(v)} vertices, not three per facet")
+        raise UnreadableMesh(f"an ASCII STL file of {len(v)} vertices, not three per facet")
     return _merged(v, np.arange(len(v)).reshape(-1, 3))
 
 
@@ -111,11 +116,11 @@ def _collada(path) -> Mesh:
     try:
         root = ET.parse(path).getroot()
     except ET.ParseError as error:
-        raise ValueError(f"not an XML file ({error})") from None
+        raise UnreadableMesh(f"not an XML file ({error})") from None
     for e in root.iter():  # namespaces dropped: <mesh> whatever the schema's version
         e.tag = _local(e.tag)
     if root.tag != "COLLADA":
-        raise ValueError(f"not a Collada file (its root is <{root.tag}>)")
+        raise UnreadableMesh(f"not a Collada file (its root is <{root.tag}>)")
     unit = root.find("asset/unit")
     metre = float(unit.get("meter", "1")) if unit is not None else 1.0
     ids = {e.get("id"): e for e in root.iter() if e.get("id")}
@@ -169,7 +174,7 @@ def _node_transform(node) -> np.ndarray:
 def _walk(node, T_parent: np.ndarray, ids: dict, placed: list, depth: int) -> None:
     """The geometries under a node, each with its transform in the scene (T = T_parent T_node)."""
     if depth > 64:
-        raise ValueError("nodes nested more than 64 deep (a cycle of <instance_node>?)")
+        raise UnreadableMesh("nodes nested more than 64 deep (a cycle of <instance_node>?)")
     T = T_parent @ _node_transform(node)
     for e in node:
         target = ids.get(e.get("url", "").lstrip("#"))
@@ -189,12 +194,12 @@ def _positions(mesh, ids: dict) -> np.ndarray:
     source = ids.get(inp.get("source", "").lstrip("#")) if inp is not None else None
     array = source.find("float_array") if source is not None else None
     if array is None:
-        raise ValueError("a <mesh> without a POSITION <float_array>")
+        raise UnreadableMesh("a <mesh> without a POSITION <float_array>")
     values = _numbers(array.text)
     accessor = source.find("technique_common/accessor")
     stride = int(accessor.get("stride", "3")) if accessor is not None else 3
     if stride < 3 or values.size % stride:
-        raise ValueError(f"a <float_array> of {values.size} numbers, not a multiple of its stride {stride}")
+        raise UnreadableMesh(f"a <float_array> of {values.size} numbers, not a multiple of its stride {stride}")
     return values.reshape(-1, stride)[:, :3]
 
 
@@ -223,7 +228,7 @@ def _geometry(geometry, ids: dict):
             counts = (np.full(len(index) // 3, 3, np.int64) if prim.tag == "triangles"
                       else _numbers(prim.findtext("vcount"), np.int64))
         if counts.sum() != len(index) or np.any(counts < 3) or np.any(index < 0) or np.any(index >= len(positions)):
-            raise ValueError(f"a <{prim.tag}> whose indices do not match its counts or its {len(positions)} positions")
+            raise UnreadableMesh(f"a <{prim.tag}> whose indices do not match its counts or its {len(positions)} positions")
         # fans: polygon (a0, a1, ..., a(c-1)) -> (a0, aj, aj+1), j = 1..c-2
         starts = np.r_[0, np.cumsum(counts)[:-1]]
         first = np.repeat(starts, counts - 2)

@@ -668,7 +668,7 @@ def _load_visuals(robot: Robot, folder: Path, package_dirs: list, flexible) -> t
                     if found not in read:
                         try:
                             read[found] = meshes.read(found)
-                        except (ValueError, OSError) as error:
+                        except (meshes.UnreadableMesh, ValueError, OSError) as error:
                             read[found] = None
                             unread.append(f"{v.filename} ({error})")
                     colour = v.colour or (read[found].colour if read[found] is not None else None)
