@@ -251,17 +251,7 @@ def test_api_names_and_notebooks_in_the_text_are_links(site):
 #: Public names whose docstrings are written in the C++ bindings (cpp/bindings): their Examples sections belong
 #: there, with the bindings' owner. Remove a name from this set once its docstring has one (the test below fails
 #: on a name listed here that has one, and on any other public name without one).
-EXAMPLES_IN_CPP = {
-    "R1", "R2", "R3", "euler_zyx", "homogeneous", "inverse", "pseudo_inertia", "skew", "joint_transform",
-    "joint_transform_derivative", "joint_transform_second_derivative", "Body", "Data", "JointSpec", "Point",
-    "Profile", "SimulationError", "ForceLawError",
-    "System.acceleration_derivatives", "System.contact_states", "System.dissipated_power", "System.driving_forces",
-    "System.elastic_energy", "System.element_states", "System.force_jacobians", "System.forward_dynamics",
-    "System.generalized_forces", "System.gravity_energy", "System.inverse_dynamics",
-    "System.inverse_dynamics_derivatives", "System.jacobian", "System.kinetic_energy", "System.loop_constraints",
-    "System.loop_multipliers", "System.loop_reactions", "System.make_data", "System.mass_matrix",
-    "System.potential_energy", "System.rhs", "System.static_forces",
-}
+EXAMPLES_IN_CPP: set[str] = set()
 
 
 def _public_objects() -> dict:

@@ -116,7 +116,19 @@ Data& data_of(const py::handle& x) {
 
 void bind_dynamics(py::module_& m) {
   // Data is registered first, so that the signatures of System's methods name it (the stub's types).
-  py::class_<Data> data(m, "Data", "Workspace of the algorithms; after each stage it holds that stage's results.");
+  py::class_<Data> data(m, "Data",
+      "Workspace of the algorithms; after each stage it holds that stage's results.\n"
+      "\n"
+      "Examples\n"
+      "--------\n"
+      ">>> import rigidfem as rf\n"
+      ">>> model, h = rf.samples.pendulum()\n"
+      ">>> system = model.compile()\n"
+      ">>> data = system.make_data()\n"
+      ">>> rf.stages.set_state(system, data, 0.0, [0.5], [0.0])\n"
+      ">>> rf.stages.kinematics(system, data)\n"
+      ">>> len(data.T), data.qa\n"
+      "(1, array([0.5]))");
   py::class_<System, std::shared_ptr<System>>(m, "_System")
       // The System is immutable: only const methods are bound.
       .def(py::init([](const Model& model, const std::string& algorithm) {
@@ -212,7 +224,17 @@ void bind_dynamics(py::module_& m) {
           },
           py::arg("t"), py::arg("q"), py::arg("qd"),
           "(g, gd, G): the loop closures' constraint equations g(q, t) (nl,) (m, or the cosine for direction\n"
-          "rows), their rates gd = G qd + dg/dt (nl,) and the Jacobian G = dg/dq (nl, nq).")
+          "rows), their rates gd = G qd + dg/dt (nl,) and the Jacobian G = dg/dq (nl, nq).\n"
+          "\n"
+          "Examples\n"
+          "--------\n"
+          ">>> import rigidfem as rf\n"
+          ">>> model, h = rf.samples.four_bar()\n"
+          ">>> system = model.compile()\n"
+          ">>> q, qd = system.assemble([0.4, -1.9, 4.6])\n"
+          ">>> g, gd, G = system.loop_constraints(0.0, q, qd)\n"
+          ">>> bool(abs(g).max() < 1e-10), G.shape\n"
+          "(True, (5, 3))")
       .def(
           "loop_multipliers",
           [](const System& s, Time t, Coordinates q, Rates qd) {
@@ -221,7 +243,16 @@ void bind_dynamics(py::module_& m) {
             return finite(VecX((*d).lambda), "loop_multipliers", t, q, qd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"),
-          "Multipliers lambda (nl,) of M qdd = f + G^T lambda at the forward-dynamics accelerations.")
+          "Multipliers lambda (nl,) of M qdd = f + G^T lambda at the forward-dynamics accelerations.\n"
+          "\n"
+          "Examples\n"
+          "--------\n"
+          ">>> import rigidfem as rf\n"
+          ">>> model, h = rf.samples.four_bar()\n"
+          ">>> system = model.compile()\n"
+          ">>> q, qd = system.assemble([0.4, -1.9, 4.6])\n"
+          ">>> system.loop_multipliers(0.0, q, qd).shape, system.nl\n"
+          "((5,), 5)")
       .def(
           "loop_reactions",
           [](const System& s, Time t, Coordinates q, Rates qd) {
@@ -232,7 +263,16 @@ void bind_dynamics(py::module_& m) {
           py::arg("t"), py::arg("q"), py::arg("qd"),
           "Reaction of every loop closure on its body b (nloops, 6): force (N) and torque (N m, about frame B's\n"
           "origin) in frame A's axes; for a distance loop (an actuator) the force along the line in column 0,\n"
-          "positive pushing b away from a.")
+          "positive pushing b away from a.\n"
+          "\n"
+          "Examples\n"
+          "--------\n"
+          ">>> import rigidfem as rf\n"
+          ">>> model, h = rf.samples.four_bar()\n"
+          ">>> system = model.compile()\n"
+          ">>> q, qd = system.assemble([0.4, -1.9, 4.6])\n"
+          ">>> system.loop_names, system.loop_reactions(0.0, q, qd).shape\n"
+          "(['C'], (1, 6))")
       .def_property_readonly(
           "element_names",
           [](const System& s) {
@@ -293,7 +333,22 @@ void bind_dynamics(py::module_& m) {
           py::arg("t"), py::arg("q"), py::arg("qd"),
           "Every overlap of two shapes of a contact at (t, q, qd), each a dict: contact (its name), a and b (the\n"
           "bodies' indices, -1 the ground), point (the contact point, m), normal (from a to b), gap (m, < 0: the\n"
-          "penetration), gap_rate (m/s), normal_force (N), force (on b, N; -force on a), slip (m/s).")
+          "penetration), gap_rate (m/s), normal_force (N), force (on b, N; -force on a), slip (m/s).\n"
+          "\n"
+          "Examples\n"
+          "--------\n"
+          ">>> import rigidfem as rf\n"
+          ">>> model = rf.Model()\n"
+          ">>> ball = model.add_body(\"ball\", model.ground, rf.Joint.prismatic(\"z\"), mass=0.1, inertia=(1e-5,) * 3)\n"
+          ">>> b = model.add_shape(\"sphere\", ball, rf.shapes.Sphere(0.05))\n"
+          ">>> floor = model.add_shape(\"floor\", model.ground, rf.shapes.HalfSpace())\n"
+          ">>> _ = model.add_contact(\"hit\", b, floor, rf.laws.Contact(stiffness=1e5, restitution=0.8))\n"
+          ">>> system = model.compile()\n"
+          ">>> system.contact_states(0.0, [0.1], [0.0])\n"
+          "[]\n"
+          ">>> (c,) = system.contact_states(0.0, [0.04], [0.0])\n"
+          ">>> c[\"contact\"], round(c[\"gap\"], 4), round(c[\"normal_force\"], 1)\n"
+          "('hit', -0.01, 100.0)")
       .def(
           "element_states",
           [](const System& s, Time t, Coordinates q, Rates qd) {
@@ -302,7 +357,19 @@ void bind_dynamics(py::module_& m) {
           },
           py::arg("t"), py::arg("q"), py::arg("qd"),
           "Length l (m), rate dl/dt (m/s) and axial force F (N, positive pushing the two points apart) of every\n"
-          "force element (nelements, 3).")
+          "force element (nelements, 3).\n"
+          "\n"
+          "Examples\n"
+          "--------\n"
+          ">>> import rigidfem as rf\n"
+          ">>> model = rf.Model(gravity=None)\n"
+          ">>> block = model.add_body(\"block\", model.ground, rf.Joint.prismatic(\"x\"), mass=2.0, inertia=(1e-3,) * 3)\n"
+          ">>> _ = model.add_spring_damper(\"s\", model.ground, block, stiffness=50.0, length=0.0, damping=1.0)\n"
+          ">>> system = model.compile()\n"
+          ">>> system.element_names\n"
+          "['s']\n"
+          ">>> system.element_states(0.0, [0.1], [0.0]).round(4)\n"
+          "array([[ 0.1,  0. , -5. ]])")
 
       .def(
           "_assemble",
@@ -319,13 +386,30 @@ void bind_dynamics(py::module_& m) {
             return finite(VecX(rigidfem::forward_dynamics(s, *d, t, q, qd)), "forward_dynamics", t, q, qd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"),
-          "Accelerations qdd (nq,) solving A(q) qdd = f(q, qd, t); t in s, q in m/rad, qd in m/s, rad/s.")
+          "Accelerations qdd (nq,) solving A(q) qdd = f(q, qd, t); t in s, q in m/rad, qd in m/s, rad/s.\n"
+          "\n"
+          "Examples\n"
+          "--------\n"
+          ">>> import rigidfem as rf\n"
+          ">>> model, h = rf.samples.pendulum()\n"
+          ">>> system = model.compile()\n"
+          ">>> system.forward_dynamics(0.0, [0.5], [0.0]).round(4)\n"
+          "array([-7.0547])")
       .def(
           "mass_matrix", [](const System& s, Time t, Coordinates q) {
             Workspace d(s);
             return finite(rigidfem::mass_matrix(s, *d, t, q), "mass_matrix", t, q);
           },
-          py::arg("t"), py::arg("q"), "Mass matrix A(q) (nq, nq), a_ij = sum_p tr(T_p,i H_p T_p,j^T).")
+          py::arg("t"), py::arg("q"),
+          "Mass matrix A(q) (nq, nq), a_ij = sum_p tr(T_p,i H_p T_p,j^T).\n"
+          "\n"
+          "Examples\n"
+          "--------\n"
+          ">>> import rigidfem as rf\n"
+          ">>> model, h = rf.samples.pendulum()\n"
+          ">>> system = model.compile()\n"
+          ">>> system.mass_matrix(0.0, [0.0]).round(4)\n"
+          "array([[0.3333]])")
       .def(
           "generalized_forces",
           [](const System& s, Time t, Coordinates q, Rates qd, LoadFactor load_factor) {
@@ -334,7 +418,15 @@ void bind_dynamics(py::module_& m) {
           },
           py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("load_factor") = 1.0,
           "Right-hand side f (nq,) of A qdd = f: loads, gravity, springs, dampers minus velocity terms (N, N m).\n"
-          "load_factor scales gravity, loads and applied generalised forces.")
+          "load_factor scales gravity, loads and applied generalised forces.\n"
+          "\n"
+          "Examples\n"
+          "--------\n"
+          ">>> import rigidfem as rf\n"
+          ">>> model, h = rf.samples.pendulum()\n"
+          ">>> system = model.compile()\n"
+          ">>> system.generalized_forces(0.0, [0.5], [0.0]).round(4)\n"
+          "array([-2.3516])")
       .def(
           "static_forces",
           [](const System& s, Time t, Coordinates q, LoadFactor load_factor) {
@@ -342,7 +434,15 @@ void bind_dynamics(py::module_& m) {
             return finite(rigidfem::static_forces(s, *d, t, q, load_factor), "static_forces", t, q);
           },
           py::arg("t"), py::arg("q"), py::arg("load_factor") = 1.0,
-          "Static residual f(q) (nq,): generalised forces at rest, prescribed coordinates held at their values at t.")
+          "Static residual f(q) (nq,): generalised forces at rest, prescribed coordinates held at their values at t.\n"
+          "\n"
+          "Examples\n"
+          "--------\n"
+          ">>> import rigidfem as rf\n"
+          ">>> model, h = rf.samples.pendulum()\n"
+          ">>> system = model.compile()\n"
+          ">>> system.static_forces(0.0, [0.5]).round(4)\n"
+          "array([-2.3516])")
       .def(
           "force_jacobians",
           [](const System& s, Time t, Coordinates q, Rates qd, LoadFactor load_factor, StaticFlag static_drives) {
@@ -353,14 +453,36 @@ void bind_dynamics(py::module_& m) {
           py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("load_factor") = 1.0, py::arg("static") = false,
           "(df/dq, df/dqd), each (nq, nq): analytic for recursive systems, central differences for\n"
           "algorithm='lagrange'. -df/dq is the tangent stiffness K,\n"
-          "-df/dqd the damping and gyroscopic matrix C. static=True holds the prescribed coordinates at t.")
+          "-df/dqd the damping and gyroscopic matrix C. static=True holds the prescribed coordinates at t.\n"
+          "\n"
+          "Examples\n"
+          "--------\n"
+          ">>> import rigidfem as rf\n"
+          ">>> model, h = rf.samples.pendulum()\n"
+          ">>> system = model.compile()\n"
+          ">>> dfdq, dfdqd = system.force_jacobians(0.0, [0.0], [0.0])\n"
+          ">>> dfdq.round(4), dfdqd.round(4) + 0.0\n"
+          "(array([[-4.905]]), array([[0.]]))")
       .def(
           "driving_forces", [](const System& s, Time t, Coordinates q, Rates qd) {
             Workspace d(s);
             return finite(rigidfem::driving_forces(s, *d, t, q, qd), "driving_forces", t, q, qd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"),
-          "Forces/torques (np,) the drives exert on the prescribed coordinates (N or N m).")
+          "Forces/torques (np,) the drives exert on the prescribed coordinates (N or N m).\n"
+          "\n"
+          "Examples\n"
+          "--------\n"
+          ">>> import rigidfem as rf\n"
+          ">>> model = rf.Model()\n"
+          ">>> arm = model.add_body(\"arm\", model.ground, rf.Joint.revolute(\"y\"), mass=1.0,\n"
+          "...                      inertia=(0.1, 0.1, 0.1), com=(0.5, 0.0, 0.0))\n"
+          ">>> _ = model.prescribe(arm, rf.motion.ramp(1.0, 0.0, 1.0))\n"
+          ">>> system = model.compile()\n"
+          ">>> system.prescribed_names\n"
+          "['arm.ry']\n"
+          ">>> system.driving_forces(0.0, [], []).round(4)\n"
+          "array([-4.905])")
       .def(
           "rhs", [](const System& s, Time t, States y) {
             Workspace d(s);
@@ -368,14 +490,31 @@ void bind_dynamics(py::module_& m) {
           },
           py::arg("t"), py::arg("y"), "dy/dt = [qd, qdd] for y = [q, qd] (2 nq,): the signature of scipy's solve_ivp.\n"
           "With loop closures qdd holds them at the acceleration level only: g(q) = 0 drifts under solve_ivp\n"
-          "(rigidfem.simulate's methods project onto the loops).")
+          "(rigidfem.simulate's methods project onto the loops).\n"
+          "\n"
+          "Examples\n"
+          "--------\n"
+          ">>> import rigidfem as rf\n"
+          ">>> model, h = rf.samples.pendulum()\n"
+          ">>> system = model.compile()\n"
+          ">>> system.rhs(0.0, [0.5, 1.0]).round(4)\n"
+          "array([ 1.    , -7.0547])")
       .def(
           "jacobian", [](const System& s, Time t, States y) {
             Workspace d(s);
             return finite(rhs_jacobian(s, *d, t, y), "jacobian", t, y);
           },
           py::arg("t"), py::arg("y"), "d(rhs)/dy (2 nq, 2 nq) for solve_ivp(jac=...): analytic for recursive systems (see\n"
-          "acceleration_derivatives), central differences for algorithm='lagrange'.")
+          "acceleration_derivatives), central differences for algorithm='lagrange'.\n"
+          "\n"
+          "Examples\n"
+          "--------\n"
+          ">>> import rigidfem as rf\n"
+          ">>> model, h = rf.samples.pendulum()\n"
+          ">>> system = model.compile()\n"
+          ">>> system.jacobian(0.0, [0.0, 0.0]).round(4) + 0.0\n"
+          "array([[  0.   ,   1.   ],\n"
+          "       [-14.715,   0.   ]])")
       .def(
           "inverse_dynamics",
           [](const System& s, Time t, Coordinates q, Rates qd, Accelerations qdd) {
@@ -385,7 +524,16 @@ void bind_dynamics(py::module_& m) {
           py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("qdd"),
           "r = A(q) qdd - f(q, qd, t) (nq,): the generalised forces (N or N m) the free coordinates\n"
           "need besides the loads, springs and dampers to move with qdd (the residual of the\n"
-          "equations of motion; zero at the forward-dynamics accelerations).")
+          "equations of motion; zero at the forward-dynamics accelerations).\n"
+          "\n"
+          "Examples\n"
+          "--------\n"
+          ">>> import rigidfem as rf\n"
+          ">>> model, h = rf.samples.pendulum()\n"
+          ">>> system = model.compile()\n"
+          ">>> qdd = system.forward_dynamics(0.0, [0.5], [0.0])\n"
+          ">>> bool(abs(system.inverse_dynamics(0.0, [0.5], [0.0], qdd)).max() < 1e-12)\n"
+          "True")
       .def(
           "inverse_dynamics_derivatives",
           [](const System& s, Time t, Coordinates q, Rates qd, Accelerations qdd) {
@@ -394,7 +542,16 @@ void bind_dynamics(py::module_& m) {
           },
           py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("qdd"),
           "(dr/dq, dr/dqd), each (nq, nq), of r = A qdd - f: analytic through the RNEA for recursive\n"
-          "systems (O(n) per column), central differences for algorithm='lagrange'.")
+          "systems (O(n) per column), central differences for algorithm='lagrange'.\n"
+          "\n"
+          "Examples\n"
+          "--------\n"
+          ">>> import rigidfem as rf\n"
+          ">>> model, h = rf.samples.pendulum()\n"
+          ">>> system = model.compile()\n"
+          ">>> drdq, drdqd = system.inverse_dynamics_derivatives(0.0, [0.0], [0.0], [0.0])\n"
+          ">>> drdq.round(4), drdqd.round(4) + 0.0\n"
+          "(array([[4.905]]), array([[0.]]))")
       .def(
           "_inverse_dynamics_direction",
           [](const System& s, Time t, Coordinates q, Rates qd, Accelerations qdd, const VecX& dq, const VecX& dqd,
@@ -425,7 +582,16 @@ void bind_dynamics(py::module_& m) {
           },
           py::arg("t"), py::arg("q"), py::arg("qd"),
           "(dqdd/dq, dqdd/dqd), each (nq, nq): -A^-1 (dr/dq, dr/dqd) at the forward-dynamics qdd; with loop\n"
-          "closures, of the constrained qdd (multipliers and constraint Jacobian varying too), by central differences.")
+          "closures, of the constrained qdd (multipliers and constraint Jacobian varying too), by central differences.\n"
+          "\n"
+          "Examples\n"
+          "--------\n"
+          ">>> import rigidfem as rf\n"
+          ">>> model, h = rf.samples.pendulum()\n"
+          ">>> system = model.compile()\n"
+          ">>> dq, dqd = system.acceleration_derivatives(0.0, [0.0], [0.0])\n"
+          ">>> dq.round(4), dqd.round(4) + 0.0\n"
+          "(array([[-14.715]]), array([[0.]]))")
       .def(
           "transform", [](const System& s, BodyArgument body, Time t, Coordinates q) {
             Workspace d(s);
@@ -456,36 +622,92 @@ void bind_dynamics(py::module_& m) {
             Workspace d(s);
             return finite(energies(s, *d, t, q, qd).kinetic, "kinetic_energy", t, q, qd);
           },
-          py::arg("t"), py::arg("q"), py::arg("qd"), "Kinetic energy 1/2 sum tr(dT H dT^T) (J).")
+          py::arg("t"), py::arg("q"), py::arg("qd"),
+          "Kinetic energy 1/2 sum tr(dT H dT^T) (J).\n"
+          "\n"
+          "Examples\n"
+          "--------\n"
+          ">>> import rigidfem as rf\n"
+          ">>> model, h = rf.samples.pendulum()\n"
+          ">>> system = model.compile()\n"
+          ">>> round(system.kinetic_energy(0.0, [0.0], [2.0]), 4)\n"
+          "0.6667")
       .def(
           "gravity_energy", [](const System& s, Time t, Coordinates q) {
             Workspace d(s);
             return finite(energies(s, *d, t, q, VecX::Zero(s.nq)).gravity, "gravity_energy", t, q);
           },
-          py::arg("t"), py::arg("q"), "Potential energy of gravity -sum m g^T r_C (J).")
+          py::arg("t"), py::arg("q"),
+          "Potential energy of gravity -sum m g^T r_C (J).\n"
+          "\n"
+          "Examples\n"
+          "--------\n"
+          ">>> import rigidfem as rf\n"
+          ">>> model, h = rf.samples.pendulum()\n"
+          ">>> system = model.compile()\n"
+          ">>> round(system.gravity_energy(0.0, [0.0]), 4)\n"
+          "-4.905")
       .def(
           "elastic_energy", [](const System& s, Time t, Coordinates q) {
             Workspace d(s);
             return finite(energies(s, *d, t, q, VecX::Zero(s.nq)).elastic, "elastic_energy", t, q);
           },
           py::arg("t"), py::arg("q"), "Energy of the joint springs 1/2 sum c (q - q_rest)^2 and of the force elements' springs\n"
-          "1/2 sum k (l - l0)^2 (J).")
+          "1/2 sum k (l - l0)^2 (J).\n"
+          "\n"
+          "Examples\n"
+          "--------\n"
+          ">>> import rigidfem as rf\n"
+          ">>> model = rf.Model(gravity=None)\n"
+          ">>> block = model.add_body(\"block\", model.ground, rf.Joint.prismatic(\"x\"), mass=2.0, inertia=(1e-3,) * 3)\n"
+          ">>> _ = model.add_spring_damper(\"s\", model.ground, block, stiffness=50.0, length=0.0, damping=1.0)\n"
+          ">>> system = model.compile()\n"
+          ">>> round(system.elastic_energy(0.0, [0.1]), 4)\n"
+          "0.25")
       .def(
           "potential_energy", [](const System& s, Time t, Coordinates q) {
             Workspace d(s);
             return finite(energies(s, *d, t, q, VecX::Zero(s.nq)).potential(), "potential_energy", t, q);
           },
-          py::arg("t"), py::arg("q"), "Gravity plus elastic energy (J).")
+          py::arg("t"), py::arg("q"),
+          "Gravity plus elastic energy (J).\n"
+          "\n"
+          "Examples\n"
+          "--------\n"
+          ">>> import rigidfem as rf\n"
+          ">>> model, h = rf.samples.pendulum()\n"
+          ">>> system = model.compile()\n"
+          ">>> round(system.potential_energy(0.0, [0.0]), 4)\n"
+          "-4.905")
       .def(
           "dissipated_power", [](const System& s, Time t, Coordinates q, Rates qd) {
             Workspace d(s);
             return finite(energies(s, *d, t, q, qd).dissipated, "dissipated_power", t, q, qd);
           },
           py::arg("t"), py::arg("q"), py::arg("qd"), "Power dissipated by the joint dampers, sum b qd^2, and by the force elements' dampers,\n"
-          "sum c (dl/dt)^2 (W).")
+          "sum c (dl/dt)^2 (W).\n"
+          "\n"
+          "Examples\n"
+          "--------\n"
+          ">>> import rigidfem as rf\n"
+          ">>> model = rf.Model(gravity=None)\n"
+          ">>> block = model.add_body(\"block\", model.ground, rf.Joint.prismatic(\"x\"), mass=2.0, inertia=(1e-3,) * 3)\n"
+          ">>> _ = model.add_spring_damper(\"s\", model.ground, block, stiffness=50.0, length=0.0, damping=1.0)\n"
+          ">>> system = model.compile()\n"
+          ">>> round(system.dissipated_power(0.0, [0.1], [1.0]), 4)\n"
+          "1.0")
       .def(
           "make_data", [](const System& s) { return std::make_unique<Data>(s); },
-          "A fresh workspace for the stage functions (allocated in place: a Data is never copied or moved).");
+          "A fresh workspace for the stage functions (allocated in place: a Data is never copied or moved).\n"
+          "\n"
+          "Examples\n"
+          "--------\n"
+          ">>> import rigidfem as rf\n"
+          ">>> model, h = rf.samples.pendulum()\n"
+          ">>> system = model.compile()\n"
+          ">>> data = system.make_data()\n"
+          ">>> type(data).__name__\n"
+          "'Data'");
 
   data.def_readonly("t", &Data::t)
       .def_readonly("qa", &Data::qa, "All coordinates (nc,), free and prescribed.")

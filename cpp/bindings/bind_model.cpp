@@ -146,7 +146,13 @@ void bind_model(py::module_& m) {
       "rigidfem._core.ForceLawError",
       "A Python force law returned no finite number (None, a string, an array, NaN or inf): a ValueError\n"
       "(and a SimulationError, with `time` and `cause`), raised by System methods; simulate() raises it as\n"
-      "the SimulationError at that time.",
+      "the SimulationError at that time.\n"
+      "\n"
+      "Examples\n"
+      "--------\n"
+      ">>> import rigidfem as rf\n"
+      ">>> issubclass(rf.ForceLawError, rf.SimulationError), issubclass(rf.ForceLawError, ValueError)\n"
+      "(True, True)",
       bases.ptr(), nullptr);
   if (force_law_error == nullptr) throw py::error_already_set();
   m.attr("ForceLawError") = py::handle(force_law_error);
@@ -161,7 +167,17 @@ void bind_model(py::module_& m) {
     }
   });
 
-  py::class_<Joint>(m, "JointSpec", "Active coordinates of a joint with their springs and dampers.")
+  py::class_<Joint>(m, "JointSpec",
+      "Active coordinates of a joint with their springs and dampers.\n"
+      "\n"
+      "Examples\n"
+      "--------\n"
+      ">>> import rigidfem as rf\n"
+      ">>> spec = rf.Joint.revolute(\"y\", stiffness=5.0, damping=0.1)\n"
+      ">>> type(spec).__name__, spec.kind, spec.coordinates\n"
+      "('JointSpec', 'revolute', ['ry'])\n"
+      ">>> spec.stiffness, spec.damping\n"
+      "([5.0], [0.1])")
       .def(py::init([](const std::string& kind, const std::vector<std::string>& coordinates) {
              std::vector<Axis> axes;
              for (const auto& c : coordinates) axes.push_back(parse_coordinate(c, "coordinates"));
@@ -214,7 +230,20 @@ void bind_model(py::module_& m) {
             return j;
           }));
 
-  py::class_<Body>(m, "Body", "Handle of a body of a Model (index -1 is the ground).")
+  py::class_<Body>(m, "Body",
+      "Handle of a body of a Model (index -1 is the ground).\n"
+      "\n"
+      "Examples\n"
+      "--------\n"
+      ">>> import rigidfem as rf\n"
+      ">>> model, h = rf.samples.pendulum()\n"
+      ">>> system = model.compile()\n"
+      ">>> h[\"link\"]\n"
+      "<rigidfem Body 'link' #0>\n"
+      ">>> h[\"link\"].index, h[\"link\"].name\n"
+      "(0, 'link')\n"
+      ">>> model.ground.index\n"
+      "-1")
       .def(py::init<>(), "The ground.")
       .def(py::init([](int index, const std::string& name, std::uint64_t model) { return Body{index, name, model}; }),
            py::arg("index"), py::arg("name"), py::arg("model") = 0)
@@ -235,7 +264,19 @@ void bind_model(py::module_& m) {
                         return Body{s[0].cast<int>(), s[1].cast<std::string>(), s[2].cast<std::uint64_t>()};
                       }));
 
-  py::class_<Point>(m, "Point", "A material point: body index and position r (m) in the body frame.")
+  py::class_<Point>(m, "Point",
+      "A material point: body index and position r (m) in the body frame.\n"
+      "\n"
+      "Examples\n"
+      "--------\n"
+      ">>> import rigidfem as rf\n"
+      ">>> model, h = rf.samples.pendulum()\n"
+      ">>> system = model.compile()\n"
+      ">>> p = h[\"link\"].point((0.0, 0.0, -1.0))\n"
+      ">>> p\n"
+      "<rigidfem Point on body #0 at r = (0, 0, -1) m>\n"
+      ">>> system.position(p, 0.0, [0.0])\n"
+      "array([ 0.,  0., -1.])")
       .def(py::init([](const py::object& body, const py::object& r) {
              return Point(static_cast<int>(int_arg(body, "body", "a body index (int; -1 the ground)")),
                           finite_offset(matrix_arg<Vec3>(r, "r", "an offset (3,) in m in the body frame")));
@@ -263,7 +304,16 @@ void bind_model(py::module_& m) {
       },
       py::arg("mass"), py::arg("com"), py::arg("inertia"),
         "Pseudo-inertia H = int r r^T dm (4, 4) of a body: mass (kg), centre of mass com (3,) m and\n"
-        "inertia tensor (3, 3) about the centre of mass (kg m^2), all in the body frame.");
+        "inertia tensor (3, 3) about the centre of mass (kg m^2), all in the body frame.\n"
+        "\n"
+        "Examples\n"
+        "--------\n"
+        ">>> import numpy as np, rigidfem as rf\n"
+        ">>> rf.pseudo_inertia(2.0, [0.5, 0.0, 0.0], np.diag([0.01, 0.02, 0.02])).round(3)\n"
+        "array([[0.515, 0.   , 0.   , 1.   ],\n"
+        "       [0.   , 0.005, 0.   , 0.   ],\n"
+        "       [0.   , 0.   , 0.005, 0.   ],\n"
+        "       [1.   , 0.   , 0.   , 2.   ]])");
 
   py::class_<Model>(m, "_Model")
       .def(py::init<const Vec3&>(), py::arg("gravity"))

@@ -37,31 +37,92 @@ void bind_transforms(py::module_& m) {
   // Arguments as py::object: a wrong type is a ValueError naming it (NaN in, NaN out is fine here).
   const auto angle = [](const py::object& x, const char* name) { return real_arg(x, name, "an angle in rad"); };
   m.def("R1", [angle](const py::object& phi1) { return R1(angle(phi1, "phi1")); }, py::arg("phi1"),
-        "Rotation matrix about x by phi1 (rad), (3, 3).");
+        "Rotation matrix about x by phi1 (rad), (3, 3).\n"
+        "\n"
+        "Examples\n"
+        "--------\n"
+        ">>> import rigidfem as rf\n"
+        ">>> rf.R1(0.5).round(3)\n"
+        "array([[ 1.   ,  0.   ,  0.   ],\n"
+        "       [ 0.   ,  0.878, -0.479],\n"
+        "       [ 0.   ,  0.479,  0.878]])");
   m.def("R2", [angle](const py::object& phi2) { return R2(angle(phi2, "phi2")); }, py::arg("phi2"),
-        "Rotation matrix about y by phi2 (rad), (3, 3).");
+        "Rotation matrix about y by phi2 (rad), (3, 3).\n"
+        "\n"
+        "Examples\n"
+        "--------\n"
+        ">>> import rigidfem as rf\n"
+        ">>> rf.R2(0.5).round(3)\n"
+        "array([[ 0.878,  0.   ,  0.479],\n"
+        "       [ 0.   ,  1.   ,  0.   ],\n"
+        "       [-0.479,  0.   ,  0.878]])");
   m.def("R3", [angle](const py::object& phi3) { return R3(angle(phi3, "phi3")); }, py::arg("phi3"),
-        "Rotation matrix about z by phi3 (rad), (3, 3).");
+        "Rotation matrix about z by phi3 (rad), (3, 3).\n"
+        "\n"
+        "Examples\n"
+        "--------\n"
+        ">>> import rigidfem as rf\n"
+        ">>> rf.R3(0.5).round(3)\n"
+        "array([[ 0.878, -0.479,  0.   ],\n"
+        "       [ 0.479,  0.878,  0.   ],\n"
+        "       [ 0.   ,  0.   ,  1.   ]])");
   m.def(
       "euler_zyx",
       [angle](const py::object& phi3, const py::object& phi2, const py::object& phi1) {
         return euler_zyx(angle(phi3, "phi3"), angle(phi2, "phi2"), angle(phi1, "phi1"));
       },
       py::arg("phi3"), py::arg("phi2"), py::arg("phi1"),
-      "R3(phi3) R2(phi2) R1(phi1), book eq. (2.7): yaw, pitch, roll in rad. (3, 3).");
+      "R3(phi3) R2(phi2) R1(phi1), book eq. (2.7): yaw, pitch, roll in rad. (3, 3).\n"
+      "\n"
+      "Examples\n"
+      "--------\n"
+      ">>> import numpy as np, rigidfem as rf\n"
+      ">>> R = rf.euler_zyx(0.1, 0.2, 0.3)\n"
+      ">>> bool(np.allclose(R, rf.R3(0.1) @ rf.R2(0.2) @ rf.R1(0.3)))\n"
+      "True");
   m.def(
       "skew", [](const py::object& w) { return skew(matrix_arg<Vec3>(w, "w", "a vector (3,)")); }, py::arg("w"),
-      "Skew-symmetric S(w) with S(w) x = w x x. (3, 3).");
+      "Skew-symmetric S(w) with S(w) x = w x x. (3, 3).\n"
+      "\n"
+      "Examples\n"
+      "--------\n"
+      ">>> import rigidfem as rf\n"
+      ">>> rf.skew([1.0, 2.0, 3.0])\n"
+      "array([[ 0., -3.,  2.],\n"
+      "       [ 3.,  0., -1.],\n"
+      "       [-2.,  1.,  0.]])\n"
+      ">>> rf.skew([1.0, 2.0, 3.0]) @ [4.0, 5.0, 6.0]\n"
+      "array([-3.,  6., -3.])");
   m.def(
       "homogeneous",
       [](const py::object& R, const py::object& r) {
         return homogeneous(matrix_arg<Mat3>(R, "R", "a rotation matrix (3, 3)"),
                            matrix_arg<Vec3>(r, "r", "a translation (3,) in m"));
       },
-      py::arg("R"), py::arg("r"), "[[R, r], [0, 1]] (4, 4); r in m.");
+      py::arg("R"), py::arg("r"),
+      "[[R, r], [0, 1]] (4, 4); r in m.\n"
+      "\n"
+      "Examples\n"
+      "--------\n"
+      ">>> import numpy as np, rigidfem as rf\n"
+      ">>> rf.homogeneous(np.eye(3), [1.0, 2.0, 3.0])\n"
+      "array([[1., 0., 0., 1.],\n"
+      "       [0., 1., 0., 2.],\n"
+      "       [0., 0., 1., 3.],\n"
+      "       [0., 0., 0., 1.]])");
   m.def(
       "inverse", [](const py::object& T) { return inverse(matrix_arg<Mat4>(T, "T", "a homogeneous transform (4, 4)")); },
-      py::arg("T"), "Inverse of a homogeneous transform, [[R^T, -R^T r], [0, 1]] (4, 4).");
+      py::arg("T"),
+      "Inverse of a homogeneous transform, [[R^T, -R^T r], [0, 1]] (4, 4).\n"
+      "\n"
+      "Examples\n"
+      "--------\n"
+      ">>> import numpy as np, rigidfem as rf\n"
+      ">>> T = rf.homogeneous(rf.R3(0.3), [1.0, 0.0, 0.0])\n"
+      ">>> bool(np.allclose(rf.inverse(T) @ T, np.eye(4)))\n"
+      "True\n"
+      ">>> rf.inverse(rf.homogeneous(np.eye(3), [1.0, 2.0, 3.0]))[:3, 3]\n"
+      "array([-1., -2., -3.])");
 
   // (coordinates, q) checked: names from x, y, z, rz, ry, rx; q a real vector of their number.
   auto axes_of = [](const py::object& coordinates) {
@@ -83,7 +144,16 @@ void bind_transforms(py::module_& m) {
       },
       py::arg("coordinates"), py::arg("q"),
       "Joint transform Trans(x, y, z) R3(phi3) R2(phi2) R1(phi1) restricted to `coordinates`\n"
-      "(names from 'x', 'y', 'z', 'rz', 'ry', 'rx', taken in the book's order); q in m and rad. (4, 4).");
+      "(names from 'x', 'y', 'z', 'rz', 'ry', 'rx', taken in the book's order); q in m and rad. (4, 4).\n"
+      "\n"
+      "Examples\n"
+      "--------\n"
+      ">>> import rigidfem as rf\n"
+      ">>> rf.joint_transform([\"x\", \"rz\"], [0.5, 0.0])\n"
+      "array([[1. , 0. , 0. , 0.5],\n"
+      "       [0. , 1. , 0. , 0. ],\n"
+      "       [0. , 0. , 1. , 0. ],\n"
+      "       [0. , 0. , 0. , 1. ]])");
   m.def(
       "joint_transform_derivative",
       [axes_of, values_of](const py::object& c, const py::object& q, const py::object& i) {
@@ -91,7 +161,17 @@ void bind_transforms(py::module_& m) {
         return joint_transform_derivative(axes, values_of(q, axes.size()),
                                           static_cast<int>(int_arg(i, "i", "the index of a coordinate")));
       },
-      py::arg("coordinates"), py::arg("q"), py::arg("i"), "dT/dq_i of joint_transform (4, 4).");
+      py::arg("coordinates"), py::arg("q"), py::arg("i"),
+      "dT/dq_i of joint_transform (4, 4).\n"
+      "\n"
+      "Examples\n"
+      "--------\n"
+      ">>> import rigidfem as rf\n"
+      ">>> rf.joint_transform_derivative([\"x\", \"rz\"], [0.5, 0.0], 0)\n"
+      "array([[0., 0., 0., 1.],\n"
+      "       [0., 0., 0., 0.],\n"
+      "       [0., 0., 0., 0.],\n"
+      "       [0., 0., 0., 0.]])");
   m.def(
       "joint_transform_second_derivative",
       [axes_of, values_of](const py::object& c, const py::object& q, const py::object& i, const py::object& j) {
@@ -100,7 +180,17 @@ void bind_transforms(py::module_& m) {
                                                  static_cast<int>(int_arg(i, "i", "the index of a coordinate")),
                                                  static_cast<int>(int_arg(j, "j", "the index of a coordinate")));
       },
-      py::arg("coordinates"), py::arg("q"), py::arg("i"), py::arg("j"), "d2T/dq_i dq_j of joint_transform (4, 4).");
+      py::arg("coordinates"), py::arg("q"), py::arg("i"), py::arg("j"),
+      "d2T/dq_i dq_j of joint_transform (4, 4).\n"
+      "\n"
+      "Examples\n"
+      "--------\n"
+      ">>> import rigidfem as rf\n"
+      ">>> rf.joint_transform_second_derivative([\"x\", \"rz\"], [0.5, 0.0], 1, 1).round(3)\n"
+      "array([[-1.,  0.,  0.,  0.],\n"
+      "       [ 0., -1.,  0.,  0.],\n"
+      "       [ 0.,  0.,  0.,  0.],\n"
+      "       [ 0.,  0.,  0.,  0.]])");
 }
 
 namespace {
@@ -147,7 +237,18 @@ ProfileValue profile_value(const ProfileArgument& a, const py::handle& x) {
 }  // namespace
 
 void bind_profiles(py::module_& m) {
-  py::class_<Profile, ProfilePtr> profile(m, "Profile", "A prescribed motion q(t) with its rates (see rigidfem.motion).",
+  py::class_<Profile, ProfilePtr> profile(m, "Profile",
+      "A prescribed motion q(t) with its rates (see rigidfem.motion).\n"
+      "\n"
+      "Examples\n"
+      "--------\n"
+      ">>> import rigidfem as rf\n"
+      ">>> p = rf.motion.ramp(2.0, 0.0, 1.0)\n"
+      ">>> [round(x, 6) for x in p(0.5)]\n"
+      "[0.148679, 1.0, 4.0]\n"
+      ">>> p.sample([0.0, 1.0]).round(3)\n"
+      "array([[0., 0., 0.],\n"
+      "       [1., 2., 0.]])",
                                           py::dynamic_attr());
   profile
       .def(
@@ -318,7 +419,13 @@ PYBIND11_MODULE(_core, m) {
   registered.attr("__doc__") =
       "A numerical failure, a RuntimeError whose message names the time (s) and the cause: a singular mass or "
       "iteration matrix, a step size below the minimum, a NaN or inf state, Newton divergence in a step or a load "
-      "step of the statics, max_steps, gimbal lock of ZYX Euler angles. Its `time` (s) and `cause` say when and why.";
+      "step of the statics, max_steps, gimbal lock of ZYX Euler angles. Its `time` (s) and `cause` say when and why.\n"
+      "\n"
+      "Examples\n"
+      "--------\n"
+      ">>> import rigidfem as rf\n"
+      ">>> issubclass(rf.SimulationError, RuntimeError)\n"
+      "True";
   // Every SimulationError carries its time and cause (ForceLawError's own translator, registered later, comes first).
   py::register_exception_translator([](std::exception_ptr p) {
     try {

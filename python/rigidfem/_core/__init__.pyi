@@ -12,10 +12,26 @@ __all__: list[str] = ['Body', 'Data', 'ForceLawError', 'IntegratorOptions', 'Joi
 class SimulationError(RuntimeError):
     """
     A numerical failure, a RuntimeError whose message names the time (s) and the cause: a singular mass or iteration matrix, a step size below the minimum, a NaN or inf state, Newton divergence in a step or a load step of the statics, max_steps, gimbal lock of ZYX Euler angles. Its `time` (s) and `cause` say when and why.
+    
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> issubclass(rf.SimulationError, RuntimeError)
+    True
     """
 class Profile:
     """
     A prescribed motion q(t) with its rates (see rigidfem.motion).
+    
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> p = rf.motion.ramp(2.0, 0.0, 1.0)
+    >>> [round(x, 6) for x in p(0.5)]
+    [0.148679, 1.0, 4.0]
+    >>> p.sample([0.0, 1.0]).round(3)
+    array([[0., 0., 0.],
+           [1., 2., 0.]])
     """
     __array_ufunc__ = None
     def __add__(self, arg0: typing.Any) -> typing.Any:
@@ -57,10 +73,25 @@ class ForceLawError(SimulationError, ValueError):
     A Python force law returned no finite number (None, a string, an array, NaN or inf): a ValueError
     (and a SimulationError, with `time` and `cause`), raised by System methods; simulate() raises it as
     the SimulationError at that time.
+    
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> issubclass(rf.ForceLawError, rf.SimulationError), issubclass(rf.ForceLawError, ValueError)
+    (True, True)
     """
 class JointSpec:
     """
     Active coordinates of a joint with their springs and dampers.
+    
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> spec = rf.Joint.revolute("y", stiffness=5.0, damping=0.1)
+    >>> type(spec).__name__, spec.kind, spec.coordinates
+    ('JointSpec', 'revolute', ['ry'])
+    >>> spec.stiffness, spec.damping
+    ([5.0], [0.1])
     """
     def __getstate__(self) -> tuple[str, list[str], list[float], list[float], list[float], bool, list]:
         ...
@@ -111,6 +142,18 @@ class JointSpec:
 class Body:
     """
     Handle of a body of a Model (index -1 is the ground).
+    
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> model, h = rf.samples.pendulum()
+    >>> system = model.compile()
+    >>> h["link"]
+    <rigidfem Body 'link' #0>
+    >>> h["link"].index, h["link"].name
+    (0, 'link')
+    >>> model.ground.index
+    -1
     """
     def __getstate__(self) -> tuple[int, str, int]:
         ...
@@ -149,6 +192,17 @@ class Body:
 class Point:
     """
     A material point: body index and position r (m) in the body frame.
+    
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> model, h = rf.samples.pendulum()
+    >>> system = model.compile()
+    >>> p = h["link"].point((0.0, 0.0, -1.0))
+    >>> p
+    <rigidfem Point on body #0 at r = (0, 0, -1) m>
+    >>> system.position(p, 0.0, [0.0])
+    array([ 0.,  0., -1.])
     """
     def __getstate__(self) -> tuple[int, typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 1]"], int]:
         ...
@@ -305,6 +359,17 @@ class _Model:
 class Data:
     """
     Workspace of the algorithms; after each stage it holds that stage's results.
+    
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> model, h = rf.samples.pendulum()
+    >>> system = model.compile()
+    >>> data = system.make_data()
+    >>> rf.stages.set_state(system, data, 0.0, [0.5], [0.0])
+    >>> rf.stages.kinematics(system, data)
+    >>> len(data.T), data.qa
+    (1, array([0.5]))
     """
     @property
     def A(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
@@ -405,107 +470,313 @@ class _System:
         """
         (dqdd/dq, dqdd/dqd), each (nq, nq): -A^-1 (dr/dq, dr/dqd) at the forward-dynamics qdd; with loop
         closures, of the constrained qdd (multipliers and constraint Jacobian varying too), by central differences.
+        
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.pendulum()
+        >>> system = model.compile()
+        >>> dq, dqd = system.acceleration_derivatives(0.0, [0.0], [0.0])
+        >>> dq.round(4), dqd.round(4) + 0.0
+        (array([[-14.715]]), array([[0.]]))
         """
     def contact_states(self, t: float, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> list:
         """
         Every overlap of two shapes of a contact at (t, q, qd), each a dict: contact (its name), a and b (the
         bodies' indices, -1 the ground), point (the contact point, m), normal (from a to b), gap (m, < 0: the
         penetration), gap_rate (m/s), normal_force (N), force (on b, N; -force on a), slip (m/s).
+        
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model = rf.Model()
+        >>> ball = model.add_body("ball", model.ground, rf.Joint.prismatic("z"), mass=0.1, inertia=(1e-5,) * 3)
+        >>> b = model.add_shape("sphere", ball, rf.shapes.Sphere(0.05))
+        >>> floor = model.add_shape("floor", model.ground, rf.shapes.HalfSpace())
+        >>> _ = model.add_contact("hit", b, floor, rf.laws.Contact(stiffness=1e5, restitution=0.8))
+        >>> system = model.compile()
+        >>> system.contact_states(0.0, [0.1], [0.0])
+        []
+        >>> (c,) = system.contact_states(0.0, [0.04], [0.0])
+        >>> c["contact"], round(c["gap"], 4), round(c["normal_force"], 1)
+        ('hit', -0.01, 100.0)
         """
     def dissipated_power(self, t: float, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> float:
         """
         Power dissipated by the joint dampers, sum b qd^2, and by the force elements' dampers,
         sum c (dl/dt)^2 (W).
+        
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model = rf.Model(gravity=None)
+        >>> block = model.add_body("block", model.ground, rf.Joint.prismatic("x"), mass=2.0, inertia=(1e-3,) * 3)
+        >>> _ = model.add_spring_damper("s", model.ground, block, stiffness=50.0, length=0.0, damping=1.0)
+        >>> system = model.compile()
+        >>> round(system.dissipated_power(0.0, [0.1], [1.0]), 4)
+        1.0
         """
     def driving_forces(self, t: float, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
         Forces/torques (np,) the drives exert on the prescribed coordinates (N or N m).
+        
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model = rf.Model()
+        >>> arm = model.add_body("arm", model.ground, rf.Joint.revolute("y"), mass=1.0,
+        ...                      inertia=(0.1, 0.1, 0.1), com=(0.5, 0.0, 0.0))
+        >>> _ = model.prescribe(arm, rf.motion.ramp(1.0, 0.0, 1.0))
+        >>> system = model.compile()
+        >>> system.prescribed_names
+        ['arm.ry']
+        >>> system.driving_forces(0.0, [], []).round(4)
+        array([-4.905])
         """
     def elastic_energy(self, t: float, q: numpy.typing.ArrayLike) -> float:
         """
         Energy of the joint springs 1/2 sum c (q - q_rest)^2 and of the force elements' springs
         1/2 sum k (l - l0)^2 (J).
+        
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model = rf.Model(gravity=None)
+        >>> block = model.add_body("block", model.ground, rf.Joint.prismatic("x"), mass=2.0, inertia=(1e-3,) * 3)
+        >>> _ = model.add_spring_damper("s", model.ground, block, stiffness=50.0, length=0.0, damping=1.0)
+        >>> system = model.compile()
+        >>> round(system.elastic_energy(0.0, [0.1]), 4)
+        0.25
         """
     def element_states(self, t: float, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
         """
         Length l (m), rate dl/dt (m/s) and axial force F (N, positive pushing the two points apart) of every
         force element (nelements, 3).
+        
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model = rf.Model(gravity=None)
+        >>> block = model.add_body("block", model.ground, rf.Joint.prismatic("x"), mass=2.0, inertia=(1e-3,) * 3)
+        >>> _ = model.add_spring_damper("s", model.ground, block, stiffness=50.0, length=0.0, damping=1.0)
+        >>> system = model.compile()
+        >>> system.element_names
+        ['s']
+        >>> system.element_states(0.0, [0.1], [0.0]).round(4)
+        array([[ 0.1,  0. , -5. ]])
         """
     def force_jacobians(self, t: float, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, load_factor: float = 1.0, static: bool = False) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]]:
         """
         (df/dq, df/dqd), each (nq, nq): analytic for recursive systems, central differences for
         algorithm='lagrange'. -df/dq is the tangent stiffness K,
         -df/dqd the damping and gyroscopic matrix C. static=True holds the prescribed coordinates at t.
+        
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.pendulum()
+        >>> system = model.compile()
+        >>> dfdq, dfdqd = system.force_jacobians(0.0, [0.0], [0.0])
+        >>> dfdq.round(4), dfdqd.round(4) + 0.0
+        (array([[-4.905]]), array([[0.]]))
         """
     def forward_dynamics(self, t: float, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
         Accelerations qdd (nq,) solving A(q) qdd = f(q, qd, t); t in s, q in m/rad, qd in m/s, rad/s.
+        
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.pendulum()
+        >>> system = model.compile()
+        >>> system.forward_dynamics(0.0, [0.5], [0.0]).round(4)
+        array([-7.0547])
         """
     def generalized_forces(self, t: float, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, load_factor: float = 1.0) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
         Right-hand side f (nq,) of A qdd = f: loads, gravity, springs, dampers minus velocity terms (N, N m).
         load_factor scales gravity, loads and applied generalised forces.
+        
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.pendulum()
+        >>> system = model.compile()
+        >>> system.generalized_forces(0.0, [0.5], [0.0]).round(4)
+        array([-2.3516])
         """
     def gravity_energy(self, t: float, q: numpy.typing.ArrayLike) -> float:
         """
         Potential energy of gravity -sum m g^T r_C (J).
+        
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.pendulum()
+        >>> system = model.compile()
+        >>> round(system.gravity_energy(0.0, [0.0]), 4)
+        -4.905
         """
     def inverse_dynamics(self, t: float, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
         r = A(q) qdd - f(q, qd, t) (nq,): the generalised forces (N or N m) the free coordinates
         need besides the loads, springs and dampers to move with qdd (the residual of the
         equations of motion; zero at the forward-dynamics accelerations).
+        
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.pendulum()
+        >>> system = model.compile()
+        >>> qdd = system.forward_dynamics(0.0, [0.5], [0.0])
+        >>> bool(abs(system.inverse_dynamics(0.0, [0.5], [0.0], qdd)).max() < 1e-12)
+        True
         """
     def inverse_dynamics_derivatives(self, t: float, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]]:
         """
         (dr/dq, dr/dqd), each (nq, nq), of r = A qdd - f: analytic through the RNEA for recursive
         systems (O(n) per column), central differences for algorithm='lagrange'.
+        
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.pendulum()
+        >>> system = model.compile()
+        >>> drdq, drdqd = system.inverse_dynamics_derivatives(0.0, [0.0], [0.0], [0.0])
+        >>> drdq.round(4), drdqd.round(4) + 0.0
+        (array([[4.905]]), array([[0.]]))
         """
     def jacobian(self, t: float, y: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
         """
         d(rhs)/dy (2 nq, 2 nq) for solve_ivp(jac=...): analytic for recursive systems (see
         acceleration_derivatives), central differences for algorithm='lagrange'.
+        
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.pendulum()
+        >>> system = model.compile()
+        >>> system.jacobian(0.0, [0.0, 0.0]).round(4) + 0.0
+        array([[  0.   ,   1.   ],
+               [-14.715,   0.   ]])
         """
     def kinetic_energy(self, t: float, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> float:
         """
         Kinetic energy 1/2 sum tr(dT H dT^T) (J).
+        
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.pendulum()
+        >>> system = model.compile()
+        >>> round(system.kinetic_energy(0.0, [0.0], [2.0]), 4)
+        0.6667
         """
     def loop_constraints(self, t: float, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]]:
         """
         (g, gd, G): the loop closures' constraint equations g(q, t) (nl,) (m, or the cosine for direction
         rows), their rates gd = G qd + dg/dt (nl,) and the Jacobian G = dg/dq (nl, nq).
+        
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.four_bar()
+        >>> system = model.compile()
+        >>> q, qd = system.assemble([0.4, -1.9, 4.6])
+        >>> g, gd, G = system.loop_constraints(0.0, q, qd)
+        >>> bool(abs(g).max() < 1e-10), G.shape
+        (True, (5, 3))
         """
     def loop_multipliers(self, t: float, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
         Multipliers lambda (nl,) of M qdd = f + G^T lambda at the forward-dynamics accelerations.
+        
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.four_bar()
+        >>> system = model.compile()
+        >>> q, qd = system.assemble([0.4, -1.9, 4.6])
+        >>> system.loop_multipliers(0.0, q, qd).shape, system.nl
+        ((5,), 5)
         """
     def loop_reactions(self, t: float, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
         """
         Reaction of every loop closure on its body b (nloops, 6): force (N) and torque (N m, about frame B's
         origin) in frame A's axes; for a distance loop (an actuator) the force along the line in column 0,
         positive pushing b away from a.
+        
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.four_bar()
+        >>> system = model.compile()
+        >>> q, qd = system.assemble([0.4, -1.9, 4.6])
+        >>> system.loop_names, system.loop_reactions(0.0, q, qd).shape
+        (['C'], (1, 6))
         """
     def make_data(self) -> Data:
         """
         A fresh workspace for the stage functions (allocated in place: a Data is never copied or moved).
+        
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.pendulum()
+        >>> system = model.compile()
+        >>> data = system.make_data()
+        >>> type(data).__name__
+        'Data'
         """
     def mass_matrix(self, t: float, q: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"]:
         """
         Mass matrix A(q) (nq, nq), a_ij = sum_p tr(T_p,i H_p T_p,j^T).
+        
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.pendulum()
+        >>> system = model.compile()
+        >>> system.mass_matrix(0.0, [0.0]).round(4)
+        array([[0.3333]])
         """
     def potential_energy(self, t: float, q: numpy.typing.ArrayLike) -> float:
         """
         Gravity plus elastic energy (J).
+        
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.pendulum()
+        >>> system = model.compile()
+        >>> round(system.potential_energy(0.0, [0.0]), 4)
+        -4.905
         """
     def rhs(self, t: float, y: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
         dy/dt = [qd, qdd] for y = [q, qd] (2 nq,): the signature of scipy's solve_ivp.
         With loop closures qdd holds them at the acceleration level only: g(q) = 0 drifts under solve_ivp
         (rigidfem.simulate's methods project onto the loops).
+        
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.pendulum()
+        >>> system = model.compile()
+        >>> system.rhs(0.0, [0.5, 1.0]).round(4)
+        array([ 1.    , -7.0547])
         """
     def static_forces(self, t: float, q: numpy.typing.ArrayLike, load_factor: float = 1.0) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
         Static residual f(q) (nq,): generalised forces at rest, prescribed coordinates held at their values at t.
+        
+        Examples
+        --------
+        >>> import rigidfem as rf
+        >>> model, h = rf.samples.pendulum()
+        >>> system = model.compile()
+        >>> system.static_forces(0.0, [0.5]).round(4)
+        array([-2.3516])
         """
     def transform(self, body: Body | int, t: float, q: numpy.typing.ArrayLike) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
         """
@@ -767,14 +1038,38 @@ class _Adjoint:
 def R1(phi1: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
     """
     Rotation matrix about x by phi1 (rad), (3, 3).
+    
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> rf.R1(0.5).round(3)
+    array([[ 1.   ,  0.   ,  0.   ],
+           [ 0.   ,  0.878, -0.479],
+           [ 0.   ,  0.479,  0.878]])
     """
 def R2(phi2: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
     """
     Rotation matrix about y by phi2 (rad), (3, 3).
+    
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> rf.R2(0.5).round(3)
+    array([[ 0.878,  0.   ,  0.479],
+           [ 0.   ,  1.   ,  0.   ],
+           [-0.479,  0.   ,  0.878]])
     """
 def R3(phi3: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
     """
     Rotation matrix about z by phi3 (rad), (3, 3).
+    
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> rf.R3(0.5).round(3)
+    array([[ 0.878, -0.479,  0.   ],
+           [ 0.479,  0.878,  0.   ],
+           [ 0.   ,  0.   ,  1.   ]])
     """
 def _auto_stiff_method(system: _System, iteration_matrix: str) -> str:
     """
@@ -838,34 +1133,105 @@ def callback_profile(function: collections.abc.Callable[[float], tuple[typing.Su
 def euler_zyx(phi3: typing.Any, phi2: typing.Any, phi1: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
     """
     R3(phi3) R2(phi2) R1(phi1), book eq. (2.7): yaw, pitch, roll in rad. (3, 3).
+    
+    Examples
+    --------
+    >>> import numpy as np, rigidfem as rf
+    >>> R = rf.euler_zyx(0.1, 0.2, 0.3)
+    >>> bool(np.allclose(R, rf.R3(0.1) @ rf.R2(0.2) @ rf.R1(0.3)))
+    True
     """
 def homogeneous(R: typing.Any, r: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
     """
     [[R, r], [0, 1]] (4, 4); r in m.
+    
+    Examples
+    --------
+    >>> import numpy as np, rigidfem as rf
+    >>> rf.homogeneous(np.eye(3), [1.0, 2.0, 3.0])
+    array([[1., 0., 0., 1.],
+           [0., 1., 0., 2.],
+           [0., 0., 1., 3.],
+           [0., 0., 0., 1.]])
     """
 def inverse(T: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
     """
     Inverse of a homogeneous transform, [[R^T, -R^T r], [0, 1]] (4, 4).
+    
+    Examples
+    --------
+    >>> import numpy as np, rigidfem as rf
+    >>> T = rf.homogeneous(rf.R3(0.3), [1.0, 0.0, 0.0])
+    >>> bool(np.allclose(rf.inverse(T) @ T, np.eye(4)))
+    True
+    >>> rf.inverse(rf.homogeneous(np.eye(3), [1.0, 2.0, 3.0]))[:3, 3]
+    array([-1., -2., -3.])
     """
 def joint_transform(coordinates: typing.Any, q: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
     """
     Joint transform Trans(x, y, z) R3(phi3) R2(phi2) R1(phi1) restricted to `coordinates`
     (names from 'x', 'y', 'z', 'rz', 'ry', 'rx', taken in the book's order); q in m and rad. (4, 4).
+    
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> rf.joint_transform(["x", "rz"], [0.5, 0.0])
+    array([[1. , 0. , 0. , 0.5],
+           [0. , 1. , 0. , 0. ],
+           [0. , 0. , 1. , 0. ],
+           [0. , 0. , 0. , 1. ]])
     """
 def joint_transform_derivative(coordinates: typing.Any, q: typing.Any, i: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
     """
     dT/dq_i of joint_transform (4, 4).
+    
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> rf.joint_transform_derivative(["x", "rz"], [0.5, 0.0], 0)
+    array([[0., 0., 0., 1.],
+           [0., 0., 0., 0.],
+           [0., 0., 0., 0.],
+           [0., 0., 0., 0.]])
     """
 def joint_transform_second_derivative(coordinates: typing.Any, q: typing.Any, i: typing.Any, j: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
     """
     d2T/dq_i dq_j of joint_transform (4, 4).
+    
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> rf.joint_transform_second_derivative(["x", "rz"], [0.5, 0.0], 1, 1).round(3)
+    array([[-1.,  0.,  0.,  0.],
+           [ 0., -1.,  0.,  0.],
+           [ 0.,  0.,  0.,  0.],
+           [ 0.,  0.,  0.,  0.]])
     """
 def pseudo_inertia(mass: typing.Any, com: typing.Any, inertia: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[4, 4]"]:
     """
     Pseudo-inertia H = int r r^T dm (4, 4) of a body: mass (kg), centre of mass com (3,) m and
     inertia tensor (3, 3) about the centre of mass (kg m^2), all in the body frame.
+    
+    Examples
+    --------
+    >>> import numpy as np, rigidfem as rf
+    >>> rf.pseudo_inertia(2.0, [0.5, 0.0, 0.0], np.diag([0.01, 0.02, 0.02])).round(3)
+    array([[0.515, 0.   , 0.   , 1.   ],
+           [0.   , 0.005, 0.   , 0.   ],
+           [0.   , 0.   , 0.005, 0.   ],
+           [1.   , 0.   , 0.   , 2.   ]])
     """
 def skew(w: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[3, 3]"]:
     """
     Skew-symmetric S(w) with S(w) x = w x x. (3, 3).
+    
+    Examples
+    --------
+    >>> import rigidfem as rf
+    >>> rf.skew([1.0, 2.0, 3.0])
+    array([[ 0., -3.,  2.],
+           [ 3.,  0., -1.],
+           [-2.,  1.,  0.]])
+    >>> rf.skew([1.0, 2.0, 3.0]) @ [4.0, 5.0, 6.0]
+    array([-3.,  6., -3.])
     """
