@@ -490,7 +490,8 @@ class _System:
         --------
         >>> import rigidfem as rf
         >>> model = rf.Model()
-        >>> ball = model.add_body("ball", model.ground, rf.Joint.prismatic("z"), mass=0.1, inertia=(1e-5,) * 3)
+        >>> ball = model.add_body("ball", model.ground, rf.Joint.prismatic("z"), mass=0.1,
+        ...                       inertia=(1e-5,) * 3)
         >>> b = model.add_shape("sphere", ball, rf.shapes.Sphere(0.05))
         >>> floor = model.add_shape("floor", model.ground, rf.shapes.HalfSpace())
         >>> _ = model.add_contact("hit", b, floor, rf.laws.Contact(stiffness=1e5, restitution=0.8))
@@ -510,7 +511,8 @@ class _System:
         --------
         >>> import rigidfem as rf
         >>> model = rf.Model(gravity=None)
-        >>> block = model.add_body("block", model.ground, rf.Joint.prismatic("x"), mass=2.0, inertia=(1e-3,) * 3)
+        >>> block = model.add_body("block", model.ground, rf.Joint.prismatic("x"), mass=2.0,
+        ...                        inertia=(1e-3,) * 3)
         >>> _ = model.add_spring_damper("s", model.ground, block, stiffness=50.0, length=0.0, damping=1.0)
         >>> system = model.compile()
         >>> round(system.dissipated_power(0.0, [0.1], [1.0]), 4)
@@ -542,7 +544,8 @@ class _System:
         --------
         >>> import rigidfem as rf
         >>> model = rf.Model(gravity=None)
-        >>> block = model.add_body("block", model.ground, rf.Joint.prismatic("x"), mass=2.0, inertia=(1e-3,) * 3)
+        >>> block = model.add_body("block", model.ground, rf.Joint.prismatic("x"), mass=2.0,
+        ...                        inertia=(1e-3,) * 3)
         >>> _ = model.add_spring_damper("s", model.ground, block, stiffness=50.0, length=0.0, damping=1.0)
         >>> system = model.compile()
         >>> round(system.elastic_energy(0.0, [0.1]), 4)
@@ -557,7 +560,8 @@ class _System:
         --------
         >>> import rigidfem as rf
         >>> model = rf.Model(gravity=None)
-        >>> block = model.add_body("block", model.ground, rf.Joint.prismatic("x"), mass=2.0, inertia=(1e-3,) * 3)
+        >>> block = model.add_body("block", model.ground, rf.Joint.prismatic("x"), mass=2.0,
+        ...                        inertia=(1e-3,) * 3)
         >>> _ = model.add_spring_damper("s", model.ground, block, stiffness=50.0, length=0.0, damping=1.0)
         >>> system = model.compile()
         >>> system.element_names
