@@ -151,6 +151,8 @@ def test_an_animation_bounds_its_frames_before_computing_them():
     (lambda s, r: rf.view("system"), "system"),
     (lambda s, r: rf.view(s, "result"), "result"),
     (lambda s, r: rf.view(s, r, trails=["tip"]), "trails"),
+    (lambda s, r: rf.view(s, trails=[rf.Point(4, (0.3, 0.0, 0.0))]), "trails"),  # a body the system has not
+    (lambda s, r: rf.view(s, r, trails=[rf.Point(-2, (0.3, 0.0, 0.0))]), "trails"),
     (lambda s, r: rf.view(s, r, frames=0), "frames"),
     (lambda s, r: rf.view(s, q=[1.0, 2.0, 3.0, 4.0]), "q"),
     (lambda s, r: rf.view(s, r, q=np.zeros(s.nq)), "q"),

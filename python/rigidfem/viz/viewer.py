@@ -438,6 +438,10 @@ def _trail_points(trails, system) -> list:
                              f"trails[{k}]")
         _checks.same_model(p, system, "trails", "a sequence of Point or Body handles of the model this system was "
                                                 f"compiled from (trails[{k}])")
+        body = p.body if isinstance(p, Point) else p.index
+        if not -1 <= body < system.nbodies:
+            raise _checks.refuse(f"trails: expected points on the system's bodies (indices -1 for the ground to "
+                                 f"{system.nbodies - 1}), got body {body} at trails[{k}]")
     return items
 
 
