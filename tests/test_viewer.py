@@ -154,6 +154,7 @@ def test_an_animation_bounds_its_frames_before_computing_them():
     (lambda s, r: rf.view(s, trails=[rf.Point(4, (0.3, 0.0, 0.0))]), "trails"),  # a body the system has not
     (lambda s, r: rf.view(s, r, trails=[rf.Point(-2, (0.3, 0.0, 0.0))]), "trails"),
     (lambda s, r: rf.view(s, r, frames=0), "frames"),
+    (lambda s, r: rf.view(s, frames=10**30), "frames"),  # one state: judged as a result's frames would be
     (lambda s, r: rf.view(s, q=[1.0, 2.0, 3.0, 4.0]), "q"),
     (lambda s, r: rf.view(s, r, q=np.zeros(s.nq)), "q"),
     (lambda s, r: rf.view(s, r, height=10), "height"),

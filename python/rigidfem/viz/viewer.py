@@ -301,8 +301,8 @@ def _layers(system, result, q, t, mode, frames, amplitude):
     if result is None:
         qs = np.zeros(system.nq) if q is None else _checks.reals(q, (system.nq,), "q")
         t = _checks.scalar(t, "t")
-        if frames is not None:  # judged, though one state is one frame
-            _checks.integer(frames, "frames", minimum=1)
+        if frames is not None:  # judged as a result's would be, though one state is one frame
+            _checks.integer(frames, "frames", minimum=1, maximum=max(MAX_POSES // max(system.nbodies, 1), 1))
         return system, [{"system": system, "t": np.array([t]), "q": qs[None, :], "qd": None, "label": "state",
                          "what": "q"}], "state"
     if q is not None:
