@@ -58,10 +58,11 @@ void objective_outputs_vjp(const System& sys, const Data& d, const std::vector<O
 
 ParameterVjp::ParameterVjp(const System& sys, const std::vector<SensitivityParameter>& parameters)
     : sys_(sys), parameters_(parameters), touched_(parameters.size()), whole_(parameters.size(), false),
-      V_(sys.nbodies), inertia_rates_(parameters.size()), rated_(sys.nbodies, 0), Vl_(sys.nbodies), al_(sys.nbodies),
-      vl_(sys.nbodies), yl_(sys.nbodies),
+      V_(sys.nbodies),
       base_{std::vector<double>(sys.nbodies), std::vector<double>(sys.nc), std::vector<double>(sys.elements.size()),
-            std::vector<double>(sys.loads.size()), std::vector<double>()} {
+            std::vector<double>(sys.loads.size()), std::vector<double>()},
+      inertia_rates_(parameters.size()), rated_(sys.nbodies, 0), Vl_(sys.nbodies), al_(sys.nbodies),
+      vl_(sys.nbodies), yl_(sys.nbodies) {
   for (std::size_t j = 0; j < parameters_.size(); ++j) {
     for (const auto& X : {parameters_[j].plus, parameters_[j].minus}) {
       if (!X) continue;

@@ -9,7 +9,20 @@
 
 namespace rigidfem {
 
+// (In a named namespace: ResidualTranspose::Prepared, declared in a header, holds them; see LoadTerms.)
+namespace detail {
+
+struct BodyLoad {
+  int body;
+  bool follower;
+  AppliedLoad load;
+};
+
+}  // namespace detail
+
 namespace {
+
+using detail::BodyLoad;
 
 // δI x for δI = s ×* I − I s ×m (the inertia turned by the twist s), without forming δI.
 Vec6 turned_inertia_times(const Vec6& s, const Mat6& I, const Vec6& x) { return crossf(s, I * x) - I * crossm(s, x); }
@@ -27,11 +40,6 @@ struct Tangent {
 };
 
 // A load on a body (the load's own point moving with it: the geometric term of the tangent).
-struct BodyLoad {
-  int body;
-  bool follower;
-  AppliedLoad load;
-};
 
 // δ(r, ṙ) of a point x (global) of body b along the direction of the tangent w: a point of a body carried by
 // the twist W_b moves by δx = W_v + W_ω × x, and its velocity ṙ = v_O + ω × x changes by δv_O + δω × x + ω × δx.
@@ -139,6 +147,11 @@ void loads_tangent(const std::vector<BodyLoad>& loads, Tangent& w) {
   }
 }
 
+}  // namespace
+
+// (Outside the anonymous namespace: ResidualTranspose::Prepared, declared in a header, keeps one.)
+namespace detail {
+
 // The loads, element states and flowing rfes' terms at the state of d (after the RNEA): what the tangents of
 // the loads' and elements' forces start from.
 struct LoadTerms {
@@ -171,6 +184,12 @@ struct LoadTerms {
     for (const FlowTerm& f : flows) flow_tangent(f, w);
   }
 };
+
+}  // namespace detail
+
+namespace {
+
+using detail::LoadTerms;
 
 // Column ∂r/∂q_j (position) or ∂r/∂q̇_j (rate) for the coordinate j with use uj on body bj,
 // into col (nq). Only the bodies carried by q_j (bj and its subtree) have tangents:

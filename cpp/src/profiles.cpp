@@ -21,9 +21,9 @@ void require_duration(double duration) {
     throw std::invalid_argument("duration: expected a positive time in s, got " + num(duration));
 }
 
-class Constant final : public Profile {
+class ConstantProfile final : public Profile {
  public:
-  explicit Constant(double v) : v_(v) {}
+  explicit ConstantProfile(double v) : v_(v) {}
   MotionState at(double) const override { return {v_, 0.0, 0.0}; }
   std::string describe() const override { return "constant(" + std::to_string(v_) + ")"; }
   ProfileRecipe recipe() const override { return {"constant_profile", {v_}}; }
@@ -208,7 +208,7 @@ class Spline final : public Profile {
 
 /// A normalised point-to-point law s(τ) on τ ∈ [0, 1], s(0) = 0, s(1) = 1, symmetric (s(τ) + s(1 − τ) = 1),
 /// with s', s'' and S(τ) = ∫₀^τ s (S(1) = 1/2).
-struct Law {
+struct MotionLaw {
   enum class Kind { Quintic, Cycloidal, Trapezoidal } kind;
   double f = 0.0;  // trapezoidal: the fraction of T spent accelerating (and decelerating), 0 < f ≤ 1/2; else 0
 
@@ -265,13 +265,13 @@ const char* law_names() {
   return names.c_str();
 }
 
-Law make_law(const std::string& name, double fraction) {
+MotionLaw make_law(const std::string& name, double fraction) {
   const auto& names = point_to_point_laws();
   const auto k = std::find(names.begin(), names.end(), name) - names.begin();
   if (k == static_cast<long>(names.size()))
     throw std::invalid_argument(std::string("law: expected ") + law_names() + ", got '" + name + "'");
-  const Law::Kind kind = static_cast<Law::Kind>(k);
-  if (kind != Law::Kind::Trapezoidal) return {kind, 0.0};
+  const MotionLaw::Kind kind = static_cast<MotionLaw::Kind>(k);
+  if (kind != MotionLaw::Kind::Trapezoidal) return {kind, 0.0};
   if (!(fraction > 0.0 && fraction <= 0.5))
     throw std::invalid_argument("fraction: expected the share of the duration spent accelerating, in (0, 0.5], got " +
                                 num(fraction));
@@ -280,7 +280,7 @@ Law make_law(const std::string& name, double fraction) {
 
 class RestToRest final : public Profile {
  public:
-  RestToRest(Law law, double q0, double q1, double t0, double T) : law_(law), q0_(q0), q1_(q1), t0_(t0), T_(T) {}
+  RestToRest(MotionLaw law, double q0, double q1, double t0, double T) : law_(law), q0_(q0), q1_(q1), t0_(t0), T_(T) {}
   MotionState at(double t) const override {
     const double tau = (t - t0_) / T_, d = q1_ - q0_;
     if (!(tau > 0.0)) return {q0_, 0.0, 0.0};  // also NaN: at rest
@@ -296,13 +296,13 @@ class RestToRest final : public Profile {
   ProfileRecipe recipe() const override { return {"rest_to_rest_profile", {law_.name(), q0_, q1_, t0_, T_, law_.f}}; }
 
  private:
-  Law law_;
+  MotionLaw law_;
   double q0_, q1_, t0_, T_;
 };
 
 class Ramp final : public Profile {
  public:
-  Ramp(Law law, double rate, double t0, double T, double start) : law_(law), v_(rate), t0_(t0), T_(T), q0_(start) {}
+  Ramp(MotionLaw law, double rate, double t0, double T, double start) : law_(law), v_(rate), t0_(t0), T_(T), q0_(start) {}
   MotionState at(double t) const override {
     const double tau = (t - t0_) / T_;
     if (!(tau > 0.0)) return {q0_, 0.0, 0.0};
@@ -320,7 +320,7 @@ class Ramp final : public Profile {
   }
 
  private:
-  Law law_;
+  MotionLaw law_;
   double v_, t0_, T_, q0_;
 };
 
@@ -412,7 +412,7 @@ class Callback final : public Profile {
 
 ProfilePtr constant_profile(double value) {
   require_finite(value, "value");
-  return std::make_shared<Constant>(value);
+  return std::make_shared<ConstantProfile>(value);
 }
 
 ProfilePtr polynomial_profile(const std::vector<double>& coefficients) {
@@ -468,7 +468,7 @@ ProfilePtr spline_profile(const std::vector<double>& t, const std::vector<double
 
 ProfilePtr rest_to_rest_profile(const std::string& law, double start, double end, double t0, double duration,
                                 double fraction) {
-  const Law l = make_law(law, fraction);
+  const MotionLaw l = make_law(law, fraction);
   require_finite(start, "start");
   require_finite(end, "end");
   require_finite(t0, "t0");
@@ -478,7 +478,7 @@ ProfilePtr rest_to_rest_profile(const std::string& law, double start, double end
 
 ProfilePtr ramp_profile(const std::string& law, double rate, double t0, double duration, double start,
                         double fraction) {
-  const Law l = make_law(law, fraction);
+  const MotionLaw l = make_law(law, fraction);
   require_finite(rate, "rate");
   require_finite(t0, "t0");
   require_finite(start, "start");
@@ -552,7 +552,7 @@ ProfilePtr callback_profile(std::function<MotionState(double)> f) {
 }
 
 const std::vector<std::string>& point_to_point_laws() {
-  static const std::vector<std::string> names{"quintic", "cycloidal", "trapezoidal"};  // the order of Law::Kind
+  static const std::vector<std::string> names{"quintic", "cycloidal", "trapezoidal"};  // the order of MotionLaw::Kind
   return names;
 }
 
