@@ -41,7 +41,13 @@ copyright = "2026, the rigidfem developers"  # noqa: A001 (Sphinx's name)
 release = rigidfem.__version__
 
 extensions = ["myst_nb", "sphinx.ext.autodoc", "sphinx.ext.autosummary", "sphinx.ext.napoleon",
-              "sphinx.ext.mathjax", "sphinx-mathjax-offline", "sphinx_copybutton", "apilinks"]
+              "sphinx.ext.mathjax", "sphinx-mathjax-offline", "sphinx_copybutton", "apilinks",
+              "matplotlib.sphinxext.plot_directive"]
+# The guides' plots: the code of each {plot} block runs when the site is built and its figures are embedded
+plot_include_source = True
+plot_html_show_source_link = False
+plot_html_show_formats = False
+plot_formats = [("png", 100)]
 mathjax_path = "mathjax/tex-chtml.js"  # in _static, copied there by sphinx-mathjax-offline (no CDN)
 # A copy button on every code block (its script and icons in _static); prompts and doctest outputs are not copied
 copybutton_prompt_text = r">>> |\.\.\. |\$ "

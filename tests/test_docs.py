@@ -212,6 +212,21 @@ def test_the_method_page_shows_the_rfe_figure_drawn_by_the_build(site):
     assert not [f for f in committed if f.endswith((".png", ".jpg", ".svg", ".gif"))]
 
 
+@pytest.mark.parametrize("page, count", [("simulation.html", 1), ("verification.html", 1)])
+def test_the_guides_plots_are_drawn_by_the_build(site, page, count):
+    """The guides' {plot} blocks run when the site is built (matplotlib's plot directive): each page shows its
+    figures, PNGs made by the build whose pixels vary (not blank), beside the code that drew them."""
+    article = _article(site / page)
+    images = re.findall(r'<img[^>]*src="([^"]*plot_directive[^"]*\.png|_images/[^"]*-\d+\.png)"', article)
+    assert len(images) >= count, images
+    import matplotlib.image
+
+    for src in images:
+        pixels = matplotlib.image.imread(site / src)
+        assert pixels.shape[1] > 400 and pixels[..., :3].std() > 0.05, (src, pixels.shape)
+    assert "rf.plots." in text(site / page) or "modal_analysis" in text(site / page)
+
+
 def _article(path: Path) -> str:
     page = path.read_text(encoding="utf-8")
     return page[page.find("<article"):page.find("</article>")]
