@@ -35,11 +35,13 @@ def main(argv=None) -> int:
     sub = parser.add_subparsers(dest="command", required=True)
     for name, text in COMMANDS.items():
         p = sub.add_parser(name, help=text, description=text)
-        p.add_argument("--output", default="bench", help="folder for the CSV tables (default bench)")
+        p.add_argument("--output", default="bench", help="folder for the tables, CSV and a markdown page each (default bench; docs/benchmarks: the site's pages)")
         p.add_argument("--quick", action="store_true", help="a few small sizes and settings (a smoke run)")
     args = parser.parse_args(argv)
     try:
         module = importlib.import_module(f"{__package__ or 'benchmarks'}.{args.command}")
+        common = importlib.import_module(f"{__package__ or 'benchmarks'}._common")
+        common.start("python -m benchmarks " + " ".join(argv if argv is not None else sys.argv[1:]))
         module.run(args.output, quick=args.quick)
     except ImportError as e:  # a peer code (or rigidfem) not installed: say what to install
         parser.exit(1, f"{parser.prog} {args.command}: {e}\n")

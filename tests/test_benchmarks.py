@@ -42,6 +42,33 @@ def test_runner_writes_and_prints_the_scaling_tables(tmp_path, capsys):
     assert "machine:" in out and "| m | nq | recursive_s |" in out and "| m | nq | spring_s_per_step |" in out
 
 
+def test_runner_writes_each_table_as_a_page_with_its_provenance(tmp_path):
+    """Each table is also a markdown page (title, command, date, processor, versions, load at start and end, the
+    table, the CSV linked): what docs/benchmarks/ holds for the site."""
+    import rigidfem as rf
+
+    assert main(["scaling", "--quick", "--output", str(tmp_path)]) == 0
+    page = (tmp_path / "dynamics_scaling.md").read_text(encoding="utf-8")
+    assert page.startswith("# ") and "`python -m benchmarks scaling --quick --output" in page
+    assert f"rigidfem {rf.__version__}" in page and "load average" in page and "at the end" in page
+    assert "[dynamics_scaling.csv](dynamics_scaling.csv)" in page
+    with open(tmp_path / "dynamics_scaling.csv") as f:
+        rows = list(csv.DictReader(f))
+    table = [line for line in page.splitlines() if line.startswith("| ")]
+    assert len(table) == 1 + len(rows) and table[0].startswith("| m | nq | recursive_s |")
+
+
+def test_the_sites_benchmark_pages_are_written_by_the_benchmarks():
+    """docs/benchmarks/: every page besides the index is a benchmark's output, with its CSV beside it."""
+    folder = Path(__file__).resolve().parents[1] / "docs" / "benchmarks"
+    pages = sorted(p for p in folder.glob("*.md") if p.name != "index.md")
+    assert pages
+    for page in pages:
+        text = page.read_text(encoding="utf-8")
+        assert "Written by `python -m benchmarks " in text and " UTC: " in text, page.name
+        assert (folder / f"{page.stem}.csv").exists(), page.name
+
+
 @pytest.mark.filterwarnings("ignore")  # a LocalCluster's start-up notices (ports, dashboards)
 def test_sweep_scaling_table():
     """The sweep benchmark's structure: four executors, all giving the serial results (asserted
