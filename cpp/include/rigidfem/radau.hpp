@@ -3,7 +3,6 @@
 #pragma once
 
 #include <cmath>
-#include <complex>
 
 #include "rigidfem/system.hpp"
 
@@ -23,21 +22,19 @@ struct RadauTableau {
         (296 + 169 * r6) / 1800, (88 + 7 * r6) / 360, (-2 - 3 * r6) / 225,   //
         (16 - r6) / 36, (16 + r6) / 36, 1.0 / 9;
     dd << -(13 + 7 * r6) / 3, (-13 + 7 * r6) / 3, -1.0 / 3;
-    // The eigenvalues of a in closed form (Hairer & Wanner IV.8, radau5.f): one real, u = (6 + ∛81 − ∛9)/30, and
-    // α ± iβ with α = (12 − ∛81 + ∛9)/60, β = √3 (∛81 + ∛9)/60. (An EigenSolver here would cost each file that
-    // includes this header seconds of compile time.)
-    const double c81 = std::cbrt(81.0), c9 = std::cbrt(9.0);
-    d << (6 + c81 - c9) / 30, std::complex<double>((12 - c81 + c9) / 60, std::sqrt(3.0) * (c81 + c9) / 60), 0;
-    d(2) = std::conj(d(1));
-    // Each eigenvector spans the null space of a − λI (rank 2): v = r₀ × r₁ of two of its rows, unconjugated
-    // (r₀ · v = r₁ · v = 0; Eigen's cross() conjugates complex results).
-    for (int k = 0; k < 2; ++k) {
-      const Eigen::Matrix3cd m = a.cast<std::complex<double>>() - d(k) * Eigen::Matrix3cd::Identity();
-      const Eigen::Vector3cd v(m(0, 1) * m(1, 2) - m(0, 2) * m(1, 1), m(0, 2) * m(1, 0) - m(0, 0) * m(1, 2),
-                               m(0, 0) * m(1, 1) - m(0, 1) * m(1, 0));
-      P.col(k) = v / v.norm();
-    }
-    P.col(2) = P.col(1).conjugate();
+    // (An EigenSolver: about 7 s of compile time in each translation unit that includes this header, which the
+    // build keeps to one, the adjoint's group. A closed form with eigenvectors of another complex phase, equal in
+    // exact arithmetic, made radau5's sensitivities to a mass fail on a planar chain (tests/fuzz_corpus).)
+    Eigen::EigenSolver<Eigen::Matrix3d> es(a);
+    Eigen::Vector3cd ev = es.eigenvalues();
+    Eigen::Matrix3cd V = es.eigenvectors();
+    int real = 0;
+    for (int k = 1; k < 3; ++k)
+      if (std::abs(ev(k).imag()) < std::abs(ev(real).imag())) real = k;
+    const int up = ev((real + 1) % 3).imag() > 0 ? (real + 1) % 3 : (real + 2) % 3, down = 3 - real - up;
+    const int order[3] = {real, up, down};
+    for (int k = 0; k < 3; ++k) d(k) = ev(order[k]), P.col(k) = V.col(order[k]);
+    d(0) = d(0).real();
     Pinv = P.inverse();
   }
 };
