@@ -3,6 +3,7 @@
 #pragma once
 
 #include <cmath>
+#include <complex>
 
 #include "rigidfem/system.hpp"
 
@@ -22,19 +23,19 @@ struct RadauTableau {
         (296 + 169 * r6) / 1800, (88 + 7 * r6) / 360, (-2 - 3 * r6) / 225,   //
         (16 - r6) / 36, (16 + r6) / 36, 1.0 / 9;
     dd << -(13 + 7 * r6) / 3, (-13 + 7 * r6) / 3, -1.0 / 3;
-    // (An EigenSolver: about 7 s of compile time in each translation unit that includes this header, which the
-    // build keeps to one, the adjoint's group. A closed form with eigenvectors of another complex phase, equal in
-    // exact arithmetic, made radau5's sensitivities to a mass fail on a planar chain (tests/fuzz_corpus).)
-    Eigen::EigenSolver<Eigen::Matrix3d> es(a);
-    Eigen::Vector3cd ev = es.eigenvalues();
-    Eigen::Matrix3cd V = es.eigenvectors();
-    int real = 0;
-    for (int k = 1; k < 3; ++k)
-      if (std::abs(ev(k).imag()) < std::abs(ev(real).imag())) real = k;
-    const int up = ev((real + 1) % 3).imag() > 0 ? (real + 1) % 3 : (real + 2) % 3, down = 3 - real - up;
-    const int order[3] = {real, up, down};
-    for (int k = 0; k < 3; ++k) d(k) = ev(order[k]), P.col(k) = V.col(order[k]);
-    d(0) = d(0).real();
+    // d and P are the eigenvalues and unit eigenvectors of a as Eigen 3.4's EigenSolver<Matrix3d> gives them,
+    // ordered (real, Im > 0, Im < 0) and written to 17 digits (round trip): the solver cost each file including
+    // this header about 7 s of compile time. Their complex phase is the solver's on purpose: eigenvectors of
+    // another phase, equal in exact arithmetic, made radau5's sensitivity to a mass fail on a planar chain whose
+    // sensitivity is exactly zero (tests/fuzz_corpus/rejected_valid_rf_simulate_valueerror_qdd.json).
+    using C = std::complex<double>;
+    d << 0.2748888295956774, C(0.16255558520216135, 0.18494932440714107), C(0.16255558520216135, -0.18494932440714107);
+    P << 0.091232394870892949, C(0.019609325891978956, -0.12985650041870567),
+        C(0.019609325891978956, 0.12985650041870567),  //
+        0.24171793270710715, C(-0.33657437071791418, 0.20604780684206114),
+        C(-0.33657437071791418, -0.20604780684206114),  //
+        0.96604818261509295, C(0.054163279153804665, 0.90778912589862681),
+        C(0.054163279153804665, -0.90778912589862681);
     Pinv = P.inverse();
   }
 };
