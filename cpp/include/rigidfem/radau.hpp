@@ -3,7 +3,6 @@
 #pragma once
 
 #include <cmath>
-#include <complex>
 
 #include "rigidfem/system.hpp"
 
@@ -16,28 +15,7 @@ struct RadauTableau {
   Eigen::Vector3d c, dd;       // dd: the estimate's weights on the stage increments (Y_i − y_n)/h
   Eigen::Matrix3cd P, Pinv;    // a = P diag(d) P⁻¹
   Eigen::Vector3cd d;          // d(0) real, d(2) = conj d(1), Im d(1) > 0
-  RadauTableau() {
-    const double r6 = std::sqrt(6.0);
-    c << (4 - r6) / 10, (4 + r6) / 10, 1;
-    a << (88 - 7 * r6) / 360, (296 - 169 * r6) / 1800, (-2 + 3 * r6) / 225,  //
-        (296 + 169 * r6) / 1800, (88 + 7 * r6) / 360, (-2 - 3 * r6) / 225,   //
-        (16 - r6) / 36, (16 + r6) / 36, 1.0 / 9;
-    dd << -(13 + 7 * r6) / 3, (-13 + 7 * r6) / 3, -1.0 / 3;
-    // d and P are the eigenvalues and unit eigenvectors of a as Eigen 3.4's EigenSolver<Matrix3d> gives them,
-    // ordered (real, Im > 0, Im < 0) and written to 17 digits (round trip): the solver cost each file including
-    // this header about 7 s of compile time. Their complex phase is the solver's on purpose: eigenvectors of
-    // another phase, equal in exact arithmetic, made radau5's sensitivity to a mass fail on a planar chain whose
-    // sensitivity is exactly zero (tests/fuzz_corpus/rejected_valid_rf_simulate_valueerror_qdd.json).
-    using C = std::complex<double>;
-    d << 0.2748888295956774, C(0.16255558520216135, 0.18494932440714107), C(0.16255558520216135, -0.18494932440714107);
-    P << 0.091232394870892949, C(0.019609325891978956, -0.12985650041870567),
-        C(0.019609325891978956, 0.12985650041870567),  //
-        0.24171793270710715, C(-0.33657437071791418, 0.20604780684206114),
-        C(-0.33657437071791418, -0.20604780684206114),  //
-        0.96604818261509295, C(0.054163279153804665, 0.90778912589862681),
-        C(0.054163279153804665, -0.90778912589862681);
-    Pinv = P.inverse();
-  }
+  RadauTableau();  // radau.cpp: d and P by an EigenSolver, compiled in that file alone
 };
 
 /// What a radau5 stepper shows besides the Stepper interface.
