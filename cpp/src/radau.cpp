@@ -1,31 +1,40 @@
-/// Radau IIA's tableau (radau.hpp). The eigen-decomposition a = P diag(d) P⁻¹ is computed by Eigen's
-/// EigenSolver, in this file alone: the solver costs about 7 s of compile time in each translation unit that
-/// instantiates it. (Written as constants, or in closed form with eigenvectors of another complex phase, the
-/// same decomposition changed radau5's runs: a sensitivity that is exactly zero failed, tests/fuzz_corpus.)
+/// Radau IIA's tableau (radau.hpp): c and a from √6, and the eigen-decomposition a = P diag(d) P⁻¹ as constants.
+/// The decomposition's numbers are the bits that Eigen's EigenSolver<Matrix3d> and P.inverse() computed for this a
+/// in this library, written as hexadecimal literals (exact). The solver cost 7 s of compile time; every other way of
+/// writing the same decomposition (a closed form, eigenvectors in another complex phase, decimal digits from a
+/// standalone program's solver) changed the last bits of radau5's runs. tests/test_higher_order.py reads these
+/// literals and checks P diag(d) P⁻¹ = a and P P⁻¹ = I to round-off.
 #include "rigidfem/radau.hpp"
 
 #include <cmath>
+#include <complex>
 
 namespace rigidfem {
 
 RadauTableau::RadauTableau() {
+  using C = std::complex<double>;
   const double r6 = std::sqrt(6.0);
   c << (4 - r6) / 10, (4 + r6) / 10, 1;
   a << (88 - 7 * r6) / 360, (296 - 169 * r6) / 1800, (-2 + 3 * r6) / 225,  //
       (296 + 169 * r6) / 1800, (88 + 7 * r6) / 360, (-2 - 3 * r6) / 225,   //
       (16 - r6) / 36, (16 + r6) / 36, 1.0 / 9;
   dd << -(13 + 7 * r6) / 3, (-13 + 7 * r6) / 3, -1.0 / 3;
-  Eigen::EigenSolver<Eigen::Matrix3d> es(a);
-  Eigen::Vector3cd ev = es.eigenvalues();
-  Eigen::Matrix3cd V = es.eigenvectors();
-  int real = 0;
-  for (int k = 1; k < 3; ++k)
-    if (std::abs(ev(k).imag()) < std::abs(ev(real).imag())) real = k;
-  const int up = ev((real + 1) % 3).imag() > 0 ? (real + 1) % 3 : (real + 2) % 3, down = 3 - real - up;
-  const int order[3] = {real, up, down};
-  for (int k = 0; k < 3; ++k) d(k) = ev(order[k]), P.col(k) = V.col(order[k]);
-  d(0) = d(0).real();
-  Pinv = P.inverse();
+  // d: the real eigenvalue, then the complex pair with Im d(1) > 0; P's columns their eigenvectors (row by row)
+  d << C(0x1.197c751498bb2p-2, 0x0p+0),
+      C(0x1.4ce9f151cdab6p-3, 0x1.7ac6b61df7bccp-3),
+      C(0x1.4ce9f151cdab6p-3, -0x1.7ac6b61df7bccp-3);
+  P << C(0x1.75b01984e65f7p-4, 0x0p+0), C(0x1.41477959c51c3p-6, -0x1.09f23473c553cp-3),
+      C(0x1.41477959c51c3p-6, 0x1.09f23473c553cp-3),
+      C(0x1.ef09cfbeab873p-3, 0x0p+0), C(-0x1.58a6f3ab9ef26p-2, 0x1.a5fc647e64b74p-3),
+      C(-0x1.58a6f3ab9ef26p-2, -0x1.a5fc647e64b74p-3),
+      C(0x1.ee9dde0d6255bp-1, 0x0p+0), C(0x1.bbb4a11382bdbp-5, 0x1.d0c9bc7ecc4d8p-1),
+      C(0x1.bbb4a11382bdbp-5, -0x1.d0c9bc7ecc4d8p-1);
+  Pinv << C(0x1.14d64d09039e1p+2, 0x0p+0), C(0x1.5b570c75819bp-2, 0x0p+0),
+      C(0x1.1562f2bdebf4p-1, 0x0p+0),
+      C(0x1.1cfe2989c69b4p-3, 0x1.27aa99a27bcdep+1), C(-0x1.6c1b6ff2f4c66p+0, 0x1.87abc1224b8e4p-4),
+      C(0x1.5ef5dc29e1be4p-2, -0x1.efc22e02839a4p-3),
+      C(0x1.1cfe2989c69b4p-3, -0x1.27aa99a27bcdep+1), C(-0x1.6c1b6ff2f4c66p+0, -0x1.87abc1224b8e4p-4),
+      C(0x1.5ef5dc29e1be4p-2, 0x1.efc22e02839a4p-3);
 }
 
 }  // namespace rigidfem

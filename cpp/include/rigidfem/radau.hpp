@@ -15,7 +15,7 @@ struct RadauTableau {
   Eigen::Vector3d c, dd;       // dd: the estimate's weights on the stage increments (Y_i − y_n)/h
   Eigen::Matrix3cd P, Pinv;    // a = P diag(d) P⁻¹
   Eigen::Vector3cd d;          // d(0) real, d(2) = conj d(1), Im d(1) > 0
-  RadauTableau();  // radau.cpp: d and P by an EigenSolver, compiled in that file alone
+  RadauTableau();  // radau.cpp: d, P and P⁻¹ as constants
 };
 
 /// What a radau5 stepper shows besides the Stepper interface.
