@@ -155,6 +155,25 @@ def test_a_tight_newton_tol_converges_on_a_redundant_loop():
     assert r.t[-1] == pytest.approx(0.05) and r.stats["newton_iterations"] <= 8 * r.stats["steps"]
 
 
+def test_generalized_alpha_at_the_default_newton_tol_converges_on_a_redundant_loop():
+    """The Bricard linkage over 4 s at the default newton_tol: the error falls about 4-fold per halving of h.
+    Newton's iterations there contract slowly with a tangent kept from an earlier step (θ ≥ 1/2); taken for
+    round-off and stopped at newton_tol (1 + |q̇|), they left errors that grew as h shrank (measured 1.6e-5,
+    5.7e-6, 1.6e-5 rad at h = 1.56, 0.78, 0.39 ms, against 1.8e-5, 4.4e-6, 1.1e-6 at newton_tol = 1e-13)."""
+    sys.path.insert(0, str(Path(__file__).resolve().parents[1]))  # the checkout's benchmarks/
+    from benchmarks.loop_peers import bricard
+
+    scene = bricard()
+    t = np.linspace(0.0, 4.0, 81)
+    ref = rf.simulate(scene.system, 4.0, method="dopri5", q0=scene.q0, rtol=1e-12, atol=1e-14, t_eval=t)
+    errors = []
+    for h in (1.5625e-3, 7.8125e-4, 3.90625e-4):
+        r = rf.simulate(scene.system, 4.0, method="generalized_alpha", q0=scene.q0, dt=h, t_eval=t)
+        errors.append(np.abs(r.q - ref.q).max())
+    ratios = np.array(errors[:-1]) / np.array(errors[1:])
+    assert np.all(ratios > 3.0), (errors, ratios)
+
+
 def test_redundant_loop_gives_the_tree_motion_and_newton_euler_reactions():
     """A rod (m = 2 kg, L = 1 m) as a pendulum about z: once as a tree (revolute on the ground),
     once as a free body closed to the ground by a revolute loop (5 rows, none redundant) and once

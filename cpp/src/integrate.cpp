@@ -580,7 +580,7 @@ const std::vector<OptionInfo>& integrator_options() {
        [](const O& o) { return OptionValue(o.rho_inf); }, [](O& o, V v) { o.rho_inf = real(v); }},
       {"newton_tol", OptionType::Real, "1", "a positive finite tolerance",
        "Newton stops when the increments of q and q̇ fall below newton_tol (1 + |q|); the Newmark family also holds "
-       "them to 0.03 of the step's local error estimate e_q (q̇'s to 0.03 e_q/√(h T), T the run's length), down to "
+       "them to 0.03 of the step's local error estimate e_q (q̇'s to 0.03 e_q/T, T the run's length), down to "
        "1e-3 newton_tol (1 + |q|) and at least 500 ε (1 + |q|), so that small steps keep the method's order; adaptive "
        "esdirk43 and radau5 runs stop it at 0.03 of the error weights instead.",
        false, [](const O& o) { return OptionValue(o.newton_tol); }, [](O& o, V v) { o.newton_tol = real(v); }},

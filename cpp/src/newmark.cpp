@@ -217,15 +217,17 @@ class NewmarkFamily final : public NewmarkStepper {
   /// Newton's stopping test on the errors it leaves in q and q̇ (dq, dv): below newton_tol (1 + |q|),
   /// newton_tol (1 + |q̇|), and, over a run of known span T, below κ = 0.03 of the step's own local error
   /// estimate e_q = h² |β − 1/6| |a_{n+1} − a_n| (as adaptive radau5 and esdirk43 hold Newton to a
-  /// fraction of their error weights): dq ≤ κ e_q and dv ≤ κ e_q / √(h T), each down to 1e-3 of the
-  /// first bounds and not below 500 ε (1 + |q|). An error dv in q̇ moves q by up to dv T by the end; the
-  /// T/h steps' errors, of either sign, add up as √(T/h), so that what Newton leaves stays κ of the
-  /// steps' own errors. Held to newton_tol (1 + |q̇|) alone, it grew as h shrank: Bricard linkage over
-  /// 1 s, 6.4e-8 at h = 62.5 µs and 2.0e-7 at 15.6 µs, where the method's own error is 3e-9. Newton
-  /// iterations a step on Kane's beam in 3D (40 elements, 20 s) at h = 2 / 0.5 ms: 3.00 / 2.92 before,
-  /// 3.47 / 3.38 now, 3.86 / 3.38 held to κ e_q / T (every step's error of one sign), for the same tip to
-  /// nine digits. Where the iterations stall (θ ≥ 1/2: round-off) within the first bounds, they are
-  /// converged as far as the arithmetic goes.
+  /// fraction of their error weights): dq ≤ κ e_q and dv ≤ κ e_q / T, each down to 1e-3 of the first
+  /// bounds and not below 500 ε (1 + |q|). An error dv in q̇ moves q by up to dv T by the end, so that
+  /// what the T/h steps leave adds up to at most κ of their own errors even where every step's is of one
+  /// sign. Held to newton_tol (1 + |q̇|) alone, it grew as h shrank: Bricard linkage over 1 s, 6.4e-8 at
+  /// h = 62.5 µs and 2.0e-7 at 15.6 µs, where the method's own error is 3e-9. Held to κ e_q / √(h T)
+  /// (errors of either sign adding up as √(T/h)), it grew too, the Bricard's being of one sign: over 4 s
+  /// 1.6e-5, 5.7e-6, 1.6e-5 rad at h = 1.56, 0.78, 0.39 ms, against 1.6e-5, 3.9e-6, 9.8e-7 with κ e_q / T
+  /// (4.35 and 4.49 Newton iterations a step at 0.39 ms). Newton iterations a step on Kane's beam in 3D
+  /// (40 elements, 20 s) at h = 2 / 0.5 ms: 3.00 / 2.92 held to newton_tol alone, 3.47 / 3.38 to
+  /// κ e_q / √(h T), 3.86 / 3.38 to κ e_q / T, for the same tip to nine digits. Where the iterations stall
+  /// (θ ≥ 1/2: round-off) within the first bounds, they are converged as far as the arithmetic goes.
   bool converged(double dq, double dv, double theta, double h, const NewmarkState& s, const NewmarkState& s1) const {
     constexpr double kappa = 0.03;
     const double q_scale = tol_ * (1.0 + max_abs(s1.q)), v_scale = tol_ * (1.0 + max_abs(s1.v));
@@ -234,7 +236,7 @@ class NewmarkFamily final : public NewmarkStepper {
     // the floor: 1e-3 of the first bounds, not below 500 ε (1 + |q|), which round-off reaches
     const double local = kappa * h * h * std::abs(beta_ - 1.0 / 6.0) * (s1.a - s.a).lpNorm<Eigen::Infinity>();
     const double floor = std::max(1e-3, 500.0 * std::numeric_limits<double>::epsilon() / tol_);
-    return dq <= std::max(local, floor * q_scale) && dv <= std::max(local / std::sqrt(h * span_), floor * v_scale);
+    return dq <= std::max(local, floor * q_scale) && dv <= std::max(local / span_, floor * v_scale);
   }
 
   void update(double h, const NewmarkState& s, NewmarkState& s1) const {
