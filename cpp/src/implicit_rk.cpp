@@ -739,13 +739,19 @@ class Radau5 final : public ImplicitRk, public RadauAccess {
   /// δV = δq̇_n 1ᵀ + h δA aᵀ, δQ = δq_n 1ᵀ + h δV aᵀ solving each stage's differentiated equations
   ///   R_i = K δQ_i + C δV_i + M δA_i − ∂(G_iᵀλ_i)/∂q δQ_i − G_iᵀ δλ_i + ∂r/∂p = 0   (loops: G_i δA_i = D(γ_i − G_i A_i))
   /// by simplified Newton with the step's matrix (solve_stages and, with loops, close_loops_correction), until
-  /// the corrections move δQ and δV by less than 1e-9 of them or stall at the differences' noise (1e-6 of δA).
-  /// False when they do not converge (the step is then retried as after Newton's failure: with a fresh tangent,
-  /// then shorter).
+  /// the corrections move δQ and δV by less than 1e-9 of them, stall at the differences' noise (1e-6 of δA), or
+  /// fall below the round-off of ∂r/∂p's difference (a sensitivity that is exactly zero, such as a freely falling
+  /// body's to its mass, converges to that round-off, where neither relative test passes). False when they do not
+  /// converge (the step is then retried as after Newton's failure: with a fresh tangent, then shorter).
   bool stage_sensitivities(double t, double h) {
     const int P = sens_->count(), nl = sys_.nl;
     Sq1_.resize(n_, P), Sv1_.resize(n_, P), Sa1_.resize(n_, P);
     const MatX A = A_, V = V_, Q = Q_, L = L_;  // the converged stages (the loop correction below reuses L_, D_)
+    // ∂r/∂p's difference carries about ε |f| / h_p (difference_noise), which S₁⁻¹ carries into δA: 64 ε S₁⁻¹|f|
+    // per unit of 1/h_p is as close as the corrections can come
+    VecX noise(n_);
+    matrix_->solve(sens_->force_sizes(t + h, Q.col(2), V.col(2)), noise);
+    const double round_off = 64.0 * std::numeric_limits<double>::epsilon() * max_abs(noise);
     if (nl > 0)
       for (int i = 0; i < 3; ++i) loop_equations(sys_, d_, t + tab_.c(i) * h, Q.col(i), V.col(i)), G_[i] = free_jacobian(sys_, d_);
     MatX dA(n_, 3), dV(n_, 3), dQ(n_, 3), R(n_, 3), dL = MatX::Zero(nl, 3);
@@ -753,6 +759,7 @@ class Radau5 final : public ImplicitRk, public RadauAccess {
       dA.colwise() = VecX(Sa_.col(j));
       dL.setZero();
       double previous = 0.0, free = 0.0;  // free: the largest correction before the loops' part
+      const double floor = round_off * sens_->difference_noise(j);
       for (int it = 0;; ++it) {
         interruption_point();
         dV.noalias() = h * dA * tab_.a.transpose();
@@ -786,7 +793,8 @@ class Radau5 final : public ImplicitRk, public RadauAccess {
         const MatX incV = h * D_ * tab_.a.transpose(), incQ = h * incV * tab_.a.transpose();
         if ((incQ.cwiseAbs().maxCoeff() <= 1e-9 * dQ.cwiseAbs().maxCoeff() &&
              incV.cwiseAbs().maxCoeff() <= 1e-9 * dV.cwiseAbs().maxCoeff()) ||
-            (nl > 0 && change <= 1e-12 * free))  // a sensitivity the loops hold at zero (sensitivity_stage)
+            (nl > 0 && change <= 1e-12 * free) ||  // a sensitivity the loops hold at zero (sensitivity_stage)
+            change <= floor)                        // at the difference's round-off
           break;
         if (it > 0 && change > 0.5 * previous && change <= 1e-6 * dA.cwiseAbs().maxCoeff()) break;
         previous = change;

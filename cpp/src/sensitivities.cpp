@@ -113,6 +113,16 @@ VecX SensitivityEquations::residual_derivative(int j, double t, const VecX& q, c
   return R;
 }
 
+double SensitivityEquations::difference_noise(int j) const {
+  const SensitivityParameter& p = parameters_[j];
+  if (!p.plus || !(p.h > 0.0)) return 0.0;
+  return p.minus ? 1.0 / (2.0 * p.h) : 1.0 / p.h;
+}
+
+VecX SensitivityEquations::force_sizes(double t, const VecX& q, const VecX& qd) {
+  return generalized_forces(sys_, e_, t, q, qd, 1.0).cwiseAbs();
+}
+
 VecX SensitivityEquations::acceleration_constraint_derivative(int j, double t, const VecX& q, const VecX& qd,
                                                                const VecX& qdd, const VecX& dq, const VecX& dqd) {
   VecX c = VecX::Zero(sys_.nl);

@@ -50,6 +50,12 @@ class SensitivityEquations {
   VecX residual_derivative(int j, double t, const VecX& q, const VecX& qd, const VecX& qdd, const VecX& lambda,
                            const VecX& dq, const VecX& dqd, const VecX& dqdd, const VecX& dlambda);
 
+  /// The round-off of ∂r/∂p_j's difference per unit of force, 1/h_j (1/(2 h_j) central): the residuals differenced
+  /// balance forces of size |f|, so the difference carries about ε |f| / h_j. 0 for an initial value (no difference).
+  double difference_noise(int j) const;
+  /// |f(q, q̇, t)| (nq), each coordinate's generalised force: the size of the terms a residual balances.
+  VecX force_sizes(double t, const VecX& q, const VecX& qd);
+
   /// Loops: D(γ − G q̈)[δq, δq̇] + ∂(γ − G q̈)/∂p_j (nl) at (t, q, q̇) and fixed free accelerations q̈, by
   /// central differences: the right-hand side of G δq̈ in the index-1 equations' derivative.
   VecX acceleration_constraint_derivative(int j, double t, const VecX& q, const VecX& qd, const VecX& qdd,
