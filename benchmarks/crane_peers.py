@@ -695,12 +695,12 @@ def run(output_dir="bench", quick: bool = False) -> dict:
     print(f"[{time.perf_counter() - start:6.1f} s] {scene.name}: timed", flush=True)
     s = summary(rows, scene)
     tables = report({
-        "crane_peers_verification": ("Models verified equal: each code's converged payload history against rigidfem's "
-                                     "(relative to the amplitude), its self-check and how its base follows the "
-                                     "profiles", checks),
-        "crane_peers_sweep": ("Every run: payload error relative to the amplitude against the code's own converged "
-                              "solution, least CPU time (s)", Table(rows, SWEEP_COLUMNS)),
-        "crane_peers_summary": ("Cheapest CPU time (s) per code to each relative payload error, and the peers' time "
-                                "over rigidfem's", s),
+        "crane_peers_verification": ("The crane, models verified equal: each code's converged payload history against "
+                                     "rigidfem's (relative to the amplitude), its self-check and how its base "
+                                     "follows the profiles", checks),
+        "crane_peers_sweep": ("The crane, every run: payload error relative to the amplitude against the code's own "
+                              "converged solution, least CPU time (s)", Table(rows, SWEEP_COLUMNS)),
+        "crane_peers_summary": ("The crane, cheapest runs: least CPU time (s) per code to each relative payload error, and "
+                                "the peers' time over rigidfem's", s),
     }, output_dir)
     return {name[len("crane_peers_"):]: table for name, table in tables.items()}

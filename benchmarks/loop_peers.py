@@ -738,12 +738,12 @@ def run(output_dir="bench", quick: bool = False) -> dict:
                             ("summary", Table(summaries, SUMMARY_COLUMNS))):
             table.to_csv(Path(output_dir) / f"loop_peers_{name}.csv")  # so far (printed at the end)
     tables = report({
-        "loop_peers_verification": ("Models verified equal: each code's converged point history against rigidfem's "
-                                    "(relative to the amplitude), its self-check and closure",
+        "loop_peers_verification": ("Closed loops, models verified equal: each code's converged point history against "
+                                    "rigidfem's (relative to the amplitude), its self-check and closure",
                                     Table(checks, VERIFY_COLUMNS)),
-        "loop_peers_sweep": ("Every run: point error relative to the amplitude against the code's own converged "
-                             "solution, closure max |g|, least CPU time (s)", Table(rows, SWEEP_COLUMNS)),
-        "loop_peers_summary": ("Cheapest CPU time (s) per code to each relative point error, the closure it keeps, and "
-                               "the peers' time over rigidfem's", Table(summaries, SUMMARY_COLUMNS)),
+        "loop_peers_sweep": ("Closed loops, every run: point error relative to the amplitude against the code's own "
+                             "converged solution, closure max |g|, least CPU time (s)", Table(rows, SWEEP_COLUMNS)),
+        "loop_peers_summary": ("Closed loops, cheapest runs: least CPU time (s) per code to each relative point error, the "
+                               "closure it keeps, and the peers' time over rigidfem's", Table(summaries, SUMMARY_COLUMNS)),
     }, output_dir)
     return {name[len("loop_peers_"):]: table for name, table in tables.items()}

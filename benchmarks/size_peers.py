@@ -476,12 +476,13 @@ def run(output_dir="bench", quick: bool = False) -> dict:
         rows += these
         summaries += summary(these, m, runners).rows
         tables = {
-            "size_peers_verification": ("The identical models checked equal", Table(checks, VERIFY_COLUMNS)),
-            "size_peers_sweep": ("Every run: largest tip error against the chain's converged solution (m), CPU time "
-                                 "(s; inf: not run, the prediction in first_cpu_s)", Table(rows, SWEEP_COLUMNS)),
-            "size_peers_steps": ("rigidfem's cost per step (s) and its growth exponent in nq", Table(steps, STEP_COLUMNS)),
-            "size_peers_summary": ("Cheapest CPU time (s) per code to each largest tip error, and the peers' time over "
-                                   "rigidfem's", Table(summaries, SUMMARY_COLUMNS)),
+            "size_peers_verification": ("Beams of 10³ and 10⁴ elements, models verified equal: the identical models checked", Table(checks, VERIFY_COLUMNS)),
+            "size_peers_sweep": ("Beams of 10³ and 10⁴ elements, every run: largest tip error against the chain's "
+                                 "converged solution (m), CPU time (s; inf: not run, the prediction in first_cpu_s)", Table(rows, SWEEP_COLUMNS)),
+            "size_peers_steps": ("Beams of 10³ and 10⁴ elements, cost per step: rigidfem's cost per step (s) and its growth "
+                                 "exponent in nq", Table(steps, STEP_COLUMNS)),
+            "size_peers_summary": ("Beams of 10³ and 10⁴ elements, cheapest runs: least CPU time (s) per code to each largest "
+                                   "tip error, and the peers' time over rigidfem's", Table(summaries, SUMMARY_COLUMNS)),
         }
         for name, (_, table) in tables.items():  # what is done so far, in case a later size fails
             table.to_csv(Path(output_dir) / f"{name}.csv")

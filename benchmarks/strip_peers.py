@@ -898,14 +898,15 @@ def run(output_dir="bench", quick: bool = False) -> dict:
         models += per_model(these, m, references).rows
         summaries += summary(these, m, references).rows
         tables = {
-            "strip_peers_verification": ("Each model's converged solution against rigidfem's (m); the identical "
-                                         "models checked", Table(checks, VERIFY_COLUMNS)),
-            "strip_peers_sweep": ("Every run: largest tip error against the code's own converged solution (m), least "
-                                  "CPU time (s)", Table(rows, SWEEP_COLUMNS)),
-            "strip_peers_models": ("Cheapest CPU time (s) per model to reach each largest tip error",
+            "strip_peers_verification": ("The whippy strip, models verified equal: each model's converged solution against "
+                                         "rigidfem's (m), the identical models checked", Table(checks, VERIFY_COLUMNS)),
+            "strip_peers_sweep": ("The whippy strip, every run: largest tip error against the code's own converged "
+                                  "solution (m), least CPU time (s)", Table(rows, SWEEP_COLUMNS)),
+            "strip_peers_models": ("The whippy strip, cheapest run of each model: least CPU time (s) to reach each largest "
+                                   "tip error",
                                    Table(models, MODELS_COLUMNS)),
-            "strip_peers_summary": ("Cheapest CPU time (s) per code to reach each largest tip error, and the peers' "
-                                    "time over rigidfem's", Table(summaries, SUMMARY_COLUMNS)),
+            "strip_peers_summary": ("The whippy strip, cheapest runs: least CPU time (s) per code to reach each largest tip "
+                                    "error, and the peers' time over rigidfem's", Table(summaries, SUMMARY_COLUMNS)),
         }
         for name, (_, table) in tables.items():  # what is done so far, in case a later size fails
             table.to_csv(Path(output_dir) / f"{name}.csv")

@@ -567,10 +567,10 @@ def run(output_dir="bench", quick: bool = False) -> dict:
         tables = measure()
     runs = tables["timing"].rows[0]["runs"]
     return report({
-        "sweep_peers_settings": ("Each code's setting: tip RMS error against its own reference at the lowest and "
+        "sweep_peers_settings": ("Sweeps, each code's setting: tip RMS error against its own reference at the lowest and "
                                  "highest Ω (m); the references against rigidfem's", tables["settings"]),
-        "sweep_peers_agreement": ("Per Ω: largest tip deflection per code and the tip RMS distance from rigidfem's "
-                                  "(m)", tables["agreement"]),
-        "sweep_peers_timing": (f"Wall time of the sweep of {runs} runs per executor (s), least of the rounds",
+        "sweep_peers_agreement": ("Sweeps, agreement per Ω: largest tip deflection per code and the tip RMS distance from "
+                                  "rigidfem's (m)", tables["agreement"]),
+        "sweep_peers_timing": (f"Sweeps, wall time per executor: the sweep of {runs} runs (s), least of the rounds",
                                tables["timing"]),
     }, output_dir)
