@@ -124,13 +124,13 @@ def impact_accuracy(methods=("dopri5", "radau5", "esdirk43"), rtols=(1e-4, 1e-6,
 
 def run(output_dir="bench", quick: bool = False) -> dict:
     print(machine())
-    return report({"contact_cost": ("One forward dynamics (µs, in C++) and the force Jacobians (ms, from Python) of a "
-                                    "strip of m rfes on the ground, without and with a capsule per rfe against it",
+    return report({"contact_cost": ("Contact, its cost on a strip: one forward dynamics (µs, in C++) and the force Jacobians (ms, from "
+                                    "Python) of a strip of m rfes on the ground, without and with a capsule per rfe against it",
                                     contact_cost(QUICK_SIZES if quick else SIZES)),
-                   "contact_groups": ("One forward dynamics (µs, in C++) of two strips of m rfes crossing, one on the other, "
-                                      "without and with a contact between their capsules (sweep and prune over "
-                                      "(m + 1)² pairs)", crossing_cost(QUICK_SIZES if quick else SIZES)),
-                   "impact_accuracy": ("A ball bouncing three times: the height's error (m) at the same tolerance with "
+                   "contact_groups": ("Contact between two bodies' groups: one forward dynamics (µs, in C++) of two strips of m rfes "
+                                      "crossing, one on the other, without and with a contact between their capsules (sweep and "
+                                      "prune over (m + 1)² pairs)", crossing_cost(QUICK_SIZES if quick else SIZES)),
+                   "impact_accuracy": ("Impacts located: a ball bouncing three times, the height's error (m) at the same tolerance with "
                                        "the contact's onsets and separations located and crossed, and the error "
                                        "estimate over the true error",
                                        impact_accuracy(("dopri5",), (1e-6,)) if quick else impact_accuracy())},

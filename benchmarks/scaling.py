@@ -187,10 +187,10 @@ def run(output_dir="bench", quick: bool = False) -> dict:
     elements = QUICK_ELEMENTS if quick else ELEMENTS
     print(machine(), flush=True)
     return report({
-        "dynamics_scaling": ("Forward dynamics, time per call (s, timed in C++) against nq",
+        "dynamics_scaling": ("Forward dynamics against nq: time per call (s, timed in C++)",
                              dynamics_scaling(elements)),
-        "implicit_step_scaling": ("Implicit step, time per step (s) against nq (h = T1/50)",
+        "implicit_step_scaling": ("Implicit step against nq: time per step (s), h = T1/50",
                                   implicit_step_scaling(elements, steps=20 if quick else 50)),
-        "implicit_methods_scaling": ("Every implicit method, time per step (s) against nq, 10^2-10^4 rfes",
+        "implicit_methods_scaling": ("Every implicit method against nq: time per step (s), 10^2-10^4 rfes",
                                      implicit_methods_scaling(QUICK_LARGE_ELEMENTS if quick else LARGE_ELEMENTS)),
     }, output_dir)

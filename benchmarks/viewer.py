@@ -125,10 +125,10 @@ def mesh_scaling(cases=MESH_CASES, frames: int = 401) -> Table:
 
 def run(output_dir="bench", quick: bool = False) -> dict:
     print(machine(), flush=True)
-    return report({"viewer_scaling": ("The 3D viewer: build time, file size, time per frame shown",
+    return report({"viewer_scaling": ("The 3D viewer, its cost: build time, file size, time per frame shown",
                                       viewer_scaling(QUICK_CASES if quick else CASES)),
-                   "viewer_bodies": ("The 3D viewer's scene against the number of bodies (build only)",
+                   "viewer_bodies": ("The 3D viewer against the number of bodies: the scene's build only",
                                      body_scaling((1000, 2000) if quick else (1000, 2000, 10000, 100000))),
-                   "viewer_meshes": ("The 3D viewer: a URDF robot drawn by its STL meshes",
+                   "viewer_meshes": ("The 3D viewer with meshes: a URDF robot drawn by its STL meshes",
                                      mesh_scaling(MESH_CASES[:1] if quick else MESH_CASES))},
                   output_dir)

@@ -69,6 +69,22 @@ def test_the_sites_benchmark_pages_are_written_by_the_benchmarks():
         assert (folder / f"{page.stem}.csv").exists(), page.name
 
 
+def test_the_guides_include_the_benchmark_pages_from_their_provenance_line():
+    """A guide that includes a benchmark's page skips its heading, description and CSV link (:start-line: N) and
+    starts at the "Written by" line, so that the table shows with its command, date, machine and load."""
+    import re
+
+    docs = Path(__file__).resolve().parents[1] / "docs"
+    found = 0
+    for guide in sorted(docs.glob("*.md")):
+        text = guide.read_text(encoding="utf-8")
+        for name, start in re.findall(r"\{include\} benchmarks/(\w+)\.md\n\s*:start-line: (\d+)", text):
+            lines = (docs / "benchmarks" / f"{name}.md").read_text(encoding="utf-8").splitlines()
+            assert lines[int(start)].startswith("Written by `python -m benchmarks "), (guide.name, name, start)
+            found += 1
+    assert found >= 20
+
+
 @pytest.mark.filterwarnings("ignore")  # a LocalCluster's start-up notices (ports, dashboards)
 def test_sweep_scaling_table():
     """The sweep benchmark's structure: four executors, all giving the serial results (asserted
