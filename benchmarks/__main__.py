@@ -26,6 +26,7 @@ COMMANDS = {
     "accuracy": "the default asked for a tip error against the best of every method: strips, tapes, the bench's scenes",
     "viewer": "the 3D viewer: build time, HTML size and time per frame in headless Chromium (needs chromium)",
     "sensitivities": "forward sensitivities: cost per parameter against the run, strips of m = 20, 80, 320",
+    "work_precision": "python -m rigidfem bench as pages: the standard scenes under the standard integrators (least time to a tip error, auto against the best) and the discretisation error",
     "contact": "contact at scale: a strip of m rfes on the ground, a capsule per rfe: forward dynamics and Jacobians",
 }
 
