@@ -1734,6 +1734,7 @@ AXES = ("x", "y", "z")
 ROT = {"x": "rx", "y": "ry", "z": "rz"}
 METHODS = tuple(m for m in rf.methods() if m != "auto")  # the method table's (with SciPy's)
 FIXED_STEP = tuple(m for m, d in rf.methods().items() if not d.adaptive)
+NO_ESTIMATE = tuple(m for m, d in rf.methods().items() if not d.error_estimate)  # adaptive=True refused
 
 
 def _compiled_parameters(function) -> tuple:
@@ -2787,8 +2788,8 @@ class Gen:
                 kw["adaptive"] = A(self.choice(["'yes'", "1"]), bad=True)
             else:
                 adaptive = self.choice(["None", "True", "False"])
-                # no error estimate: euler, symplectic_euler, rk4 (and implicit_spring's Newton matrix has none either)
-                kw["adaptive"] = A(adaptive, bad=adaptive == "True" and method in ("euler", "symplectic_euler", "rk4"),
+                # no error estimate: euler, symplectic_euler, rk4, gauss6 (the method table's)
+                kw["adaptive"] = A(adaptive, bad=adaptive == "True" and method in NO_ESTIMATE,
                                    names=("adaptive", "method"))
                 if adaptive == "False" and "dt" not in kw and not heavy:
                     kw["adaptive"]["bad"], kw["adaptive"]["names"] = 1, ["adaptive", "dt"]   # a fixed step needs dt
@@ -2811,7 +2812,7 @@ class Gen:
                             kw[key]["soft"] = 1
                     else:
                         kw[key] = A(self.choice(good))
-                        if key == "iteration_matrix" and method == "radau5" and kw[key]["e"] == "'spring'":
+                        if key == "iteration_matrix" and method in ("radau5", "gauss6") and kw[key]["e"] == "'spring'":
                             kw[key] = A("'spring'", bad=True, names=("iteration_matrix",))  # tangent only
                         if key == "iteration_matrix" and kw[key]["e"] == "'krylov'":
                             # recursive systems only (a linear beam compiles as Lagrange; scipy: methods check it too)

@@ -307,26 +307,39 @@ def test_dop853_on_a_free_four_bar_keeps_the_loop_and_agrees_with_radau5():
         assert max(closure) <= 1e-12
 
 
-def test_radau_decomposition_constants():
-    """radau.cpp writes Radau IIA's a = P diag(d) P⁻¹ as hexadecimal constants: read from the source, they must be
-    the eigen-decomposition of a computed here from √6 (Hairer & Wanner IV.5, Table 5.6) to round-off, with d(0)
-    real and Im d(1) > 0, and P⁻¹ P's inverse."""
+def _tableau(name):
+    """c, a of Radau IIA (Hairer & Wanner IV.5, Table 5.6, from √6) or Gauss–Legendre (Table 5.2, from √15)."""
+    if name == "radau":
+        r6 = np.sqrt(6.0)
+        return np.array([[(88 - 7 * r6) / 360, (296 - 169 * r6) / 1800, (-2 + 3 * r6) / 225],
+                         [(296 + 169 * r6) / 1800, (88 + 7 * r6) / 360, (-2 - 3 * r6) / 225],
+                         [(16 - r6) / 36, (16 + r6) / 36, 1 / 9]])
+    r15 = np.sqrt(15.0)
+    return np.array([[5 / 36, 2 / 9 - r15 / 15, 5 / 36 - r15 / 30],
+                     [5 / 36 + r15 / 24, 2 / 9, 5 / 36 - r15 / 24],
+                     [5 / 36 + r15 / 30, 2 / 9 + r15 / 15, 5 / 36]])
+
+
+@pytest.mark.parametrize("name,constructor", [("radau", "RadauTableau::RadauTableau"),
+                                              ("gauss", "GaussTableau::GaussTableau")])
+def test_collocation_decomposition_constants(name, constructor):
+    """radau.cpp writes Radau IIA's and Gauss–Legendre's a = P diag(d) P⁻¹ as hexadecimal constants: read from the
+    source, they must be the eigen-decomposition of a computed here to round-off, with d(0) real and
+    Im d(1) > 0, and P⁻¹ P's inverse."""
     import re
     from pathlib import Path
 
     source = (Path(__file__).parents[1] / "cpp" / "src" / "radau.cpp").read_text()
+    source = source[source.index(constructor + "()"):]
 
-    def constants(name, count):
-        block = re.search(rf"\b{name} << (.*?);", source, re.S).group(1)
+    def constants(key, count):
+        block = re.search(rf"\b{key} << (.*?);", source, re.S).group(1)
         pairs = re.findall(r"C\(([-+0-9a-fx.p]+), ([-+0-9a-fx.p]+)\)", block)
         assert len(pairs) == count
         return np.array([complex(float.fromhex(x), float.fromhex(y)) for x, y in pairs])
 
     d, P, Pinv = constants("d", 3), constants("P", 9).reshape(3, 3), constants("Pinv", 9).reshape(3, 3)
-    r6 = np.sqrt(6.0)
-    a = np.array([[(88 - 7 * r6) / 360, (296 - 169 * r6) / 1800, (-2 + 3 * r6) / 225],
-                  [(296 + 169 * r6) / 1800, (88 + 7 * r6) / 360, (-2 - 3 * r6) / 225],
-                  [(16 - r6) / 36, (16 + r6) / 36, 1 / 9]])
+    a = _tableau(name)
     assert d[0].imag == 0.0 and d[1].imag > 0.0 and d[2] == np.conj(d[1])
     np.testing.assert_allclose(np.sort_complex(d), np.sort_complex(np.linalg.eigvals(a)), rtol=0, atol=1e-15)
     np.testing.assert_allclose(a @ P, P @ np.diag(d), rtol=0, atol=1e-15)  # P's columns: eigenvectors

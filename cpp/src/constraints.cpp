@@ -197,6 +197,14 @@ VecX least_norm(const MatX& A, const VecX& b) {
   return svd.matrixV() * c;
 }
 
+void row_basis(const MatX& G, MatX& B) {
+  Eigen::JacobiSVD<MatX> svd(G, Eigen::ComputeThinU);
+  const VecX& s = svd.singularValues();
+  Eigen::Index r = 0;
+  while (r < s.size() && s(r) > 1e-5 * s(0)) ++r;
+  B = svd.matrixU().leftCols(r);
+}
+
 void least_norm_symmetric(const MatX& A, const VecX& b, Eigen::SelfAdjointEigenSolver<MatX>& eigen, VecX& c,
                           VecX& x) {
   // x = V Λ⁺ Vᵀ b, A = V Λ Vᵀ (the lower triangle read), λ_i⁺ = 1/λ_i for λ_i > 1e-10 λ_max, else 0

@@ -582,7 +582,9 @@ const std::vector<OptionInfo>& integrator_options() {
        "Newton stops when the increments of q and q̇ fall below newton_tol (1 + |q|); the Newmark family also holds "
        "them to 0.03 of the step's local error estimate e_q (q̇'s to 0.03 e_q/T, T the run's length), down to "
        "1e-3 newton_tol (1 + |q|) and at least 500 ε (1 + |q|), so that small steps keep the method's order; adaptive "
-       "esdirk43 and radau5 runs stop it at 0.03 of the error weights instead.",
+       "esdirk43 and radau5 runs stop it at 0.03 of the error weights instead; gauss6 holds them to 1e-4 newton_tol "
+       "(1 + |q|), or newton_tol where they stop contracting or the iterations run out (its leftovers, of one sign, "
+       "would make a conservative system's energy drift).",
        false, [](const O& o) { return OptionValue(o.newton_tol); }, [](O& o, V v) { o.newton_tol = real(v); }},
       {"newton_max_iterations", OptionType::Integer, "", "an integer in [1, 1000000]", "Newton iterations per step (or stage) at most.", false,
        [](const O& o) { return OptionValue(long(o.newton_max_iterations)); },

@@ -32,6 +32,11 @@ MatX free_jacobian(const System& sys, const Data& d);
 /// position (a four-bar flat) the row G loses carries no multiplier.
 VecX least_norm(const MatX& A, const VecX& b);
 
+/// An orthonormal basis B (nl, r) of the range of G (nl, nq): the left singular vectors of the singular values
+/// above 1e-5 of the largest (least_norm's rank decision on G S⁻¹ Gᵀ). The multipliers Bμ are least-norm for
+/// this G: they leave out the rows' dependent combinations.
+void row_basis(const MatX& G, MatX& B);
+
 /// The same for a symmetric positive semi-definite A (G M⁻¹ Gᵀ, M symmetric): by its eigenvalues,
 /// which are its singular values (the same rank decision), without the Jacobi SVD's sweeps.
 VecX least_norm_symmetric(const MatX& A, const VecX& b);

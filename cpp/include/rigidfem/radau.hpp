@@ -1,5 +1,6 @@
-/// Radau IIA of order 5 (implicit_rk.cpp) as the adjoint (adjoint.hpp) drives it: its tableau, the converged
-/// stages of a step, and its state to keep at checkpoints and to start again from.
+/// The 3-stage collocation methods (implicit_rk.cpp): their tableaus (Radau IIA, Gauss–Legendre), and what the
+/// adjoint (adjoint.hpp) reads of a radau5 stepper: the converged stages of a step, and its state to keep at
+/// checkpoints and to start again from.
 #pragma once
 
 #include <cmath>
@@ -8,14 +9,27 @@
 
 namespace rigidfem {
 
-/// The tableau: c, a, and a = P diag(d) P⁻¹ (the transformed real/complex form of Hairer & Wanner IV.8).
-struct RadauTableau {
+/// A 3-stage collocation tableau: c, a, b, and a = P diag(d) P⁻¹ (the transformed real/complex form of Hairer &
+/// Wanner IV.8), which Radau IIA and Gauss–Legendre share: one real eigenvalue and a complex pair.
+struct CollocationTableau {
   static constexpr int s = 3;
   Eigen::Matrix3d a;
-  Eigen::Vector3d c, dd;       // dd: the estimate's weights on the stage increments (Y_i − y_n)/h
+  Eigen::Vector3d c, b;
+  Eigen::Vector3d dd;          // Radau IIA: the estimate's weights on the stage increments (Y_i − y_n)/h
   Eigen::Matrix3cd P, Pinv;    // a = P diag(d) P⁻¹
   Eigen::Vector3cd d;          // d(0) real, d(2) = conj d(1), Im d(1) > 0
+  bool stiffly_accurate;       // b = the last row of a: the step ends at the last stage
+};
+
+/// Radau IIA, order 5: stiffly accurate, L-stable.
+struct RadauTableau : CollocationTableau {
   RadauTableau();  // radau.cpp: d, P and P⁻¹ as constants
+};
+
+/// Gauss–Legendre, order 6: symmetric, A-stable (|R(iy)| = 1: an undamped oscillation keeps its amplitude); the
+/// step ends at y_n + h Σ b_i f(Y_i).
+struct GaussTableau : CollocationTableau {
+  GaussTableau();  // radau.cpp: d, P and P⁻¹ as constants
 };
 
 /// What a radau5 stepper shows besides the Stepper interface.

@@ -38,8 +38,20 @@ from far above. Both methods: output at ``t_eval`` by the quintic Hermite interp
 (q, q̇, q̈) at both ends of each step. Loop closures: ``esdirk43`` holds them at the acceleration
 level in each stage (M A − f − Gᵀλ = 0 with G A = γ, by the Schur complement as in the Newmark
 family) and projects each step's end onto them, like the explicit methods; ``radau5`` holds them in
-all its stages at once (the Schur complement W = 𝒢 𝒮⁻¹ 𝒢ᵀ over the stages, 3 nl × 3 nl, each stage
-with its own G_i) and projects likewise.
+all its stages at once (the Schur complement W = 𝒢 𝒮⁻¹ 𝒢ᵀ over the stages, each stage with its own
+G_i, on the rows' r independent combinations at the step's first stage: 3r × 3r, factorised once a
+step; the 3 nl rows with least-norm multipliers where the stages cross a singular position) and
+projects likewise.
+
+``gauss6`` (Gauss–Legendre, 3 stages, order 6) solves its stages as radau5 does (the same real and
+complex blocks, its own Butcher matrix) and ends the step at y_n + h Σ b_i f(Y_i). It is symmetric:
+run forward, its velocities reversed and run again, the double pendulum comes back to its start to
+Newton's tolerance (4.6e-11 at h = 50 ms; radau5 misses by 8.6e-5). It keeps a linear system's
+energy at any step (a spring-mass at hω = 50: to 1.7e-13 over 100 steps) and a regular conservative
+mechanism's without drift (a pendulum from 2.5 rad over 500 s at h = 50 ms: 4.2e-8 J over the first
+fifth and over the last; radau5 2.5e-4 then 1.3e-3 J, rk4 5.4e-3 then 2.7e-2 J). Fixed steps only
+(no error estimate), no sensitivities, no Maxwell arms; Newton to 1e-4 ``newton_tol``, since the
+leftovers of a looser Newton, of one sign, would make the energy drift.
 """
 
 from __future__ import annotations
@@ -107,7 +119,8 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
         ``stats["auto_trials"]``, ``stats["probe_steps"]`` and ``stats["omega_max"]`` the details.
         Closed chains too (both methods project each step onto the loops).
         Otherwise see the module docstring: "euler", "symplectic_euler", "rk4", "dopri5", "rkf45",
-        "newmark", "hht", "generalized_alpha", "implicit_spring", "esdirk43", "radau5", or "scipy:Radau",
+        "dop853", "bs23", "newmark", "hht", "generalized_alpha", "implicit_spring", "esdirk43", "radau5",
+        "gauss6", or "scipy:Radau",
         "scipy:BDF",
         "scipy:LSODA", "scipy:RK45", "scipy:DOP853". "implicit_spring" is generalised-α (``rho_inf``)
         whose Newton matrix holds only the coordinates' springs and dampers,
