@@ -1,4 +1,4 @@
-"""``python -m benchmarks {scaling,peers,scale,loops,implicit_step,sweep,kane_peers,loop_peers,sweep_peers,strip_peers,crane_peers,size_peers,evaluations,orders,tolerance,accuracy,viewer,sensitivities,contact} [--quick] [--output DIR]``, from the root of a checkout."""
+"""``python -m benchmarks {scaling,peers,scale,loops,implicit_step,sweep,kane_peers,loop_peers,sweep_peers,strip_peers,crane_peers,size_peers,evaluations,orders,tolerance,accuracy,viewer,sensitivities,contact,energy} [--quick] [--output DIR]``, from the root of a checkout."""
 
 from __future__ import annotations
 
@@ -27,6 +27,7 @@ COMMANDS = {
     "viewer": "the 3D viewer: build time, HTML size and time per frame in headless Chromium (needs chromium)",
     "sensitivities": "forward sensitivities: cost per parameter against the run, strips of m = 20, 80, 320",
     "work_precision": "python -m rigidfem bench as pages: the standard scenes under the standard integrators (least time to a tip error, auto against the best) and the discretisation error",
+    "energy": "conservative mechanisms over long runs (pendulums, a four-bar, the Bricard linkage): the energy error early and late by gauss6, radau5, rk4, generalised-α (ρ∞ = 1) and dop853",
     "contact": "contact at scale: a strip of m rfes on the ground, a capsule per rfe: forward dynamics and Jacobians",
 }
 

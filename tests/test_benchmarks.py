@@ -374,3 +374,19 @@ def test_contact_benchmark_quick():
     assert row["overlaps"] == 2 * 11 and row["fd_us_with"] > 0 and row["jac_ms_with"] > 0
     for row in contact.impact_accuracy(("dopri5",), (1e-6,)).rows:  # p = 1 and 1.5
         assert row["error_located"] < row["error_crossed"] and 1 / 3 < row["estimate_over_error_located"] < 3
+
+
+def test_energy_benchmark_quick():
+    """The energy benchmark's table (a tenth of each run): a row per scene and setting, every run finished or
+    failed with its time; on the pendulum gauss6's energy error stays where it started while rk4's grows."""
+    from benchmarks import energy
+
+    table = energy.study(quick=True)
+    scenes = {r["scene"] for r in table.rows}
+    assert len(scenes) == 4
+    assert len(table.rows) == 4 * (len(energy.FIXED) + len(energy.COARSER) + len(energy.ADAPTIVE_RTOLS))
+    for r in table.rows:
+        assert r.get("note", "").startswith("failed at t = ") or r["energy_error_last_fifth_J"] >= 0.0
+    pendulum = {r["method"] + " " + r["setting"]: r for r in table.rows if r["scene"].startswith("pendulum")}
+    assert pendulum["gauss6 dt=0.05"]["last_over_first"] < 1.2
+    assert pendulum["rk4 dt=0.05"]["last_over_first"] > 3
