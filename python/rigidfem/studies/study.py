@@ -39,6 +39,7 @@ from ..base.persistence import Versioned
 from ..model.materials import Material, Section
 from ..model.model import Model
 from ..simulation.integration import simulate
+from ..simulation.options import methods as _methods
 from ..simulation.result import finished as _finished
 
 
@@ -156,20 +157,22 @@ class Table(Versioned):
         return np.array([r.get(name, np.nan) for r in self.rows], dtype=float)
 
     def summary(self, thresholds=(1e-4, 1e-6), error: str = "tip_error_rms_m") -> Table:
-        """Per scene and method (and setting kind): the least wall time among the runs whose
-        ``error`` is at most each threshold ("-" when none reaches it)."""
+        """Per scene and method (and setting kind): the method's order (``rf.methods()``; auto's: its stiff
+        method's), the least wall time among the runs whose ``error`` is at most each threshold ("-" when none
+        reaches it), and the smallest error reached."""
         groups = {}
         for r in self.rows:
             groups.setdefault((r["scene"], r["method"], r["setting"]), []).append(r)
         rows = []
         for (scene, method, setting), runs in groups.items():
-            row = {"scene": scene, "method": f"{method} ({setting})"}
+            known = _methods().get(method.split(" ")[0])  # "esdirk43 (spring)": esdirk43
+            row = {"scene": scene, "method": f"{method} ({setting})", "order": known.order if known else "-"}
             for tol in thresholds:
                 best = cheapest(runs, error, "wall_time_s", tol)
                 row[f"time_s_to_{tol:g}"] = best["wall_time_s"] if best else "-"
             row["smallest_error"] = min(r[error] for r in runs)
             rows.append(row)
-        return Table(rows, ("scene", "method", *(f"time_s_to_{t:g}" for t in thresholds), "smallest_error"))
+        return Table(rows, ("scene", "method", "order", *(f"time_s_to_{t:g}" for t in thresholds), "smallest_error"))
 
     def auto_against_best(self, thresholds=(1e-4, 1e-6), error: str = "tip_error_rms_m") -> Table:
         """Per scene and threshold: the cheapest run of ``method="auto"`` reaching it against the
