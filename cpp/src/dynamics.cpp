@@ -151,13 +151,18 @@ std::string worst_loop(const System& sys, const Data& d) {
 }
 
 /// d.Y = M⁻¹ Gᵀ of the loops' free columns d.Gfree with the factorisation of M in d: the tree's, a column at a
-/// time in place (no allocation), or the Lagrange engine's LLT.
+/// time in place (no allocation), or the Lagrange engine's LLT. A row that is exactly zero (a planar loop's
+/// out-of-plane rows: 3 of a revolute loop joint's 5 in the plane) has a zero column without a solve.
 void mass_weighted_rows(const System& sys, Data& d) {
   if (!recursive(sys)) {
     d.Y = d.llt.solve(d.Gfree.transpose());
     return;
   }
   for (Eigen::Index j = 0; j < d.Gfree.rows(); ++j) {
+    if ((d.Gfree.row(j).array() == 0.0).all()) {
+      d.Y.col(j).setZero();
+      continue;
+    }
     d.loop_col = d.Gfree.row(j).transpose();
     aba_solve(sys, d, d.loop_col, d.loop_col);
     d.Y.col(j) = d.loop_col;
