@@ -694,11 +694,11 @@ class Collocation final : public ImplicitRk, public RadauAccess {
         Aprev_(n_, 3), Rt_(n_, 3), Dt_(n_, 3), z_(n_), zs_(n_), x_(n_), xs_(n_), b1_(n_), b2_(n_), qx_(n_), vx_(n_),
         L_(sys.nl, 3), Cres_(sys.nl, 3), W_(3 * sys.nl, 3 * sys.nl),
         w_(3 * sys.nl), E_(n_, 3), Z_(n_, 3) {
-    // gauss6: Newton to 1e-2 newton_tol (symmetric_tol), or newton_tol where it stops contracting or runs out of
-    // iterations. A symmetric method keeps a conservative system's energy
-    // only with its equations solved well below its step's error: Newton's leftovers have one sign and add up
-    // over the steps: the double pendulum at h = 10 ms over 500 s, energy drifting by 2.1e-6 J with Newton's
-    // increments held to 1e-10 (1 + |y|), bounded by 2.2e-7 J at 1e-12.
+    // gauss6: Newton to 1e-4 newton_tol (symmetric_tol), or newton_tol where it stops contracting or runs out of
+    // iterations. A symmetric method keeps a conservative system's energy only with its equations solved well
+    // below its step's error: Newton's leftovers have one sign and add up over the steps. The double pendulum at
+    // h = 10 ms over 500 s: its energy drifted by 2.1e-6 J with the increments held to 1e-10 (1 + |y|), by 2e-8 J
+    // at 1e-12; the Bricard linkage at h = 10 ms over 200 s: 8.2e-7 J at 1e-12, 1.2e-8 J at 1e-14.
     if (!tab_.stiffly_accurate) newton_tol_ *= symmetric_tol;
   }
 
@@ -898,21 +898,21 @@ class Collocation final : public ImplicitRk, public RadauAccess {
     if (!lu_valid_) schur(Gr_, r);
     for (int i = 0; i < 3; ++i) w_.segment(i * r, r).noalias() = basis_.transpose() * (Cres_.col(i) - G_[i] * D_.col(i));
     // the multipliers themselves, Ŵ μ⁺ = ĉ − 𝒢̂ ΔA + Ŵ μ, as below
-    VecX mu(3 * r);
-    for (int i = 0; i < 3; ++i) mu.segment(i * r, r).noalias() = basis_.transpose() * L_.col(i);
+    mu_.resize(3 * r);
+    for (int i = 0; i < 3; ++i) mu_.segment(i * r, r).noalias() = basis_.transpose() * L_.col(i);
     auto Wr = W_.topLeftCorner(3 * r, 3 * r);
-    w_.head(3 * r).noalias() += Wr * mu;
+    w_.head(3 * r).noalias() += Wr * mu_;
     if (!lu_valid_) lu_.compute(Wr);
     lu_valid_ = true;
     if (!(lu_.rcond() > 1e-10)) {
       full_ = true;  // for the rest of this solve
       return close_loops_full();
     }
-    const VecX dmu = lu_.solve(w_.head(3 * r)) - mu;
-    for (int i = 0; i < 3; ++i) E_.col(i).noalias() = Gr_[i].transpose() * dmu.segment(i * r, r);
+    mu1_ = lu_.solve(w_.head(3 * r));  // μ⁺
+    for (int i = 0; i < 3; ++i) E_.col(i).noalias() = Gr_[i].transpose() * (mu1_ - mu_).segment(i * r, r);
     solve_stages(E_, Z_);
     D_ += Z_;
-    for (int i = 0; i < 3; ++i) L_.col(i).noalias() = basis_ * (mu + dmu).segment(i * r, r);
+    for (int i = 0; i < 3; ++i) L_.col(i).noalias() = basis_ * mu1_.segment(i * r, r);
   }
 
   /// W (its leading 3k × 3k) = 𝒢 𝒮⁻¹ 𝒢ᵀ for the stages' rows G[i] (k, nq): one stage solve per row and stage.
@@ -1069,6 +1069,7 @@ class Collocation final : public ImplicitRk, public RadauAccess {
   MatX basis_;        // (nl, r) orthonormal basis of the range of G at this solve's first stage (row_basis)
   MatX Gr_[3];        // (r, nq) the stages' independent rows Bᵀ G_i
   Eigen::PartialPivLU<MatX> lu_;      // of 𝒢̂ 𝒮⁻¹ 𝒢̂ᵀ
+  VecX mu_, mu1_;                     // (3r) the stages' multipliers in the basis: the iterate's and the next
   bool basis_valid_ = false, full_ = false, lu_valid_ = false;  // basis_ is this solve's; the full W is needed in this solve
   VecX w_;            // (3 nl) its right-hand side
   MatX E_, Z_;        // (nq, 3) stage right-hand sides and their 𝒮⁻¹
