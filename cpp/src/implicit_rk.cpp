@@ -1086,28 +1086,20 @@ std::unique_ptr<Stepper> make_implicit_rk(const System& sys, const IntegratorOpt
 
 namespace {
 
-// radau5's own: it takes the exact tangent only, and no Maxwell arms (esdirk43 takes both).
-void check_radau5(const System& sys, const IntegratorOptions& o) {
+// The collocation methods' own (radau5, gauss6): the exact tangent only, and no Maxwell arms, since their stages
+// are coupled (esdirk43 takes both); gauss6 also no sensitivities (its step does not end at a stage, where the
+// staggered direct method takes them).
+void check_collocation(const System& sys, const IntegratorOptions& o) {
+  const std::string name = method_name(o.method);
   if (sys.nz > 0)
-    throw std::invalid_argument("method: 'radau5' does not integrate Maxwell arms (the system has " +
+    throw std::invalid_argument("method: '" + name + "' does not integrate Maxwell arms (the system has " +
                                 std::to_string(sys.nz) + " arm forces as internal variables); use esdirk43, "
                                 "generalized_alpha or dopri5");
   if (o.iteration_matrix == IterationMatrix::Spring)
-    throw std::invalid_argument("iteration_matrix: radau5 takes the exact tangent ('auto', 'tangent' or 'krylov'), got "
-                                "'spring' ('krylov' is its O(n) form); use esdirk43 for the spring matrix");
-}
-
-// gauss6's own: as radau5's (its stages are coupled too), and no sensitivities (its step does not end at a stage,
-// where the staggered direct method takes them).
-void check_gauss6(const System& sys, const IntegratorOptions& o) {
-  if (sys.nz > 0)
-    throw std::invalid_argument("method: 'gauss6' does not integrate Maxwell arms (the system has " +
-                                std::to_string(sys.nz) + " arm forces as internal variables); use esdirk43, "
-                                "generalized_alpha or dopri5");
-  if (o.iteration_matrix == IterationMatrix::Spring)
-    throw std::invalid_argument("iteration_matrix: gauss6 takes the exact tangent ('auto', 'tangent' or 'krylov'), got "
-                                "'spring'; use esdirk43 for the spring matrix");
-  if (!o.sensitivities.empty())
+    throw std::invalid_argument("iteration_matrix: " + name + " takes the exact tangent ('auto', 'tangent' or "
+                                "'krylov'), got 'spring' ('krylov' is its O(n) form); use esdirk43 for the spring "
+                                "matrix");
+  if (o.method == Method::Gauss6 && !o.sensitivities.empty())
     throw std::invalid_argument("sensitivities: gauss6 has no sensitivities; use radau5, esdirk43 or an explicit "
                                 "method");
 }
@@ -1124,13 +1116,13 @@ const std::vector<MethodInfo>& implicit_rk_methods() {
       {Method::Radau5, "radau5", "implicit Runge-Kutta", 5, true, true, true, true, method_options(true, true),
        "Radau IIA, 3 stages, order 5, L-stable, stiffly accurate; simplified Newton on all stages in the transformed "
        "real/complex form (exact tangent only), Hairer's filtered estimate, PI control, dense output quintic Hermite",
-       make_implicit_rk, check_radau5},
+       make_implicit_rk, check_collocation},
       {Method::Gauss6, "gauss6", "implicit Runge-Kutta", 6, false, false, false, false, method_options(false, true),
        "Gauss-Legendre, 3 stages, order 6, fixed step: symmetric (time-reversible) and A-stable without damping "
        "(undamped modes keep their amplitude; a linear system's energy is kept exactly), so a regular conservative "
        "mechanism's energy error stays bounded over long runs; simplified Newton as radau5's, to 1e-4 newton_tol; "
        "dense output quintic Hermite",
-       make_implicit_rk, check_gauss6},
+       make_implicit_rk, check_collocation},
   };
   return rows;
 }
