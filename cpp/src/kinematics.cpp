@@ -142,7 +142,8 @@ void kinematics(const System& sys, Data& d, bool rates) {
 void frames_and_axes(const System& sys, Data& d) {
   static const Mat4 I4 = Mat4::Identity();
   for (int p = 0; p < sys.nbodies; ++p) {
-    Mat4 G = parent_value(sys, d.T, p, I4) * sys.B[p];
+    Mat4 G;
+    compose(parent_value(sys, d.T, p, I4), sys.B[p], G);
     joint_frames(joint_uses(sys, p), d.qa, G, d.axes.data() + sys.use_start[p]);  // data(): valid for none
     d.T[p] = G;
   }

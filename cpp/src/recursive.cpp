@@ -116,15 +116,8 @@ namespace {
 using SmallVec = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 6, 1>;
 using SmallMat = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 6, 6>;
 
-// D⁻¹ of a symmetric positive definite D (nf ≤ 6) by Cholesky; fixed-size code for the
-// common three rotations of an sde. False if D is not positive definite.
+// D⁻¹ of a symmetric positive definite D (4 ≤ nf ≤ 6) by Cholesky; false if D is not positive definite.
 bool invert_spd(const SmallMat& D, SmallMat& Dinv) {
-  if (D.rows() == 3) {
-    const Eigen::LLT<Mat3> llt{Mat3(D)};
-    if (llt.info() != Eigen::Success) return false;
-    Dinv = llt.solve(Mat3::Identity());
-    return true;
-  }
   const Eigen::LLT<SmallMat> llt(D);
   if (llt.info() != Eigen::Success) return false;
   Dinv = llt.solve(SmallMat::Identity(D.rows(), D.cols()));
@@ -158,9 +151,41 @@ bool invert_spd3(const Mat3& D, Mat3& Dinv) {
                                  "' is singular (a massless chain or a singular configuration)");
 }
 
+// D⁻¹ of a symmetric N × N D (N = 1, 2, 3: the fixed-size paths); false unless D is positive definite.
+template <int N>
+bool invert_fixed(const Eigen::Matrix<double, N, N>& D, Eigen::Matrix<double, N, N>& Dinv) {
+  if constexpr (N == 1) {
+    if (!(D(0, 0) > 0.0)) return false;
+    Dinv(0, 0) = 1.0 / D(0, 0);
+    return true;
+  } else if constexpr (N == 2) {  // D⁻¹ = [[d, −b], [−b, a]] / (a d − b²)
+    const double det = D(0, 0) * D(1, 1) - D(0, 1) * D(0, 1);
+    if (!(D(0, 0) > 0.0 && det > 0.0)) return false;
+    Dinv << D(1, 1) / det, -D(0, 1) / det, -D(0, 1) / det, D(0, 0) / det;
+    return true;
+  } else {
+    return invert_spd3(D, Dinv);
+  }
+}
+
+// ABA pass 2, inertia part, of a body with N = 1, 2 or 3 free coordinates (a revolute joint, an sde's two or
+// three rotations) in fixed-size arithmetic: U = I^A S, D = Sᵀ U + diag(δ), I^a = I^A − U D⁻¹ Uᵀ.
+template <int N>
+void fixed_inertia(const System& sys, Data& d, const VecX* armature, int p) {
+  using MatN = Eigen::Matrix<double, N, N>;
+  const auto S = d.S[p].template leftCols<N>();
+  const Eigen::Matrix<double, 6, N> U = d.IA[p] * S;
+  MatN D = S.transpose() * U, Dinv;
+  if (armature) D.diagonal() += armature->template segment<N>(sys.q_index[p]);
+  if (!invert_fixed<N>(D, Dinv)) singular_articulated_inertia(sys, d, p);
+  d.U6[p] = U;
+  d.Dinv[p] = Dinv;
+  d.IA[p].noalias() -= (U * Dinv) * U.transpose();
+}
+
 // ABA pass 2, inertia part (leaves to root): S the free axes, U = I^A S, D = Sᵀ U + diag(δ), and
 // the parent gets I^a = I^A − U D⁻¹ Uᵀ, kept in d.IA[p] for the bias pass. δ = 0 without an armature.
-// One and three free coordinates (a revolute joint, an sde's three rotations) take fixed-size paths.
+// One to three free coordinates take the fixed-size path (fixed_inertia).
 void articulated_inertias(const System& sys, Data& d, const VecX* armature) {
   d.IA = d.I;
   for (int p = sys.nbodies - 1; p >= 0; --p) {
@@ -169,20 +194,11 @@ void articulated_inertias(const System& sys, Data& d, const VecX* armature) {
     S.resize(6, nf);
     for (int k = 0; k < nf; ++k) S.col(k) = d.axes[sys.q_use[k0 + k]];
     if (nf == 1) {
-      const Vec6 U = d.IA[p] * S.col(0);
-      const double D = S.col(0).dot(U) + (armature ? (*armature)(k0) : 0.0);
-      if (!(D > 0.0)) singular_articulated_inertia(sys, d, p);
-      d.U6[p] = U;
-      d.Dinv[p].setConstant(1, 1, 1.0 / D);
-      d.IA[p].noalias() -= (U / D) * U.transpose();
+      fixed_inertia<1>(sys, d, armature, p);
+    } else if (nf == 2) {
+      fixed_inertia<2>(sys, d, armature, p);
     } else if (nf == 3) {
-      const Eigen::Matrix<double, 6, 3> U = d.IA[p] * S.leftCols<3>();
-      Mat3 D = S.leftCols<3>().transpose() * U, Dinv;
-      if (armature) D.diagonal() += armature->segment<3>(k0);
-      if (!invert_spd3(D, Dinv)) singular_articulated_inertia(sys, d, p);
-      d.U6[p] = U;
-      d.Dinv[p] = Dinv;
-      d.IA[p].noalias() -= (U * Dinv) * U.transpose();
+      fixed_inertia<3>(sys, d, armature, p);
     } else {
       d.U6[p].noalias() = d.IA[p] * S;
       if (nf > 0) {
@@ -196,6 +212,26 @@ void articulated_inertias(const System& sys, Data& d, const VecX* armature) {
   }
 }
 
+// The fixed-size bias of fixed_inertia's body: u = τ − Sᵀ p^A, and U D⁻¹ u added into the parent's p^a.
+template <int N>
+void fixed_bias(const System& sys, Data& d, const VecX& tau, int p, Vec6& pa) {
+  const Eigen::Matrix<double, N, N> Dinv = d.Dinv[p].template topLeftCorner<N, N>();
+  const Eigen::Matrix<double, N, 1> u =
+      tau.template segment<N>(sys.q_index[p]) - d.S[p].template leftCols<N>().transpose() * d.pA[p];
+  d.u[p] = u;
+  pa.noalias() += d.U6[p].template leftCols<N>() * (Dinv * u);
+}
+
+// The fixed-size accelerations of fixed_inertia's body: q̈ = D⁻¹ (u − Uᵀ a') into x, a' + S q̈ into a.
+template <int N>
+void fixed_acceleration(const System& sys, Data& d, int p, VecX& x, Vec6& a) {
+  const Eigen::Matrix<double, N, N> Dinv = d.Dinv[p].template topLeftCorner<N, N>();
+  const Eigen::Matrix<double, N, 1> qdd =
+      Dinv * (d.u[p].template head<N>() - d.U6[p].template leftCols<N>().transpose() * a);
+  x.template segment<N>(sys.q_index[p]) = qdd;
+  a.noalias() += d.S[p].template leftCols<N>() * qdd;
+}
+
 // ABA pass 2, bias part, and pass 3, given the bias forces p^A (d.pA), joint biases c (d.c),
 // the forces τ (nq) on the free coordinates and the base acceleration a_0:
 //   u = τ − Sᵀ p^A, the parent gets p^a = p^A + I^a c + U D⁻¹ u (leaves to root);
@@ -205,10 +241,12 @@ void articulated_accelerations(const System& sys, Data& d, const VecX& tau, cons
   for (int p = sys.nbodies - 1; p >= 0; --p) {
     Vec6 pa = d.pA[p] + d.IA[p] * d.c[p];
     const int k0 = sys.q_index[p], nf = sys.nq_of[p];
-    if (nf == 3) {  // the fixed-size path of articulated_inertias
-      const Vec3 u = tau.segment<3>(k0) - d.S[p].leftCols<3>().transpose() * d.pA[p];
-      d.u[p] = u;
-      pa.noalias() += d.U6[p].leftCols<3>() * (d.Dinv[p].topLeftCorner<3, 3>() * u);
+    if (nf == 1) {
+      fixed_bias<1>(sys, d, tau, p, pa);
+    } else if (nf == 2) {
+      fixed_bias<2>(sys, d, tau, p, pa);
+    } else if (nf == 3) {
+      fixed_bias<3>(sys, d, tau, p, pa);
     } else if (nf > 0) {
       d.u[p] = tau.segment(k0, nf) - d.S[p].transpose() * d.pA[p];
       pa += d.U6[p] * (d.Dinv[p] * d.u[p]);
@@ -218,10 +256,12 @@ void articulated_accelerations(const System& sys, Data& d, const VecX& tau, cons
   for (int p = 0; p < sys.nbodies; ++p) {
     Vec6 a = parent_value(sys, d.a, p, a0) + d.c[p];
     const int k0 = sys.q_index[p], nf = sys.nq_of[p];
-    if (nf == 3) {
-      const Vec3 qdd = d.Dinv[p].topLeftCorner<3, 3>() * (d.u[p].head<3>() - d.U6[p].leftCols<3>().transpose() * a);
-      x.segment<3>(k0) = qdd;
-      a.noalias() += d.S[p].leftCols<3>() * qdd;
+    if (nf == 1) {
+      fixed_acceleration<1>(sys, d, p, x, a);
+    } else if (nf == 2) {
+      fixed_acceleration<2>(sys, d, p, x, a);
+    } else if (nf == 3) {
+      fixed_acceleration<3>(sys, d, p, x, a);
     } else if (nf > 0) {
       const SmallVec qdd = d.Dinv[p] * (d.u[p] - d.U6[p].transpose() * a);
       x.segment(k0, nf) = qdd;

@@ -39,6 +39,15 @@ Mat4 inverse(const Mat4& T);
 /// [[M⁻¹, −M⁻¹ r], [0, 1]].
 Mat4 affine_inverse(const Mat4& T);
 
+/// A B of two affine [[M, r], [0, 1]]: [[M_A M_B, M_A r_B + r_A], [0, 1]] (36 multiplications, not a 4 × 4
+/// product's 64).
+inline void compose(const Mat4& A, const Mat4& B, Mat4& AB) {
+  AB.topLeftCorner<3, 3>().noalias() = A.topLeftCorner<3, 3>() * B.topLeftCorner<3, 3>();
+  AB.topRightCorner<3, 1>().noalias() = A.topLeftCorner<3, 3>() * B.topRightCorner<3, 1>();
+  AB.topRightCorner<3, 1>() += A.topRightCorner<3, 1>();
+  AB.row(3) << 0.0, 0.0, 0.0, 1.0;
+}
+
 /// m ×m s, the motion cross product (Featherstone's crm): (ω × s_ω, ω × s_v + v × s_ω) for m = (ω, v), written
 /// out by components so that the compiler inlines it (Eigen's comma initialiser kept GCC from doing so).
 inline Vec6 crossm(const Vec6& m, const Vec6& s) {
