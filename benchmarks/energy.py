@@ -3,7 +3,7 @@
     python -m benchmarks energy [--quick] [--output DIR]
 
 Four conservative mechanisms, no damping, gravity only: a pendulum released at 2.5 rad (500 s, about 140 swings),
-the double pendulum released from (1, 0.5) rad (500 s; chaotic), the four-bar of the tests falling from its crank
+the double pendulum released from (1, 0.5) rad (500 s; chaotic), the four-bar of ``rf.samples.four_bar`` falling from its crank
 at 0.4 rad (200 s: a loop joint, 3 of its 5 rows redundant) and the orthogonal Bricard linkage of
 ``benchmarks.loop_peers`` released under gravity (200 s: a loop of 6 revolutes with one degree of freedom).
 Each is run by gauss6 (Gauss–Legendre, symmetric), radau5 (L-stable; here at fixed steps), rk4 and generalised-α
@@ -34,20 +34,25 @@ COLUMNS = ("scene", "method", "setting", "first_fifth_J", "last_fifth_J", "last_
            "newton_iterations", "note")
 
 
+def _four_bar_q(t1: float) -> np.ndarray:
+    """rf.samples.four_bar's joint angles (crank, coupler relative to the crank, rocker; rad) closing its loop
+    at crank angle t1, by the law of cosines: the assembly's starting guess."""
+    a, b, c, d = 0.3, 0.8, 0.6, 0.7  # crank, coupler, rocker, ground link (m)
+    ax, ay = a * np.cos(t1), a * np.sin(t1)
+    e = np.hypot(ax - d, ay)
+    t3 = np.arctan2(ay, ax - d) + np.arccos((e * e + c * c - b * b) / (2 * e * c))
+    t2 = np.arctan2(c * np.sin(t3) - ay, d + c * np.cos(t3) - ax)
+    return np.array([t1, t2 - t1, t3])
+
+
 def scenes(quick: bool = False) -> list:
     """(name, system, q0, t_end, dt) of each mechanism; quick: a tenth of each run."""
-    import sys
-    from pathlib import Path
-
-    sys.path.insert(0, str(Path(__file__).resolve().parents[1] / "tests"))
-    from test_loops import closed_q, four_bar  # the tests' four-bar
-
     from .loop_peers import bricard
 
     pendulum = rf.samples.pendulum()[0].compile()
     double = rf.samples.double_pendulum()[0].compile()
-    bar = four_bar()
-    bar_q0, _ = bar.assemble(closed_q(0.4))
+    bar = rf.samples.four_bar()[0].compile()
+    bar_q0, _ = bar.assemble(_four_bar_q(0.4))
     b = bricard()
     cut = 0.1 if quick else 1.0
     return [("pendulum from 2.5 rad", pendulum, np.array([2.5]), 500.0 * cut, 0.05),

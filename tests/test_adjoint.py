@@ -400,3 +400,51 @@ def test_a_step_whose_iterate_overflows_is_a_simulation_error(method):
         with pytest.raises(rf.SimulationError, match="reduce dt"):
             rf.gradient(s, 1e300, ["b.mass"], outputs={"p": body.point((0.0, 1.0, 0.0))},
                         terminal=lambda y: float(np.sum(y["p"] ** 2)), dt=1e300, method=method)
+
+
+def test_drive_numbers_the_profiles_are_affine_in():
+    """The kinds' table says which numbers a profile is affine in (the adjoint differences those one-sided, by a
+    large step): the second difference of (q, q̇, q̈) in each such number vanishes at every time, and a number that is
+    not (a harmonic's omega) is refused. Each kind is made by its own builder in rigidfem.motion."""
+    from rigidfem.model import parameters as P
+
+    law = rf.motion.rest_to_rest(0.2, 1.5, 0.1, 0.8, law="trapezoidal", fraction=0.3)
+    profiles = [rf.motion.polynomial([0.3, -0.7, 0.4]), rf.motion.harmonic(0.6, 2.0, 0.3, 0.1),
+                rf.motion.spline(np.linspace(0.0, 2.0, 6), [0.0, 0.3, -0.2, 0.5, 0.1, 0.4]), law,
+                rf.motion.ramp(1.5, 0.2, 0.6, start=0.3), rf.motion.chirp(0.4, 0.5, 2.0, 0.1, 1.5),
+                rf.motion.harmonic(0.6, 2.0) + 0.5 * rf.motion.polynomial([0.1, 0.2])]
+    times = np.linspace(-0.5, 2.5, 31)
+    for profile in profiles:
+        leaves = P.profile_leaves(profile)
+        affine = P.affine_leaves(profile)
+        assert affine and affine <= set(leaves), profile
+        for path in affine:
+            e = 0.37 * max(1.0, abs(leaves[path]))
+            q = [P.remade(profile, {path: leaves[path] + k * e}).sample(times) for k in range(3)]
+            np.testing.assert_allclose(q[2] - 2 * q[1] + q[0], 0.0, atol=1e-12 * max(1.0, np.abs(q[0]).max()),
+                                       err_msg=f"{profile!r}: {path}")
+    assert P.affine_leaves(rf.motion.harmonic(0.6, 2.0)) == {"amplitude", "offset"}
+
+
+def test_a_spline_drive_by_its_knots():
+    """A hub turned by a spline through 9 knots, a 3-rfe beam on it: the gradient by every knot (each differenced
+    one-sided by the adjoint, the spline being affine in its values) against the forward sensitivities of the same
+    run (which difference the residual centrally) and one knot against central differences of whole runs."""
+    model = rf.Model(gravity=(0.0, -G, 0.0))
+    hub = model.add_body("hub", model.ground, rf.Joint.revolute("z"), mass=1.0, inertia=(1.0, 1.0, 1.0))
+    knots = np.linspace(0.0, 0.4, 9)
+    model.prescribe(hub, rf.motion.spline(knots, 2.0 * knots**2 + 0.3 * np.sin(10 * knots)))
+    beam = model.add_beam("beam", hub, 1.0, rf.Material(E=7e10, rho=2700.0), rf.Section.rectangle(0.02, 0.01), 3,
+                          deform=("bend_z", "bend_y"))
+    s = model.compile()
+    names = [n for n in s.parameters if ".q[" in n]
+    assert len(names) == 9
+    run = dict(dt=1e-3, newton_tol=1e-14)
+    g = rf.gradient(s, 0.4, names, outputs={"p": beam.tip}, running=running, terminal=terminal, **run)
+    _, expected = forward_gradient(s, beam.tip, names, 0.4, **run)
+    assert_gradients_agree(g.gradient, expected, 1e-7)
+    name, h = "hub.rz.drive.q[4]", 1e-4
+    p = s.parameters[name].value
+    J = [rf.gradient(s.with_parameters({name: p + sign * h}), 0.4, [], outputs={"p": beam.tip}, running=running,
+                     terminal=terminal, **run).value for sign in (1, -1)]
+    assert (J[0] - J[1]) / (2 * h) == pytest.approx(g[name], rel=1e-6)

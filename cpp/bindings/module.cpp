@@ -388,12 +388,13 @@ void bind_profiles(py::module_& m) {
           py::list arguments;
           for (const ProfileArgument& a : k.arguments)
             arguments.append(py::dict(py::arg("name") = a.name, py::arg("type") = types[a.type],
-                                      py::arg("expected") = a.expected));
+                                      py::arg("expected") = a.expected, py::arg("affine") = a.affine));
           kinds.append(py::dict(py::arg("maker") = k.maker, py::arg("arguments") = arguments));
         }
         return kinds;
       },
-      "The kinds of profile, each a dict: maker, arguments (name, type, expected) in the maker's order.");
+      "The kinds of profile, each a dict: maker, arguments (name, type, expected, affine: whether the profile is "
+      "affine in its numbers) in the maker's order.");
   m.def("_point_to_point_laws", &point_to_point_laws, "The laws of rest_to_rest_profile and ramp_profile, by name.");
   m.def(
       "callback_profile",

@@ -61,8 +61,7 @@ ParameterVjp::ParameterVjp(const System& sys, const std::vector<SensitivityParam
       V_(sys.nbodies),
       base_{std::vector<double>(sys.nbodies), std::vector<double>(sys.nc), std::vector<double>(sys.elements.size()),
             std::vector<double>(sys.loads.size()), std::vector<double>()},
-      inertia_rates_(parameters.size()), rated_(sys.nbodies, 0), Vl_(sys.nbodies), al_(sys.nbodies),
-      vl_(sys.nbodies), yl_(sys.nbodies) {
+      inertia_rates_(parameters.size()), rated_(sys.nbodies, 0), W_(sys.nbodies), own_(sys.coords.size()), own_at_t_(sys.coords.size(), 0) {
   for (std::size_t j = 0; j < parameters_.size(); ++j) {
     for (const auto& X : {parameters_[j].plus, parameters_[j].minus}) {
       if (!X) continue;
@@ -159,12 +158,18 @@ double ParameterVjp::base_power(const Data& d, const Component& c, const VecX& m
   return cached;
 }
 
-MotionState ParameterVjp::drive_derivative(int j, int coord, double t) const {
+MotionState ParameterVjp::drive_derivative(int j, int coord, double t) {
   const SensitivityParameter& p = parameters_[j];
   const MotionState up = p.plus->coords[coord].drive->at(t);
-  const MotionState down = p.minus ? p.minus->coords[coord].drive->at(t) : sys_.coords[coord].drive->at(t);
+  const MotionState down = p.minus ? p.minus->coords[coord].drive->at(t) : own_drive(coord, t);
   const double h = p.minus ? 2.0 * p.h : p.h;
   return {(up.q - down.q) / h, (up.qd - down.qd) / h, (up.qdd - down.qdd) / h};
+}
+
+const MotionState& ParameterVjp::own_drive(int coord, double t) {
+  if (!(t == own_t_)) own_t_ = t, std::fill(own_at_t_.begin(), own_at_t_.end(), 0);
+  if (!own_at_t_[coord]) own_[coord] = sys_.coords[coord].drive->at(t), own_at_t_[coord] = 1;
+  return own_[coord];
 }
 
 const MotionState& ParameterVjp::drive_rate(int j, const Component& c, double t) {
@@ -196,7 +201,8 @@ void ParameterVjp::add(const Data& d, const VecX& mu, const ResidualVjp& r, doub
     for (int u = sys_.use_start[b]; u < sys_.use_start[b + 1]; ++u)
       if (sys_.use_q[u] >= 0) V_[b] += d.axes[u] * mu(sys_.use_q[u]);
   }
-  // V̂, â, v̂ and ŷ = −v̂ ×m V̂ in each rated body's frame: (ω, v_O) ↦ (Rᵀω, Rᵀ(v_O + ω × o)), o its origin
+  // V̂, â, v̂ and ŷ = −v̂ ×m V̂ in each rated body's frame: (ω, v_O) ↦ (Rᵀω, Rᵀ(v_O + ω × o)), o its origin; a
+  // parameter's part V̂ᵀ İ â + ŷᵀ İ v̂ is ⟨İ, W⟩ (the sum of the entries' products) with W = V̂ âᵀ + ŷ v̂ᵀ, once a body
   for (int b = 0; b < sys_.nbodies; ++b) {
     if (!rated_[b]) continue;
     const Mat3 Rt = d.T[b].topLeftCorner<3, 3>().transpose();
@@ -206,8 +212,9 @@ void ParameterVjp::add(const Data& d, const VecX& mu, const ResidualVjp& r, doub
       x << Rt * m.head<3>(), Rt * (m.tail<3>() + m.head<3>().cross(o));
       return x;
     };
-    Vl_[b] = local(V_[b]), al_[b] = local(d.a[b]), vl_[b] = local(d.v[b]);
-    yl_[b] = -crossm(vl_[b], Vl_[b]);
+    const Vec6 V = local(V_[b]), a = local(d.a[b]), v = local(d.v[b]), y = -crossm(v, V);
+    W_[b].noalias() = V * a.transpose();
+    W_[b].noalias() += y * v.transpose();
   }
   const double t = d.t;
   for (auto& cache : base_) std::fill(cache.begin(), cache.end(), std::numeric_limits<double>::quiet_NaN());
@@ -222,8 +229,7 @@ void ParameterVjp::add(const Data& d, const VecX& mu, const ResidualVjp& r, doub
       continue;
     }
     double sum = 0.0;
-    for (const InertiaRate& r : inertia_rates_[j])
-      sum += Vl_[r.body].dot(r.rate * al_[r.body]) + yl_[r.body].dot(r.rate * vl_[r.body]);
+    for (const InertiaRate& r : inertia_rates_[j]) sum += r.rate.cwiseProduct(W_[r.body]).sum();
     for (const Component& c : touched_[j]) {
       if (c.kind == Component::Actuator || c.kind == Component::Body) continue;
       if (c.kind == Component::Drive) {  // the reverse mode's ∂(μᵀr)/∂ of the prescribed coordinate's motion

@@ -571,43 +571,44 @@ const std::vector<ProfileKind>& profile_kinds() {
   static const char* finite = "a finite number";
   static const char* values = "a 1-D sequence of finite numbers";
   static const std::vector<ProfileKind> kinds = {
-      {"constant_profile", {{"value", P::Number, finite}}, [](const Arguments& a) { return constant_profile(number(a, 0)); }},
-      {"polynomial_profile", {{"coefficients", P::Numbers, values}},
+      {"constant_profile", {{"value", P::Number, finite, true}}, [](const Arguments& a) { return constant_profile(number(a, 0)); }},
+      {"polynomial_profile", {{"coefficients", P::Numbers, values, true}},
        [](const Arguments& a) { return polynomial_profile(numbers(a, 0)); }},
       {"harmonic_profile",
-       {{"amplitude", P::Number, finite}, {"omega", P::Number, finite}, {"phase", P::Number, finite},
-        {"offset", P::Number, finite}},
+       {{"amplitude", P::Number, finite, true}, {"omega", P::Number, finite}, {"phase", P::Number, finite},
+        {"offset", P::Number, finite, true}},
        [](const Arguments& a) { return harmonic_profile(number(a, 0), number(a, 1), number(a, 2), number(a, 3)); }},
       {"harmonic_series_profile",
-       {{"amplitudes", P::Numbers, values}, {"omegas", P::Numbers, values}, {"phases", P::Numbers, values},
-        {"offset", P::Number, finite}},
+       {{"amplitudes", P::Numbers, values, true}, {"omegas", P::Numbers, values}, {"phases", P::Numbers, values},
+        {"offset", P::Number, finite, true}},
        [](const Arguments& a) {
          return harmonic_series_profile(numbers(a, 0), numbers(a, 1), numbers(a, 2), number(a, 3));
        }},
       {"chirp_profile",
-       {{"amplitude", P::Number, finite}, {"f0", P::Number, "a frequency >= 0 in Hz"},
+       {{"amplitude", P::Number, finite, true}, {"f0", P::Number, "a frequency >= 0 in Hz"},
         {"f1", P::Number, "a frequency >= 0 in Hz"}, {"t0", P::Number, finite},
         {"duration", P::Number, "a positive time in s"}},
        [](const Arguments& a) { return chirp_profile(number(a, 0), number(a, 1), number(a, 2), number(a, 3), number(a, 4)); }},
       {"spin_up_profile", {{"omega", P::Number, finite}, {"duration", P::Number, "a positive time in s"}},
        [](const Arguments& a) { return spin_up_profile(number(a, 0), number(a, 1)); }},
-      {"spline_profile", {{"t", P::Numbers, values}, {"q", P::Numbers, values}},
+      {"spline_profile", {{"t", P::Numbers, values}, {"q", P::Numbers, values, true}},
        [](const Arguments& a) { return spline_profile(numbers(a, 0), numbers(a, 1)); }},
       {"rest_to_rest_profile",
-       {{"law", P::Name, law_names()}, {"start", P::Number, finite}, {"end", P::Number, finite},
+       {{"law", P::Name, law_names()}, {"start", P::Number, finite, true}, {"end", P::Number, finite, true},
         {"t0", P::Number, finite}, {"duration", P::Number, "a positive time in s"}, {"fraction", P::Number, finite}},
        [](const Arguments& a) {
          return rest_to_rest_profile(name(a, 0), number(a, 1), number(a, 2), number(a, 3), number(a, 4), number(a, 5));
        }},
       {"ramp_profile",
-       {{"law", P::Name, law_names()}, {"rate", P::Number, finite}, {"t0", P::Number, finite},
-        {"duration", P::Number, "a positive time in s"}, {"start", P::Number, finite}, {"fraction", P::Number, finite}},
+       {{"law", P::Name, law_names()}, {"rate", P::Number, finite, true}, {"t0", P::Number, finite},
+        {"duration", P::Number, "a positive time in s"}, {"start", P::Number, finite, true},
+        {"fraction", P::Number, finite}},
        [](const Arguments& a) {
          return ramp_profile(name(a, 0), number(a, 1), number(a, 2), number(a, 3), number(a, 4), number(a, 5));
        }},
       {"sum_profile",
-       {{"weights", P::Numbers, values}, {"parts", P::Parts, "a list of rigidfem.motion profiles"},
-        {"offset", P::Number, finite}},
+       {{"weights", P::Numbers, values, true}, {"parts", P::Parts, "a list of rigidfem.motion profiles"},
+        {"offset", P::Number, finite, true}},
        [](const Arguments& a) {
          return sum_profile(numbers(a, 0), std::get<std::vector<ProfilePtr>>(a[1]), number(a, 2));
        }},

@@ -112,7 +112,12 @@ class ParameterVjp {
     }
   }
   double base_power(const Data& d, const Component& c, const VecX& mu);
-  MotionState drive_derivative(int j, int coord, double t) const;
+  /// (q, q̇, q̈) of the drive of coordinate `coord` at t differenced between parameter j's systems (one-sided against
+  /// the run's own drive where j has no system at p − h: a number the profile is affine in).
+  MotionState drive_derivative(int j, int coord, double t);
+  /// The run's own drive of coordinate `coord` at t, kept while t stays (the other side of every one-sided difference
+  /// of that drive).
+  const MotionState& own_drive(int coord, double t);
   /// drive_derivative of a Drive component at t, kept while t stays (the objective's outputs and the step's end ask
   /// at the same t).
   const MotionState& drive_rate(int j, const Component& c, double t);
@@ -131,10 +136,13 @@ class ParameterVjp {
   };
   std::vector<std::vector<InertiaRate>> inertia_rates_;  // per parameter
   std::vector<char> rated_;                              // per body: some parameter moves its inertia
-  std::vector<Vec6> Vl_, al_, vl_, yl_;                  // per rated body: V̂, â, v̂, ŷ at the state
+  std::vector<Mat6> W_;                                  // per rated body: V̂ âᵀ + ŷ v̂ᵀ at the state
   double rates_t_ = std::numeric_limits<double>::quiet_NaN();  // the time of the drive rates kept
   std::vector<MotionState> rates_;                             // per Drive component (its slot)
   std::vector<char> rated_at_t_;                               // per slot: kept at rates_t_
+  double own_t_ = std::numeric_limits<double>::quiet_NaN();    // the time of the own drives kept
+  std::vector<MotionState> own_;                               // per coordinate (in coords): own_drive at own_t_
+  std::vector<char> own_at_t_;                                 // per coordinate: kept at own_t_
   std::unique_ptr<Data> e_;                       // the loops' terms on the systems at p ± h (same sizes)
 };
 

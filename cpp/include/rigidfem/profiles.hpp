@@ -86,6 +86,9 @@ struct ProfileArgument {
   const char* name;
   Type type;
   const char* expected;
+  /// Whether the profile is affine in this argument's numbers, the others fixed (a spline's values, a harmonic's
+  /// amplitude): a difference of two profiles by any step is then its derivative, to round-off.
+  bool affine = false;
 };
 
 /// A kind of profile, described once: its maker's name, its arguments in order (its recipe's), and the maker, which

@@ -1121,7 +1121,7 @@ def _point_to_point_laws() -> list[str]:
     """
 def _profile_kinds() -> list:
     """
-    The kinds of profile, each a dict: maker, arguments (name, type, expected) in the maker's order.
+    The kinds of profile, each a dict: maker, arguments (name, type, expected, affine: whether the profile is affine in its numbers) in the maker's order.
     """
 def _real(x: typing.Any, name: str, expected: str) -> float:
     """

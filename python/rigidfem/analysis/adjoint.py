@@ -154,7 +154,7 @@ def gradient(system, t_end: float, parameters=None, *, outputs, running=None, te
     if parameters is None:
         parameters = list(system.parameters)
     _probe(system, specs, names, running, terminal, t0, q0)  # a bad objective is named before any run
-    directions = sensitivities_.directions(system, parameters, opt, t0, t_end, "parameters")
+    directions = sensitivities_.directions(system, parameters, opt, t0, t_end, "parameters", one_sided_drives=True)
     integration._check_closed(system, t0, q0, qd0)  # the arguments first, then whether the state closes the loops
     adjoint = _core._Adjoint(system, opt, specs, memory)
     start = time.perf_counter()

@@ -378,6 +378,13 @@ class Parameters:
         """The compiled system ``base`` with the parameter ``name`` at its value + h (unchecked: a difference's)."""
         return self.changes({name: self.values[name] + h}).apply(base)
 
+    def drive_affine(self, name: str) -> bool:
+        """Whether ``name`` is a number of a prescribed coordinate's drive that its profile is affine in: the
+        difference of the profiles at p + h and p is then (q, q̇, q̈)'s derivative by it for any h, to round-off."""
+        prefix, short = self.where[name]
+        group = self.groups[prefix]
+        return isinstance(group, ProfileGroup) and group.what == "drive" and group.affine(short)
+
     def step(self, name: str) -> float:
         """The step h of the parameter's difference (R(p + h) − R(p))/h: the constants it sets enter the
         residual linearly, so any h gives ∂R/∂p to round-off; h = |p| (1 of its unit at p = 0) keeps that
@@ -440,6 +447,10 @@ class Parameters:
 #: The arguments of each kind of profile, in the order of its recipe (``Profile.__reduce__``): the C++ table's
 #: (``profile_kinds`` in ``cpp/src/profiles.cpp``).
 PROFILE_ARGUMENTS = {k["maker"]: tuple(a["name"] for a in k["arguments"]) for k in _core._profile_kinds()}
+#: The arguments each kind of profile is affine in, the others fixed (the same table's ``affine``).
+PROFILE_AFFINE = {k["maker"]: frozenset(a["name"] for a in k["arguments"] if a["affine"]) for k in _core._profile_kinds()}
+#: The kinds whose parts' numbers stay affine in the whole (Σ w_k p_k + offset, p(t − delay)).
+AFFINE_IN_PARTS = frozenset({"sum_profile", "shifted_profile"})
 
 
 def _recipe(profile):
@@ -471,6 +482,27 @@ def profile_leaves(profile, path: str = "") -> dict[str, float]:
             out.update({f"{here}[{k}]": float(v) for k, v in enumerate(arg)})
         elif isinstance(arg, float):
             out[here] = arg
+    return out
+
+
+def affine_leaves(profile, path: str = "") -> set[str]:
+    """The paths of profile_leaves the profile is affine in (each alone, the others fixed): its kind's affine
+    arguments, and a sum's or a shift's parts' own, by the kinds' table."""
+    recipe = _recipe(profile)
+    if recipe is None:
+        return set()
+    maker, names, args = recipe
+    out = set()
+    for name, arg in zip(names, args):
+        here = f"{path}{name}"
+        if isinstance(arg, _core.Profile):
+            out |= affine_leaves(arg, here + ".") if maker in AFFINE_IN_PARTS else set()
+        elif isinstance(arg, (list, tuple)) and arg and isinstance(arg[0], _core.Profile):
+            if maker in AFFINE_IN_PARTS:
+                for k, part in enumerate(arg):
+                    out |= affine_leaves(part, f"{here}[{k}].")
+        elif name in PROFILE_AFFINE[maker]:
+            out |= {f"{here}[{k}]" for k in range(len(arg))} if isinstance(arg, (list, tuple)) else {here}
     return out
 
 
@@ -532,3 +564,9 @@ class ProfileGroup(Group):
         if not hasattr(self, "leaves"):
             self.leaves = profile_leaves(self.profile)
         return self.leaves
+
+    def affine(self, short: str) -> bool:
+        """Whether the profile is affine in its number ``short`` (``affine_leaves``)."""
+        if not hasattr(self, "affine_paths"):
+            self.affine_paths = affine_leaves(self.profile)
+        return short in self.affine_paths

@@ -44,10 +44,14 @@ from ..base import _checks
 from ..model import parameters as parameters_
 
 
-def directions(system, names, options, t0: float, t1: float, argument: str = "sensitivities") -> list[str]:
+def directions(system, names, options, t0: float, t1: float, argument: str = "sensitivities",
+               one_sided_drives: bool = False) -> list[str]:
     """Adds each named direction's systems at p + h (and p − h for a profile's number) and initial sensitivity
-    to the C++ ``options`` for a run over [t0, t1] (s); returns the names. ValueError naming what is not a
-    parameter or an initial value of the system."""
+    to the C++ ``options`` for a run over [t0, t1] (s); returns the names. ``one_sided_drives`` (the adjoint's,
+    which differences only a drive's (q, q̇, q̈), not the residual): a number a drive's profile is affine in (a
+    spline's values) takes the system at p + h alone, h = |p| (1 at p = 0), on a system without loops (whose g,
+    G and γ the prescribed coordinates reach nonlinearly). ValueError naming what is not a parameter or an
+    initial value of the system."""
     system = _checks.system(system)
     names = parameters_.names_argument(names, argument, "parameter names (System.parameters) or initial "
                                                               "values 'q0[<coordinate>]', 'qd0[<coordinate>]'")
@@ -62,7 +66,7 @@ def directions(system, names, options, t0: float, t1: float, argument: str = "se
             continue
         params = system._parameters
         parameter = params.parameter(name, argument)  # ValueError naming an unknown one
-        if parameter.linear:
+        if parameter.linear or (one_sided_drives and not system.nl and params.drive_affine(name)):
             h = params.step(name)
             options.add_sensitivity(params.shifted(system, name, h), None, h, S0)
             continue
