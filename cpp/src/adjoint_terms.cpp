@@ -61,7 +61,8 @@ ParameterVjp::ParameterVjp(const System& sys, const std::vector<SensitivityParam
       V_(sys.nbodies),
       base_{std::vector<double>(sys.nbodies), std::vector<double>(sys.nc), std::vector<double>(sys.elements.size()),
             std::vector<double>(sys.loads.size()), std::vector<double>()},
-      inertia_rates_(parameters.size()), rated_(sys.nbodies, 0), W_(sys.nbodies), own_(sys.coords.size()), own_at_t_(sys.coords.size(), 0) {
+      inertia_rates_(parameters.size()), rated_(sys.nbodies, 0), W_(sys.nbodies), own_(sys.coords.size()),
+      own_at_t_(sys.coords.size(), 0) {
   for (std::size_t j = 0; j < parameters_.size(); ++j) {
     for (const auto& X : {parameters_[j].plus, parameters_[j].minus}) {
       if (!X) continue;

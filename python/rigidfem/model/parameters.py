@@ -540,7 +540,9 @@ class ProfileGroup(Group):
     a winch's unstretched length ("<rope>.length"), a cylinder's force ("<element>.profile"), a load's scale
     ("<load>.scale"), an actuator's length ("<actuator>.length") or a link's free length ("<beam>.length") — each a parameter "<prefix>.<path>":
     ``coefficients[2]`` of a polynomial, ``amplitude`` of a harmonic, ``q[3]`` of a spline, ``parts[1].omega`` of
-    a sum. The residual is not linear in them: their sensitivities difference the systems at p ± h."""
+    a sum. The residual is not linear in them: their sensitivities difference the systems at p ± h. The adjoint
+    (``rf.gradient``) differences only a drive's (q, q̇, q̈): a number the profile is affine in (``affine``) takes
+    the system at p + h alone."""
 
     def __init__(self, prefix, what: str, body: int, index: int, profile, unit: str):
         self.profile, self.what, self.body, self.index = profile, what, body, index
