@@ -130,6 +130,28 @@ def test_stiff_beam_implicit_methods_take_steps_100_times_the_explicit_limit():
         rf.simulate(system, t_end, method="dopri5", q0=q0, max_steps=2000)
 
 
+def test_a_fixed_step_beyond_the_limit_ends_before_an_event_fires_on_noise():
+    """An arm on a universal joint held by a spring of 1e8 N/m (ω = 5.3e3 and 6.6e3 rad/s), from rest, at rk4's
+    h = 1 ms (h ω ≈ 6, past the limit 2.8): in its first steps the state goes from 0 to 7e6, then to 1e49 in one step
+    (the rotations' quadratic terms). The run stops there with a SimulationError naming the stability limit and the
+    one step's growth, before its terminal rate event can be located in a step whose state spans 40 orders of
+    magnitude (a root there would be rounding noise, not the event's level). At h = 10 µs the same event fires where
+    the rate is 0.1."""
+    model = rf.Model(gravity=None)
+    R = rf.euler_zyx(0.3, 2.0, -0.2)
+    arm = model.add_body("arm", model.ground, rf.Joint.universal(("y", "z"), stiffness=[0.0, 20.0]), mass=2.0,
+                         inertia=R @ np.diag((0.2, 0.14, 0.3366)) @ R.T,
+                         placement=rf.transform((-0.2, -1.0, -0.2), (1.0, -0.2, -0.2)))
+    model.add_spring_damper("spring", arm.point((0.3, 0.0, -0.2)), model.ground.point((0.0, 0.0, 0.0)),
+                            stiffness=1e8, length=1.0)
+    system = model.compile()
+    event = rf.Event("fast", "arm.rz", rate=True, value=0.1, terminal=True)
+    with pytest.raises(rf.SimulationError, match=r"beyond the stability limit of rk4.*in one step"):
+        rf.simulate(system, 0.2, method="rk4", dt=1e-3, events=[event])
+    r = rf.simulate(system, 0.2, method="rk4", dt=1e-5, events=[event])
+    assert len(r.events) == 1 and r.events[0].qd[0] == pytest.approx(0.1, rel=1e-6)
+
+
 def test_stiff_beam_explicit_adaptive_finishes_correctly_at_a_documented_cost():
     system, beam, q0 = stiff_beam(m=10)
     _, w = modal_reference(system, q0, [0.0])

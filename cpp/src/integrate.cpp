@@ -345,6 +345,11 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
   const Tolerances* tol = choice ? &choice->tolerances() : &asked;
   double h = o.dt > 0.0 ? std::min(o.dt, span) : stepper->initial_step(span, *tol, o.max_step);
 
+  // A fixed step of an explicit method beyond its stability limit: the state (q, q̇) growing more than 1e10 times in
+  // one step (from at least 1 of its units) ends the run, as NaN would a few steps later (an event located in such a
+  // step would be noise, not a root)
+  const bool blowups = !adaptive && method_info(first.method).make == make_runge_kutta && n > 0;
+  const auto size = [&] { return stepper->state().head(2 * n).cwiseAbs().maxCoeff(); };
   double t = t0;
   bool measured = false;  // the measure is linearised at the current state
   while (t < t_end) {
@@ -383,7 +388,11 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
       }
       control.stiffness(stepper->h_rho(), t1, stats);
     }
+    const double before = blowups ? size() : 0.0;
     stepper->accept();
+    if (blowups && size() > 1e10 * std::max(1.0, before))
+      step_failure(t, hs, "the largest of q and q̇ went from " + num(before) + " to " + num(size()) +
+                              " (m, rad, per s) in one step");
     measured = false;
     if (sys.nl > 0) stepper->project(t1);
     if (!events.empty()) {
