@@ -137,7 +137,9 @@ def test_an_error_estimate_answers_ctrl_c_with_keyboard_interrupt():
     """Ctrl-C in the second run of Result.error_estimate: KeyboardInterrupt naming it, not an estimate
     from a partial run."""
     model, _ = samples.kane_beam(omega=4.0, elements=8)
-    first = rf.simulate(model.compile(), 100.0, method="dopri5", rtol=1e-7, atol=1e-9, t_eval=[0.0, 100.0],
+    # 300 s: the second run takes about 1 s on 2 cores (100 s took 0.34 s, too close to the 0.3 s the interrupt
+    # comes after)
+    first = rf.simulate(model.compile(), 300.0, method="dopri5", rtol=1e-7, atol=1e-9, t_eval=[0.0, 300.0],
                         stiffness_warning=False)
 
     def run():

@@ -391,8 +391,9 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
     const double before = blowups ? size() : 0.0;
     stepper->accept();
     if (blowups && size() > 1e10 * std::max(1.0, before))
-      step_failure(t, hs, "the largest of q and q̇ went from " + num(before) + " to " + num(size()) +
-                              " (m, rad, per s) in one step");
+      throw SimulationError(t, "the fixed step dt = " + num(o.dt) + " s is beyond the stability limit of " +
+                                   std::string(method_name(first.method)) + " for this problem: the largest of q and q̇ "
+                                   "went from " + num(before) + " to " + num(size()) + " (m, rad, per s) in one step");
     measured = false;
     if (sys.nl > 0) stepper->project(t1);
     if (!events.empty()) {
@@ -474,6 +475,7 @@ void run(const System& sys, double t0, double t_end, const VecX& q0, const VecX&
 /// ones are unconditionally stable and say why Newton failed), or Euler angles near gimbal lock.
 SimulationError explained(const SimulationError& e, const System& sys, const VecX& q0, const VecX& last_q,
                           const IntegratorOptions& o) {
+  if (e.cause.rfind("the fixed step dt", 0) == 0) return e;  // the run's own blow-up stop says it already
   const double growth = max_abs(last_q) / std::max(max_abs(q0), 1e-6);
   const bool explicit_method = method_info(o.method).make == make_runge_kutta;
   if (!is_adaptive(o) && explicit_method && (growth > 1e3 || !last_q.allFinite()))
