@@ -3,6 +3,7 @@
 #include <cmath>
 #include <stdexcept>
 #include <string>
+#include <type_traits>
 
 #include "rigidfem/errors.hpp"
 
@@ -168,6 +169,18 @@ bool invert_fixed(const Eigen::Matrix<double, N, N>& D, Eigen::Matrix<double, N,
   }
 }
 
+// Calls f(std::integral_constant<int, N>()) for a body's N = nf free coordinates where N is 1, 2 or 3 (the
+// fixed-size paths); false for any other nf.
+template <class F>
+bool fixed_size(int nf, F&& f) {
+  switch (nf) {
+    case 1: f(std::integral_constant<int, 1>()); return true;
+    case 2: f(std::integral_constant<int, 2>()); return true;
+    case 3: f(std::integral_constant<int, 3>()); return true;
+    default: return false;
+  }
+}
+
 // ABA pass 2, inertia part, of a body with N = 1, 2 or 3 free coordinates (a revolute joint, an sde's two or
 // three rotations) in fixed-size arithmetic: U = I^A S, D = Sᵀ U + diag(δ), I^a = I^A − U D⁻¹ Uᵀ.
 template <int N>
@@ -193,13 +206,7 @@ void articulated_inertias(const System& sys, Data& d, const VecX* armature) {
     Subspace& S = d.S[p];
     S.resize(6, nf);
     for (int k = 0; k < nf; ++k) S.col(k) = d.axes[sys.q_use[k0 + k]];
-    if (nf == 1) {
-      fixed_inertia<1>(sys, d, armature, p);
-    } else if (nf == 2) {
-      fixed_inertia<2>(sys, d, armature, p);
-    } else if (nf == 3) {
-      fixed_inertia<3>(sys, d, armature, p);
-    } else {
+    if (!fixed_size(nf, [&](auto N) { fixed_inertia<N>(sys, d, armature, p); })) {
       d.U6[p].noalias() = d.IA[p] * S;
       if (nf > 0) {
         SmallMat D = S.transpose() * d.U6[p];
@@ -241,13 +248,7 @@ void articulated_accelerations(const System& sys, Data& d, const VecX& tau, cons
   for (int p = sys.nbodies - 1; p >= 0; --p) {
     Vec6 pa = d.pA[p] + d.IA[p] * d.c[p];
     const int k0 = sys.q_index[p], nf = sys.nq_of[p];
-    if (nf == 1) {
-      fixed_bias<1>(sys, d, tau, p, pa);
-    } else if (nf == 2) {
-      fixed_bias<2>(sys, d, tau, p, pa);
-    } else if (nf == 3) {
-      fixed_bias<3>(sys, d, tau, p, pa);
-    } else if (nf > 0) {
+    if (!fixed_size(nf, [&](auto N) { fixed_bias<N>(sys, d, tau, p, pa); }) && nf > 0) {
       d.u[p] = tau.segment(k0, nf) - d.S[p].transpose() * d.pA[p];
       pa += d.U6[p] * (d.Dinv[p] * d.u[p]);
     }
@@ -256,13 +257,7 @@ void articulated_accelerations(const System& sys, Data& d, const VecX& tau, cons
   for (int p = 0; p < sys.nbodies; ++p) {
     Vec6 a = parent_value(sys, d.a, p, a0) + d.c[p];
     const int k0 = sys.q_index[p], nf = sys.nq_of[p];
-    if (nf == 1) {
-      fixed_acceleration<1>(sys, d, p, x, a);
-    } else if (nf == 2) {
-      fixed_acceleration<2>(sys, d, p, x, a);
-    } else if (nf == 3) {
-      fixed_acceleration<3>(sys, d, p, x, a);
-    } else if (nf > 0) {
+    if (!fixed_size(nf, [&](auto N) { fixed_acceleration<N>(sys, d, p, x, a); }) && nf > 0) {
       const SmallVec qdd = d.Dinv[p] * (d.u[p] - d.U6[p].transpose() * a);
       x.segment(k0, nf) = qdd;
       for (int k = 0; k < nf; ++k) a += d.S[p].col(k) * qdd(k);
