@@ -112,3 +112,36 @@ def test_velocity_projection_is_mass_weighted_at_a_singular_position(system):
         assert system.kinetic_energy(0.0, q, qd_p) <= system.kinetic_energy(0.0, q, qd) + 1e-12
         g, gd, _ = system.loop_constraints(0.0, q, qd_p)
         assert np.abs(gd).max() < 1e-12
+
+
+def _pseudo_inverse(A, b):
+    """A⁺ b by numpy's eigh: eigenvalues at most 1e-10 of the largest count as zero."""
+    lam, V = np.linalg.eigh(A)
+    keep = lam > 1e-10 * lam.max() if lam.max() > 0 else np.zeros(len(lam), bool)
+    c = V.T @ b
+    c[keep] /= lam[keep]
+    c[~keep] = 0.0
+    return V @ c
+
+
+@pytest.mark.parametrize("n, rank, zero_rows, gap", [(5, 4, 0, 0.0), (5, 2, 3, 0.0), (6, 6, 0, 0.0), (8, 5, 1, 0.0),
+                                                     (5, 5, 0, 1e-8), (5, 5, 0, 1e-12), (12, 9, 2, 0.0), (3, 0, 3, 0.0)])
+def test_the_loops_least_norm_solve_is_the_pseudo_inverse(n, rank, zero_rows, gap):
+    """The solve of the loops' G M⁻¹ Gᵀ λ = r: exact dependencies (a Bricard linkage's redundant row, a planar
+    loop's zero rows out of its plane), a smallest eigenvalue 1e-8 of the largest (kept) or 1e-12 (dropped), more
+    rows than the small path takes; against numpy's eigendecomposition with the same floor."""
+    rng = np.random.default_rng(n * 100 + rank + zero_rows)
+    for _ in range(20):
+        B = rng.normal(size=(n, max(rank, 1))) * (rank > 0)
+        if gap:
+            B[:, -1] *= np.sqrt(gap) * np.linalg.norm(B[:, :-1], 2)
+        B[rng.permutation(n)[:zero_rows]] = 0.0
+        A = B @ B.T
+        b = rng.normal(size=n)
+        x = rf._core._least_norm_symmetric(A, b)
+        expected = _pseudo_inverse(A, b)
+        scale = max(1.0, np.abs(expected).max())
+        # to the round-off the conditioning allows: 1e8 times the unit round-off where an eigenvalue is 1e-8
+        np.testing.assert_allclose(x, expected, rtol=0, atol=(1e-6 if gap == 1e-8 else 1e-10) * scale)
+    with pytest.raises(ValueError, match="A, b"):
+        rf._core._least_norm_symmetric(np.eye(3), np.ones(2))

@@ -115,6 +115,16 @@ Data& data_of(const py::handle& x) {
 }  // namespace
 
 void bind_dynamics(py::module_& m) {
+  m.def(
+      "_least_norm_symmetric", [](const MatX& A, const VecX& b) {
+        if (A.rows() != A.cols() || b.size() != A.rows())
+          throw std::invalid_argument("A, b: expected a square (n, n) array A and b of n numbers");
+        return least_norm_symmetric(A, b);
+      },
+      py::arg("A"),
+      py::arg("b"),
+      "x = A⁺ b for a symmetric positive semi-definite A (the loops' G M⁻¹ Gᵀ): its eigenvalues below 1e-10 of the "
+      "largest count as zero (constraints.hpp).");
   // Data is registered first, so that the signatures of System's methods name it (the stub's types).
   py::class_<Data> data(m, "Data",
       "Workspace of the algorithms; after each stage it holds that stage's results.\n"

@@ -1,5 +1,6 @@
 #include "rigidfem/constraints.hpp"
 
+#include <Eigen/Cholesky>
 #include <Eigen/Eigenvalues>
 #include <Eigen/SVD>
 #include <array>
@@ -75,21 +76,22 @@ void spatial_track(const System& sys, const Data& d, int p, const std::pair<Vec6
     }
 }
 
-/// The columns h = 0..3 of frame F in body p as tracks, from the spatial kinematics or the 4x4 ones.
-/// Into tr, whose Jacobians keep their storage from call to call (the loops' rows allocate nothing once sized).
-void frame_tracks(const System& sys, const Data& d, int p, const Mat4& F, int columns, bool spatial,
+/// The columns h of frame F in body p whose bit 1 << h is in `columns` (0..2: the axes, 3: the origin) as
+/// tracks, from the spatial kinematics or the 4x4 ones. Into tr, whose Jacobians keep their storage from call
+/// to call (the loops' rows allocate nothing once sized).
+void frame_tracks(const System& sys, const Data& d, int p, const Mat4& F, unsigned columns, bool spatial,
                   std::array<Track, 4>& tr) {
-  if (p < 0) {  // the ground: F itself, at rest
-    for (int h = 0; h < 4; ++h) {
+  const auto motion = spatial && p >= 0 ? body_motion(sys, d, p) : std::pair<Vec6, Vec6>{};
+  for (int h = 0; h < 4; ++h) {
+    if (!(columns & (1u << h))) continue;
+    if (p < 0) {  // the ground: F itself, at rest
       tr[h].x = F.block<3, 1>(0, h), tr[h].xd.setZero(), tr[h].xdd.setZero();
       tr[h].J.setZero(3, sys.nc);
+    } else if (spatial) {
+      spatial_track(sys, d, p, motion, F, h, tr[h]);
+    } else {
+      homogeneous_track(sys, d, p, F, h, tr[h]);
     }
-    return;
-  }
-  const auto motion = spatial ? body_motion(sys, d, p) : std::pair<Vec6, Vec6>{};
-  for (int h = 4 - columns; h < 4; ++h) {
-    if (spatial) spatial_track(sys, d, p, motion, F, h, tr[h]);
-    else homogeneous_track(sys, d, p, F, h, tr[h]);
   }
 }
 
@@ -110,6 +112,14 @@ struct KindRow {
   const char* doc;
   std::vector<int> positions;
   std::vector<std::pair<int, int>> directions;
+  /// The columns of frames A and B (bits 1 << h, h = 3 the origin) that its rows read.
+  std::pair<unsigned, unsigned> columns() const {
+    if (kind == LoopKind::Distance) return {8u, 8u};
+    unsigned a = positions.empty() ? 0u : 8u, b = a;
+    for (int i : positions) a |= 1u << i;
+    for (const auto& [j, i] : directions) b |= 1u << j, a |= 1u << i;
+    return {a, b};
+  }
 };
 
 const std::vector<KindRow>& kind_table() {
@@ -162,14 +172,15 @@ void constraint_equations(const System& sys, Data& d, bool spatial) {
   for (std::size_t k = 0; k < sys.loops.size(); ++k) {
     const Loop& L = sys.loops[k];
     int r = sys.loop_row[k];
-    // The origins (columns 3) and, for the joints, the axes (columns 0..2) of frames A and B.
-    const int columns = L.kind == LoopKind::Distance ? 1 : 4;
+    // The origins (columns 3) and the axes (columns 0..2) of frames A and B that the kind's rows read.
+    const KindRow& rows = layout(L.kind);
+    const auto [columns_a, columns_b] = rows.columns();
     // the frames' tracks in a workspace of this thread, sized once for the system's coordinates
     thread_local std::array<Track, 4> a, b;
     thread_local Track dr;
-    frame_tracks(sys, d, L.body_a, L.frame_a, columns, spatial, a);
-    frame_tracks(sys, d, L.body_b, L.frame_b, columns, spatial, b);
-    difference(b[3], a[3], dr);
+    frame_tracks(sys, d, L.body_a, L.frame_a, columns_a, spatial, a);
+    frame_tracks(sys, d, L.body_b, L.frame_b, columns_b, spatial, b);
+    if (columns_a & 8u) difference(b[3], a[3], dr);
     if (L.kind == LoopKind::Distance) {
       const MotionState l = L.drive ? L.drive->at(d.t) : MotionState{L.length, 0.0, 0.0};
       if (!std::isfinite(l.q) || !std::isfinite(l.qd) || !std::isfinite(l.qdd))
@@ -177,7 +188,6 @@ void constraint_equations(const System& sys, Data& d, bool spatial) {
       distance_row(d, r, dr, l, L.name);
       continue;
     }
-    const KindRow& rows = layout(L.kind);
     for (int i : rows.positions) dot_row(d, r++, dr, a[i]);
     for (const auto& [j, i] : rows.directions) dot_row(d, r++, b[j], a[i]);
   }
@@ -205,8 +215,58 @@ void row_basis(const MatX& G, MatX& B) {
   B = svd.matrixU().leftCols(r);
 }
 
+namespace {
+
+using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 8, 8>;  // a few loop rows, on the stack
+using SmallV = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 8, 1>;
+
+/// x = A⁺ b (n <= 8) by a diagonally pivoted Cholesky factor P A Pᵀ = L Lᵀ (L: n × r) where A's spectrum has a
+/// clear gap: the Schur complement left after r pivots has a trace <= 1e-14 tr A (the round-off of exact
+/// dependencies: a Bricard linkage's redundant row, a planar loop's rows out of its plane) and LᵀL, whose
+/// eigenvalues are A's r others, a reciprocal condition estimate > 1e-6. The eigenvalue floor of
+/// least_norm_symmetric (1e-10 λ_max) keeps those r and drops the rest, and then A⁺ = Pᵀ L (LᵀL)⁻² Lᵀ P.
+/// False where the gap is not that clear.
+bool pseudo_inverse_by_pivots(const MatX& A, const VecX& b, VecX& x) {
+  const Eigen::Index n = A.rows();
+  Small W = A.selfadjointView<Eigen::Lower>(), L = Small::Zero(n, n);
+  Eigen::Matrix<Eigen::Index, Eigen::Dynamic, 1, 0, 8, 1> p(n);
+  for (Eigen::Index i = 0; i < n; ++i) p(i) = i;
+  const double trace = W.trace();
+  if (!(trace >= 0.0) || !std::isfinite(trace)) return false;
+  Eigen::Index r = 0;
+  for (; r < n; ++r) {
+    Eigen::Index j;
+    const double pivot = W.diagonal().tail(n - r).maxCoeff(&j);
+    if (!(pivot > 1e-14 * trace)) break;
+    j += r;
+    if (j != r) {  // the pivot's row and column to position r
+      W.row(r).swap(W.row(j)), W.col(r).swap(W.col(j)), L.row(r).swap(L.row(j)), std::swap(p(r), p(j));
+    }
+    // L_kr = W_kr / √W_rr (k >= r), W_kl −= L_kr L_lr on the rest
+    L.col(r).tail(n - r) = W.col(r).tail(n - r) / std::sqrt(pivot);
+    W.bottomRightCorner(n - r - 1, n - r - 1).noalias() -= L.col(r).tail(n - r - 1) * L.col(r).tail(n - r - 1).transpose();
+  }
+  if (r < n && !(W.diagonal().tail(n - r).cwiseAbs().sum() <= 1e-14 * trace)) return false;
+  x.setZero(n);
+  if (r == 0) return true;  // A = 0
+  const auto B = L.leftCols(r);
+  const Eigen::LLT<Small> gram(Small(B.transpose() * B));
+  if (gram.info() != Eigen::Success || !(gram.rcond() > 1e-6)) return false;
+  SmallV bp(n);
+  for (Eigen::Index i = 0; i < n; ++i) bp(i) = b(p(i));
+  SmallV z = B.transpose() * bp;
+  gram.solveInPlace(z);
+  gram.solveInPlace(z);
+  const SmallV xp = B * z;
+  for (Eigen::Index i = 0; i < n; ++i) x(p(i)) = xp(i);
+  return x.allFinite();
+}
+
+}  // namespace
+
 void least_norm_symmetric(const MatX& A, const VecX& b, Eigen::SelfAdjointEigenSolver<MatX>& eigen, VecX& c,
                           VecX& x) {
+  if (A.rows() <= 8 && pseudo_inverse_by_pivots(A, b, x)) return;
   // x = V Λ⁺ Vᵀ b, A = V Λ Vᵀ (the lower triangle read), λ_i⁺ = 1/λ_i for λ_i > 1e-10 λ_max, else 0
   // (a negative λ_i is round-off of a zero one).
   eigen.compute(A);

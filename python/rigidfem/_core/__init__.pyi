@@ -1095,6 +1095,10 @@ def _integer(x: typing.Any, name: str, expected: str, lo: typing.SupportsInt | t
     """
 def _integrate(system: _System, t0: typing.SupportsFloat | typing.SupportsIndex, t_end: typing.SupportsFloat | typing.SupportsIndex, q0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], qd0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], t_eval: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], options: IntegratorOptions, keep_going: typing.Any) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], dict, bool, typing.Any, typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], list]:
     ...
+def _least_norm_symmetric(A: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"], b: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+    """
+    x = A⁺ b for a symmetric positive semi-definite A (the loops' G M⁻¹ Gᵀ): its eigenvalues below 1e-10 of the largest count as zero (constraints.hpp).
+    """
 def _make_profile(maker: str, *args) -> typing.Any:
     """
     The profile of the kind `maker` (a row of _profile_kinds) from its arguments, in the row's order.
