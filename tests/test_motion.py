@@ -107,6 +107,8 @@ def test_spin_up_continuity_at_the_end_of_the_ramp(W, T):
         ([0.0, 1.0], [1.0, 3.0]),  # two points: a straight line
         ([-1.0, 0.5, 2.0], [0.0, 2.0, -1.0]),
         (np.linspace(0, 1, 11), np.sin(3 * np.linspace(0, 1, 11))),
+        # unevenly spaced knots: the interval found by bisection where the even-spacing guess misses
+        (np.cumsum(np.r_[0.0, np.random.default_rng(3).uniform(0.05, 1.0, 40)]), np.cos(np.arange(41.0))),
     ],
 )
 def test_spline_matches_scipy_natural_cubic_spline(t, q):

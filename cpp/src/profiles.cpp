@@ -188,14 +188,24 @@ class Spline final : public Profile {
       const double slope = segment(k, te).qd;
       return {(left ? q_.front() : q_.back()) + slope * (t - te), slope, 0.0};
     }
-    // The knot interval [t_k, t_k+1) holding t; clamped, so a NaN t reads no knot beyond the table.
-    const size_t after = static_cast<size_t>(std::upper_bound(t_.begin(), t_.end(), t) - t_.begin());
-    return segment(std::min(std::max(after, size_t{1}), n - 1) - 1, t);
+    return segment(interval(t), t);
   }
   std::string describe() const override { return "spline(" + std::to_string(t_.size()) + " points)"; }
   ProfileRecipe recipe() const override { return {"spline_profile", {t_, q_}}; }
 
  private:
+  /// The knot interval [t_k, t_k+1) holding t (t_0 < t < t_n): guessed as if the knots were evenly spaced (one
+  /// look for np.linspace's), checked, else found by bisection; a NaN t reads no knot beyond the table.
+  size_t interval(double t) const {
+    const size_t n = t_.size();
+    const double guess = (t - t_.front()) / (t_.back() - t_.front()) * static_cast<double>(n - 1);
+    if (guess >= 0.0 && guess < static_cast<double>(n - 1)) {
+      const size_t k = static_cast<size_t>(guess);
+      if (t_[k] <= t && t < t_[k + 1]) return k;
+    }
+    const size_t after = static_cast<size_t>(std::upper_bound(t_.begin(), t_.end(), t) - t_.begin());
+    return std::min(std::max(after, size_t{1}), n - 1) - 1;
+  }
   MotionState segment(size_t k, double t) const {
     const double h = t_[k + 1] - t_[k], a = (t_[k + 1] - t) / h, b = (t - t_[k]) / h;
     const double m0 = m_[k], m1 = m_[k + 1];
