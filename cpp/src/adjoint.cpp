@@ -77,7 +77,7 @@ class Transposes : public AdjointSteps {
     stepper().start(t0, y0);
   }
   const Data& at_end(const StepRecord& end) override {
-    at(end.t, end.q, end.v, end.qdd);
+    at(d_, end.t, end.q, end.v, end.qdd);
     return d_;
   }
   void step(double t, double h) override {
@@ -102,16 +102,17 @@ class Transposes : public AdjointSteps {
     loop_equations(sys_, e_, t, q - eps * v, qd);
     return (up - free_jacobian(sys_, e_).transpose() * lambda) / (2.0 * eps);
   }
-  /// set_state, q̈ and the axes on d_ at (t, q, q̇, q̈): what the reverse mode starts from.
-  void at(double t, const Eigen::Ref<const VecX>& q, const Eigen::Ref<const VecX>& v, const Eigen::Ref<const VecX>& a) {
-    set_state(sys_, d_, t, q, v);
-    set_accelerations(sys_, d_, a);
-    tree_kinematics(sys_, d_);
+  /// set_state, q̈ and the axes on d at (t, q, q̇, q̈): what the reverse mode starts from.
+  void at(Data& d, double t, const Eigen::Ref<const VecX>& q, const Eigen::Ref<const VecX>& v,
+          const Eigen::Ref<const VecX>& a) {
+    set_state(sys_, d, t, q, v);
+    set_accelerations(sys_, d, a);
+    tree_kinematics(sys_, d);
   }
   /// (Kᵀμ, Cᵀμ, Mμ) at (t, q, q̇, q̈); d_ keeps the state's spatial kinematics and RNEA pass (ParameterVjp::add).
   ResidualVjp vjp(double t, const Eigen::Ref<const VecX>& q, const Eigen::Ref<const VecX>& v,
                   const Eigen::Ref<const VecX>& a, const VecX& mu) {
-    at(t, q, v, a);
+    at(d_, t, q, v, a);
     transpose_.prepare(d_);
     return transpose_.apply(d_, mu);
   }
@@ -142,8 +143,10 @@ class Transposes : public AdjointSteps {
   std::unique_ptr<NewtonMatrix> matrix_;
   Gmres<double> gmres_;
   // measured on strips of 20-320 elements over 1000 steps: an O(n) armature factor is worth refreshing after 2
-  // iterations, a dense LU after 5 (2.6-4.1 runs for the gradient; 4.6-5.4 after 3 or 4, 3.7-5.2 after 8)
-  const long refresh_above_ = matrix_->krylov() ? 2 : 5;
+  // iterations, a dense LU after 5 (2.6-4.1 runs for the gradient; 4.6-5.4 after 3 or 4, 3.7-5.2 after 8); the
+  // Newmark family's sweep lowers the dense one to 4 where the forward run kept each factorisation 100 steps or more
+  // (NewmarkSteps::transpose)
+  long refresh_above_ = matrix_->krylov() ? 2 : 5;
   bool fresh_ = false;
   long last_iterations_ = 0;
 };
@@ -157,12 +160,15 @@ class NewmarkSteps final : public Transposes {
   void start(double t0, const VecX& q0, const VecX& qd0) override {
     Transposes::start(t0, q0, qd0);
     factors_.clear(), made_at_.clear();
-    keeping_ = true;
+    keeping_ = in_forward_ = true;
+    forward_steps_ = 0, forward_factors_ = 0;
+    istats_.factorizations = 0;
   }
   /// A step of the forward run keeps the stepper's dense factorisation when it made a new one (in a replay the
   /// stepper makes them again: not kept), while they fit into an eighth of the adjoint's memory.
   void step(double t, double h) override {
     Transposes::step(t, h);
+    if (in_forward_) ++forward_steps_, forward_factors_ = istats_.factorizations;
     if (!keeping_) return;
     auto f = stepper_->dense_factor();
     if (!f || (!factors_.empty() && f == factors_.back())) return;
@@ -179,7 +185,7 @@ class NewmarkSteps final : public Transposes {
     return {t, h, s.q, s.v, s.qdd, s.a, s.lambda, {}, {}, {}, {}};
   }
   void restore(const StepRecord& r) override {
-    keeping_ = false;  // a replay's
+    keeping_ = in_forward_ = false;  // a replay's
     NewmarkState s;
     s.q = r.q, s.v = r.v, s.qdd = r.qdd, s.a = r.a, s.s = VecX(0), s.lambda = r.lambda;
     stepper_->restore(r.t, s);
@@ -189,6 +195,10 @@ class NewmarkSteps final : public Transposes {
   void transpose(const StepRecord& s, VecX& bars, VecX& grad) override {
     const int n = sys_.nq;
     const double h = s.h, z = (1.0 - k_.af) / (1.0 - k_.am), c1 = k_.gamma * z * h, c2 = k_.beta * z * h * h;
+    // a Jacobian that drifts slowly (the forward run's factorisations kept 100 steps or more each: Kane's smooth
+    // spin-up, 222) keeps a refreshed preconditioner good for long, which pays for refreshing it one iteration
+    // sooner: the gradient of that run by 108 parameters 2.86 → 2.72 runs; the shaken strip (20 steps each) not
+    if (!matrix_->krylov()) refresh_above_ = forward_steps_ >= 100 * std::max<long>(1, forward_factors_) ? 4 : 5;
     auto qb = bars.segment(0, n), vb = bars.segment(n, n), ab = bars.segment(2 * n, n), zb = bars.segment(3 * n, n);
     const VecX g = zb + z * (ab + (k_.beta * h * h) * qb + (k_.gamma * h) * vb);
     // Sᵀ μ = g, Sᵀv = M v + c₁ Cᵀ v + c₂ Kᵀ v by the reverse mode at the step's end (d_: at_end)
@@ -297,6 +307,8 @@ class NewmarkSteps final : public Transposes {
   std::vector<std::shared_ptr<const Eigen::PartialPivLU<MatX>>> factors_;  // the forward run's, in order
   std::vector<double> made_at_;  // the end of the step that made each
   bool keeping_ = false;         // in the forward run (not a replay) and within memory
+  bool in_forward_ = false;      // in the forward run
+  long forward_steps_ = 0, forward_factors_ = 0;  // its steps and the stepper's factorisations
   const Eigen::PartialPivLU<MatX>* forward_ = nullptr;  // the forward factorisation in use
   bool own_ = false;             // the sweep's own factorisation preferred to forward_
 };
@@ -308,6 +320,7 @@ class RadauSteps final : public Transposes {
       : Transposes(sys, o, params), stepper_(make_implicit_rk(sys, o, istats_)),
         access_(dynamic_cast<RadauAccess*>(stepper_.get())) {
     if (!access_) throw std::logic_error("RadauSteps: the stepper is not radau5");
+    for (int i = 0; i < 3; ++i) stage_d_[i] = std::make_unique<Data>(sys), stage_[i] = std::make_unique<ResidualTranspose>(sys);
   }
 
   StepRecord record(double t, double h) const override {
@@ -335,12 +348,17 @@ class RadauSteps final : public Transposes {
       for (int i = 0; i < 3; ++i) loop_rates(t0 + tab_.c(i) * h, s.Q.col(i), s.V.col(i), s.A.col(i), Gs[i], DV[i], DQ[i]);
     const MatX Vt = Vb + h * Qb * a;
     const MatX G = h * Vt * a;
+    // the reverse mode at each stage, prepared once for the step's products
+    for (int i = 0; i < 3; ++i) {
+      at(*stage_d_[i], t0 + tab_.c(i) * h, s.Q.col(i), s.V.col(i), s.A.col(i));
+      stage_[i]->prepare(*stage_d_[i]);
+    }
     // 𝒮ᵀ μ by the reverse mode at each stage: M_j μ_j + h Σ_i a_ij C_iᵀ μ_i + h² Σ_i (a²)_ij K_iᵀ μ_i
     MatX Kmu(n, 3), Cmu(n, 3), Mmu(n, 3);
     auto products = [&](const MatX& mu) {
       for (int i = 0; i < 3; ++i) {
         const double ti = t0 + tab_.c(i) * h;
-        const ResidualVjp r = vjp(ti, s.Q.col(i), s.V.col(i), s.A.col(i), mu.col(i));
+        const ResidualVjp& r = stage_[i]->apply(*stage_d_[i], mu.col(i));
         Kmu.col(i) = r.q, Cmu.col(i) = r.qd, Mmu.col(i) = r.qdd;
         if (loops) Kmu.col(i) -= hessian(ti, s.Q.col(i), s.V.col(i), s.L.col(i), mu.col(i));  // K_i − H_i
       }
@@ -402,9 +420,9 @@ class RadauSteps final : public Transposes {
     VecX qb = VecX::Zero(n), vb = VecX::Zero(n);
     for (int i = 0; i < 3; ++i) {
       const double ti = t0 + tab_.c(i) * h;
-      const ResidualVjp r = vjp(ti, s.Q.col(i), s.V.col(i), s.A.col(i), mu.col(i));
+      const ResidualVjp& r = stage_[i]->apply(*stage_d_[i], mu.col(i));
       VecX Qh = Qb.col(i) - r.q, Vh = Vb.col(i) - r.qd;
-      params_.add(d_, mu.col(i), r, -1.0, grad);
+      params_.add(*stage_d_[i], mu.col(i), r, -1.0, grad);
       if (loops) {
         Qh += hessian(ti, s.Q.col(i), s.V.col(i), s.L.col(i), mu.col(i)) - DQ[i].transpose() * nu.col(i);
         Vh -= DV[i].transpose() * nu.col(i);
@@ -470,6 +488,8 @@ class RadauSteps final : public Transposes {
   std::unique_ptr<Stepper> stepper_;
   RadauAccess* access_;
   const RadauTableau tab_;
+  std::unique_ptr<Data> stage_d_[3];                // each stage's state, kinematics and RNEA pass
+  std::unique_ptr<ResidualTranspose> stage_[3];     // the reverse mode prepared there
 };
 
 }  // namespace
