@@ -161,17 +161,18 @@ class NewmarkSteps final : public Transposes {
     Transposes::start(t0, q0, qd0);
     factors_.clear(), made_at_.clear();
     keeping_ = in_forward_ = true;
-    forward_steps_ = 0, forward_factors_ = 0;
-    istats_.factorizations = 0;
+    forward_steps_ = 0, forward_factors_ = 0, last_factor_.reset();
   }
   /// A step of the forward run keeps the stepper's dense factorisation when it made a new one (in a replay the
   /// stepper makes them again: not kept), while they fit into an eighth of the adjoint's memory.
   void step(double t, double h) override {
     Transposes::step(t, h);
-    if (in_forward_) ++forward_steps_, forward_factors_ = istats_.factorizations;
-    if (!keeping_) return;
+    if (!in_forward_) return;
+    ++forward_steps_;
     auto f = stepper_->dense_factor();
-    if (!f || (!factors_.empty() && f == factors_.back())) return;
+    if (!f || f == last_factor_) return;
+    ++forward_factors_, last_factor_ = f;
+    if (!keeping_) return;
     const double bytes = 8.0 * sys_.nq * sys_.nq * static_cast<double>(factors_.size() + 1);
     if (bytes > memory_ / 8.0) {
       keeping_ = false;
@@ -308,7 +309,8 @@ class NewmarkSteps final : public Transposes {
   std::vector<double> made_at_;  // the end of the step that made each
   bool keeping_ = false;         // in the forward run (not a replay) and within memory
   bool in_forward_ = false;      // in the forward run
-  long forward_steps_ = 0, forward_factors_ = 0;  // its steps and the stepper's factorisations
+  long forward_steps_ = 0, forward_factors_ = 0;  // its steps and the dense factorisations it made
+  std::shared_ptr<const Eigen::PartialPivLU<MatX>> last_factor_;  // the last of them
   const Eigen::PartialPivLU<MatX>* forward_ = nullptr;  // the forward factorisation in use
   bool own_ = false;             // the sweep's own factorisation preferred to forward_
 };

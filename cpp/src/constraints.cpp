@@ -246,18 +246,22 @@ bool pseudo_inverse_by_pivots(const MatX& A, const VecX& b, VecX& x) {
     L.col(r).tail(n - r) = W.col(r).tail(n - r) / std::sqrt(pivot);
     W.bottomRightCorner(n - r - 1, n - r - 1).noalias() -= L.col(r).tail(n - r - 1) * L.col(r).tail(n - r - 1).transpose();
   }
-  if (r < n && !(W.diagonal().tail(n - r).cwiseAbs().sum() <= 1e-14 * trace)) return false;
-  x.setZero(n);
-  if (r == 0) return true;  // A = 0
+  // the Schur complement left, entry by entry (its diagonal alone bounds it only where A is semi-definite)
+  if (r < n && !(W.bottomRightCorner(n - r, n - r).cwiseAbs().sum() <= 1e-14 * trace)) return false;
+  SmallV bp(n);  // P b, read before x is written (x may be b)
+  for (Eigen::Index i = 0; i < n; ++i) bp(i) = b(p(i));
+  if (r == 0) {  // A = 0
+    x.setZero(n);
+    return true;
+  }
   const auto B = L.leftCols(r);
   const Eigen::LLT<Small> gram(Small(B.transpose() * B));
   if (gram.info() != Eigen::Success || !(gram.rcond() > 1e-6)) return false;
-  SmallV bp(n);
-  for (Eigen::Index i = 0; i < n; ++i) bp(i) = b(p(i));
   SmallV z = B.transpose() * bp;
   gram.solveInPlace(z);
   gram.solveInPlace(z);
   const SmallV xp = B * z;
+  x.resize(n);
   for (Eigen::Index i = 0; i < n; ++i) x(p(i)) = xp(i);
   return x.allFinite();
 }
