@@ -393,6 +393,17 @@ void bind_dynamics(py::module_& m) {
           },
           py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("tol"), py::arg("max_iterations"))
       .def(
+          "_assemble_and_accelerate",
+          [](const System& s, Time t, Coordinates q, Rates qd, double tol, int max_iterations) {
+            Workspace d(s);
+            VecX x = q.vector(), xd = qd.vector();
+            const VecX xdd = project_and_forward_dynamics(s, *d, t, x, xd, tol, max_iterations);
+            return py::make_tuple(x, xd, xdd);
+          },
+          py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("tol"), py::arg("max_iterations"),
+          "(q, q̇, q̈): _assemble, then the forward dynamics at the state it reached, on the projection's own "
+          "factorisation (what the integrators do after each step on loops).")
+      .def(
           "forward_dynamics", [](const System& s, Time t, Coordinates q, Rates qd) {
             Workspace d(s);
             return finite(VecX(rigidfem::forward_dynamics(s, *d, t, q, qd)), "forward_dynamics", t, q, qd);

@@ -220,10 +220,30 @@ namespace {
 using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 8, 8>;  // a few loop rows, on the stack
 using SmallV = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 8, 1>;
 
+/// (LᵀL)⁻¹ of the Gram matrix C = LᵀL (r × r, r <= 8) as Mᵀ M from its Cholesky factor C = K Kᵀ, M = K⁻¹ (lower);
+/// false unless C is positive definite with cond₂(C) < 1e6, which the bound cond₂(C) = cond₂(K)² <=
+/// (‖K‖_F ‖M‖_F)² guarantees without an estimator's extra solves.
+bool gram_inverse(const Small& C, Small& Cinv) {
+  const Eigen::Index r = C.rows();
+  const Eigen::LLT<Small> llt(C);
+  if (llt.info() != Eigen::Success) return false;
+  const Small K = llt.matrixL();
+  Small M = Small::Zero(r, r);
+  // M = K⁻¹ column by column: M_jj = 1/K_jj, M_ij = −(Σ_{j<=k<i} K_ik M_kj) / K_ii
+  for (Eigen::Index j = 0; j < r; ++j) {
+    M(j, j) = 1.0 / K(j, j);
+    for (Eigen::Index i = j + 1; i < r; ++i) M(i, j) = -K.row(i).segment(j, i - j).dot(M.col(j).segment(j, i - j)) / K(i, i);
+  }
+  const double bound = K.squaredNorm() * M.squaredNorm();
+  if (!(bound < 1e6)) return false;
+  Cinv.noalias() = M.transpose() * M;
+  return true;
+}
+
 /// x = A⁺ b (n <= 8) by a diagonally pivoted Cholesky factor P A Pᵀ = L Lᵀ (L: n × r) where A's spectrum has a
 /// clear gap: the Schur complement left after r pivots has a trace <= 1e-14 tr A (the round-off of exact
 /// dependencies: a Bricard linkage's redundant row, a planar loop's rows out of its plane) and LᵀL, whose
-/// eigenvalues are A's r others, a reciprocal condition estimate > 1e-6. The eigenvalue floor of
+/// eigenvalues are A's r others, a condition number below 1e6 (gram_inverse). The eigenvalue floor of
 /// least_norm_symmetric (1e-10 λ_max) keeps those r and drops the rest, and then A⁺ = Pᵀ L (LᵀL)⁻² Lᵀ P.
 /// False where the gap is not that clear.
 bool pseudo_inverse_by_pivots(const MatX& A, const VecX& b, VecX& x) {
@@ -255,12 +275,9 @@ bool pseudo_inverse_by_pivots(const MatX& A, const VecX& b, VecX& x) {
     return true;
   }
   const auto B = L.leftCols(r);
-  const Eigen::LLT<Small> gram(Small(B.transpose() * B));
-  if (gram.info() != Eigen::Success || !(gram.rcond() > 1e-6)) return false;
-  SmallV z = B.transpose() * bp;
-  gram.solveInPlace(z);
-  gram.solveInPlace(z);
-  const SmallV xp = B * z;
+  Small Ginv;
+  if (!gram_inverse(Small(B.transpose() * B), Ginv)) return false;
+  const SmallV xp = B * (Ginv * (Ginv * (B.transpose() * bp)));
   x.resize(n);
   for (Eigen::Index i = 0; i < n; ++i) x(p(i)) = xp(i);
   return x.allFinite();

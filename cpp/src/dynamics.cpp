@@ -171,17 +171,25 @@ void mass_weighted_rows(const System& sys, Data& d) {
 
 }  // namespace
 
-void close_loops(const System& sys, Data& d) {
-  // λ = (G M⁻¹ Gᵀ)⁺ (γ − G q̈), q̈ += M⁻¹ Gᵀ λ, in d's workspace (no allocation on the recursive path)
-  d.Gfree = d.G(Eigen::all, sys.free_coords);
-  mass_weighted_rows(sys, d);
-  d.GY.noalias() = d.Gfree * d.Y;
+namespace {
+
+/// λ = (G M⁻¹ Gᵀ)⁺ (γ − G q̈), q̈ += M⁻¹ Gᵀ λ with Y = M⁻¹ Gᵀ and G Y in d (no allocation).
+void loop_accelerations(const System& sys, Data& d) {
   d.loop_rhs = d.gamma;
   d.loop_rhs.noalias() -= d.Gfree * d.qdd;
   least_norm_symmetric(d.GY, d.loop_rhs, d.loop_eigen, d.loop_c, d.lambda);
   d.qdd.noalias() += d.Y * d.lambda;
   set_accelerations(sys, d, d.qdd);
   if (!d.qdd.allFinite()) throw SimulationError(d.t, "accelerations of the closed loops are NaN or inf");
+}
+
+}  // namespace
+
+void close_loops(const System& sys, Data& d) {
+  d.Gfree = d.G(Eigen::all, sys.free_coords);
+  mass_weighted_rows(sys, d);
+  d.GY.noalias() = d.Gfree * d.Y;
+  loop_accelerations(sys, d);
 }
 
 void loop_equations(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
@@ -191,11 +199,18 @@ void loop_equations(const System& sys, Data& d, double t, const Eigen::Ref<const
 }
 
 void factor_mass(const System& sys, Data& d) {
-  if (recursive(sys)) spatial_kinematics(sys, d);
-  factor_armature(sys, d, VecX::Zero(sys.nq));
+  if (!recursive(sys)) return factor_armature(sys, d, VecX::Zero(sys.nq));
+  spatial_kinematics(sys, d);
+  aba_factor(sys, d);
 }
 
-double project_onto_loops(const System& sys, Data& d, double t, VecX& q, VecX& qd, double tol, int max_iterations) {
+namespace {
+
+/// project_onto_loops; with `factor_at_end` the velocity's projection factorises M at the projected q (rather
+/// than keep a Gauss-Newton iterate's factorisation), so that d leaves with M factorised, G, Y = M⁻¹ Gᵀ and G Y
+/// all at the projected q.
+double project(const System& sys, Data& d, double t, VecX& q, VecX& qd, double tol, int max_iterations,
+               bool factor_at_end) {
   if (sys.nl == 0) return 0.0;
   constexpr double eps = std::numeric_limits<double>::epsilon();
   double residual = 0.0, previous = 0.0;
@@ -240,9 +255,30 @@ double project_onto_loops(const System& sys, Data& d, double t, VecX& q, VecX& q
   // q̇ ← q̇ − M⁻¹Gᵀ (G M⁻¹ Gᵀ)⁺ ġ, ġ = G q̇ + ∂g/∂t: the correction is M-orthogonal to every motion
   // the loops allow, so it never raises the kinetic energy and takes none from the admissible motion
   // (the Euclidean Gᵀ(GGᵀ)⁺ġ does, where G loses rank).
-  weighted(false);
+  weighted(factor_at_end);
   qd -= corrected(d.gd);
   return residual;
+}
+
+}  // namespace
+
+double project_onto_loops(const System& sys, Data& d, double t, VecX& q, VecX& qd, double tol, int max_iterations) {
+  return project(sys, d, t, q, qd, tol, max_iterations, false);
+}
+
+const VecX& project_and_forward_dynamics(const System& sys, Data& d, double t, VecX& q, VecX& qd, double tol,
+                                         int max_iterations) {
+  if (sys.nl == 0 || !recursive(sys)) {
+    project_onto_loops(sys, d, t, q, qd, tol, max_iterations);
+    return forward_dynamics(sys, d, t, q, qd);
+  }
+  project(sys, d, t, q, qd, tol, max_iterations, true);
+  // the configuration is the projection's last: its frames, G, the articulated inertias, Y and G Y stand
+  set_state(sys, d, t, q, qd);
+  constraint_equations(sys, d, true);  // ġ and γ at the projected q̇
+  aba_on_factor(sys, d);
+  loop_accelerations(sys, d);
+  return d.qdd;
 }
 
 const MatX& mass_matrix(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q) {

@@ -127,10 +127,9 @@ class ImplicitRk : public Stepper {
   /// Loops: (q, q̇) onto the constraint manifold at t after each accepted step (closure residual
   /// <= 1e-12), and q̈, λ by the constrained forward dynamics there (the next step's first stage).
   void project(double t) override {
-    project_onto_loops(sys_, d_, t, q_, v_, 1e-12, 10);
     ++stats_.rhs_evaluations;
     set_arm_forces(sys_, d_, s_);
-    a_ = forward_dynamics(sys_, d_, t, q_, v_);
+    a_ = project_and_forward_dynamics(sys_, d_, t, q_, v_, 1e-12, 10);
     lambda_ = d_.lambda;
     y_ << q_, v_;
     if (sens_) {  // onto the tangent of the loops, and S̈ of the next step's first stage with q̈ there

@@ -141,11 +141,13 @@ void kinematics(const System& sys, Data& d, bool rates) {
 
 void frames_and_axes(const System& sys, Data& d) {
   static const Mat4 I4 = Mat4::Identity();
+  Mat4 T = I4;  // the previous body's frame: the parent's in a chain (no reload of d.T)
   for (int p = 0; p < sys.nbodies; ++p) {
+    if (sys.parent[p] != p - 1) T = parent_value(sys, d.T, p, I4);
     Mat4 G;
-    compose(parent_value(sys, d.T, p, I4), sys.B[p], G);
+    compose(T, sys.B[p], G);
     joint_frames(joint_uses(sys, p), d.qa, G, d.axes.data() + sys.use_start[p]);  // data(): valid for none
-    d.T[p] = G;
+    d.T[p] = T = G;
   }
 }
 

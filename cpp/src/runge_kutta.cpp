@@ -25,25 +25,21 @@ class FirstOrder {
   void eval(double t, const VecX& y, VecX& ydot) {
     if (!y.allFinite())
       throw SimulationError(t, "the state became NaN or inf: the step was unstable");
-    ++stats_.rhs_evaluations;
     const int n = sys_.nq, nz = sys_.nz;
-    ydot.resize(y.size());
-    ydot.head(n) = y.segment(n, n);
     set_arm_forces(sys_, d_, y.segment(2 * n, nz));
-    ydot.segment(n, n) = forward_dynamics(sys_, d_, t, y.head(n), y.segment(n, n));
-    arm_rates(sys_, y.segment(n, n), y.segment(2 * n, nz), ydot.segment(2 * n, nz));
-    if (!sens_) return;
-    const int k = state_size();
-    sens_->rates(d_, t, y.head(n), y.segment(n, n), y.tail(y.size() - k), ydot.tail(y.size() - k));
+    rates(t, y, forward_dynamics(sys_, d_, t, y.head(n), y.segment(n, n)), ydot);
   }
-  /// [q, q̇] of y onto the loops' constraint manifold at t (closure residual <= 1e-12), and the
-  /// sensitivities onto its tangent there.
-  void project(double t, VecX& y) {
-    const int n = sys_.nq;
+  /// [q, q̇] of y onto the loops' constraint manifold at t (closure residual <= 1e-12), the sensitivities
+  /// onto its tangent there, and ydot = f(t, y) at the projected y, for about the price of the projection
+  /// (project_and_forward_dynamics).
+  void project_and_eval(double t, VecX& y, VecX& ydot) {
+    const int n = sys_.nq, nz = sys_.nz;
     VecX q = y.head(n), qd = y.segment(n, n);
-    project_onto_loops(sys_, d_, t, q, qd, 1e-12, 10);
+    set_arm_forces(sys_, d_, y.segment(2 * n, nz));
+    const VecX& qdd = project_and_forward_dynamics(sys_, d_, t, q, qd, 1e-12, 10);
     y.head(n) = q, y.segment(n, n) = qd;
     for (int j = 0; sens_ && j < sens_->count(); ++j) sens_->project(j, t, q, qd, y.segment(state_size() + 2 * n * j, 2 * n));
+    rates(t, y, qdd, ydot);
   }
   int controlled() const { return 2 * sys_.nq; }  ///< the error is controlled on y's first 2 nq: [q, q̇]
   bool loops() const { return sys_.nl > 0; }     ///< every accepted step is projected onto the loops (project)
@@ -52,6 +48,19 @@ class FirstOrder {
   int sensitivity_count() const { return sens_ ? sens_->count() : 0; }
 
  private:
+  /// ydot = [q̇, q̈, ṡ, Ṡ_1 .. Ṡ_P] of y with q̈ the forward dynamics d_ has just evaluated at y.
+  void rates(double t, const VecX& y, const VecX& qdd, VecX& ydot) {
+    ++stats_.rhs_evaluations;
+    const int n = sys_.nq, nz = sys_.nz;
+    ydot.resize(y.size());
+    ydot.head(n) = y.segment(n, n);
+    ydot.segment(n, n) = qdd;
+    arm_rates(sys_, y.segment(n, n), y.segment(2 * n, nz), ydot.segment(2 * n, nz));
+    if (!sens_) return;
+    const int k = state_size();
+    sens_->rates(d_, t, y.head(n), y.segment(n, n), y.tail(y.size() - k), ydot.tail(y.size() - k));
+  }
+
   const System& sys_;
   Data d_;
   IntegratorStats& stats_;
@@ -234,8 +243,7 @@ class RungeKutta final : public Stepper {
   const VecX& state() const override { return y_; }
 
   void project(double t) override {
-    ode_.project(t, y_);
-    ode_.eval(t, y_, f_);  // the next step starts from the projected state
+    ode_.project_and_eval(t, y_, f_);  // the next step starts from the projected state
     if (tab_.e.empty()) f1_ = f_;  // the dense output's end slope (attempt left it to here)
   }
 
@@ -383,10 +391,7 @@ class Dop853 final : public Stepper {
 
   const VecX& state() const override { return y_; }
 
-  void project(double t) override {
-    ode_.project(t, y_);
-    ode_.eval(t, y_, f_);
-  }
+  void project(double t) override { ode_.project_and_eval(t, y_, f_); }
 
   /// y(t0 + θh) = y0 + Σ of the seven terms F_k, nested in θ and 1 − θ alternately (Hairer's CONTD8): F_0 = Δy,
   /// F_1 = h f0 − Δy, F_2 = 2 Δy − h (f0 + f1), F_{3..6} = h Σ_j d_kj k_j over the 16 stages.

@@ -109,6 +109,12 @@ void close_loops(const System& sys, Data& d);
 void loop_equations(const System& sys, Data& d, double t, const Eigen::Ref<const VecX>& q,
                     const Eigen::Ref<const VecX>& qd);
 double project_onto_loops(const System& sys, Data& d, double t, VecX& q, VecX& qd, double tol, int max_iterations);
+/// project_onto_loops, then forward_dynamics at the projected state: the velocity's projection factorises M at
+/// the projected q, and the accelerations keep that factorisation, the frames, G, Y = M⁻¹Gᵀ and G Y (all of q
+/// alone), so that both cost about one constrained forward dynamics (recursive engine; the Lagrange engine
+/// evaluates anew). q̈ (nq) as d.qdd.
+const VecX& project_and_forward_dynamics(const System& sys, Data& d, double t, VecX& q, VecX& qd, double tol,
+                                         int max_iterations);
 
 // The operator of the implicit methods.
 /// Factorises M + diag(δ) (δ (nq) ≥ 0) at the state of the last inverse_dynamics: O(n) by the

@@ -39,6 +39,11 @@ void aba(const System& sys, Data& d);
 /// Needs spatial_kinematics: the articulated-body factorisation of M + diag(δ), δ (nq) ≥ 0 added
 /// to the free coordinates the way joint armature is (D = Sᵀ I^A S + diag δ). O(n).
 void aba_factor(const System& sys, Data& d, const VecX& armature);
+/// The same without armature (δ = 0): the factorisation aba itself makes.
+void aba_factor(const System& sys, Data& d);
+/// Needs set_state, the axes and an aba_factor without armature at the same q and t (q̇ may differ): aba
+/// without its factorisation, q̈ from the articulated inertias in d.
+void aba_on_factor(const System& sys, Data& d);
 /// After aba_factor: x = (M + diag δ)⁻¹ b (nq) by the bias passes of ABA for a system at rest
 /// with no gravity or loads under the forces b (x may be b). O(n). Overwrites the ABA workspace (c, p^A, a).
 void aba_solve(const System& sys, Data& d, const VecX& b, VecX& x);
