@@ -243,7 +243,7 @@ bool gram_inverse(const Small& C, Small& Cinv) {
 /// x = A⁺ b (n <= 8) by a diagonally pivoted Cholesky factor P A Pᵀ = L Lᵀ (L: n × r) where A's spectrum has a
 /// clear gap: the Schur complement left after r pivots has a trace <= 1e-14 tr A (the round-off of exact
 /// dependencies: a Bricard linkage's redundant row, a planar loop's rows out of its plane) and LᵀL, whose
-/// eigenvalues are A's r others, a condition number below 1e6 (gram_inverse). The eigenvalue floor of
+/// eigenvalues are A's r others, a condition bound below 1e6 (gram_inverse; a cond₂ of 1e6/r² may already fail it). The eigenvalue floor of
 /// least_norm_symmetric (1e-10 λ_max) keeps those r and drops the rest, and then A⁺ = Pᵀ L (LᵀL)⁻² Lᵀ P.
 /// False where the gap is not that clear.
 bool pseudo_inverse_by_pivots(const MatX& A, const VecX& b, VecX& x) {

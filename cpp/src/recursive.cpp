@@ -246,7 +246,8 @@ void fixed_acceleration(const System& sys, Data& d, int p, VecX& x, Vec6& a) {
 // the forces τ (nq) on the free coordinates and the base acceleration a_0:
 //   u = τ − Sᵀ p^A, the parent gets p^a = p^A + I^a c + U D⁻¹ u (leaves to root);
 //   a' = a_λ + c, q̈ = D⁻¹ (u − Uᵀ a'), a = a' + S q̈ (root to leaves), into x (nq).
-// `at_rest`: p^A, c and a_0 are zero (M x = τ), and the terms in them are left out.
+// `at_rest` (M x = τ: the system at rest, a_0 = 0): the joint biases c are zero, and the terms I^a c and a' += c are
+// left out (p^A holds only what the children hand on).
 // τ is read only before x is written: they may be the same vector.
 void articulated_accelerations(const System& sys, Data& d, const VecX& tau, const Vec6& a0, VecX& x, bool at_rest) {
   // A body's p^a goes to its parent through d.pA, but to the body just before it (a chain's parent, visited
@@ -329,10 +330,7 @@ void aba_factor(const System& sys, Data& d) {
 void aba_solve(const System& sys, Data& d, const VecX& b, VecX& x) {
   require_tree(sys);
   // M x = b is the forward dynamics of a system at rest, without gravity or loads, under b.
-  for (int p = 0; p < sys.nbodies; ++p) {
-    d.pA[p].setZero();
-    d.c[p].setZero();
-  }
+  for (int p = 0; p < sys.nbodies; ++p) d.pA[p].setZero();  // c is not read at rest
   if (&x != &b) x.resize(sys.nq);
   articulated_accelerations(sys, d, b, Vec6::Zero(), x, true);
 }

@@ -45,7 +45,7 @@ void aba_factor(const System& sys, Data& d);
 /// without its factorisation, q̈ from the articulated inertias in d.
 void aba_on_factor(const System& sys, Data& d);
 /// After aba_factor: x = (M + diag δ)⁻¹ b (nq) by the bias passes of ABA for a system at rest
-/// with no gravity or loads under the forces b (x may be b). O(n). Overwrites the ABA workspace (c, p^A, a).
+/// with no gravity or loads under the forces b (x may be b). O(n). Overwrites the ABA workspace (p^A, u, a).
 void aba_solve(const System& sys, Data& d, const VecX& b, VecX& x);
 /// After aba: the driving forces τ (np) of the prescribed coordinates by RNEA with the full accelerations.
 void rnea_driving_forces(const System& sys, Data& d);
