@@ -150,6 +150,29 @@ def test_the_loops_least_norm_solve_is_the_pseudo_inverse(n, rank, zero_rows, ga
         rf._core._least_norm_symmetric(np.eye(3), np.ones(2))
 
 
+def test_the_loops_least_norm_solve_keeps_to_a_given_rank_where_the_rest_is_small():
+    """A step's stage off the loops by a drift δ: A = B Bᵀ (rank r, a redundant row's exact dependency) plus δ² u uᵀ.
+    Kept to rank r, the solve is B Bᵀ's pseudo-inverse to O(δ²) (the δ² direction's multiplier, of order 1/δ², left
+    out); without the rank it counts that direction (above 1e-10 of the largest eigenvalue); and where the rest is not
+    small (δ² = 1e-3 of the trace, over the 1e-6 allowed) the rank is not imposed."""
+    rng = np.random.default_rng(5)
+    for n, r in ((5, 4), (6, 3), (8, 7), (12, 9)):  # the last by the eigendecomposition
+        B = rng.normal(size=(n, r))
+        A0, b = B @ B.T, rng.normal(size=n)
+        exact = _pseudo_inverse(A0, b)
+        u = np.linalg.svd(B.T)[2][-1]  # a unit vector out of B's range, where the drift's eigenvalue grows
+        for d2 in (1e-8, 1e-7):
+            A = A0 + d2 * np.trace(A0) * np.outer(u, u)
+            kept = rf._core._least_norm_symmetric(A, b, r)
+            lam = np.linalg.eigvalsh(A0)[n - r:]
+            assert np.abs(kept - exact).max() < 10 * d2 * (lam[-1] / lam[0]) ** 2 * np.abs(exact).max()
+            counted = rf._core._least_norm_symmetric(A, b)
+            np.testing.assert_allclose(counted, _pseudo_inverse(A, b), rtol=1e-5)
+            assert np.abs(counted - exact).max() > 1e3 * np.abs(exact).max()
+        A = A0 + 1e-3 * np.trace(A0) * np.outer(u, u)
+        np.testing.assert_allclose(rf._core._least_norm_symmetric(A, b, r), _pseudo_inverse(A, b), rtol=1e-8)
+
+
 def test_the_loops_least_norm_solve_follows_a_reordering_of_the_rows():
     """Reordering the rows and columns of A (and b) reorders x alike: the pivots' permutation undone; and a
     symmetric A that is not semi-definite (off the loops' G M⁻¹ Gᵀ) gets the eigendecomposition's answer, its

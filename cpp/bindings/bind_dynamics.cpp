@@ -1,6 +1,8 @@
 // System, Data and the named stages of the equations of motion: each binding calls one C++ function.
 #include <algorithm>
 #include <memory>
+#include <optional>
+#include <utility>
 #include <vector>
 
 #include "bindings.hpp"
@@ -57,6 +59,7 @@ class Workspace {
     it->busy = true;
     data_ = it->data.get();
     data_->load_factor = 1.0;
+    data_->loop_rank = -1;  // a call decides the loops' rank itself (a step's stages keep their projection's)
   }
   ~Workspace() {
     if (fresh_) return;
@@ -116,15 +119,16 @@ Data& data_of(const py::handle& x) {
 
 void bind_dynamics(py::module_& m) {
   m.def(
-      "_least_norm_symmetric", [](const MatX& A, const VecX& b) {
+      "_least_norm_symmetric", [](const MatX& A, const VecX& b, int rank) {
         if (A.rows() != A.cols() || b.size() != A.rows())
           throw std::invalid_argument("A, b: expected a square (n, n) array A and b of n numbers");
-        return least_norm_symmetric(A, b);
+        return least_norm_symmetric(A, b, rank);
       },
       py::arg("A"),
       py::arg("b"),
+      py::arg("rank") = -1,
       "x = A⁺ b for a symmetric positive semi-definite A (the loops' G M⁻¹ Gᵀ): its eigenvalues below 1e-10 of the "
-      "largest count as zero (constraints.hpp).");
+      "largest count as zero; with rank >= 0, at most rank directions where the rest are small (constraints.hpp).");
   // Data is registered first, so that the signatures of System's methods name it (the stub's types).
   py::class_<Data> data(m, "Data",
       "Workspace of the algorithms; after each stage it holds that stage's results.\n"
@@ -394,15 +398,20 @@ void bind_dynamics(py::module_& m) {
           py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("tol"), py::arg("max_iterations"))
       .def(
           "_assemble_and_accelerate",
-          [](const System& s, Time t, Coordinates q, Rates qd, double tol, int max_iterations) {
+          [](const System& s, Time t, Coordinates q, Rates qd, double tol, int max_iterations,
+             std::optional<std::pair<Coordinates, Rates>> stage) {
             Workspace d(s);
             VecX x = q.vector(), xd = qd.vector();
             const VecX xdd = project_and_forward_dynamics(s, *d, t, x, xd, tol, max_iterations);
-            return py::make_tuple(x, xd, xdd);
+            if (!stage) return py::tuple(py::make_tuple(x, xd, xdd));
+            const VecX sdd = rigidfem::forward_dynamics(s, *d, t, stage->first.vector(), stage->second.vector());
+            return py::tuple(py::make_tuple(x, xd, xdd, sdd));
           },
           py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("tol"), py::arg("max_iterations"),
+          py::arg("stage") = py::none(),
           "(q, q̇, q̈): _assemble, then the forward dynamics at the state it reached, on the projection's own "
-          "factorisation (what the integrators do after each step on loops).")
+          "factorisation (what the integrators do after each step on loops); with stage = (q_s, q̇_s), also q̈ "
+          "there with the same workspace, as a step's stages evaluate it (the rank kept on the loops).")
       .def(
           "forward_dynamics", [](const System& s, Time t, Coordinates q, Rates qd) {
             Workspace d(s);

@@ -245,16 +245,18 @@ bool gram_inverse(const Small& C, Small& Cinv) {
 /// dependencies: a Bricard linkage's redundant row, a planar loop's rows out of its plane) and LᵀL, whose
 /// eigenvalues are A's r others, a condition bound below 1e6 (gram_inverse; a cond₂ of 1e6/r² may already fail it). The eigenvalue floor of
 /// least_norm_symmetric (1e-10 λ_max) keeps those r and drops the rest, and then A⁺ = Pᵀ L (LᵀL)⁻² Lᵀ P.
-/// False where the gap is not that clear.
-bool pseudo_inverse_by_pivots(const MatX& A, const VecX& b, VecX& x) {
+/// With `rank` >= 0 it stops after that many pivots and accepts a Schur complement up to 1e-6 tr A. Returns
+/// r, or -1 where the gap is not that clear.
+int pseudo_inverse_by_pivots(const MatX& A, const VecX& b, VecX& x, int rank) {
   const Eigen::Index n = A.rows();
   Small W = A.selfadjointView<Eigen::Lower>(), L = Small::Zero(n, n);
   Eigen::Matrix<Eigen::Index, Eigen::Dynamic, 1, 0, 8, 1> p(n);
   for (Eigen::Index i = 0; i < n; ++i) p(i) = i;
   const double trace = W.trace();
-  if (!(trace >= 0.0) || !std::isfinite(trace)) return false;
+  if (!(trace >= 0.0) || !std::isfinite(trace)) return -1;
+  const Eigen::Index cap = rank >= 0 ? std::min<Eigen::Index>(rank, n) : n;
   Eigen::Index r = 0;
-  for (; r < n; ++r) {
+  for (; r < cap; ++r) {
     Eigen::Index j;
     const double pivot = W.diagonal().tail(n - r).maxCoeff(&j);
     if (!(pivot > 1e-14 * trace)) break;
@@ -267,41 +269,53 @@ bool pseudo_inverse_by_pivots(const MatX& A, const VecX& b, VecX& x) {
     W.bottomRightCorner(n - r - 1, n - r - 1).noalias() -= L.col(r).tail(n - r - 1) * L.col(r).tail(n - r - 1).transpose();
   }
   // the Schur complement left, entry by entry (its diagonal alone bounds it only where A is semi-definite)
-  if (r < n && !(W.bottomRightCorner(n - r, n - r).cwiseAbs().sum() <= 1e-14 * trace)) return false;
+  const double left = r < n ? W.bottomRightCorner(n - r, n - r).cwiseAbs().sum() : 0.0;
+  if (!(left <= (r == cap && cap < n ? 1e-6 : 1e-14) * trace)) return -1;
   SmallV bp(n);  // P b, read before x is written (x may be b)
   for (Eigen::Index i = 0; i < n; ++i) bp(i) = b(p(i));
   if (r == 0) {  // A = 0
     x.setZero(n);
-    return true;
+    return 0;
   }
   const auto B = L.leftCols(r);
   Small Ginv;
-  if (!gram_inverse(Small(B.transpose() * B), Ginv)) return false;
+  if (!gram_inverse(Small(B.transpose() * B), Ginv)) return -1;
   const SmallV xp = B * (Ginv * (Ginv * (B.transpose() * bp)));
   x.resize(n);
   for (Eigen::Index i = 0; i < n; ++i) x(p(i)) = xp(i);
-  return x.allFinite();
+  return x.allFinite() ? static_cast<int>(r) : -1;
 }
 
 }  // namespace
 
-void least_norm_symmetric(const MatX& A, const VecX& b, Eigen::SelfAdjointEigenSolver<MatX>& eigen, VecX& c,
-                          VecX& x) {
-  if (A.rows() <= 8 && pseudo_inverse_by_pivots(A, b, x)) return;
+int least_norm_symmetric(const MatX& A, const VecX& b, Eigen::SelfAdjointEigenSolver<MatX>& eigen, VecX& c,
+                         VecX& x, int rank) {
+  if (A.rows() <= 8) {
+    const int r = pseudo_inverse_by_pivots(A, b, x, rank);
+    if (r >= 0) return r;
+  }
   // x = V Λ⁺ Vᵀ b, A = V Λ Vᵀ (the lower triangle read), λ_i⁺ = 1/λ_i for λ_i > 1e-10 λ_max, else 0
-  // (a negative λ_i is round-off of a zero one).
+  // (a negative λ_i is round-off of a zero one); with `rank`, 0 also for all but the `rank` largest where
+  // those sum to at most 1e-6 tr A.
   eigen.compute(A);
   const VecX& s = eigen.eigenvalues();  // ascending
-  const double floor = s.size() > 0 ? 1e-10 * s(s.size() - 1) : 0.0;
+  double floor = s.size() > 0 ? 1e-10 * s(s.size() - 1) : 0.0;
+  const Eigen::Index drop = rank >= 0 ? s.size() - std::min<Eigen::Index>(rank, s.size()) : 0;
+  if (drop > 0 && s.head(drop).cwiseAbs().sum() <= 1e-6 * s.sum()) floor = std::max(floor, s(drop - 1));
   c.noalias() = eigen.eigenvectors().transpose() * b;
-  for (Eigen::Index i = 0; i < s.size(); ++i) c(i) = s(i) > floor ? c(i) / s(i) : 0.0;
+  int kept = 0;
+  for (Eigen::Index i = 0; i < s.size(); ++i) {
+    c(i) = s(i) > floor ? c(i) / s(i) : 0.0;
+    kept += s(i) > floor;
+  }
   x.noalias() = eigen.eigenvectors() * c;
+  return kept;
 }
 
-VecX least_norm_symmetric(const MatX& A, const VecX& b) {
+VecX least_norm_symmetric(const MatX& A, const VecX& b, int rank) {
   Eigen::SelfAdjointEigenSolver<MatX> eigen(A.rows());
   VecX c, x;
-  least_norm_symmetric(A, b, eigen, c, x);
+  least_norm_symmetric(A, b, eigen, c, x, rank);
   return x;
 }
 

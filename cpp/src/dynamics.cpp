@@ -177,7 +177,7 @@ namespace {
 void loop_accelerations(const System& sys, Data& d) {
   d.loop_rhs = d.gamma;
   d.loop_rhs.noalias() -= d.Gfree * d.qdd;
-  least_norm_symmetric(d.GY, d.loop_rhs, d.loop_eigen, d.loop_c, d.lambda);
+  least_norm_symmetric(d.GY, d.loop_rhs, d.loop_eigen, d.loop_c, d.lambda, d.loop_rank);
   d.qdd.noalias() += d.Y * d.lambda;
   set_accelerations(sys, d, d.qdd);
   if (!d.qdd.allFinite()) throw SimulationError(d.t, "accelerations of the closed loops are NaN or inf");
@@ -225,9 +225,10 @@ double project(const System& sys, Data& d, double t, VecX& q, VecX& qd, double t
     if (refactor || !factored) factor_mass(sys, d), factored = true;
     mass_weighted_rows(sys, d);
   };
+  int rank = -1;
   auto corrected = [&](const VecX& residuals) -> const VecX& {  // Y (G Y)⁺ residuals, into d.loop_col
     d.GY.noalias() = G * Y;
-    least_norm_symmetric(d.GY, residuals, d.loop_eigen, d.loop_c, d.loop_rhs);
+    rank = least_norm_symmetric(d.GY, residuals, d.loop_eigen, d.loop_c, d.loop_rhs);
     d.loop_col.noalias() = Y * d.loop_rhs;
     return d.loop_col;
   };
@@ -257,19 +258,23 @@ double project(const System& sys, Data& d, double t, VecX& q, VecX& qd, double t
   // (the Euclidean Gᵀ(GGᵀ)⁺ġ does, where G loses rank).
   weighted(factor_at_end);
   qd -= corrected(d.gd);
+  // on the loops the rank decision has its clear gap; the step's stages, off them by its drift, keep to it
+  d.loop_rank = rank;
   return residual;
 }
 
 }  // namespace
 
 double project_onto_loops(const System& sys, Data& d, double t, VecX& q, VecX& qd, double tol, int max_iterations) {
-  return project(sys, d, t, q, qd, tol, max_iterations, false);
+  const double residual = project(sys, d, t, q, qd, tol, max_iterations, false);
+  d.loop_rank = -1;  // a projection by itself leaves later evaluations their own rank decision
+  return residual;
 }
 
 const VecX& project_and_forward_dynamics(const System& sys, Data& d, double t, VecX& q, VecX& qd, double tol,
                                          int max_iterations) {
   if (sys.nl == 0 || !recursive(sys)) {
-    project_onto_loops(sys, d, t, q, qd, tol, max_iterations);
+    project(sys, d, t, q, qd, tol, max_iterations, false);
     return forward_dynamics(sys, d, t, q, qd);
   }
   project(sys, d, t, q, qd, tol, max_iterations, true);

@@ -39,10 +39,15 @@ void row_basis(const MatX& G, MatX& B);
 
 /// The same for a symmetric positive semi-definite A (G M⁻¹ Gᵀ, M symmetric): by its eigenvalues,
 /// which are its singular values (the same rank decision), without the Jacobi SVD's sweeps.
-VecX least_norm_symmetric(const MatX& A, const VecX& b);
-/// The same into x, with the caller's eigensolver and scratch c (no allocation once they are sized).
-void least_norm_symmetric(const MatX& A, const VecX& b, Eigen::SelfAdjointEigenSolver<MatX>& eigen, VecX& c,
-                          VecX& x);
+VecX least_norm_symmetric(const MatX& A, const VecX& b, int rank = -1);
+/// The same into x, with the caller's eigensolver and scratch c (no allocation once they are sized); returns
+/// the rank it kept. With `rank` >= 0 (the rank found on the loops, project_and_forward_dynamics) it keeps at
+/// most that many of A's directions where the others sum to at most 1e-6 tr A. That is a step's stage, off the
+/// loops by a drift δ: there a redundant row's direction, of eigenvalue 0 on the loops, has one of order δ² and
+/// a right-hand side of order δ, so that counting it would move q̈ by O(1) however small δ is. Otherwise it
+/// decides as above.
+int least_norm_symmetric(const MatX& A, const VecX& b, Eigen::SelfAdjointEigenSolver<MatX>& eigen, VecX& c,
+                         VecX& x, int rank = -1);
 
 /// The wrench each loop joint applies to its body B, in frame A's axes: (force N, torque N·m about
 /// B's frame origin) per loop, from the multipliers λ (nl); for a Distance loop the force along the

@@ -112,7 +112,9 @@ double project_onto_loops(const System& sys, Data& d, double t, VecX& q, VecX& q
 /// project_onto_loops, then forward_dynamics at the projected state: the velocity's projection factorises M at
 /// the projected q, and the accelerations keep that factorisation, the frames, G, Y = M⁻¹Gᵀ and G Y (all of q
 /// alone), so that both cost about one constrained forward dynamics (recursive engine; the Lagrange engine
-/// evaluates anew). q̈ (nq) as d.qdd.
+/// evaluates anew). q̈ (nq) as d.qdd. It also records in d.loop_rank the rank of G M⁻¹ Gᵀ on the loops, which the
+/// forward dynamics with d keep to until the next projection (a step's stages, off the loops by the step's
+/// drift: least_norm_symmetric).
 const VecX& project_and_forward_dynamics(const System& sys, Data& d, double t, VecX& q, VecX& qd, double tol,
                                          int max_iterations);
 

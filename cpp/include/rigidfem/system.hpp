@@ -150,6 +150,8 @@ struct Data {
   MatX Gfree, Y, GY;
   VecX loop_rhs, loop_col, loop_c;
   Eigen::SelfAdjointEigenSolver<MatX> loop_eigen;
+  int loop_rank = -1;          // rank of G M⁻¹Gᵀ kept at the last project_and_forward_dynamics' projected state, which
+                               // the forward dynamics keep to until the next one (a step's stages; -1: none)
   // Recursive algorithms (ground coordinates, at the global origin):
   std::vector<Vec6> axes;      // (nuses) coordinate axes s = (ω, v_O)
   std::vector<Vec6> v, c, a;   // (nbodies) spatial velocity, joint bias acceleration, acceleration

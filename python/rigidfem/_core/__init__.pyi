@@ -450,9 +450,9 @@ class _System:
         ...
     def _assemble(self, t: float, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, tol: typing.SupportsFloat | typing.SupportsIndex, max_iterations: typing.SupportsInt | typing.SupportsIndex) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]]:
         ...
-    def _assemble_and_accelerate(self, t: float, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, tol: typing.SupportsFloat | typing.SupportsIndex, max_iterations: typing.SupportsInt | typing.SupportsIndex) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]]:
+    def _assemble_and_accelerate(self, t: float, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, tol: typing.SupportsFloat | typing.SupportsIndex, max_iterations: typing.SupportsInt | typing.SupportsIndex, stage: tuple[numpy.typing.ArrayLike, numpy.typing.ArrayLike] | None = None) -> tuple:
         """
-        (q, q̇, q̈): _assemble, then the forward dynamics at the state it reached, on the projection's own factorisation (what the integrators do after each step on loops).
+        (q, q̇, q̈): _assemble, then the forward dynamics at the state it reached, on the projection's own factorisation (what the integrators do after each step on loops); with stage = (q_s, q̇_s), also q̈ there with the same workspace, as a step's stages evaluate it (the rank kept on the loops).
         """
     def _inverse_dynamics_direction(self, t: float, q: numpy.typing.ArrayLike, qd: numpy.typing.ArrayLike, qdd: numpy.typing.ArrayLike, dq: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], dqd: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], dqdd: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """
@@ -1099,9 +1099,9 @@ def _integer(x: typing.Any, name: str, expected: str, lo: typing.SupportsInt | t
     """
 def _integrate(system: _System, t0: typing.SupportsFloat | typing.SupportsIndex, t_end: typing.SupportsFloat | typing.SupportsIndex, q0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], qd0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], t_eval: typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], options: IntegratorOptions, keep_going: typing.Any) -> tuple[typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], dict, bool, typing.Any, typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, n]"], list]:
     ...
-def _least_norm_symmetric(A: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"], b: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
+def _least_norm_symmetric(A: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, n]"], b: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"], rank: typing.SupportsInt | typing.SupportsIndex = -1) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
     """
-    x = A⁺ b for a symmetric positive semi-definite A (the loops' G M⁻¹ Gᵀ): its eigenvalues below 1e-10 of the largest count as zero (constraints.hpp).
+    x = A⁺ b for a symmetric positive semi-definite A (the loops' G M⁻¹ Gᵀ): its eigenvalues below 1e-10 of the largest count as zero; with rank >= 0, at most rank directions where the rest are small (constraints.hpp).
     """
 def _make_profile(maker: str, *args) -> typing.Any:
     """
