@@ -132,14 +132,13 @@ class ImplicitRk : public Stepper {
     a_ = project_and_forward_dynamics(sys_, d_, t, q_, v_, 1e-12, 10);
     lambda_ = d_.lambda;
     y_ << q_, v_;
-    if (sens_) {  // onto the tangent of the loops, and S̈ of the next step's first stage with q̈ there
-      VecX S(2 * n_);
+    if (sens_) {  // onto the tangent of the loops (in sens_'s own workspace), and S̈ of the next step's first stage
+      VecX S(2 * n_);  // with d_ still holding the forward dynamics at the projected state
       for (int j = 0; j < sens_->count(); ++j) {
         S << Sq_.col(j), Sv_.col(j);
         sens_->project(j, t, q_, v_, S);
         Sq_.col(j) = S.head(n_), Sv_.col(j) = S.tail(n_);
       }
-      forward_dynamics(sys_, d_, t, q_, v_);
       sensitivity_accelerations(t);
     }
     ys_ << y_, s_, sensitivity_blocks();
