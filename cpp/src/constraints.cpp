@@ -217,6 +217,10 @@ void row_basis(const MatX& G, MatX& B) {
 
 namespace {
 
+/// What a rank kept from the loops (least_norm_symmetric's `rank`) may leave out: directions summing to at most
+/// this fraction of tr A (on the Bricard linkage, a stage about 5e-3 rad off the loops).
+constexpr double kept_rank_slack = 1e-6;
+
 using Small = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, 0, 8, 8>;  // a few loop rows, on the stack
 using SmallV = Eigen::Matrix<double, Eigen::Dynamic, 1, 0, 8, 1>;
 
@@ -245,7 +249,7 @@ bool gram_inverse(const Small& C, Small& Cinv) {
 /// dependencies: a Bricard linkage's redundant row, a planar loop's rows out of its plane) and LᵀL, whose
 /// eigenvalues are A's r others, a condition bound below 1e6 (gram_inverse; a cond₂ of 1e6/r² may already fail it). The eigenvalue floor of
 /// least_norm_symmetric (1e-10 λ_max) keeps those r and drops the rest, and then A⁺ = Pᵀ L (LᵀL)⁻² Lᵀ P.
-/// With `rank` >= 0 it stops after that many pivots and accepts a Schur complement up to 1e-6 tr A. Returns
+/// With `rank` >= 0 it stops after that many pivots and accepts a Schur complement up to kept_rank_slack tr A. Returns
 /// r, or -1 where the gap is not that clear.
 int pseudo_inverse_by_pivots(const MatX& A, const VecX& b, VecX& x, int rank) {
   const Eigen::Index n = A.rows();
@@ -270,7 +274,7 @@ int pseudo_inverse_by_pivots(const MatX& A, const VecX& b, VecX& x, int rank) {
   }
   // the Schur complement left, entry by entry (its diagonal alone bounds it only where A is semi-definite)
   const double left = r < n ? W.bottomRightCorner(n - r, n - r).cwiseAbs().sum() : 0.0;
-  if (!(left <= (r == cap && cap < n ? 1e-6 : 1e-14) * trace)) return -1;
+  if (!(left <= (r == cap && cap < n ? kept_rank_slack : 1e-14) * trace)) return -1;
   SmallV bp(n);  // P b, read before x is written (x may be b)
   for (Eigen::Index i = 0; i < n; ++i) bp(i) = b(p(i));
   if (r == 0) {  // A = 0
@@ -296,12 +300,12 @@ int least_norm_symmetric(const MatX& A, const VecX& b, Eigen::SelfAdjointEigenSo
   }
   // x = V Λ⁺ Vᵀ b, A = V Λ Vᵀ (the lower triangle read), λ_i⁺ = 1/λ_i for λ_i > 1e-10 λ_max, else 0
   // (a negative λ_i is round-off of a zero one); with `rank`, 0 also for all but the `rank` largest where
-  // those sum to at most 1e-6 tr A.
+  // those sum to at most kept_rank_slack tr A.
   eigen.compute(A);
   const VecX& s = eigen.eigenvalues();  // ascending
   double floor = s.size() > 0 ? 1e-10 * s(s.size() - 1) : 0.0;
   const Eigen::Index drop = rank >= 0 ? s.size() - std::min<Eigen::Index>(rank, s.size()) : 0;
-  if (drop > 0 && s.head(drop).cwiseAbs().sum() <= 1e-6 * s.sum()) floor = std::max(floor, s(drop - 1));
+  if (drop > 0 && s.head(drop).cwiseAbs().sum() <= kept_rank_slack * s.sum()) floor = std::max(floor, s(drop - 1));
   c.noalias() = eigen.eigenvectors().transpose() * b;
   int kept = 0;
   for (Eigen::Index i = 0; i < s.size(); ++i) {
