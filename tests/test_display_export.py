@@ -69,7 +69,7 @@ def test_result_html_shows_the_method_and_counters(run):
     _, _, res = run
     page = res._repr_html_()
     s = res.stats
-    for text in ("dopri5", f"outputs: {len(res.t)}", f"steps: {s['steps']}", f"rejected steps: {s['rejected_steps']}",
+    for text in ("dop853", f"outputs: {len(res.t)}", f"steps: {s['steps']}", f"rejected steps: {s['rejected_steps']}",
                  f"rhs evaluations: {s['rhs_evaluations']}", "interrupted: False"):
         assert text in page
 

@@ -91,8 +91,9 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
     method : str
         "auto" (default): dopri5 while it is the cheaper, a stiff method where it is not: radau5, or
         esdirk43 with Maxwell arms or with ``iteration_matrix="spring"`` (radau5 takes neither). At
-        rtol <= 1e-7 dop853 takes dopri5's place (its order 8 takes fewer evaluations there: 1.2-2 times
-        as fast on a double pendulum, a four-bar and the Bricard linkage), by the same rules with its
+        rtol <= 1e-6 (the default) dop853 takes dopri5's place (its order 8 takes fewer evaluations
+        there: at rtol 1e-6, 1.1-1.6 times as fast on a double pendulum, the Bricard linkage and a
+        chain of stiff springs; at 3e-6 the double pendulum went to dopri5), by the same rules with its
         stability boundary (h ρ > 3.6 counted near it, where dopri5's is h ρ > 2). dopri5
         holds the state (its stability rests on its error control); radau5 measures its error on the
         outputs (``error_on``: the bodies' displacements by default), esdirk43 holds the state. First auto estimates the
@@ -108,14 +109,16 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
         unit of work as the probe — counted, not timed (right-hand sides, nq per tangent, (nq/50)²
         per dense factorisation), so the choice is the same on every machine and thread — else
         dopri5 goes on. A later window that looks bounded by stability (a fifth of its steps at
-        h ρ > 2, or, for dopri5, a sixth as many rejections) hands the run over to the stiff method from the
-        state reached, after waiting twice as many windows if the probe's trial was lost. A
-        hand-over is final. On a non-stiff problem run for long the rule by ρ can misjudge: a
-        pendulum over 1000 s (over 500 periods) runs radau5, 1.5 times dopri5's time at rtol = 1e-3,
-        0.88 and 0.79 times at 1e-6 and 1e-9.
+        h ρ > 2) hands the run over to the stiff method from the state reached, after waiting twice
+        as many windows if the probe's trial was lost; rejected steps alone do not (a swinging double
+        pendulum rejects a third of dopri5's steps and is not stiff). A hand-over is final. The rule
+        by ρ can misjudge: a pendulum over 1000 s (over 500 periods) runs radau5, 1.5 times dopri5's
+        time at rtol = 1e-3, 0.88 and 0.79 times at 1e-6 and 1e-9; and where the stiff mode itself
+        rings (a four-bar's crank on a 1e6 N·m/rad spring, barely damped, over 2 s) radau5 must
+        follow it and took 1.6-3.5 times dop853's time at rtol 1e-3 to 1e-7. Name the method there.
         ``stats["method"]`` says what ran ("dopri5", "radau5 from the start (omega_max = ... rad/s:
-        stiff for dopri5)", "radau5 from the start (a dopri5 probe of ... steps found the problem
-        stiff)", or "dopri5, then radau5 from t = ... s"), ``stats["switched_at"]``,
+        stiff for dop853)", "radau5 from the start (a dopri5 probe of ... steps found the problem
+        stiff)", or "dop853, then radau5 from t = ... s"), ``stats["switched_at"]``,
         ``stats["auto_trials"]``, ``stats["probe_steps"]`` and ``stats["omega_max"]`` the details.
         Closed chains too (both methods project each step onto the loops).
         Otherwise see the module docstring: "euler", "symplectic_euler", "rk4", "dopri5", "rkf45",
@@ -202,7 +205,7 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
     >>> system = model.compile()
     >>> res = rf.simulate(system, 1.0, q0=[0.5])
     >>> res.stats["method"], round(float(res.q[-1, 0]), 4)
-    ('dopri5', -0.4034)
+    ('dop853', -0.4034)
     """
     o = options_.resolve(options)
     dt, rtol, atol, error_on, first_step = o["dt"], o["rtol"], o["atol"], o["error_on"], o["first_step"]
