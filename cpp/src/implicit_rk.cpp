@@ -900,12 +900,12 @@ class Collocation final : public ImplicitRk, public RadauAccess {
     for (int i = 0; i < 3; ++i) mu_.segment(i * r, r).noalias() = basis_.transpose() * L_.col(i);
     auto Wr = W_.topLeftCorner(3 * r, 3 * r);
     w_.head(3 * r).noalias() += Wr * mu_;
-    if (!lu_valid_) lu_.compute(Wr);
-    lu_valid_ = true;
-    if (!(lu_.rcond() > 1e-10)) {
-      full_ = true;  // for the rest of this solve
-      return close_loops_full();
+    if (!lu_valid_) {  // Ŵ factorised once per solve, and its condition estimated then (a few solves)
+      lu_.compute(Wr);
+      lu_valid_ = true;
+      full_ = !(lu_.rcond() > 1e-10);  // singular: the full W for the rest of this solve
     }
+    if (full_) return close_loops_full();
     mu1_ = lu_.solve(w_.head(3 * r));  // μ⁺
     for (int i = 0; i < 3; ++i) E_.col(i).noalias() = Gr_[i].transpose() * (mu1_ - mu_).segment(i * r, r);
     solve_stages(E_, Z_);
