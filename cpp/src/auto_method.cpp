@@ -154,7 +154,7 @@ bool AutoChoice::after_step(double t, double h_rho, const IntegratorStats& stats
   // cut where the motion turns sharply (the Bricard linkage through its singular configuration at t = 4 s: a window
   // of 20 steps with 7 rejected, which once handed the run to radau5 at 7 times dop853's cost), dopri5's alike
   const bool near = near_boundary_ * 5 >= window;
-  const bool trial = (near && first_window_) || (near && ++windows_since_trial_ >= backoff_);
+  const bool trial = near && (first_window_ || ++windows_since_trial_ >= backoff_);
   first_window_ = false;
   mark(t, stats);
   return trial;

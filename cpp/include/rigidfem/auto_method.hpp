@@ -83,8 +83,8 @@ class AutoChoice {
   bool krylov_ = false;  // the stiff method's tangent is matrix-free
   bool stiff_running_ = false, spring_ = false, restarted_ = false, first_window_ = true;
   double probe_end_ = 0.0, probe_rate_ = 0.0;  // the restarted trial's comparison (switched_at)
-  // The first window holds dopri5's start from its first step (rejections, a low rate): only its steps at the
-  // stability boundary start a trial after it.
+  // A window whose steps reach the stability boundary starts a trial: the first at once (dopri5 was a probe), a
+  // later one after `backoff_` windows.
   int steps_ = 0, near_boundary_ = 0, windows_since_trial_ = -1, backoff_ = 1;
   double t_mark_ = 0.0, work_mark_ = 0.0, h_explicit_ = 0.0;
 };
