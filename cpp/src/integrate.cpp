@@ -57,7 +57,7 @@ const std::vector<MethodInfo>& method_table() {
     rows.push_back({Method::Auto, "auto", "auto", 5, true, true, true, false, method_options(true, true),
                     "radau5 (esdirk43 with Maxwell arms or the spring matrix) from the start where the highest "
                     "frequency at t0 (stats['omega_max'], by power iteration) would hold dopri5 to 200 steps or more "
-                    "for stability alone; otherwise dopri5 (dop853 at rtol <= 1e-7), handing over for good where its steps sit at "
+                    "for stability alone; otherwise dopri5 (dop853 at rtol <= 1e-6), handing over for good where its steps sit at "
                     "the stability "
                     "limit (from the start if that is in its first window, kept if it beats dopri5's probe by a count "
                     "of work); stats['method'] says what ran",
@@ -552,7 +552,7 @@ const std::vector<OptionInfo>& integrator_options() {
        "force, N) and loop names (their multipliers, N or N·m), each error mapped from the state's through the "
        "output's Jacobian, a velocity's held as the displacement it makes over the step. None (the default): "
        "'bodies' — every body's displacement, the RMS over its material √(|δc|² + δθᵀ I_C δθ/m) — for radau5, the "
-       "adaptive Newmark family and auto's radau5; 'state' for dopri5, dop853, rkf45, bs23, esdirk43 and auto's dopri5 phase. "
+       "adaptive Newmark family and auto's radau5; 'state' for dopri5, dop853, rkf45, bs23, esdirk43 and auto's explicit phase. "
        "A mode that no output sees is not resolved: the L-stable radau5 damps it (the released strip of 1 m, m = 32: "
        "2,800 steps to 1e-6 m instead of 177,000).",
        true, [](const O&) { return OptionValue(); }, nullptr},
