@@ -65,14 +65,13 @@ void apply_elementary(Mat4& G, Axis a, double q) {
   G.col(k2) = -s * c1 + c * c2;
 }
 
-Vec6 motion_axis(const Mat4& G, Axis a) {
+void motion_axis(const Mat4& G, Axis a, Vec6& s) {
+  // Written into its place component by component: a 6-vector built on the stack and copied out was read back as
+  // pairs just after its single components were stored, a stall on every axis (measured: 5 % of a forward dynamics).
   const Vec3 e = G.col(axis_index(a)).head<3>();
-  Vec6 s;
-  if (is_rotation(a))
-    s << e, G.col(3).head<3>().cross(e);
-  else
-    s << Vec3::Zero(), e;
-  return s;
+  const Vec3 v = is_rotation(a) ? Vec3(G.col(3).head<3>().cross(e)) : e;
+  const Vec3 w = is_rotation(a) ? e : Vec3::Zero();
+  for (int i = 0; i < 3; ++i) s(i) = w(i), s(3 + i) = v(i);
 }
 
 namespace {
@@ -158,7 +157,7 @@ void joint_motion(const JointUses& j, const VecX& qa, const VecX& qda, const Vec
 void joint_frames(const JointUses& j, const VecX& qa, Mat4& G, Vec6* axes) {
   for (int k = 0; k < j.n; ++k) {
     apply_elementary(G, j.axis[k], qa(j.coord[k]));
-    axes[k] = motion_axis(G, j.axis[k]);
+    motion_axis(G, j.axis[k], axes[k]);
   }
 }
 

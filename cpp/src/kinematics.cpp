@@ -216,10 +216,9 @@ std::pair<AppliedLoad, AppliedLoad> element_loads(const ElementState& s) {
   return {{s.xb, s.F * s.e + s.wb, Vec3::Zero()}, {s.xa, -s.F * s.e + s.wa, Vec3::Zero()}};
 }
 
-double passive_force(const System& sys, const Data& d, int i, bool spatial) {
+double further_force(const System& sys, const Data& d, int i, bool spatial) {
   const Coordinate& c = sys.coords[i];
-  // −s (k (q − q⁰) + c q̇) − Σ s_arm + λ Q₀ + Σ Q_law + Σ r P c of the ropes wound on it
-  double Q = c.spring.elastic_force(d.qa(i), d.qda(i), d.spring_scale(i)) - d.arm_force(i) + d.load_factor * c.spring.force;
+  double Q = 0.0;
   for (const auto& law : c.laws) Q += law->force(d.t, d.qa(i), d.qda(i), d.load_factor);
   for (const auto& [k, j] : c.windings) {
     const ForceElement& E = sys.elements[k];
@@ -259,8 +258,10 @@ std::string gimbal_lock_hint(const System& sys, const VecX& q, double tol) {
 }
 
 void check_gimbal_lock(const System& sys, const Data& d) {
+  // |cos φ2| < 1e-9 where φ2 = π/2 + kπ + r with |r| < 1e-9 (|cos φ2| = |sin r|): no cosine per call
+  constexpr double pi = 3.14159265358979323846;
   for (int i : sys.zyx_pitch)
-    if (std::abs(std::cos(d.qa(i))) < 1e-9)
+    if (const double x = d.qa(i) - 0.5 * pi; std::abs(x - pi * std::round(x / pi)) < 1e-9)
       throw SimulationError(d.t, "gimbal lock: the ZYX angles of " + joint_name(sys.coords[i]) +
                                      " reached pitch phi2 = +-pi/2, where the mass matrix is singular; turn the joint "
                                      "frame (placement) so the motion keeps away from it");

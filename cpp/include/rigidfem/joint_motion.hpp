@@ -35,9 +35,9 @@ Mat4 elementary(Axis a, double q);
 Mat4 generator(Axis a);
 /// G ← G E_a(q), the factor applied to the columns of the frame G (no 4x4 product).
 void apply_elementary(Mat4& G, Axis a, double q);
-/// The axis s = (ω, v_O) of the motion a in the frame G (ground coordinates): (e, o × e) for a
+/// The axis s = (ω, v_O) of the motion a in the frame G (ground coordinates), into s: (e, o × e) for a
 /// rotation about the unit vector e through the origin o of G, (0, e) for a translation along e.
-Vec6 motion_axis(const Mat4& G, Axis a);
+void motion_axis(const Mat4& G, Axis a, Vec6& s);
 
 /// Joint transform T̃(q) = Π_k E_{axes[k]}(q_k) (4x4); axes must be in the book's order.
 Mat4 joint_transform(const std::vector<Axis>& axes, const VecX& q);

@@ -113,10 +113,19 @@ void for_each_body_load(const System& sys, const Data& d, bool spatial, Visit&& 
   });
 }
 
+/// Σ Q_law + Σ r P c of coordinate i: its further laws' Q(t, q, q̇) (coordinate_laws.hpp) and, as a drum or a
+/// sheave's slip, r P c of each rope wound on it (force_elements.hpp: Winding; its state from d.v where `spatial`, else
+/// d.Td). Out of line: passive_force calls it only for the coordinates that have them.
+double further_force(const System& sys, const Data& d, int i, bool spatial);
 /// Q_i of the laws on coordinate i (all coordinates): its spring-damping law −s (k (q − q⁰) + c q̇) + λ Q₀, its
-/// Maxwell arms' −Σ s (d.arm_force), its further laws' Q(t, q, q̇) (coordinate_laws.hpp) and, as a drum or a sheave's
-/// slip, r P c of each rope wound on it (force_elements.hpp: Winding; its state from d.v where `spatial`, else d.Td).
-double passive_force(const System& sys, const Data& d, int i, bool spatial);
+/// Maxwell arms' −Σ s (d.arm_force) and further_force.
+inline double passive_force(const System& sys, const Data& d, int i, bool spatial) {
+  const Coordinate& c = sys.coords[i];
+  // −s (k (q − q⁰) + c q̇) − Σ s_arm + λ Q₀ + Σ Q_law + Σ r P c of the ropes wound on it
+  const double Q = c.spring.elastic_force(d.qa(i), d.qda(i), d.spring_scale(i)) - d.arm_force(i) +
+                   d.load_factor * c.spring.force;
+  return c.laws.empty() && c.windings.empty() ? Q : Q + further_force(sys, d, i, spatial);
+}
 /// (∂Q/∂q_i, ∂Q/∂q̇_i) of coordinate i's further laws (coordinate_laws.hpp) at d's state: the spring-damping
 /// law's own are exact constants the callers take from Coordinate::spring, and the arms' are internal variables.
 std::pair<double, double> coordinate_derivatives(const System& sys, const Data& d, int i);
