@@ -289,8 +289,15 @@ def test_free_body_near_gimbal_lock_against_a_quaternion_reference():
     assert np.all(np.isfinite(r.q))
     assert np.max(np.abs(r.q[:, 4])) > 1.4  # the pitch came near π/2
     np.testing.assert_allclose(system.transform(0, 0.0, r.q[-1])[:3, :3], R_ref, atol=1e-6)
-    with pytest.raises(rf.SimulationError, match="gimbal lock"):
-        system.forward_dynamics(0.0, [0, 0, 0, 0, np.pi / 2, 0], np.zeros(6))
+    # At every pitch where |cos φ2| < 1e-9 (π/2 + kπ, to within 1e-9 rad), and only there.
+    for pitch in (np.pi / 2, -np.pi / 2, 3 * np.pi / 2, -5 * np.pi / 2 + 5e-10, np.pi / 2 - 5e-10):
+        assert abs(np.cos(pitch)) < 1e-9
+        with pytest.raises(rf.SimulationError, match="gimbal lock"):
+            system.forward_dynamics(0.0, [0, 0, 0, 0, pitch, 0], np.zeros(6))
+    # Far out (a run blowing up) π/2 + kπ in floating point is 4e-7 off the lock: no gimbal-lock message there
+    for pitch in (np.pi / 2 - 1e-6, 3 * np.pi / 2 + 1e-6, np.pi, np.pi / 2 + 3e9 * np.pi):
+        assert abs(np.cos(pitch)) > 1e-9
+        assert np.all(np.isfinite(system.forward_dynamics(0.0, [0, 0, 0, 0, pitch, 0], np.zeros(6))))
 
 
 def test_bad_options_are_value_errors():
