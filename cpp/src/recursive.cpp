@@ -138,7 +138,7 @@ bool invert_spd(const SmallMat& D, SmallMat& Dinv) {
 
 // D⁻¹ of a symmetric 3 × 3 D through its factors D = L diag(d) Lᵀ (L unit lower: Cholesky's arithmetic without its
 // square roots, which stood in the chain of dependent operations from one body to the next: measured, a
-// 3-rotation chain's forward dynamics 7 % faster), written out: N = L⁻¹, D⁻¹ = Nᵀ diag(1/d) N; false unless D is
+// 3-rotation chain's forward dynamics 5–7 % faster), written out: N = L⁻¹, D⁻¹ = Nᵀ diag(1/d) N; false unless D is
 // positive definite.
 bool invert_spd3(const Mat3& D, Mat3& Dinv) {
   if (!(D(0, 0) > 0.0)) return false;
