@@ -299,11 +299,7 @@ namespace {
 // forces τ of the free coordinates go into d.qdd, which pass 3 overwrites with q̈.
 void bias_forces(const System& sys, Data& d) {
   for (int p = 0; p < sys.nbodies; ++p) {
-    // v ×* (I v) − f_ext by halves, (ω × h_ω + v_O × h_v, ω × h_v) − f_ext for h = I v, into p^A: crossf's result,
-    // a 6-vector, was read back in pairs just after its single components were stored, a stall on every body
-    const Vec6 h = d.I[p] * d.v[p];
-    const Vec3 w = d.v[p].head<3>(), vO = d.v[p].tail<3>(), hw = h.head<3>(), hv = h.tail<3>();
-    d.pA[p] << w.cross(hw) + vO.cross(hv) - d.fext[p].head<3>(), w.cross(hv) - d.fext[p].tail<3>();
+    d.pA[p] = crossf(d.v[p], d.I[p] * d.v[p]) - d.fext[p];
     for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) {
       const int i = sys.use_coord[u];
       if (sys.use_drive[u] >= 0) d.c[p] += d.axes[u] * d.qdda(i);
