@@ -263,7 +263,7 @@ def test_a_rope_over_a_sheave_holds_below_eulers_ratio_and_slips_at_it(ratio):
         assert r.qd[-1, u] == pytest.approx(v_eps * math.atanh(math.log(M1 / M2) / (mu * wrap)), rel=1e-3)
         assert abs(r.q[-1, u]) < 1e-3
     else:
-        udd = np.gradient(r.qd[:, u], t, edge_order=2)[-1]
+        udd = s.forward_dynamics(t[-1], r.q[-1], r.qd[-1])[u]  # the model's ü at the end (not a difference quotient)
         assert T[-1, 0] == pytest.approx(euler * T[-1, 1] + 0.1 * udd, rel=1e-6)
         k1, k2 = np.searchsorted(t, [1.5, 2.0])
         accel = (r.qd[k2, light] - r.qd[k1, light]) / (t[k2] - t[k1])
