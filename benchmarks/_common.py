@@ -62,7 +62,7 @@ def provenance() -> str:
     when = f"{started:%Y-%m-%d %H:%M} UTC" if started else "an unrecorded date"
     return (f"Written by `{_STARTED.get('command', 'python -m benchmarks')}` on {when}: {_cpu()}, "
             f"{os.cpu_count()} cores, {platform.system()}; Python {platform.python_version()}, rigidfem "
-            f"{rf.__version__}, numpy {np.__version__}; load average (1, 5, 15 min) {_STARTED.get('load', 'unknown')} "
+            f"{rf.__version__} (core build {rf._core.build}), numpy {np.__version__}; load average (1, 5, 15 min) {_STARTED.get('load', 'unknown')} "
             f"at the start, {_load()} at the end.")
 
 

@@ -56,9 +56,9 @@ python -m pip install -q --disable-pip-version-check scikit-build-core
 python -m scikit_build_core.build requires \
   | python -c 'import json, subprocess, sys; subprocess.check_call([sys.executable, "-m", "pip", "install", "-q", "--disable-pip-version-check", *json.load(sys.stdin)])'
 
-echo "== sanitize: build (ASan + UBSan, RelWithDebInfo) in build/sanitize/"
+echo "== sanitize: build (ASan + UBSan, RelWithDebInfo; the portable core only) in build/sanitize/"
 python -m pip install -q --disable-pip-version-check --no-build-isolation -e ".[test]" \
-  -Ccmake.define.RIGIDFEM_SANITIZE=ON \
+  -Ccmake.define.RIGIDFEM_SANITIZE=ON -Ccmake.define.RIGIDFEM_X86_64_V3=OFF \
   -Ccmake.build-type=RelWithDebInfo \
   "-Cbuild-dir=build/sanitize/{wheel_tag}"
 t_built=$(stamp)

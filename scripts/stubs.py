@@ -11,6 +11,7 @@ names — not how pybind11 spells the types, so a new pybind11 release does not 
 from __future__ import annotations
 
 import ast
+import re
 import shutil
 import subprocess
 import sys
@@ -24,7 +25,12 @@ def generate(into: Path) -> Path:
     """The stubs of rigidfem._core written under ``into``; returns their folder."""
     subprocess.run([sys.executable, "-m", "pybind11_stubgen", "rigidfem._core", "-o", str(into)], check=True,
                    capture_output=True, text=True)
-    return into / "rigidfem" / "_core"
+    folder = into / "rigidfem" / "_core"
+    # `build` is the loaded build's name, which depends on the processor: declared, not valued
+    init = folder / "__init__.pyi"
+    init.write_text(re.sub(r"(?m)^build: str = .*$", 'build: str  # "baseline" or "x86-64-v3" (rigidfem/_load_core.py)',
+                           init.read_text()))
+    return folder
 
 
 def declared(folder: Path) -> dict[str, tuple]:

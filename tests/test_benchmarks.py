@@ -50,7 +50,8 @@ def test_runner_writes_each_table_as_a_page_with_its_provenance(tmp_path):
     assert main(["scaling", "--quick", "--output", str(tmp_path)]) == 0
     page = (tmp_path / "dynamics_scaling.md").read_text(encoding="utf-8")
     assert page.startswith("# ") and "`python -m benchmarks scaling --quick --output" in page
-    assert f"rigidfem {rf.__version__}" in page and "load average" in page and "at the end" in page
+    assert f"rigidfem {rf.__version__} (core build {rf._core.build})" in page and "load average" in page
+    assert "at the end" in page
     assert "[dynamics_scaling.csv](dynamics_scaling.csv)" in page
     with open(tmp_path / "dynamics_scaling.csv") as f:
         rows = list(csv.DictReader(f))

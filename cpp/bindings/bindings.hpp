@@ -244,6 +244,8 @@ void bind_model(py::module_& m);
 void bind_dynamics(py::module_& m);
 void bind_profiles(py::module_& m);
 void bind_integrators(py::module_& m);
+/// Everything of the module rigidfem._core (module_init.cpp's entry point calls it).
+void bind_module(py::module_& m);
 }  // namespace rigidfem::bindings
 
 namespace pybind11::detail {

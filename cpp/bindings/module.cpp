@@ -408,11 +408,7 @@ void bind_profiles(py::module_& m) {
       py::arg("function"));
 }
 
-}  // namespace rigidfem::bindings
-
-PYBIND11_MODULE(_core, m) {
-  namespace py = pybind11;
-  using namespace rigidfem::bindings;
+void bind_module(py::module_& m) {
   m.doc() = "rigidfem C++ core: transforms, models, kinematics, the Lagrange and recursive formulations, integrators.";
   static PyObject* simulation_error = nullptr;  // the Python type, for the translator below
   auto& registered = py::register_exception<rigidfem::SimulationError>(m, "SimulationError", PyExc_RuntimeError);
@@ -465,3 +461,5 @@ PYBIND11_MODULE(_core, m) {
       "Seconds per call of the parts of an implicit step (residual, tangent, LU factor and solve, the O(n)\n"
       "armature factor and solve), timed in C++.");
 }
+
+}  // namespace rigidfem::bindings

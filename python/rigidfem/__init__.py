@@ -9,6 +9,10 @@ C++ core. SI units throughout.
 import importlib
 import sys
 
+from . import _load_core
+
+_load_core.load(__name__)  # the core built for this processor, as rigidfem._core: before the imports below
+
 # The layers, bottom to top (tests/test_structure.py holds their imports downwards): base, model, simulation,
 # analysis, viz, studies. Every public name is here, and the modules users reach as rf.<module>.
 from ._core import (

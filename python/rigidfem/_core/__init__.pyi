@@ -8,7 +8,7 @@ import numpy.typing
 import typing
 from . import stages
 from . import _bench
-__all__: list[str] = ['Body', 'Data', 'ForceLawError', 'IntegratorOptions', 'JointSpec', 'Point', 'Profile', 'R1', 'R2', 'R3', 'SimulationError', 'callback_profile', 'euler_zyx', 'homogeneous', 'inverse', 'joint_transform', 'joint_transform_derivative', 'joint_transform_second_derivative', 'pseudo_inertia', 'skew', 'stages']
+__all__: list[str] = ['Body', 'Data', 'ForceLawError', 'IntegratorOptions', 'JointSpec', 'Point', 'Profile', 'R1', 'R2', 'R3', 'SimulationError', 'build', 'callback_profile', 'euler_zyx', 'homogeneous', 'inverse', 'joint_transform', 'joint_transform_derivative', 'joint_transform_second_derivative', 'pseudo_inertia', 'skew', 'stages']
 class SimulationError(RuntimeError):
     """
     A numerical failure, a RuntimeError whose message names the time (s) and the cause: a singular mass or iteration matrix, a step size below the minimum, a NaN or inf state, Newton divergence in a step or a load step of the statics, max_steps, gimbal lock of ZYX Euler angles. Its `time` (s) and `cause` say when and why.
@@ -1247,3 +1247,4 @@ def skew(w: typing.Any) -> typing.Annotated[numpy.typing.NDArray[numpy.float64],
     >>> rf.skew([1.0, 2.0, 3.0]) @ [4.0, 5.0, 6.0]
     array([-3.,  6., -3.])
     """
+build: str  # "baseline" or "x86-64-v3" (rigidfem/_load_core.py)
