@@ -1,4 +1,4 @@
-"""``python -m benchmarks {scaling,peers,scale,loops,implicit_step,sweep,kane_peers,loop_peers,sweep_peers,strip_peers,crane_peers,size_peers,evaluations,orders,tolerance,accuracy,viewer,sensitivities,contact,energy} [--quick] [--output DIR]``, from the root of a checkout."""
+"""``python -m benchmarks {scaling,peers,scale,loops,implicit_step,sweep,kane_peers,loop_peers,sweep_peers,strip_peers,crane_peers,size_peers,evaluations,orders,tolerance,accuracy,viewer,sensitivities,contact,energy,core_builds} [--quick] [--output DIR]``, from the root of a checkout."""
 
 from __future__ import annotations
 
@@ -28,6 +28,7 @@ COMMANDS = {
     "sensitivities": "forward sensitivities: cost per parameter against the run, strips of m = 20, 80, 320",
     "work_precision": "python -m rigidfem bench as pages: the standard scenes under the standard integrators (least time to a tip error, auto against the best) and the discretisation error",
     "energy": "conservative mechanisms over long runs (pendulums, a four-bar, the Bricard linkage): the energy error early and late by gauss6, radau5, rk4, generalised-α (ρ∞ = 1) and dop853",
+    "core_builds": "the portable and the x86-64-v3 build of the C++ core side by side: forward dynamics on the peers pages' models and the README's run (needs an x86-64-v3 processor and: pip install mujoco)",
     "contact": "contact at scale: a strip of m rfes on the ground, a capsule per rfe: forward dynamics and Jacobians",
 }
 
