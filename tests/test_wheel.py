@@ -19,6 +19,8 @@ from pathlib import Path
 
 import pytest
 
+from rigidfem import _load_core
+
 ROOT = Path(__file__).resolve().parents[1]
 TAG = f"cp{sys.version_info.major}{sys.version_info.minor}"
 COMPILERS = ("cc", "c++", "gcc", "g++", "clang", "clang++", "zig")
@@ -78,10 +80,14 @@ def installed(wheel, tmp_path_factory):
 
 def test_no_compiler_and_the_module_comes_from_the_wheel(installed):
     python, env, cwd, _ = installed
-    code = f"import shutil, rigidfem._core as c; print([n for n in {COMPILERS!r} if shutil.which(n)]); print(c.__file__)"
+    code = (f"import shutil, rigidfem._core as c; print([n for n in {COMPILERS!r} if shutil.which(n)]); "
+            "print(c.__file__); print(c.build)")
     where = run([python, "-c", code], env, cwd).split("\n")
     assert where[0] == "[]", f"compilers on the test's PATH: {where[0]}"
     assert Path(where[1]).is_relative_to(python.parent.parent), where[1]
+    # an x86-64 wheel holds both builds of the core, and loads the x86-64-v3 one where the processor has it
+    v3_here = platform.machine() == "x86_64" and _load_core.X86_64_V3_FLAGS <= _load_core.cpu_flags()
+    assert where[2] == ("x86-64-v3" if v3_here else "baseline"), where[2]
 
 
 def test_demo(installed):

@@ -2,9 +2,9 @@
 
 On x86-64 Linux two builds of the same core ship: ``_core`` for any x86-64 processor and ``_core_v3`` compiled
 for x86-64-v3 (AVX, AVX2, FMA, BMI1, BMI2, F16C, LZCNT, MOVBE: Intel since Haswell, 2013, AMD since
-Excavator, 2015), whose forward dynamics run 5-23 % faster. The second is loaded where /proc/cpuinfo lists
-those features; elsewhere, and on other systems, the first. Both name themselves ``rigidfem._core``, and
-``rigidfem._core.build`` says which one runs ("x86-64-v3" or "baseline").
+Excavator, 2015), whose forward dynamics run 3-21 % faster (python -m benchmarks core_builds). The second is
+loaded where /proc/cpuinfo lists those features; elsewhere, and on other systems, the first. Both name themselves
+``rigidfem._core``, and ``rigidfem._core.build`` says which one runs ("x86-64-v3" or "baseline").
 
 The environment variable ``RIGIDFEM_CORE`` overrides the choice: "baseline" loads the portable build,
 "x86-64-v3" the other. ``import rigidfem`` raises an ImportError naming the variable for any other value, and
