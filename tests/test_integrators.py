@@ -340,7 +340,7 @@ def test_progress_reports_and_the_gil_is_released(capsys):
     thread = threading.Thread(target=spin)
     thread.start()
     try:
-        r = rf.simulate(system, 0.02, method="rk4", dt=2e-6, q0=q0, progress=True)
+        r = rf.simulate(system, 0.04, method="rk4", dt=2e-6, q0=q0, progress=True)  # > 0.2 s on the fastest build
     finally:
         stop.set()
         thread.join()
