@@ -30,6 +30,7 @@ COMMANDS = {
     "energy": "conservative mechanisms over long runs (pendulums, a four-bar, the Bricard linkage): the energy error early and late by gauss6, radau5, rk4, generalised-α (ρ∞ = 1) and dop853",
     "core_builds": "the portable and the x86-64-v3 build of the C++ core side by side: forward dynamics on the peers pages' models and the README's run (needs an x86-64-v3 processor and: pip install mujoco)",
     "contact": "contact at scale: a strip of m rfes on the ground, a capsule per rfe: forward dynamics and Jacobians",
+    "limits": "where radau5's cheapest runs go on the peers page's rows under the lead asked (the strip at m = 16 to 1e-6 m, the crane to 1e-4): counts, residuals and tangents at their cost per call, the strip's modes in its motion",
 }
 
 

@@ -393,3 +393,23 @@ def test_energy_benchmark_quick():
     pendulum = {r["method"] + " " + r["setting"]: r for r in table.rows if r["scene"].startswith("pendulum")}
     assert pendulum["gauss6 dt=0.05"]["last_over_first"] < 1.2
     assert pendulum["rk4 dt=0.05"]["last_over_first"] > 3
+
+
+def test_limits_quick():
+    """python -m benchmarks limits' strip study at m = 8: the stage residuals, timed apart in C++, take part of
+    each run's CPU time, three per Newton iteration; the tighter run's error is smaller and its observed order in
+    the step count between 1 and radau5's 5; and the first mode carries the tip's swing about the sag: half its
+    range is beam theory's static sag w L⁴ / 8EI to 5 %, each other mode's under a tenth of it."""
+    from benchmarks import limits
+
+    rows, modes, _ = limits.strip_study(8, (1e-5, 2e-6))
+    limits._orders(rows)
+    for r in rows:
+        assert 0.0 < r["residuals_ms"] < r["cpu_ms"]
+        assert r["residuals"] == pytest.approx(3 * r["newton_per_step"] * r["steps"], abs=3)
+    assert rows[1]["error"] < rows[0]["error"] and 1.0 < rows[1]["order"] < 5.0
+    E, rho, width, thickness = 2.1e11, 7850.0, 0.02, 0.002
+    EI, w = E * width * thickness**3 / 12, rho * width * thickness * 9.81
+    first, *others = modes.rows
+    assert first["tip_amplitude_m"] == pytest.approx(w / (8 * EI), rel=0.05)
+    assert all(r["tip_amplitude_m"] < first["tip_amplitude_m"] / 10 for r in others)

@@ -684,12 +684,11 @@ class Esdirk final : public ImplicitRk {
 /// (gauss6: fixed steps, the step ends at y_n + h Σ b_i f(Y_i)).
 class Collocation final : public ImplicitRk, public RadauAccess {
   using cplx = std::complex<double>;
-  using MatXc = Eigen::MatrixXcd;
 
  public:
   Collocation(const System& sys, const IntegratorOptions& o, IntegratorStats& stats, const CollocationTableau& tab)
       : ImplicitRk(sys, o, stats), tab_(tab), A_(n_, 3), V_(n_, 3), Q_(n_, 3), R_(n_, 3), D_(n_, 3), dV_(n_, 3), dQ_(n_, 3),
-        Aprev_(n_, 3), Rt_(n_, 3), Dt_(n_, 3), z_(n_), zs_(n_), x_(n_), xs_(n_), b1_(n_), b2_(n_), qx_(n_), vx_(n_),
+        Aprev_(n_, 3), z_(n_), zs_(n_), x_(n_), xs_(n_), zr_(n_), zi_(n_), b1_(n_), b2_(n_), qx_(n_), vx_(n_),
         L_(sys.nl, 3), Cres_(sys.nl, 3), W_(3 * sys.nl, 3 * sys.nl),
         w_(3 * sys.nl), E_(n_, 3), Z_(n_, 3) {
     // gauss6: Newton to 1e-4 newton_tol (symmetric_tol), or newton_tol where it stops contracting or runs out of
@@ -698,6 +697,7 @@ class Collocation final : public ImplicitRk, public RadauAccess {
     // h = 10 ms over 500 s: its energy drifted by 2.1e-6 J with the increments held to 1e-10 (1 + |y|), by 2e-8 J
     // at 1e-12; the Bricard linkage at h = 10 ms over 200 s: 8.2e-7 J at 1e-12, 1.2e-8 J at 1e-14.
     if (!tab_.stiffly_accurate) newton_tol_ *= symmetric_tol;
+    check_pairs();
   }
 
   void stages(MatX& Q, MatX& V, MatX& A) const override { Q = Q_, V = V_, A = A_; }
@@ -852,18 +852,29 @@ class Collocation final : public ImplicitRk, public RadauAccess {
   }
 
   /// Y = 𝒮⁻¹ X (nq, 3) for Newton's matrix 𝒮 = I⊗M + h a⊗C + h² a²⊗K on the stages (columns): X̃ = X P⁻ᵀ,
-  /// each column solved with its block (S₁ real, S₂ complex, the third the conjugate), Y = Re(Ỹ Pᵀ).
+  /// each column solved with its block (S₁ real, S₂ complex, the third the conjugate), Y = Re(Ỹ Pᵀ). With P's
+  /// first column and P⁻¹'s first row real and the others conjugate pairs (check_pairs), in real arithmetic:
+  /// x = X p̂₀ (p̂ⱼ = P⁻¹'s row j), z = X p̂₁, and Y = S₁⁻¹x p₀ᵀ + 2 Re(S₂⁻¹z p₁ᵀ) (pⱼ = P's column j).
   void solve_stages(const MatX& X, MatX& Y) {
-    Rt_.noalias() = X.cast<cplx>() * tab_.Pinv.transpose();
-    x_ = Rt_.col(0).real();
+    x_.noalias() = X * pinv0_;
+    zr_.noalias() = X * pinv1_.real();
+    zi_.noalias() = X * pinv1_.imag();
+    z_.real() = zr_, z_.imag() = zi_;
     matrix_->solve(x_, xs_);
-    Dt_.col(0) = xs_.cast<cplx>();
-    z_ = Rt_.col(1);
     matrix_->solve(z_, zs_);
-    Dt_.col(1) = zs_;
-    Dt_.col(2) = zs_.conjugate();
-    Y.noalias() = Dt_.real() * tab_.P.real().transpose();
-    Y.noalias() -= Dt_.imag() * tab_.P.imag().transpose();
+    zr_ = zs_.real(), zi_ = zs_.imag();
+    for (int j = 0; j < 3; ++j)
+      Y.col(j) = p0_(j) * xs_ + (2.0 * p1_(j).real()) * zr_ - (2.0 * p1_(j).imag()) * zi_;
+  }
+
+  /// The tableau's P and P⁻¹ in the form solve_stages takes: P's first column and P⁻¹'s first row real, the
+  /// other two conjugate, as the decomposition of a real matrix with one real eigenvalue gives them.
+  void check_pairs() {
+    const bool real = tab_.P.col(0).imag().isZero(0.0) && tab_.Pinv.row(0).imag().isZero(0.0);
+    const bool pairs = tab_.P.col(2) == tab_.P.col(1).conjugate() && tab_.Pinv.row(2) == tab_.Pinv.row(1).conjugate();
+    if (!real || !pairs) throw std::logic_error("collocation tableau: P and P⁻¹ are not in real-and-pair form");
+    p0_ = tab_.P.col(0).real(), p1_ = tab_.P.col(1);
+    pinv0_ = tab_.Pinv.row(0).real().transpose(), pinv1_ = tab_.Pinv.row(1).transpose();
   }
 
   /// Loops, index 1 at each stage: M A_i − f_i − G_iᵀλ_i = 0 and G_i A_i = γ_i. With ΔA = −𝒮⁻¹R on entry
@@ -1055,9 +1066,12 @@ class Collocation final : public ImplicitRk, public RadauAccess {
   const CollocationTableau tab_;
   Tolerances tol_;  // the tolerances the estimate is held to (controlled)
   MatX A_, V_, Q_, R_, D_, dV_, dQ_, Aprev_;  // (nq, 3) stages, residuals, increments, last step's A
-  MatXc Rt_, Dt_;                             // (nq, 3) transformed residuals and increments
   Eigen::VectorXcd z_, zs_;                   // (nq) the complex block's right-hand side and solution
-  VecX x_, xs_, b1_, b2_, qx_, vx_;           // (nq) the error estimate's
+  VecX x_, xs_;                               // (nq) the real block's (and the error estimate's)
+  VecX zr_, zi_;                              // (nq) z's and S₂⁻¹z's real and imaginary parts
+  VecX b1_, b2_, qx_, vx_;                    // (nq) the error estimate's
+  Eigen::Vector3d p0_, pinv0_;                // P's first column, P⁻¹'s first row (real: check_pairs)
+  Eigen::Vector3cd p1_, pinv1_;               // P's second column, P⁻¹'s second row
   double h_factored_ = 0.0, h_previous_ = 1.0;
   bool have_previous_ = false, rejected_ = false;
   MatX G_[3];         // (nl, nq) the loops' Jacobian at each stage of the iterate

@@ -33,6 +33,72 @@ MatX NewtonMatrix::solve(const MatX& B) {
 
 namespace {
 
+/// What check_regular tests against 1e-15 for a factorisation with these pivots (the diagonal of U): their
+/// spread min |u_ii| / max |u_ii| (|re| + |im| for a complex pivot) while it is above 1e-8, else rcond(), the
+/// estimate of 1/cond₁(S). The estimate takes several solves and, in complex arithmetic, a hypot per entry: on
+/// the crane (n = 21) radau5's complex estimate cost as much as its factorisation. A singular S leaves a pivot at
+/// round-off of the largest, so the spread falls far below 1e-8 there and the estimate decides as before.
+template <class Pivots, class Rcond>
+double regularity(const Pivots& pivots, Rcond&& rcond) {
+  double least = std::numeric_limits<double>::infinity(), most = 0.0;
+  for (Eigen::Index i = 0; i < pivots.size(); ++i) {
+    const double size = std::abs(std::real(pivots(i))) + std::abs(std::imag(pivots(i)));
+    if (!std::isfinite(size)) return rcond();
+    least = std::min(least, size), most = std::max(most, size);
+  }
+  const double spread = least / most;
+  return spread > 1e-8 ? spread : rcond();
+}
+
+/// LU with partial pivoting of a complex S (P S = L U, P the row swaps in order), each column's pivot the entry
+/// of largest |re| + |im| (LAPACK's izamax) and its multipliers scaled by the pivot's reciprocal. Eigen's
+/// PartialPivLU takes |z| = hypot(re, im) for the pivot and divides each multiplier, which made radau5's complex
+/// factorisation on the crane (n = 21) cost twice its real one.
+class ComplexLU {
+ public:
+  void compute(const Eigen::MatrixXcd& S) {
+    LU_ = S;
+    const Eigen::Index n = LU_.rows();
+    swaps_.resize(n);
+    for (Eigen::Index k = 0; k < n; ++k) {
+      Eigen::Index p = k;
+      double largest = -1.0;
+      for (Eigen::Index i = k; i < n; ++i)
+        if (const double size = std::abs(LU_(i, k).real()) + std::abs(LU_(i, k).imag()); size > largest)
+          largest = size, p = i;
+      swaps_(k) = p;
+      if (p != k) LU_.row(k).swap(LU_.row(p));
+      if (LU_(k, k) == cplx(0.0)) continue;  // singular: regularity reports it
+      // l_ik = s_ik / u_kk, and the trailing block less l u_k (row k of U)
+      const Eigen::Index m = n - k - 1;
+      LU_.col(k).tail(m) *= cplx(1.0) / LU_(k, k);
+      LU_.bottomRightCorner(m, m).noalias() -= LU_.col(k).tail(m) * LU_.row(k).tail(m);
+    }
+  }
+
+  auto pivots() const { return LU_.diagonal(); }
+
+  /// x = S⁻¹ b: L U x = P b.
+  void solve(const VecXc& b, VecXc& x) const {
+    x = b;
+    for (Eigen::Index k = 0; k < x.size(); ++k) std::swap(x(k), x(swaps_(k)));
+    LU_.triangularView<Eigen::UnitLower>().solveInPlace(x);
+    LU_.triangularView<Eigen::Upper>().solveInPlace(x);
+  }
+
+  /// x = S⁻ᵀ b (the transpose, not the adjoint): Uᵀ Lᵀ (P x) = b.
+  void solve_transposed(const VecXc& b, VecXc& x) const {
+    x = b;
+    LU_.transpose().triangularView<Eigen::Lower>().solveInPlace(x);
+    LU_.transpose().triangularView<Eigen::UnitUpper>().solveInPlace(x);
+    for (Eigen::Index k = x.size() - 1; k >= 0; --k) std::swap(x(k), x(swaps_(k)));
+  }
+
+ private:
+  Eigen::MatrixXcd LU_;  // L below the diagonal (unit diagonal implied), U on and above it
+  Eigen::VectorXi swaps_;  // row k swapped with row swaps_(k) at step k
+};
+
 /// The dense form: M, C, K at the tangent, S by LU.
 class DenseNewtonMatrix final : public NewtonMatrix {
  public:
@@ -59,20 +125,20 @@ class DenseNewtonMatrix final : public NewtonMatrix {
     auto lu = std::make_shared<Eigen::PartialPivLU<MatX>>(S_);
     lu_ = lu;
     ++stats_.factorizations;
-    return lu_->rcond();
+    return regularity(lu_->matrixLU().diagonal(), [&] { return lu_->rcond(); });
   }
 
   double factor(cplx c1, cplx c2) override {
     Sc_ = M_.cast<cplx>() + c1 * C_.cast<cplx>() + c2 * K_.cast<cplx>();
     luc_.compute(Sc_);
     ++stats_.factorizations;
-    return luc_.rcond();
+    return regularity(luc_.pivots(), [&] { return Eigen::PartialPivLU<Eigen::MatrixXcd>(Sc_).rcond(); });
   }
 
   void solve(const VecX& b, VecX& x) override { x.noalias() = lu_->solve(b); }
-  void solve(const VecXc& b, VecXc& x) override { x.noalias() = luc_.solve(b); }
+  void solve(const VecXc& b, VecXc& x) override { luc_.solve(b, x); }
   void precondition_transposed(const VecX& b, VecX& x) override { x.noalias() = lu_->transpose().solve(b); }
-  void precondition_transposed(const VecXc& b, VecXc& x) override { x.noalias() = luc_.transpose().solve(b); }
+  void precondition_transposed(const VecXc& b, VecXc& x) override { luc_.solve_transposed(b, x); }
   bool krylov() const override { return false; }
   std::shared_ptr<const Eigen::PartialPivLU<MatX>> dense_factor() const override { return lu_; }
 
@@ -83,7 +149,7 @@ class DenseNewtonMatrix final : public NewtonMatrix {
   MatX K_, C_, M_, S_;
   Eigen::MatrixXcd Sc_;
   std::shared_ptr<Eigen::PartialPivLU<MatX>> lu_;
-  Eigen::PartialPivLU<Eigen::MatrixXcd> luc_;
+  ComplexLU luc_;
 };
 
 /// M + diag(δ) for complex δ factorised by the articulated-body recursion (recursive.hpp's aba_factor and

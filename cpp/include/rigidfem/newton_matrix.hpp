@@ -57,8 +57,10 @@ class NewtonMatrix {
   /// out = K δq + C δq̇ + M δq̈ at the tangent.
   virtual void derivative(const VecX& dq, const VecX& dqd, const VecX& dqdd, VecX& out) = 0;
   /// Factorises S = M + c₁ C + c₂ K + diag(e) of the tangent (e empty: none) in slot 0 (real) ...
-  /// Returns the reciprocal condition number of a dense factorisation (1 for Krylov's, whose
-  /// recursion throws SimulationError at a singular pivot): the caller names the failure.
+  /// Returns a measure of regularity that falls below 1e-15 for a singular S: for a dense factorisation the
+  /// pivots' spread, or the reciprocal condition number where the spread is below 1e-8 (newton_matrix.cpp's
+  /// regularity); 1 for Krylov's, whose recursion throws SimulationError at a singular pivot. The caller
+  /// names the failure.
   virtual double factor(double c1, double c2, const VecX& e) = 0;
   /// ... or slot 1 (complex, no e).
   virtual double factor(cplx c1, cplx c2) = 0;
