@@ -236,13 +236,16 @@ class RigidfemCrane:
         self.scene = scene
 
     def run(self, method: str, setting: str, value: float, **options) -> np.ndarray:
+        return np.asarray(self.simulation(method, setting, value, **options).q)[:, self.scene.payload_index]
+
+    def simulation(self, method: str, setting: str, value: float, **options):
+        """The run's ``rigidfem.Result`` (``run`` returns the payload's coordinates from it)."""
         kw = {setting: value, **options}
         if setting == "rtol":
             kw["atol"] = value * 1e-2
         s = self.scene
-        r = simulate(s.system, s.t_end, method=method, q0=s.q0, t_eval=s.t_eval, max_steps=10**8,
-                     stiffness_warning=False, **kw)
-        return np.asarray(r.q)[:, s.payload_index]
+        return simulate(s.system, s.t_end, method=method, q0=s.q0, t_eval=s.t_eval, max_steps=10**8,
+                        stiffness_warning=False, **kw)
 
     def reference(self, rtol: float = 1e-11) -> np.ndarray:
         return self.run("radau5", "rtol", rtol)

@@ -233,6 +233,10 @@ class RigidfemStrip(_OnTheChain):
         self.s = s
 
     def run(self, method: str, setting: str, value: float, t_end: float | None = None) -> np.ndarray:
+        return np.asarray(self.simulation(method, setting, value, t_end).q)
+
+    def simulation(self, method: str, setting: str, value: float, t_end: float | None = None):
+        """The run's ``rigidfem.Result`` (``run`` returns its coordinates)."""
         kw = {setting: value}
         if setting == "rtol":
             kw["atol"] = value * 1e-2
@@ -241,9 +245,8 @@ class RigidfemStrip(_OnTheChain):
         t_end = self.s.t_end if t_end is None else t_end
         with warnings.catch_warnings():
             warnings.simplefilter("ignore")
-            r = simulate(self.s.system, t_end, method=method, t_eval=self.s.t_eval[self.s.t_eval <= t_end + 1e-12],
-                         max_steps=10**8, stiffness_warning=False, **kw)
-        return np.asarray(r.q)
+            return simulate(self.s.system, t_end, method=method, t_eval=self.s.t_eval[self.s.t_eval <= t_end + 1e-12],
+                            max_steps=10**8, stiffness_warning=False, **kw)
 
     def references(self) -> list:
         """radau5 at rtol = 1e-11 (its error on the bodies' displacements), checked at 1e-10."""

@@ -402,7 +402,7 @@ def test_limits_quick():
     range is beam theory's static sag w L⁴ / 8EI to 5 %, each other mode's under a tenth of it."""
     from benchmarks import limits
 
-    rows, modes, _ = limits.strip_study(8, (1e-5, 2e-6))
+    rows, modes = limits.strip_study(8, (1e-5, 2e-6))
     limits._orders(rows)
     for r in rows:
         assert 0.0 < r["residuals_ms"] < r["cpu_ms"]
