@@ -86,15 +86,17 @@ def test_rk4_converges_at_fourth_order_through_the_passages(system, reference, r
 
 
 def test_energy_is_not_lost_in_the_projection_at_a_passage(system, rk4_runs):
-    """rk4's energy change over each step at 2 ms: at a passage (|sin θ| < 0.01 at either end) no
-    larger than the integrator's own change elsewhere (measured 3.9e-11 J at most; before the fix 4.7e-5 J in one step)."""
+    """rk4's energy change over each step at 2 ms: at a passage (|sin θ| < 0.01 at either end) within 10 times the
+    integrator's own change elsewhere (3.9e-11 J at most). Rounding, amplified near the singular position, scatters
+    the ratio: 0.4-2.5 over eight starts 1e-9 rad apart with libm's sine and cosine, 0.5-4.1 with the core's.
+    Before the fix one step lost 4.7e-5 J, a million times more."""
     r = rk4_runs[2e-3]
     E = np.array([energy(system, q, qd) for q, qd in zip(r.q, r.qd)])
     near = np.abs(np.sin(r.q[:, 0])) < 0.01
     passage = near[:-1] | near[1:]
     assert passage.sum() >= 20
     step = np.abs(np.diff(E))
-    assert step[passage].max() < 2 * step[~passage].max() + 1e-12
+    assert step[passage].max() < 10 * step[~passage].max() + 1e-12
     assert abs(E[-1] - E[0]) < 1e-8
 
 

@@ -59,7 +59,8 @@ void apply_elementary(Mat4& G, Axis a, double q) {
     return;
   }
   const int k1 = (k + 1) % 3, k2 = (k + 2) % 3;
-  const double c = std::cos(q), s = std::sin(q);
+  double s, c;
+  sin_cos(q, s, c);
   const Vec4 c1 = G.col(k1), c2 = G.col(k2);
   G.col(k1) = c * c1 + s * c2;
   G.col(k2) = -s * c1 + c * c2;

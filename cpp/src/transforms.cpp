@@ -5,21 +5,24 @@
 namespace rigidfem {
 
 Mat3 R1(double phi1) {
-  const double c = std::cos(phi1), s = std::sin(phi1);
+  double s, c;
+  sin_cos(phi1, s, c);
   Mat3 R;
   R << 1, 0, 0, 0, c, -s, 0, s, c;
   return R;
 }
 
 Mat3 R2(double phi2) {
-  const double c = std::cos(phi2), s = std::sin(phi2);
+  double s, c;
+  sin_cos(phi2, s, c);
   Mat3 R;
   R << c, 0, s, 0, 1, 0, -s, 0, c;
   return R;
 }
 
 Mat3 R3(double phi3) {
-  const double c = std::cos(phi3), s = std::sin(phi3);
+  double s, c;
+  sin_cos(phi3, s, c);
   Mat3 R;
   R << c, -s, 0, s, c, 0, 0, 0, 1;
   return R;

