@@ -143,10 +143,12 @@ def test_dense_output_between_steps(pendulum2, method):
     steps = rf.simulate(system, 1.0, method=method, q0=Y0[:2], rtol=1e-7, atol=1e-9)  # the same steps
     np.testing.assert_array_equal(r.t, t)
     assert r.stats["steps"] == steps.stats["steps"] and not np.isin(t[1:-1], steps.t).any()  # all inside steps
-    for k, what in ((slice(0, 2), "q"), (slice(2, 4), "qd")):
+    # q̇ is the quintic's derivative, an order lower: between steps its error was 1.3-2.05 times that at the
+    # steps for esdirk43 at rtol 3e-8 to 1e-6 (0.84-1.09 for radau5; q's 0.99-1.01 for both)
+    for k, what, most in ((slice(0, 2), "q", 2), (slice(2, 4), "qd", 3)):
         at_steps = np.max(np.abs(getattr(steps, what) - ref.sol(steps.t)[k].T))
         between = np.max(np.abs(getattr(r, what) - ref.sol(t)[k].T))
-        assert between < 2 * at_steps, (what, between, at_steps)
+        assert between < most * at_steps, (what, between, at_steps)
     # Fixed steps: the quintic Hermite interpolant of (q, q̇, q̈) is O(h⁶) in q, beyond the methods'
     # own order: at mid-steps the error is no larger than at the steps' ends.
     at_ends = rf.simulate(system, 1.0, method=method, dt=0.05, adaptive=False, q0=Y0[:2], **TIGHT)
@@ -345,3 +347,22 @@ def test_collocation_decomposition_constants(name, constructor):
     np.testing.assert_allclose(a @ P, P @ np.diag(d), rtol=0, atol=1e-15)  # P's columns: eigenvectors
     np.testing.assert_allclose(P @ Pinv, np.eye(3), rtol=0, atol=1e-15)
     np.testing.assert_allclose((P @ np.diag(d) @ Pinv).real, a, rtol=0, atol=1e-15)
+
+
+def test_radau5_renews_a_long_serving_tangent_when_newton_slows():
+    """A steel strip (1 m, 20 × 2 mm, m = 8, bending only, undamped) released from rest under gravity
+    for 2 s: the tangent taken at the start would serve the whole run while Newton's contraction
+    slows as the strip bends (θ > 0.05). Renewed once it has served 20 steps, it keeps Newton under
+    2.1 iterations a step (measured: 2.02 with 8 tangents; 2.22 with the start's alone) at no cost
+    in accuracy: the tip within 10 rtol of its sag of a run at rtol 1e-10."""
+    model = rf.Model(gravity=(0.0, -9.81, 0.0))
+    beam = model.add_beam("beam", model.ground, 1.0, rf.Material(E=2.1e11, rho=7850.0),
+                          rf.Section.rectangle(0.002, 0.02), 8, deform=("bend_z",))
+    system = model.compile()
+    t = np.linspace(0.0, 2.0, 201)
+    r = rf.simulate(system, 2.0, method="radau5", rtol=1e-5, atol=1e-7, t_eval=t, stiffness_warning=False)
+    s = r.stats
+    assert s["jacobians"] >= 4 and s["newton_iterations"] < 2.1 * s["steps"], s
+    ref = rf.simulate(system, 2.0, method="radau5", rtol=1e-10, atol=1e-12, t_eval=t, stiffness_warning=False)
+    sag = np.max(np.abs(ref.position(beam.tip)[:, 1] - ref.position(beam.tip)[0, 1]))
+    assert np.max(np.abs(r.position(beam.tip) - ref.position(beam.tip))) < 10 * 1e-5 * sag
