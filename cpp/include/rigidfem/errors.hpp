@@ -44,12 +44,13 @@ inline std::string num(double x, int digits = 6) {
 }
 
 /// The size check of every entry point: "q: expected 12 (nq) values, got 10", then
-/// "q: expected 12 (nq) finite values, got NaN or inf".
-inline void check_vector(const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::Index n, const std::string& name,
-                         const std::string& size_name) {
-  const std::string expected = std::to_string(n) + " (" + size_name + ")";
-  if (v.size() != n) bad(name, expected + " values", std::to_string(v.size()));
-  if (!v.allFinite()) bad(name, expected + " finite values", "NaN or inf");
+/// "q: expected 12 (nq) finite values, got NaN or inf". The message is built only on failure: the check runs at
+/// every stage residual of an integration (set_state).
+inline void check_vector(const Eigen::Ref<const Eigen::VectorXd>& v, Eigen::Index n, const char* name,
+                         const char* size_name) {
+  const auto expected = [&] { return std::to_string(n) + " (" + size_name + ")"; };
+  if (v.size() != n) bad(name, expected() + " values", std::to_string(v.size()));
+  if (!v.allFinite()) bad(name, expected() + " finite values", "NaN or inf");
 }
 
 // Ctrl-C in long computations. Whoever can be interrupted installs a check for the running thread
