@@ -202,14 +202,12 @@ class ImplicitRk : public Stepper {
     }
     ys_ << y_, s_, sensitivity_blocks();
     jacobian_fresh_ = false;
-    // a new tangent for the next step where Newton contracted slowly (progress), and after `oldest` steps
+    // a new tangent for the next step where Newton contracted slowly (progress), and after 5 `served_` steps
     // whatever θ: the error estimate is filtered through it ((I − γhJ)⁻¹, filter), and a stale one can hold the
     // step down while Newton converges at once. A block creeping on an incline under regularised friction
     // (v_ε = 1e-5 m/s, radau5 at rtol 1e-9 and 1e-10) took 69,562 and 43,445 steps with its start's tangent,
-    // 138 and 143 with one renewed every 100 steps; the whippy strip's radau5 (m = 16, rtol 2e-6) takes 26
-    // tangents instead of 9 in the same time.
-    constexpr int oldest = 100;
-    if (slow_ || ++tangent_age_ >= oldest) jacobian_valid_ = false;
+    // 138 and 143 with one renewed every 100 steps.
+    if (slow_ || ++tangent_age_ >= 5 * served_) jacobian_valid_ = false;
     accepted();
   }
 
@@ -386,19 +384,17 @@ class ImplicitRk : public Stepper {
   /// η size <= 1, η = θ/(1 − θ) from the contraction rate θ (the sum of the remaining increments of
   /// a contraction; Hairer & Wanner IV.8), the last η on the first iteration; failed when
   /// θ >= 0.99 or the iterations run out. A slow contraction asks for a fresh tangent: θ > 0.2 always, θ > 0.05
-  /// once the tangent has served 20 steps, about what it costs in stage residuals (measured: 18 on the crane, 24
-  /// on the whippy strip). One that serves long pays for itself in iterations saved: strip m = 16, radau5 rtol
-  /// 2e-6, 9 tangents instead of 1, 2.02 Newton iterations a step instead of 2.26, 10 % less time. One that
-  /// serves a few steps does not: on the crane (tangents kept 2-8 steps) θ > 0.05 alone took 33 tangents
-  /// instead of 13, and 33 % more time.
+  /// once the tangent has served `served_` steps, what it costs in stage residuals. One that serves long pays
+  /// for itself in iterations saved: strip m = 16, radau5 rtol 2e-6, 9 tangents instead of 1, 2.02 Newton
+  /// iterations a step instead of 2.26, 10 % less time. One that serves a few steps does not: on the crane
+  /// (tangents kept 2-8 steps) θ > 0.05 alone took 33 tangents instead of 13, and 33 % more time.
   Newton progress(int it, double size, double& previous) {
     constexpr double slow = 0.2, mild = 0.05;
-    constexpr int served = 20;
     double eta = eta_;
     if (it >= 1) {
       const double theta = size / previous;
       if (!(theta < 0.99)) return Newton::Failed;
-      if (theta > slow || (theta > mild && tangent_age_ >= served)) slow_ = true;
+      if (theta > slow || (theta > mild && tangent_age_ >= served_)) slow_ = true;
       eta = theta / (1.0 - theta);
     }
     previous = size;
@@ -442,6 +438,9 @@ class ImplicitRk : public Stepper {
   MatX Sq_, Sv_, Sa_, Sqp_, Svp_, Sap_, Sq1_, Sv1_, Sa1_;  // (nq, P) their q, q̇, q̈: now, at the last step's start, its end
   bool jacobian_valid_ = false, jacobian_fresh_ = false, slow_ = false;
   int tangent_age_ = 0;  // steps accepted since the tangent was taken
+  // A tangent's cost in stage residuals, at least 20: 1.5 nq on the whippy strip (24, 48 and 95 at nq = 16, 32
+  // and 64; the tangent's columns are O(n) each), 22 on the crane.
+  const int served_ = std::max(20, 3 * n_ / 2);
   bool sensitivities_failed_ = false;  // the last solve's sensitivities did not converge (its state did)
   double eta_ = 1.0;          // Newton's η of the last converged stage
   double t_ = 0.0, h_ = 1.0;  // the last attempted step
