@@ -386,8 +386,9 @@ class ImplicitRk : public Stepper {
   /// θ >= 0.99 or the iterations run out. A slow contraction asks for a fresh tangent: θ > 0.2 always, θ > 0.05
   /// once the tangent has served `served_` steps, what it costs in stage residuals. One that serves long pays
   /// for itself in iterations saved: strip m = 16, radau5 rtol 2e-6, 9 tangents instead of 1, 2.02 Newton
-  /// iterations a step instead of 2.26, 10 % less time. One that serves a few steps does not: on the crane
-  /// (tangents kept 2-8 steps) θ > 0.05 alone took 33 tangents instead of 13, and 33 % more time.
+  /// iterations a step instead of 2.26, 10 % less time (with renewal by age too: 22 tangents, 1.98). One that
+  /// serves a few steps does not: on the crane (tangents kept 2-8 steps) θ > 0.05 alone took 33 tangents
+  /// instead of 13, and 33 % more time.
   Newton progress(int it, double size, double& previous) {
     constexpr double slow = 0.2, mild = 0.05;
     double eta = eta_;
@@ -438,8 +439,8 @@ class ImplicitRk : public Stepper {
   MatX Sq_, Sv_, Sa_, Sqp_, Svp_, Sap_, Sq1_, Sv1_, Sa1_;  // (nq, P) their q, q̇, q̈: now, at the last step's start, its end
   bool jacobian_valid_ = false, jacobian_fresh_ = false, slow_ = false;
   int tangent_age_ = 0;  // steps accepted since the tangent was taken
-  // A tangent's cost in stage residuals, at least 20: 1.5 nq on the whippy strip (24, 48 and 95 at nq = 16, 32
-  // and 64; the tangent's columns are O(n) each), 22 on the crane.
+  // A tangent's cost in stage residuals, at least 20: measured 24, 48 and 95 on the whippy strip at nq = 16, 32
+  // and 64 (1.5 nq: the tangent's columns are O(n) each), 22 on the crane at nq = 21.
   const int served_ = std::max(20, 3 * n_ / 2);
   bool sensitivities_failed_ = false;  // the last solve's sensitivities did not converge (its state did)
   double eta_ = 1.0;          // Newton's η of the last converged stage
