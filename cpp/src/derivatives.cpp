@@ -24,19 +24,30 @@ namespace {
 
 using detail::BodyLoad;
 
-// δI x for δI = s ×* I − I s ×m (the inertia turned by the twist s), without forming δI.
-Vec6 turned_inertia_times(const Vec6& s, const Mat6& I, const Vec6& x) { return crossf(s, I * x) - I * crossm(s, x); }
-
 // Tangents of the RNEA quantities along one direction (one coordinate's q or q̇, or any (δq, δq̇, δq̈)).
 struct Tangent {
-  explicit Tangent(const System& sys)
+  /// At the state of d after the RNEA pass (its v, a and I).
+  Tangent(const System& sys, const Data& d)
       : inside(sys.nbodies), W(sys.nbodies, Vec6::Zero()), v(sys.nbodies, Vec6::Zero()), a(sys.nbodies),
-        f(sys.nbodies), dq(VecX::Zero(sys.nq)), dqd(VecX::Zero(sys.nq)), dQ(VecX::Zero(sys.nq)) {}
+        f(sys.nbodies), dq(VecX::Zero(sys.nq)), dqd(VecX::Zero(sys.nq)), dQ(VecX::Zero(sys.nq)), Iv(sys.nbodies),
+        Ia(sys.nbodies) {
+    for (int p = 0; p < sys.nbodies; ++p) Iv[p] = d.I[p] * d.v[p], Ia[p] = d.I[p] * d.a[p];
+  }
+  /// δf̄_p = I δa + δv ×* I v + v ×* I δv + δI a + v ×* δI v of body p (velocity v, acceleration a) with its inertia
+  /// turned by the twist Wp (δI x = Wp ×* I x − I (Wp ×m x)), as two products with I:
+  ///   δf̄_p = I (δa − Wp ×m a) + δv ×* I v + Wp ×* I a + v ×* (I (δv − Wp ×m v) + Wp ×* I v).
+  Vec6 body_force(const Data& d, int p, const Vec6& Wp, const Vec6& dv, const Vec6& da) const {
+    const Mat6& I = d.I[p];
+    const Vec6& vp = d.v[p];
+    return I * (da - crossm(Wp, d.a[p])) + crossf(dv, Iv[p]) + crossf(Wp, Ia[p]) +
+           crossf(vp, I * (dv - crossm(Wp, vp)) + crossf(Wp, Iv[p]));
+  }
   std::vector<char> inside;  // body moved by the direction (its frame, or its velocity)
   std::vector<Vec6> W;       // the twist δT_p T_p⁻¹ that carries body p's frame (zero: it stays)
   std::vector<Vec6> v, a, f;  // δv_p, δa_p, δf̄_p (v zero for a body the direction leaves)
   VecX dq, dqd;  // the direction's (δq, δq̇) (nq): the drums' δφ of the ropes wound on them
   VecX dQ;       // δQ of the free coordinates' generalised forces outside the RNEA (a drum's r δP)
+  std::vector<Vec6> Iv, Ia;  // each body's I v and I a at the state (the same for every direction)
 };
 
 // A load on a body (the load's own point moving with it: the geometric term of the tangent).
@@ -175,7 +186,18 @@ struct LoadTerms {
         contacts.push_back(c);
         contact_J.push_back(contact_jacobian(sys, c));
       });
+    bodies.clear();
+    for (const BodyLoad& L : loads) bodies.push_back(L.body);
+    for (const ForceElement& E : sys.elements) bodies.push_back(E.body_a), bodies.push_back(E.body_b);
+    for (const ContactForce& c : contacts) bodies.push_back(c.body_a), bodies.push_back(c.body_b);
+    for (const FlowTerm& f : flows) bodies.push_back(f.body), bodies.push_back(f.prev);
+    bodies.erase(std::remove(bodies.begin(), bodies.end(), -1), bodies.end());
+    std::sort(bodies.begin(), bodies.end());
+    bodies.erase(std::unique(bodies.begin(), bodies.end()), bodies.end());
   }
+  /// Whether there are none.
+  bool empty() const { return loads.empty() && elements.empty() && contacts.empty() && flows.empty(); }
+  std::vector<int> bodies;  // the bodies whose tangents (W, δv, δf̄) the terms read or write, once each
   // The tangents of the loads, the elements' and the contacts' forces and the flowing material's loads.
   void tangent(const Data& d, const System& sys, Tangent& w) const {
     loads_tangent(loads, w);
@@ -191,57 +213,119 @@ namespace {
 
 using detail::LoadTerms;
 
-// Column ∂r/∂q_j (position) or ∂r/∂q̇_j (rate) for the coordinate j with use uj on body bj,
-// into col (nq). Only the bodies carried by q_j (bj and its subtree) have tangents:
-//   position: the later axes turn, δs_u = s_j ×m s_u, and so do inertias and follower loads;
-//   rate:     δq̇_j = 1, so δv gains s_j from the use uj on and δc gains v ×m s_j there.
-// Then δc = Σ (δv ×m s_u + v ×m δs_u) q̇_u, δv = Σ δs_u q̇_u, δa_p = δa_λ + δc + Σ δs_u q̈_u,
-// δf_p = δI a + I δa + δv ×* I v + v ×* (δI v + I δv) − δf_ext, summed over subtrees, and
-// δr_i = δs_iᵀ f̄_b + s_iᵀ δf̄_b.
-void tangent_column(const System& sys, const Data& d, const LoadTerms& terms, int uj, int bj, bool position, Tangent& w,
-                    Eigen::Ref<VecX> col) {
-  const Vec6& s = d.axes[uj];
-  const int j = sys.use_q[uj];  // the column's own free coordinate: δq_j = 1 or δq̇_j = 1 (a drum pays out with it)
-  w.dq.setZero(), w.dqd.setZero(), w.dQ.setZero();
-  (position ? w.dq : w.dqd)(j) = 1.0;
-  auto turned = [&](int p, int u) { return position && w.inside[p] && (p != bj || u > uj); };
-  for (int p = 0; p < sys.nbodies; ++p) {
-    w.inside[p] = p == bj || (p > bj && sys.parent[p] >= 0 && w.inside[sys.parent[p]]);  // parent[p] < p
-    // the frame of a body after the coordinate's use turns with s (its own body: the uses after it do, the
-    // frame itself does too: the body frame is after all its joint's uses)
-    w.W[p] = position && w.inside[p] ? s : Vec6::Zero();
-    if (!w.inside[p]) {
-      w.f[p].setZero();
-      w.v[p].setZero();
-      continue;
-    }
-    const int lam = sys.parent[p];
-    Vec6 v = lam >= 0 ? d.v[lam] : Vec6::Zero();
-    Vec6 dv = p == bj ? Vec6::Zero() : w.v[lam];
-    Vec6 da = p == bj ? Vec6::Zero() : w.a[lam];
-    for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) {
-      const int i = sys.use_coord[u];
-      const double qd = d.qda(i);
-      const Vec6 ds = turned(p, u) ? crossm(s, d.axes[u]) : Vec6::Zero();
-      da += (crossm(dv, d.axes[u]) + crossm(v, ds)) * qd + ds * d.qdda(i);
-      dv += ds * qd;
-      if (!position && u == uj) {
-        da += crossm(v, d.axes[u]);
-        dv += d.axes[u];
+// The matrices of x ↦ v ×m x and x ↦ x ×* f.
+Mat6 motion_cross_matrix(const Vec6& v) {
+  Mat6 X;
+  for (int i = 0; i < 6; ++i) X.col(i) = crossm(v, Vec6::Unit(i));
+  return X;
+}
+Mat6 force_cross_matrix(const Vec6& f) {
+  Mat6 X;
+  for (int i = 0; i < 6; ++i) X.col(i) = crossf(Vec6::Unit(i), f);
+  return X;
+}
+
+// The inertial part of the tangent in closed form over subtrees (the idea of Carpentier & Mansard's RNEA
+// derivatives, in the global spatial vectors of the book). Turning q_j by δq_j = 1 turns the subtree after its use
+// u_j about the axis s = s_j: with v⁻, a⁻ the velocity and acceleration before u_j, w = s ×m v⁻ and z = s ×m a⁻,
+// every body p it carries has
+//   W_p = s,  δv_p = s ×m (v_p − v⁻),  δa_p = s ×m (a_p − a⁻) − w ×m (v_p − v⁻)
+// (the later axes s_u and their rates ṡ_u = v_before ×m s_u turned, by Jacobi's identity), and δq̇_j = 1 gives
+//   W_p = 0,  δv_p = s,  δa_p = s ×m v_p − 2 w.
+// Put into δf_p = I δa + δv ×* I v + v ×* I δv + δI a + v ×* δI v (Tangent::body_force) and summed over the subtree
+// of X, with P_p = I_p (v_p ×m), R_p = −(h_p ×*)(v_p ×m) (x ↦ x ×* h_p), h_p = I_p v_p, g_p = I_p a_p,
+//   position: δf̄_X = Ī (w ×m v⁻ − z) + Ḡ w + H̄ s − w ×* h̄ + s ×* ḡ,
+//   rate:     δf̄_X = −Ḡ s − 2 Ī w + s ×* h̄,
+// where Ī, ḡ, h̄ sum I_p, g_p, h_p and Ḡ, H̄ the symmetric P_p + P_pᵀ and the skew R_p − R_pᵀ over the subtree
+// (v ×* = −(v ×m)ᵀ, and x ↦ x ×* h is skew). A row k (use u_k on body b_k, r_k = s_kᵀ f̄_{b_k}) sees X = b_j if b_k is b_j or above it,
+// X = b_k if below (nothing on another branch), and δs_k = s ×m s_k if u_k is after u_j. Below, by (x ×* f)ᵀ m =
+// −fᵀ (x ×m m), a pair costs three dot products with the row's β_k = Ī s_k, γ_k = Ḡ s_k + s_k ×* h̄ and
+// δ_k = H̄ᵀ s_k − s_k ×* ḡ + s_k ×* f̄ (X = b_k):
+//   position: δr_k = β_k·(w ×m v⁻ − z) + γ_k·w + δ_k·s,   rate: δr_k = −γ_k·s − 2 β_k·w.
+struct InertialTangent {
+  std::vector<Mat6> I, G, H;  // (nbodies) Ī, Ḡ, H̄
+  std::vector<Vec6> h, g;     // (nbodies) h̄, ḡ
+  std::vector<Vec6> vb, ab;   // (nuses) the velocity and acceleration before each use
+  std::vector<Vec6> beta, gamma, delta;  // (nq) each row's β, γ, δ
+
+  // At the state of d after the RNEA pass.
+  InertialTangent(const System& sys, const Data& d)
+      : I(sys.nbodies), G(sys.nbodies), H(sys.nbodies), h(sys.nbodies), g(sys.nbodies), vb(sys.nuses), ab(sys.nuses),
+        beta(sys.nq), gamma(sys.nq), delta(sys.nq) {
+    const Vec6 O6 = Vec6::Zero(), a0 = gravity_acceleration(sys, d);
+    for (int p = 0; p < sys.nbodies; ++p) {
+      const Mat6 V = motion_cross_matrix(d.v[p]);
+      h[p] = d.I[p] * d.v[p], g[p] = d.I[p] * d.a[p];
+      const Mat6 P = d.I[p] * V, R = -force_cross_matrix(h[p]) * V;
+      I[p] = d.I[p], G[p] = P + P.transpose(), H[p] = R - R.transpose();
+      // a_u⁻ and v_u⁻ along the body's uses: a += (v ×m s_u) q̇_u + s_u q̈_u, v += s_u q̇_u
+      Vec6 v = parent_value(sys, d.v, p, O6), a = parent_value(sys, d.a, p, a0);
+      for (int u = sys.use_start[p]; u < sys.use_start[p + 1]; ++u) {
+        const int i = sys.use_coord[u];
+        vb[u] = v, ab[u] = a;
+        a += crossm(v, d.axes[u]) * d.qda(i) + d.axes[u] * d.qdda(i);
+        v += d.axes[u] * d.qda(i);
       }
-      v += d.axes[u] * qd;
     }
-    const Mat6& I = d.I[p];
-    w.v[p] = dv;
-    w.a[p] = da;
-    w.f[p] = I * da + crossf(dv, I * d.v[p]) + crossf(d.v[p], I * dv);
-    if (position) w.f[p] += turned_inertia_times(s, I, d.a[p]) + crossf(d.v[p], turned_inertia_times(s, I, d.v[p]));
+    accumulate_subtrees(sys, I), accumulate_subtrees(sys, G), accumulate_subtrees(sys, H);
+    accumulate_subtrees(sys, h), accumulate_subtrees(sys, g);
+    for (int k = 0; k < sys.nq; ++k) {
+      const int b = sys.coords[sys.free_coords[k]].body;
+      const Vec6& s = d.axes[sys.q_use[k]];
+      beta[k] = I[b] * s;
+      gamma[k] = G[b] * s + crossf(s, h[b]);
+      delta[k] = H[b].transpose() * s - crossf(s, g[b]) + crossf(s, d.sf[b]);
+    }
   }
-  terms.tangent(d, sys, w);
-  accumulate_subtrees(sys, w.f);
-  for (int k = 0; k < sys.nq; ++k) {
-    const int b = sys.coords[sys.free_coords[k]].body, u = sys.q_use[k];
-    col(k) = d.axes[u].dot(w.f[b]) + (turned(b, u) ? crossm(s, d.axes[u]).dot(d.sf[b]) : 0.0) - w.dQ(k);
+
+  // Columns ∂r/∂q_j and ∂r/∂q̇_j (inertial part) of the free coordinate j (use uj on body bj) into dq, dqd; inside
+  // (nbodies) flags bj's subtree, above the bodies from bj to the root.
+  void columns(const System& sys, const Data& d, int uj, int bj, const std::vector<char>& inside,
+               const std::vector<char>& above, Eigen::Ref<VecX> dq, Eigen::Ref<VecX> dqd) const {
+    const Vec6& s = d.axes[uj];
+    const Vec6 w = crossm(s, vb[uj]), x = crossm(w, vb[uj]) - crossm(s, ab[uj]);  // x = w ×m v⁻ − z
+    const Vec6 F = I[bj] * x + G[bj] * w + H[bj] * s - crossf(w, h[bj]) + crossf(s, g[bj]);
+    const Vec6 Fd = -(G[bj] * s) - 2.0 * (I[bj] * w) + crossf(s, h[bj]);
+    for (int k = 0; k < sys.nq; ++k) {
+      const int b = sys.coords[sys.free_coords[k]].body, u = sys.q_use[k];
+      if (inside[b] && (b != bj || u > uj)) {  // below u_j: X = b_k, s_k turned
+        dq(k) = beta[k].dot(x) + gamma[k].dot(w) + delta[k].dot(s);
+        dqd(k) = -gamma[k].dot(s) - 2.0 * beta[k].dot(w);
+      } else if (above[b]) {  // X = b_j
+        dq(k) = d.axes[u].dot(F);
+        dqd(k) = d.axes[u].dot(Fd);
+      } else {
+        dq(k) = dqd(k) = 0.0;
+      }
+    }
+  }
+};
+
+// The loads', elements', contacts' and flows' part of the columns of q_j and q̇_j (use uj, inside flagging the
+// subtree it carries), added into dq and dqd: their tangents at the bodies they touch (terms.bodies), carried as
+// above (W_p and δv_p), each body's δf handed to the rows of the bodies from it to the root (rows: the free
+// coordinates of each body), δr_k = s_kᵀ δf̄_{b_k} − δQ_k.
+void terms_columns(const System& sys, const Data& d, const LoadTerms& terms, const InertialTangent& it, int uj,
+                   const std::vector<char>& inside, const std::vector<std::vector<int>>& rows, Tangent& w,
+                   Eigen::Ref<VecX> dq, Eigen::Ref<VecX> dqd) {
+  const Vec6& s = d.axes[uj];
+  const int j = sys.use_q[uj];  // δq_j = 1 or δq̇_j = 1 (a drum pays out with it)
+  for (const bool position : {true, false}) {
+    w.dq.setZero(), w.dqd.setZero(), w.dQ.setZero();
+    (position ? w.dq : w.dqd)(j) = 1.0;
+    for (const int p : terms.bodies) {
+      w.inside[p] = inside[p];
+      w.f[p].setZero();
+      w.W[p] = position && inside[p] ? s : Vec6::Zero();
+      w.v[p] = !inside[p] ? Vec6::Zero() : position ? Vec6(crossm(s, d.v[p] - it.vb[uj])) : s;
+    }
+    terms.tangent(d, sys, w);
+    auto col = position ? dq : dqd;
+    for (const int b : terms.bodies)
+      if (!w.f[b].isZero(0.0))
+        for (int p = b; p >= 0; p = sys.parent[p])
+          for (const int k : rows[p]) col(k) += d.axes[sys.q_use[k]].dot(w.f[b]);
+    col -= w.dQ;
   }
 }
 
@@ -251,7 +335,7 @@ VecX rnea_directional_derivative(const System& sys, Data& d, const VecX& dq, con
   spatial_kinematics(sys, d);
   rnea_pass(sys, d);
   const LoadTerms terms(sys, d);
-  Tangent w(sys);
+  Tangent w(sys, d);
   w.dq = dq, w.dqd = dqd;
   std::vector<Vec6> W_before(sys.nuses);  // the twist carrying each use's axis: δs_u = W ×m s_u
   static const Vec6 O6 = Vec6::Zero();
@@ -273,10 +357,7 @@ VecX rnea_directional_derivative(const System& sys, Data& d, const VecX& dq, con
     }
     w.inside[p] = true;
     w.W[p] = W, w.v[p] = dv, w.a[p] = da;
-    const Mat6& I = d.I[p];
-    // δf = I δa + δv ×* I v + v ×* I δv + δI a + v ×* δI v, δI the inertia turned by W
-    w.f[p] = I * da + crossf(dv, I * d.v[p]) + crossf(d.v[p], I * dv) + turned_inertia_times(W, I, d.a[p]) +
-             crossf(d.v[p], turned_inertia_times(W, I, d.v[p]));
+    w.f[p] = w.body_force(d, p, W, dv, da);
   }
   terms.tangent(d, sys, w);
   accumulate_subtrees(sys, w.f);
@@ -506,13 +587,20 @@ std::pair<MatX, MatX> rnea_derivatives(const System& sys, Data& d) {
   // The loads (their geometric term) and the states of the elements and flowing rfes whose forces
   // change with the state.
   const LoadTerms terms(sys, d);
+  const InertialTangent inertial(sys, d);
   MatX dq(sys.nq, sys.nq), dqd(sys.nq, sys.nq);
-  Tangent w(sys);
+  Tangent w(sys, d);
+  std::vector<char> inside(sys.nbodies), above(sys.nbodies);
+  std::vector<std::vector<int>> rows(sys.nbodies);  // each body's free coordinates
+  for (int k = 0; k < sys.nq; ++k) rows[sys.coords[sys.free_coords[k]].body].push_back(k);
   for (int j = 0; j < sys.nq; ++j) {
     const int i = sys.free_coords[j], b = sys.coords[i].body, u = sys.q_use[j];
     interruption_point();
-    tangent_column(sys, d, terms, u, b, true, w, dq.col(j));
-    tangent_column(sys, d, terms, u, b, false, w, dqd.col(j));
+    std::fill(above.begin(), above.end(), 0);
+    for (int p = b; p >= 0; p = sys.parent[p]) above[p] = 1;
+    for (int p = 0; p < sys.nbodies; ++p) inside[p] = p == b || (p > b && sys.parent[p] >= 0 && inside[sys.parent[p]]);
+    inertial.columns(sys, d, u, b, inside, above, dq.col(j), dqd.col(j));
+    if (!terms.empty()) terms_columns(sys, d, terms, inertial, u, inside, rows, w, dq.col(j), dqd.col(j));
     // −∂Q_j/∂(q_j, q̇_j) of the coordinate's own spring-damping law and its further laws.
     const Coordinate& c = sys.coords[i];
     const auto [k_own, c_own] = c.spring.derivatives(d.spring_scale(i));

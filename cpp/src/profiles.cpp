@@ -1,6 +1,7 @@
 #include "rigidfem/profiles.hpp"
 
 #include "rigidfem/errors.hpp"
+#include "rigidfem/transforms.hpp"
 
 #include <algorithm>
 #include <cmath>
@@ -115,7 +116,8 @@ class HarmonicSeries final : public Profile {
     // q = c + Σ a_k sin(ω_k t + φ_k), q̇ = Σ a_k ω_k cos(ω_k t + φ_k), q̈ = −Σ a_k ω_k² sin(ω_k t + φ_k).
     MotionState m{off_, 0.0, 0.0};
     for (size_t k = 0; k < a_.size(); ++k) {
-      const double s = std::sin(w_[k] * t + ph_[k]), c = std::cos(w_[k] * t + ph_[k]);
+      double s, c;
+      sin_cos(w_[k] * t + ph_[k], s, c);
       m.q += a_[k] * s;
       m.qd += a_[k] * w_[k] * c;
       m.qdd -= a_[k] * w_[k] * w_[k] * s;

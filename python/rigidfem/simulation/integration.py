@@ -336,7 +336,7 @@ GROWTH_WARNING = 1e6
 def _warn_growth(result: Result, q0, qd0) -> None:
     """RuntimeWarning when a coordinate grew GROWTH_WARNING times beyond its start (the linear Kane model
     finished with angles of 1e26 rad without a word)."""
-    if not result.q.size:
+    if not result.q.size or np.abs(result.q).max() <= GROWTH_WARNING:  # every start is at least 1 (and NaN goes on)
         return
     span = result.t[-1] - result.t[0] if len(result.t) else 0.0
     start = np.maximum(1.0, np.maximum(np.abs(q0), np.abs(qd0) * span))
