@@ -237,8 +237,9 @@ Mat6 force_cross_matrix(const Vec6& f) {
 //   position: δf̄_X = Ī (w ×m v⁻ − z) + Ḡ w + H̄ s − w ×* h̄ + s ×* ḡ,
 //   rate:     δf̄_X = −Ḡ s − 2 Ī w + s ×* h̄,
 // where Ī, ḡ, h̄ sum I_p, g_p, h_p and Ḡ, H̄ the symmetric P_p + P_pᵀ and the skew R_p − R_pᵀ over the subtree
-// (v ×* = −(v ×m)ᵀ, and x ↦ x ×* h is skew). A row k (use u_k on body b_k, r_k = s_kᵀ f̄_{b_k}) sees X = b_j if b_k is b_j or above it,
-// X = b_k if below (nothing on another branch), and δs_k = s ×m s_k if u_k is after u_j. Below, by (x ×* f)ᵀ m =
+// (v ×* = −(v ×m)ᵀ, and x ↦ x ×* h is skew). A row k (use u_k on body b_k, r_k = s_kᵀ f̄_{b_k}) sees X = b_j if b_k
+// is b_j or above it, X = b_k if below (nothing on another branch), and δs_k = s ×m s_k if u_k is after u_j. Below,
+// by (x ×* f)ᵀ m =
 // −fᵀ (x ×m m), a pair costs three dot products with the row's β_k = Ī s_k, γ_k = Ḡ s_k + s_k ×* h̄ and
 // δ_k = H̄ᵀ s_k − s_k ×* ḡ + s_k ×* f̄ (X = b_k):
 //   position: δr_k = β_k·(w ×m v⁻ − z) + γ_k·w + δ_k·s,   rate: δr_k = −γ_k·s − 2 β_k·w.

@@ -7,7 +7,8 @@
 /// and its subtree) by the twist s_j δ, so, in Featherstone's notation,
 ///   ∂s_u/∂q_j = s_j ×m s_u,   ∂I_p/∂q_j = s_j ×* I_p − I_p s_j ×m,   ∂f_ext/∂q_j = s_j ×* f (follower)
 /// for every use u and body p below q_j; the tangents of v, c, a and f follow by the product
-/// rule through the three RNEA passes, one pass per direction: O(n) per column, O(n²) in all.
+/// rule: along one direction through the three RNEA passes (O(n)), and as the matrices ∂r/∂q, ∂r/∂q̇
+/// in closed form over subtrees (derivatives.cpp: a few dot products per entry, O(n²) in all).
 #pragma once
 
 #include <algorithm>
