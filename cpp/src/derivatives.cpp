@@ -26,28 +26,24 @@ using detail::BodyLoad;
 
 // Tangents of the RNEA quantities along one direction (one coordinate's q or q̇, or any (δq, δq̇, δq̈)).
 struct Tangent {
-  /// At the state of d after the RNEA pass (its v, a and I).
-  Tangent(const System& sys, const Data& d)
+  explicit Tangent(const System& sys)
       : inside(sys.nbodies), W(sys.nbodies, Vec6::Zero()), v(sys.nbodies, Vec6::Zero()), a(sys.nbodies),
-        f(sys.nbodies), dq(VecX::Zero(sys.nq)), dqd(VecX::Zero(sys.nq)), dQ(VecX::Zero(sys.nq)), Iv(sys.nbodies),
-        Ia(sys.nbodies) {
-    for (int p = 0; p < sys.nbodies; ++p) Iv[p] = d.I[p] * d.v[p], Ia[p] = d.I[p] * d.a[p];
-  }
+        f(sys.nbodies), dq(VecX::Zero(sys.nq)), dqd(VecX::Zero(sys.nq)), dQ(VecX::Zero(sys.nq)) {}
   /// δf̄_p = I δa + δv ×* I v + v ×* I δv + δI a + v ×* δI v of body p (velocity v, acceleration a) with its inertia
   /// turned by the twist Wp (δI x = Wp ×* I x − I (Wp ×m x)), as two products with I:
   ///   δf̄_p = I (δa − Wp ×m a) + δv ×* I v + Wp ×* I a + v ×* (I (δv − Wp ×m v) + Wp ×* I v).
-  Vec6 body_force(const Data& d, int p, const Vec6& Wp, const Vec6& dv, const Vec6& da) const {
+  static Vec6 body_force(const Data& d, int p, const Vec6& Wp, const Vec6& dv, const Vec6& da) {
     const Mat6& I = d.I[p];
     const Vec6& vp = d.v[p];
-    return I * (da - crossm(Wp, d.a[p])) + crossf(dv, Iv[p]) + crossf(Wp, Ia[p]) +
-           crossf(vp, I * (dv - crossm(Wp, vp)) + crossf(Wp, Iv[p]));
+    const Vec6 Iv = I * vp;
+    return I * (da - crossm(Wp, d.a[p])) + crossf(dv, Iv) + crossf(Wp, I * d.a[p]) +
+           crossf(vp, I * (dv - crossm(Wp, vp)) + crossf(Wp, Iv));
   }
   std::vector<char> inside;  // body moved by the direction (its frame, or its velocity)
   std::vector<Vec6> W;       // the twist δT_p T_p⁻¹ that carries body p's frame (zero: it stays)
   std::vector<Vec6> v, a, f;  // δv_p, δa_p, δf̄_p (v zero for a body the direction leaves)
   VecX dq, dqd;  // the direction's (δq, δq̇) (nq): the drums' δφ of the ropes wound on them
   VecX dQ;       // δQ of the free coordinates' generalised forces outside the RNEA (a drum's r δP)
-  std::vector<Vec6> Iv, Ia;  // each body's I v and I a at the state (the same for every direction)
 };
 
 // A load on a body (the load's own point moving with it: the geometric term of the tangent).
@@ -304,11 +300,10 @@ struct InertialTangent {
 
 // The loads', elements', contacts' and flows' part of the columns of q_j and q̇_j (use uj, inside flagging the
 // subtree it carries), added into dq and dqd: their tangents at the bodies they touch (terms.bodies), carried as
-// above (W_p and δv_p), each body's δf handed to the rows of the bodies from it to the root (rows: the free
-// coordinates of each body), δr_k = s_kᵀ δf̄_{b_k} − δQ_k.
+// above (W_p and δv_p), each body's δf handed to the rows of the bodies from it to the root (a body's free
+// coordinates: q_index[p] ... q_index[p] + nq_of[p] − 1), δr_k = s_kᵀ δf̄_{b_k} − δQ_k.
 void terms_columns(const System& sys, const Data& d, const LoadTerms& terms, const InertialTangent& it, int uj,
-                   const std::vector<char>& inside, const std::vector<std::vector<int>>& rows, Tangent& w,
-                   Eigen::Ref<VecX> dq, Eigen::Ref<VecX> dqd) {
+                   const std::vector<char>& inside, Tangent& w, Eigen::Ref<VecX> dq, Eigen::Ref<VecX> dqd) {
   const Vec6& s = d.axes[uj];
   const int j = sys.use_q[uj];  // δq_j = 1 or δq̇_j = 1 (a drum pays out with it)
   for (const bool position : {true, false}) {
@@ -325,7 +320,8 @@ void terms_columns(const System& sys, const Data& d, const LoadTerms& terms, con
     for (const int b : terms.bodies)
       if (!w.f[b].isZero(0.0))
         for (int p = b; p >= 0; p = sys.parent[p])
-          for (const int k : rows[p]) col(k) += d.axes[sys.q_use[k]].dot(w.f[b]);
+          for (int k = sys.q_index[p]; k < sys.q_index[p] + sys.nq_of[p]; ++k)
+            col(k) += d.axes[sys.q_use[k]].dot(w.f[b]);
     col -= w.dQ;
   }
 }
@@ -336,7 +332,7 @@ VecX rnea_directional_derivative(const System& sys, Data& d, const VecX& dq, con
   spatial_kinematics(sys, d);
   rnea_pass(sys, d);
   const LoadTerms terms(sys, d);
-  Tangent w(sys, d);
+  Tangent w(sys);
   w.dq = dq, w.dqd = dqd;
   std::vector<Vec6> W_before(sys.nuses);  // the twist carrying each use's axis: δs_u = W ×m s_u
   static const Vec6 O6 = Vec6::Zero();
@@ -358,7 +354,7 @@ VecX rnea_directional_derivative(const System& sys, Data& d, const VecX& dq, con
     }
     w.inside[p] = true;
     w.W[p] = W, w.v[p] = dv, w.a[p] = da;
-    w.f[p] = w.body_force(d, p, W, dv, da);
+    w.f[p] = Tangent::body_force(d, p, W, dv, da);
   }
   terms.tangent(d, sys, w);
   accumulate_subtrees(sys, w.f);
@@ -590,10 +586,8 @@ std::pair<MatX, MatX> rnea_derivatives(const System& sys, Data& d) {
   const LoadTerms terms(sys, d);
   const InertialTangent inertial(sys, d);
   MatX dq(sys.nq, sys.nq), dqd(sys.nq, sys.nq);
-  Tangent w(sys, d);
+  Tangent w(sys);
   std::vector<char> inside(sys.nbodies), above(sys.nbodies);
-  std::vector<std::vector<int>> rows(sys.nbodies);  // each body's free coordinates
-  for (int k = 0; k < sys.nq; ++k) rows[sys.coords[sys.free_coords[k]].body].push_back(k);
   for (int j = 0; j < sys.nq; ++j) {
     const int i = sys.free_coords[j], b = sys.coords[i].body, u = sys.q_use[j];
     interruption_point();
@@ -601,7 +595,7 @@ std::pair<MatX, MatX> rnea_derivatives(const System& sys, Data& d) {
     for (int p = b; p >= 0; p = sys.parent[p]) above[p] = 1;
     for (int p = 0; p < sys.nbodies; ++p) inside[p] = p == b || (p > b && sys.parent[p] >= 0 && inside[sys.parent[p]]);
     inertial.columns(sys, d, u, b, inside, above, dq.col(j), dqd.col(j));
-    if (!terms.empty()) terms_columns(sys, d, terms, inertial, u, inside, rows, w, dq.col(j), dqd.col(j));
+    if (!terms.empty()) terms_columns(sys, d, terms, inertial, u, inside, w, dq.col(j), dqd.col(j));
     // −∂Q_j/∂(q_j, q̇_j) of the coordinate's own spring-damping law and its further laws.
     const Coordinate& c = sys.coords[i];
     const auto [k_own, c_own] = c.spring.derivatives(d.spring_scale(i));

@@ -442,7 +442,7 @@ class ImplicitRk : public Stepper {
   // Steps a tangent serves before a mild θ renews it: at least 20, 1.5 nq for large nq. Set to the tangent's cost in
   // stage residuals while its columns cost O(n) each (24, 48 and 95 residuals on the whippy strip at nq = 16, 32 and
   // 64, 22 on the crane at nq = 21). With the tangent's inertial part summed over subtrees (derivatives.cpp) it
-  // costs 6.0, 7.3, 10 and 9.8 residuals, and served = 3, 5, 10 or 20 gave the same times within 4 % on the crane
+  // costs 6.0, 7.3, 10 and 9.8 residuals, and served = 3, 5, 10 or 20 gave the same times within 4.5 % on the crane
   // (rtol 1e-4, 3e-4) and the strip (m = 16 at rtol 2e-6 and 1e-6, m = 64 at 2e-4 and 2e-6) but for 3 at m = 64
   // and rtol 2e-6 (8 % slower): the rule stayed.
   const int served_ = std::max(20, 3 * n_ / 2);
