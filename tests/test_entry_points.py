@@ -347,8 +347,7 @@ def test_simulate_refuses_output_times_whose_states_cannot_fit_before_running(pe
     from rigidfem.simulation import integration
 
     _, _, system = pendulum
-    sizes = {"SC_PAGE_SIZE": 4096, "SC_PHYS_PAGES": 1000}
-    monkeypatch.setattr(integration.os, "sysconf", lambda name: sizes[name])
+    monkeypatch.setattr(integration, "_physical_memory", lambda: 4096 * 1000)
     t = np.linspace(0.0, 1.0, 300_000)  # 300,000 × 2 doubles = 4.8 MB
     with pytest.raises(ValueError, match=r"^t_eval: expected at most 256,000 output times \(their states, 2 numbers "
                                          r"each, within the machine's 0.0041 GB\), got 300,000"):

@@ -56,6 +56,7 @@ leftovers of a looser Newton, of one sign, would make the energy drift.
 
 from __future__ import annotations
 
+import functools
 import os
 import warnings
 
@@ -231,7 +232,9 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
     # the C++ options, each converted by the bindings (ValueError naming it); scipy: methods check the C++ ones too
     # (they use only first_step of them), so that a bad option is named whatever the method
     opt = options_.compiled("dopri5" if scipy else method, o)  # what the method reads; the others at their defaults
-    judged = options_.compiled("dopri5" if scipy else method, o, every=True)  # every option given: their values
+    # every option given, for their values to be judged: the same options where the method reads them all
+    judged = opt if options_.read_by(method, o) and not scipy else options_.compiled("dopri5" if scipy else method, o,
+                                                                                       every=True)
     opt.rtol, opt.atol = judged.rtol, judged.atol = rtol, atol
     row = options_.method(method)
     fixed = adaptive is False or (not row.adaptive and adaptive is not True)
@@ -388,12 +391,20 @@ def _keep_going(bar, stop, t0):
     return keep_going
 
 
+@functools.cache
+def _physical_memory() -> int | None:
+    """The machine's memory (bytes), asked once; None where sysconf cannot tell."""
+    try:
+        return os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
+    except (AttributeError, ValueError, OSError):
+        return None
+
+
 def _check_output_memory(outputs: int, numbers: int) -> None:
     """ValueError naming t_eval when its outputs' states (``numbers`` doubles each: q, q̇, the arms' forces, the
     sensitivities) would not fit in the machine's memory: refused before the run rather than after it."""
-    try:
-        memory = os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES")
-    except (AttributeError, ValueError, OSError):  # no sysconf (Windows): the run finds out itself
+    memory = _physical_memory()
+    if memory is None:  # no sysconf (Windows): the run finds out itself
         return
     need = 8.0 * outputs * numbers
     if need > memory:

@@ -142,14 +142,28 @@ def compiled(method: str, options: dict, every: bool = False) -> _core.Integrato
     the method does not read (the method table's) is converted and left at its default: rk4 given ``first_step``
     or ``max_step`` steps at dt as without them. ``every``: all of them set, for ``check_options`` to judge their
     values (a bad one is named whatever the method). ``adaptive`` is a request, always passed on: a method
-    without an error estimate refuses True (``check_options``)."""
+    without an error estimate refuses True (``check_options``). An option at its default (the table's own object,
+    as ``resolve`` fills it in) is not set again: a fresh ``IntegratorOptions`` holds the table's defaults."""
     opt = _core.IntegratorOptions()
     opt.method = method
     reads = _METHODS[method].options if method in _METHODS else ()
-    for name, value in options.items():
-        if name not in ("error_on", "rtol", "atol"):
-            (opt if every or name in reads or name == "adaptive" else _core.IntegratorOptions()).set(name, value)
+    for name, value in given(options).items():
+        (opt if every or name in reads or name == "adaptive" else _core.IntegratorOptions()).set(name, value)
     return opt
+
+
+def given(options: dict) -> dict:
+    """The options of ``options`` that ``compiled`` sets: those not at their default (the table's own object),
+    except error_on, rtol and atol (the caller's)."""
+    return {name: value for name, value in options.items()
+            if name not in ("error_on", "rtol", "atol") and value is not _BY_NAME[name].default}
+
+
+def read_by(method: str, options: dict) -> bool:
+    """Whether ``method`` reads every option that ``compiled`` sets (adaptive counts as read): then the options
+    with every one set are the method's own."""
+    reads = _METHODS[method].options if method in _METHODS else ()
+    return all(name in reads or name == "adaptive" for name in given(options))
 
 
 def _readers(o: Option) -> str:
