@@ -72,27 +72,14 @@ RowMatX multipliers(const std::vector<VecX>& rows, int nl) {
 }  // namespace
 
 void bind_integrators(py::module_& m) {
-  py::class_<IntegratorOptions>(m, "IntegratorOptions", "Options of the C++ integrators (see rigidfem.simulate).")
+  py::class_<IntegratorOptions>(m, "IntegratorOptions",
+                                "Options of the C++ integrators (see rigidfem.simulate): each option of the table "
+                                "(_option_table) through set and get; the method, s0 and stiff_method as attributes.")
       .def(py::init<>())
       .def_property(
           "method", [](const IntegratorOptions& o) { return method_name(o.method); },
           [](IntegratorOptions& o, const std::string& name) { o.method = parse_method(name); })
-      .def_readwrite("dt", &IntegratorOptions::dt)
-      .def_readwrite("adaptive", &IntegratorOptions::adaptive, "-1: the method's default, 0: fixed dt, 1: adaptive")
-      .def_readwrite("rtol", &IntegratorOptions::rtol)
-      .def_readwrite("atol", &IntegratorOptions::atol)
-      .def_readwrite("max_step", &IntegratorOptions::max_step)
-      .def_readwrite("max_steps", &IntegratorOptions::max_steps)
-      .def_readwrite("beta", &IntegratorOptions::beta)
-      .def_readwrite("gamma", &IntegratorOptions::gamma)
-      .def_readwrite("alpha", &IntegratorOptions::alpha)
-      .def_readwrite("rho_inf", &IntegratorOptions::rho_inf)
-      .def_readwrite("newton_tol", &IntegratorOptions::newton_tol)
-      .def_readwrite("newton_max_iterations", &IntegratorOptions::newton_max_iterations)
       .def_readwrite("s0", &IntegratorOptions::s0, "(nz) the Maxwell arms' initial forces (N or N·m); empty: zero")
-      .def_property(
-          "iteration_matrix", [](const IntegratorOptions& o) { return iteration_matrix_name(o.iteration_matrix); },
-          [](IntegratorOptions& o, const std::string& name) { o.iteration_matrix = parse_iteration_matrix(name); })
       .def(
           "set_error_on",
           [](IntegratorOptions& o, const std::vector<std::tuple<std::string, int, Vec3>>& outputs) {

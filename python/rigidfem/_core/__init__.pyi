@@ -923,9 +923,8 @@ class _System:
         """
 class IntegratorOptions:
     """
-    Options of the C++ integrators (see rigidfem.simulate).
+    Options of the C++ integrators (see rigidfem.simulate): each option of the table (_option_table) through set and get; the method, s0 and stiff_method as attributes.
     """
-    iteration_matrix: str
     method: str
     stiff_method: str
     def __init__(self) -> None:
@@ -950,80 +949,6 @@ class IntegratorOptions:
         """
         The outputs the error is measured on: (kind, index, r) each; [] for the state.
         """
-    @property
-    def adaptive(self) -> int:
-        """
-        -1: the method's default, 0: fixed dt, 1: adaptive
-        """
-    @adaptive.setter
-    def adaptive(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
-        ...
-    @property
-    def alpha(self) -> float:
-        ...
-    @alpha.setter
-    def alpha(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
-        ...
-    @property
-    def atol(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
-        ...
-    @atol.setter
-    def atol(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> None:
-        ...
-    @property
-    def beta(self) -> float:
-        ...
-    @beta.setter
-    def beta(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
-        ...
-    @property
-    def dt(self) -> float:
-        ...
-    @dt.setter
-    def dt(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
-        ...
-    @property
-    def gamma(self) -> float:
-        ...
-    @gamma.setter
-    def gamma(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
-        ...
-    @property
-    def max_step(self) -> float:
-        ...
-    @max_step.setter
-    def max_step(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
-        ...
-    @property
-    def max_steps(self) -> int:
-        ...
-    @max_steps.setter
-    def max_steps(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
-        ...
-    @property
-    def newton_max_iterations(self) -> int:
-        ...
-    @newton_max_iterations.setter
-    def newton_max_iterations(self, arg0: typing.SupportsInt | typing.SupportsIndex) -> None:
-        ...
-    @property
-    def newton_tol(self) -> float:
-        ...
-    @newton_tol.setter
-    def newton_tol(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
-        ...
-    @property
-    def rho_inf(self) -> float:
-        ...
-    @rho_inf.setter
-    def rho_inf(self, arg0: typing.SupportsFloat | typing.SupportsIndex) -> None:
-        ...
-    @property
-    def rtol(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
-        ...
-    @rtol.setter
-    def rtol(self, arg0: typing.Annotated[numpy.typing.ArrayLike, numpy.float64, "[m, 1]"]) -> None:
-        ...
     @property
     def s0(self) -> typing.Annotated[numpy.typing.NDArray[numpy.float64], "[m, 1]"]:
         """

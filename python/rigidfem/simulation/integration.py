@@ -235,7 +235,9 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
     # every option given, for their values to be judged: the same options where the method reads them all
     judged = opt if options_.read_by(method, o) and not scipy else options_.compiled("dopri5" if scipy else method, o,
                                                                                        every=True)
-    opt.rtol, opt.atol = judged.rtol, judged.atol = rtol, atol
+    for x in (opt, judged):
+        x.set("rtol", rtol)
+        x.set("atol", atol)
     row = options_.method(method)
     fixed = adaptive is False or (not row.adaptive and adaptive is not True)
     if error_on is not None and (scipy or fixed) and not (isinstance(error_on, str) and error_on == "state"):
@@ -251,7 +253,7 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
         raise _checks.refuse("adaptive: expected None or True with method 'auto' (it controls its steps), got False")
     for x in (opt, judged):
         if scipy:
-            x.adaptive = -1  # SciPy's solvers are adaptive whatever it says (its type is checked)
+            x.set("adaptive", None)  # SciPy's solvers are adaptive whatever it says (its type is checked)
         x.s0 = s0
         x.set_error_on(outputs)
     _core._check_options(system, t0, t_end, q0, qd0, t_eval, judged)  # the values, once (the sensitivities': integrate)
@@ -279,11 +281,11 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
     bar = ProgressBar(t_end - t0, "s", "simulate") if _checks.boolean(progress, "progress") else None
     try:
         if dt is not None and adaptive is None and first_step is None and row.adaptive and not scipy:
-            warnings.warn(f"dt: {method!r} is adaptive: dt = {opt.dt:g} s only sets its first step; give "
+            warnings.warn(f"dt: {method!r} is adaptive: dt = {opt.get('dt'):g} s only sets its first step; give "
                           "adaptive=False for fixed steps of dt, or first_step= for the first step without this warning",
                           UserWarning, stacklevel=2)
         if scipy:
-            first = None if first_step is None else opt.dt
+            first = None if first_step is None else opt.get("dt")
             run = _run_scipy(system, method[6:], t0, t_end, q0, qd0, t_eval, rtol, atol, max_step, max_steps,
                              _keep_going(bar, stop, t0), first)
         else:
