@@ -104,7 +104,7 @@ def test_fast_subset(installed):
     """The fast subset from a copy of tests/ and pyproject.toml in the run folder, as cibuildwheel's test-sources
     lays them out: `import rigidfem` can only find the wheel's package."""
     python, env, cwd, _ = installed
-    run([python, "-m", "pip", "install", "-q", "--only-binary=:all:", "pytest>=8.2", "hypothesis>=6"], env, cwd)
+    run([python, "-m", "pip", "install", "-q", "--only-binary=:all:", "pytest>=8.2", "pytest-xdist>=3", "hypothesis>=6"], env, cwd)
     shutil.copytree(ROOT / "tests", cwd / "tests", ignore=shutil.ignore_patterns("__pycache__", "fuzz_corpus"))
     shutil.copy(ROOT / "pyproject.toml", cwd)
     start = time.perf_counter()
