@@ -235,9 +235,6 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
     # every option given, for their values to be judged: the same options where the method reads them all
     judged = opt if options_.read_by(method, o) and not scipy else options_.compiled("dopri5" if scipy else method, o,
                                                                                        every=True)
-    for x in (opt, judged):
-        x.set("rtol", rtol)
-        x.set("atol", atol)
     row = options_.method(method)
     fixed = adaptive is False or (not row.adaptive and adaptive is not True)
     if error_on is not None and (scipy or fixed) and not (isinstance(error_on, str) and error_on == "state"):
@@ -252,6 +249,8 @@ def simulate(system, t_end: float, method: str = "auto", *, t0: float = 0.0, q0=
     if method == "auto" and adaptive is False:
         raise _checks.refuse("adaptive: expected None or True with method 'auto' (it controls its steps), got False")
     for x in (opt, judged):
+        x.set("rtol", rtol)
+        x.set("atol", atol)
         if scipy:
             x.set("adaptive", None)  # SciPy's solvers are adaptive whatever it says (its type is checked)
         x.s0 = s0
