@@ -176,13 +176,19 @@ def test_the_citation_file_names_the_package_and_the_book():
 
 def test_the_gallery_embeds_the_viewers_standalone_pages(site):
     """The site's gallery shows pages of rf.view (written by the build from docs/viewer_gallery.py) in iframes, each
-    page in the site, self-contained (its three.js inline), and the notebooks that show the viewer carry its page."""
+    page in the site, self-contained (its three.js inline, packed), and the notebooks that show the viewer carry its
+    page."""
+    import base64
+    import zlib
+
     gallery = (site / "gallery.html").read_text(encoding="utf-8")
     shown = re.findall(r'<iframe src="(viewer/\w+\.html)"', gallery)
     assert len(shown) == 4, shown
     for page in shown:
         body = (site / page).read_text(encoding="utf-8")
-        assert "window.RIGIDFEM" in body and "REVISION" in body, page
+        packed = re.search(r'rigidfemUnpack\("([A-Za-z0-9+/=]+)"\)', body)
+        assert "window.RIGIDFEM" in body and packed, page
+        assert "REVISION" in zlib.decompress(base64.b64decode(packed.group(1)), wbits=-15).decode("utf-8"), page
     for nb in ("06_offshore_crane", "09_cantilever_frequencies", "11_kane", "12_whippy_beam"):
         assert "<iframe srcdoc=" in (site / "notebooks" / f"{nb}.html").read_text(encoding="utf-8"), nb
 

@@ -240,6 +240,104 @@ setTimeout(() => {
     assert state.get("saved") == "300" and state.get("shown") == "300"  # the slider's frame, back in the model
 
 
+def test_the_page_packs_its_scripts_and_unpacks_them_whole(kane):
+    """three.js, its orbit controls and viewer.js travel as one raw DEFLATE stream in base64: the page holds them at a
+    quarter of their size, and the stream decodes to the three files as shipped."""
+    import base64
+    import zlib
+
+    from rigidfem.viz.viewer import ASSETS, SCRIPTS
+
+    *_, viewer, path = kane
+    page = viewer.html()
+    packed = re.search(r'rigidfemUnpack\("([A-Za-z0-9+/=]+)"\)', page).group(1)
+    code = zlib.decompress(base64.b64decode(packed), wbits=-15).decode("utf-8")
+    texts = [(ASSETS / name).read_text(encoding="utf-8") for name in SCRIPTS]
+    assert code == "\n;\n".join(texts)
+    assert not any(text[:200] in page for text in texts)  # not also inline as text
+    shipped = sum(len(t.encode("utf-8")) for t in texts)
+    assert len(packed) < 0.3 * shipped
+
+
+def test_a_frame_asked_before_the_scripts_unpack_is_shown(kane, tmp_path):
+    """The notebook widget sends its frame when the iframe loads, before the unpacked viewer.js listens:
+    the page shows that frame (not frame 0) once it runs."""
+    import json
+
+    from rigidfem.viz.viewer import ASSETS
+
+    *_, viewer, _ = kane
+    esm = (ASSETS / "widget.js").read_text(encoding="utf-8")
+    host = tmp_path / "host.html"
+    host.write_text("""<!DOCTYPE html><html><body><div id="host"></div>
+<script type="module">
+const esm = %s;
+const url = URL.createObjectURL(new Blob([esm], {type: "text/javascript"}));
+const widget = (await import(url)).default;
+const state = {page: %s, height: 300, frames: %d, frame: 250};
+const model = {get: (k) => state[k], set: (k, v) => { state[k] = v; }, on: () => {}, save_changes: () => {}};
+widget.render({model, el: document.getElementById("host")});
+const iframe = document.querySelector("iframe");
+setTimeout(() => {
+  const inner = iframe.contentDocument.body.dataset;
+  document.body.dataset.inner = inner.frame;
+  document.body.dataset.innerReady = inner.ready;
+}, 2500);
+</script></body></html>""" % (*(json.dumps(x).replace("</", "<\\/") for x in (esm, viewer.html())), viewer.frames),
+                    encoding="utf-8")
+    state = _open(host, "")
+    assert state.get("inner-ready") == "1" and state.get("inner") == "250"
+
+
+def test_the_pages_inflate_decodes_what_zlib_encodes(tmp_path):
+    """unpack.js's DEFLATE decoder, run in Chromium on streams of Python's zlib: stored blocks (level 0, over 64 kB:
+    several), the fixed codes (a short text), dynamic codes (three.js), overlapping copies (distance 1) and an empty
+    input decode to the bytes encoded; a stream cut short or corrupted is an error, not wrong text."""
+    import base64
+    import json
+    import zlib
+
+    from rigidfem.viz.viewer import ASSETS
+
+    def raw(data, level):
+        c = zlib.compressobj(level, zlib.DEFLATED, -15)
+        return c.compress(data) + c.flush()
+
+    rng = np.random.default_rng(1)
+    three = (ASSETS / "three.min.js").read_bytes()[:200_000]
+    cases = {"stored": (rng.integers(0, 256, 70_000, dtype=np.uint8).tobytes(), 0),
+             "fixed": (b"rigid finite elements", 9), "dynamic": (three, 9),
+             "overlap": (b"a" * 100_000 + b"ab" * 5_000, 9), "empty": (b"", 9)}
+    streams = {name: raw(data, level) for name, (data, level) in cases.items()}
+    assert [streams[k][0] >> 1 & 3 for k in ("stored", "fixed", "dynamic")] == [0, 1, 2]  # each block type is met
+    bad = {"cut": streams["dynamic"][:5_000], "corrupt": streams["dynamic"][:40] + bytes(60) + streams["dynamic"][100:]}
+    encoded = {k: base64.b64encode(v).decode() for k, v in {**streams, **bad}.items()}
+    expected = {k: base64.b64encode(data).decode() for k, (data, _) in cases.items()}
+    host = tmp_path / "inflate.html"
+    host.write_text("""<!DOCTYPE html><html><body><script>%s</script><script>
+const streams = %s, expected = %s, results = {};
+const bytes = (b64) => Uint8Array.from(atob(b64), (c) => c.charCodeAt(0));
+const b64 = (u8) => {
+  let s = "";
+  for (let i = 0; i < u8.length; i += 8192) s += String.fromCharCode(...u8.subarray(i, i + 8192));
+  return btoa(s);
+};
+for (const k in streams) {
+  try {
+    const out = b64(rigidfemInflate(bytes(streams[k])));
+    results[k] = k in expected ? (out === expected[k] ? "same" : "differs") : "no error";
+  } catch (e) { results[k] = String(e.message); }
+}
+document.body.dataset.results = JSON.stringify(results);
+</script></body></html>""" % ((ASSETS / "unpack.js").read_text(encoding="utf-8"), json.dumps(encoded),
+                                 json.dumps(expected)), encoding="utf-8")
+    import html as html_
+    results = json.loads(html_.unescape(_open(host, "")["results"]))
+    assert {k: results[k] for k in cases} == dict.fromkeys(cases, "same")
+    assert results["cut"].startswith("unpack: the stream ends early")
+    assert results["corrupt"].startswith("unpack: ")
+
+
 # -- trails and paths: TypeError ('not iterable', pathlib's) before, ValueError naming the argument now -------
 
 @pytest.fixture(scope="module")
@@ -709,9 +807,9 @@ window.addEventListener("load", copy);
     assert "error" not in state and state.get("ready") == "1" and int(state["ink"]) > 500, state
 
 
-#: The largest a committed notebook may be (bytes): a page of the viewer adds about 1.1 MB (three.js 0.85 MB as an
-#: escaped srcdoc, and the frames), so a notebook shows one viewer and a few figures.
-NOTEBOOK_BYTES = 3_000_000
+#: The largest a committed notebook may be (bytes): a page of the viewer adds 0.33-0.42 MB (its scripts packed, 0.24
+#: MB, and the frames), so a notebook shows one viewer and a few figures.
+NOTEBOOK_BYTES = 1_200_000
 
 
 def test_the_notebooks_show_the_viewer_and_stay_small():
