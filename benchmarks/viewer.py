@@ -23,6 +23,7 @@ import numpy as np
 
 import rigidfem as rf
 from rigidfem.studies.study import Table
+from rigidfem.viz.viewer import _packed
 
 from ._common import machine, report
 
@@ -44,6 +45,7 @@ def _ms_per_frame(path: Path) -> float:
 
 
 def viewer_scaling(cases=CASES) -> Table:
+    _packed()  # the scripts packed once per process, not in the first case's build time
     rows = []
     with tempfile.TemporaryDirectory() as folder:
         for m, frames in cases:

@@ -364,7 +364,7 @@ def test_viewer_benchmark_quick(tmp_path, capsys):
     table = viewer.run(tmp_path, quick=True)["viewer_scaling"]
     row = table.rows[0]
     assert (row["m"], row["bodies"], row["frames"]) == (20, 22, 101)
-    # the packed scripts (0.24 MB) and 64 bytes a body and frame (0.14 MB), besides the markup
+    # the packed scripts (0.25 MB) and 64 bytes a body and frame (0.14 MB), besides the markup
     assert 0.38 < row["file_MB"] < 0.6 and (tmp_path / "viewer_scaling.csv").exists()
     assert "ms_per_frame" in capsys.readouterr().out
 

@@ -49,9 +49,15 @@ def test_the_scene_holds_every_frame_and_the_beam(kane):
 
 
 def test_the_page_is_offline_and_small(kane):
+    import base64
+    import zlib
+
     *_, viewer, path = kane
     page = path.read_text(encoding="utf-8")
-    assert not re.search(r'(src|href)\s*=\s*["\']?(https?:)?//', page), "the page fetches something"
+    packed = re.search(r'rigidfemUnpack\("([A-Za-z0-9+/=]+)"\)', page).group(1)
+    scripts = zlib.decompress(base64.b64decode(packed)).decode("utf-8")  # what the page runs, unpacked
+    for text in (page, scripts):
+        assert not re.search(r'(src|href)\s*=\s*["\']?(https?:)?//', text), "the page fetches something"
     size = path.stat().st_size
     assert size < 5e6, size  # the issue's bound for this run (a 20 s Kane run, m = 20, 401 frames)
     # poses: 48 bytes per frame and body, 4/3 in base64; the rest is three.js and the viewer
@@ -241,8 +247,8 @@ setTimeout(() => {
 
 
 def test_the_page_packs_its_scripts_and_unpacks_them_whole(kane):
-    """three.js, its orbit controls and viewer.js travel as one raw DEFLATE stream in base64: the page holds them at a
-    quarter of their size, and the stream decodes to the three files as shipped."""
+    """three.js, its orbit controls and viewer.js travel as one zlib stream in base64: the page holds them at under
+    30 % of their size, and the stream decodes to the three files as shipped."""
     import base64
     import zlib
 
@@ -251,7 +257,7 @@ def test_the_page_packs_its_scripts_and_unpacks_them_whole(kane):
     *_, viewer, path = kane
     page = viewer.html()
     packed = re.search(r'rigidfemUnpack\("([A-Za-z0-9+/=]+)"\)', page).group(1)
-    code = zlib.decompress(base64.b64decode(packed), wbits=-15).decode("utf-8")
+    code = zlib.decompress(base64.b64decode(packed)).decode("utf-8")
     texts = [(ASSETS / name).read_text(encoding="utf-8") for name in SCRIPTS]
     assert code == "\n;\n".join(texts)
     assert not any(text[:200] in page for text in texts)  # not also inline as text
@@ -259,9 +265,9 @@ def test_the_page_packs_its_scripts_and_unpacks_them_whole(kane):
     assert len(packed) < 0.3 * shipped
 
 
-def test_a_frame_asked_before_the_scripts_unpack_is_shown(kane, tmp_path):
-    """The notebook widget sends its frame when the iframe loads, before the unpacked viewer.js listens:
-    the page shows that frame (not frame 0) once it runs."""
+def test_a_frame_sent_at_the_iframes_load_is_shown(kane, tmp_path):
+    """The notebook widget sends its frame when the iframe loads: the page's scripts have unpacked and run by then
+    (synchronously, where they stand), so the page shows that frame, not frame 0."""
     import json
 
     from rigidfem.viz.viewer import ASSETS
@@ -290,27 +296,57 @@ setTimeout(() => {
 
 
 def test_the_pages_inflate_decodes_what_zlib_encodes(tmp_path):
-    """unpack.js's DEFLATE decoder, run in Chromium on streams of Python's zlib: stored blocks (level 0, over 64 kB:
-    several), the fixed codes (a short text), dynamic codes (three.js), overlapping copies (distance 1) and an empty
-    input decode to the bytes encoded; a stream cut short or corrupted is an error, not wrong text."""
+    """unpack.js's zlib decoder, run in Chromium on streams of Python's zlib: stored blocks (level 0, 70 kB: two),
+    the fixed codes (a short text), dynamic codes (three.js), overlapping copies (distance 1) and an empty input
+    decode to the bytes encoded. A stream cut short, one with any of 40 single bits flipped (the Adler-32 catches
+    what DEFLATE decodes), a bad header, and hand-made codes that zlib refuses (over-subscribed, incomplete, no
+    end-of-block code) are errors, not wrong text."""
     import base64
     import json
     import zlib
 
     from rigidfem.viz.viewer import ASSETS
 
-    def raw(data, level):
-        c = zlib.compressobj(level, zlib.DEFLATED, -15)
-        return c.compress(data) + c.flush()
+    def dynamic_block(literal_lengths, data):
+        """A zlib stream of one dynamic block whose literal/length code has ``literal_lengths`` ({symbol: bits},
+        257 symbols, no distance code), then ``data``: the codes (str of 0/1, most significant first) of the
+        symbols written. The code-length code gives lengths 0, 1, 2 the codes 0, 10, 11. Ends with 'A's Adler-32."""
+        bits = []
+
+        def put(value, n):  # a header field, least significant bit first
+            bits.extend((value >> i) & 1 for i in range(n))
+
+        order = [16, 17, 18, 0, 8, 7, 9, 6, 10, 5, 11, 4, 12, 3, 13, 2, 14, 1, 15]
+        put(1, 1), put(2, 2), put(0, 5), put(0, 5), put(18 - 4, 4)  # last block, dynamic; 257, 1, 18 lengths
+        for symbol in order[:18]:
+            put({0: 1, 1: 2, 2: 2}.get(symbol, 0), 3)
+        for L in [literal_lengths.get(k, 0) for k in range(257)] + [0]:
+            bits.extend(int(c) for c in {0: "0", 1: "10", 2: "11"}[L])
+        bits.extend(int(c) for c in data)
+        bits += [0] * (-len(bits) % 8)
+        body = bytes(sum(b << i for i, b in enumerate(bits[k:k + 8])) for k in range(0, len(bits), 8))
+        return b"\x78\x9c" + body + zlib.adler32(b"A").to_bytes(4, "big")
 
     rng = np.random.default_rng(1)
     three = (ASSETS / "three.min.js").read_bytes()[:200_000]
     cases = {"stored": (rng.integers(0, 256, 70_000, dtype=np.uint8).tobytes(), 0),
              "fixed": (b"rigid finite elements", 9), "dynamic": (three, 9),
              "overlap": (b"a" * 100_000 + b"ab" * 5_000, 9), "empty": (b"", 9)}
-    streams = {name: raw(data, level) for name, (data, level) in cases.items()}
-    assert [streams[k][0] >> 1 & 3 for k in ("stored", "fixed", "dynamic")] == [0, 1, 2]  # each block type is met
-    bad = {"cut": streams["dynamic"][:5_000], "corrupt": streams["dynamic"][:40] + bytes(60) + streams["dynamic"][100:]}
+    streams = {name: zlib.compress(data, level) for name, (data, level) in cases.items()}
+    assert [streams[k][2] >> 1 & 3 for k in ("stored", "fixed", "dynamic")] == [0, 1, 2]  # each block type is met
+    # a valid hand-made block (the builder's check: 'A' is code 0, the end of block 1), then codes zlib refuses
+    made = {"made": dynamic_block({65: 1, 256: 1}, "01")}
+    bad = {"cut": streams["dynamic"][:5_000], "header": b"\x78\x9d" + streams["fixed"][2:],
+           "oversubscribed": dynamic_block({65: 1, 66: 1, 256: 1}, "01"),
+           "incomplete": dynamic_block({65: 1, 256: 2}, "010"),
+           "no end of block": dynamic_block({65: 1, 66: 1}, "0")}
+    flips = rng.choice(8 * (len(streams["dynamic"]) - 6), 40, replace=False) + 16  # in the DEFLATE data only
+    for k, at in enumerate(flips):
+        damaged = bytearray(streams["dynamic"])
+        damaged[at // 8] ^= 1 << (at % 8)
+        bad[f"flip{k}"] = bytes(damaged)
+    streams.update(made)
+    cases["made"] = (b"A", None)
     encoded = {k: base64.b64encode(v).decode() for k, v in {**streams, **bad}.items()}
     expected = {k: base64.b64encode(data).decode() for k, (data, _) in cases.items()}
     host = tmp_path / "inflate.html"
@@ -335,7 +371,11 @@ document.body.dataset.results = JSON.stringify(results);
     results = json.loads(html_.unescape(_open(host, "")["results"]))
     assert {k: results[k] for k in cases} == dict.fromkeys(cases, "same")
     assert results["cut"].startswith("unpack: the stream ends early")
-    assert results["corrupt"].startswith("unpack: ")
+    assert results["header"].startswith("unpack: a zlib header")
+    assert results["oversubscribed"].startswith("unpack: an over-subscribed literal/length code")
+    assert results["incomplete"].startswith("unpack: an incomplete literal/length code")
+    assert results["no end of block"].startswith("unpack: no end-of-block code")
+    assert all(results[f"flip{k}"].startswith("unpack: ") for k in range(40)), results
 
 
 # -- trails and paths: TypeError ('not iterable', pathlib's) before, ValueError naming the argument now -------
@@ -807,7 +847,7 @@ window.addEventListener("load", copy);
     assert "error" not in state and state.get("ready") == "1" and int(state["ink"]) > 500, state
 
 
-#: The largest a committed notebook may be (bytes): a page of the viewer adds 0.33-0.42 MB (its scripts packed, 0.24
+#: The largest a committed notebook may be (bytes): a page of the viewer adds 0.33-0.42 MB (its scripts packed, 0.25
 #: MB, and the frames), so a notebook shows one viewer and a few figures.
 NOTEBOOK_BYTES = 1_200_000
 
@@ -822,8 +862,9 @@ def test_the_notebooks_show_the_viewer_and_stay_small():
     folder = Path(__file__).resolve().parents[1] / "notebooks"
     for name in ("06_offshore_crane", "09_cantilever_frequencies", "11_kane", "12_whippy_beam"):
         cells = json.loads((folder / f"{name}.ipynb").read_text(encoding="utf-8"))["cells"]
-        pages = [o for c in cells if c["cell_type"] == "code" for o in c.get("outputs", [])
-                 if "window.RIGIDFEM" in "".join(o.get("data", {}).get("text/html", ""))]
-        assert len(pages) == 1, name
+        pages = ["".join(o.get("data", {}).get("text/html", "")) for c in cells if c["cell_type"] == "code"
+                 for o in c.get("outputs", [])]
+        pages = [p for p in pages if "window.RIGIDFEM" in p]
+        assert len(pages) == 1 and "rigidfemUnpack(" in pages[0], name  # its scripts packed
     sizes = {p.name: p.stat().st_size for p in folder.glob("*.ipynb")}
     assert max(sizes.values()) < NOTEBOOK_BYTES, sizes

@@ -34,8 +34,8 @@ For example::
     path = viewer.to_html("kane.html")          # a self-contained page, about 0.5 MB (10 bodies)
 
 The file holds every frame's pose of every body as float32: 48 bytes × frames × bodies before base64
-(4/3), plus 0.24 MB of scripts (three.js, its orbit controls and ``viewer.js``, 0.9 MB as text, packed as one raw
-DEFLATE stream in base64, which the page's ``unpack.js`` inflates as it loads); a 20 s Kane run (m = 20, 401
+(4/3), plus 0.25 MB of scripts (three.js, its orbit controls and ``viewer.js``, 0.9 MB as text, packed as one zlib
+stream in base64, which the page's ``unpack.js`` inflates as it loads); a 20 s Kane run (m = 20, 401
 frames, 22 bodies) is about 0.83 MB. A URDF
 robot's meshes add about 24 bytes a triangle, at most ``MAX_TRIANGLES`` = 200,000 of them (about 4.8 MB).
 """
@@ -174,13 +174,17 @@ body {{ margin: 0; font: 13px sans-serif; }}
 SCRIPTS = ("three.min.js", "OrbitControls.js", "viewer.js")
 
 
-@functools.cache
 def _packed() -> str:
-    """SCRIPTS as one raw DEFLATE stream (RFC 1951) in base64, which the page's unpack.js inflates and runs: 0.24 MB
-    in the page instead of 0.9 MB of text (more in a notebook, whose iframe escapes the text's markup)."""
+    """SCRIPTS as one zlib stream (RFC 1950: DEFLATE and its Adler-32) in base64, which the page's unpack.js inflates,
+    checks and runs: 0.25 MB in the page instead of 0.9 MB of text (more in a notebook, whose iframe escapes the
+    text's markup). Packed once per version of the files (their modification times)."""
+    return _packed_files(tuple((ASSETS / name).stat().st_mtime_ns for name in SCRIPTS))
+
+
+@functools.lru_cache(maxsize=1)
+def _packed_files(versions: tuple) -> str:
     code = "\n;\n".join((ASSETS / name).read_text(encoding="utf-8") for name in SCRIPTS)
-    deflate = zlib.compressobj(9, zlib.DEFLATED, -15)  # raw: no zlib or gzip header
-    return base64.b64encode(deflate.compress(code.encode("utf-8")) + deflate.flush()).decode("ascii")
+    return base64.b64encode(zlib.compress(code.encode("utf-8"), 9)).decode("ascii")
 
 
 def _iframe(page: str, height: int) -> str:
