@@ -212,14 +212,14 @@ def test_the_widget_holds_the_page_and_checks_its_frame():
         w.frame = 101
 
 
-def test_the_widget_and_the_page_follow_each_other_in_a_browser(kane, tmp_path):
-    """widget.js run in Chromium with a stand-in for anywidget's model: setting ``frame`` from the
-    Python side shows that frame in the page, and moving the page's slider sets ``frame``."""
+def _widget_in_browser(viewer, tmp_path, frame, then):
+    """The body data attributes after widget.js rendered ``viewer``'s page in Chromium, with a stand-in for
+    anywidget's model (its ``frame`` first at ``frame``; ``on`` keeps the handlers, ``save_changes`` records the
+    frame in data-saved, the page's "shown" messages go to data-shown) and the script ``then`` run after it."""
     import json
 
     from rigidfem.viz.viewer import ASSETS
 
-    *_, viewer, _ = kane
     esm = (ASSETS / "widget.js").read_text(encoding="utf-8")
     host = tmp_path / "host.html"
     host.write_text("""<!DOCTYPE html><html><body><div id="host"></div>
@@ -227,21 +227,29 @@ def test_the_widget_and_the_page_follow_each_other_in_a_browser(kane, tmp_path):
 const esm = %s;
 const url = URL.createObjectURL(new Blob([esm], {type: "text/javascript"}));
 const widget = (await import(url)).default;
-const state = {page: %s, height: 300, frames: %d, frame: 0}, on = {};
+const state = {page: %s, height: 300, frames: %d, frame: %d}, on = {};
 const model = {get: (k) => state[k], set: (k, v) => { state[k] = v; }, on: (e, f) => { on[e] = f; },
                save_changes: () => { document.body.dataset.saved = state.frame; }};
 window.addEventListener("message", (e) => { if (e.data && e.data.rigidfem === "shown") document.body.dataset.shown = e.data.frame; });
 widget.render({model, el: document.getElementById("host")});
 const iframe = document.querySelector("iframe");
+%s
+</script></body></html>""" % (*(json.dumps(x).replace("</", "<\\/") for x in (esm, viewer.html())), viewer.frames, frame,
+                              then), encoding="utf-8")
+    return _open(host, "")
+
+
+def test_the_widget_and_the_page_follow_each_other_in_a_browser(kane, tmp_path):
+    """widget.js run in Chromium with a stand-in for anywidget's model: setting ``frame`` from the
+    Python side shows that frame in the page, and moving the page's slider sets ``frame``."""
+    *_, viewer, _ = kane
+    state = _widget_in_browser(viewer, tmp_path, 0, """
 setTimeout(() => { state.frame = 150; on["change:frame"](); }, 1500);
 setTimeout(() => {
   document.body.dataset.inner = iframe.contentDocument.body.dataset.frame;
   const slider = iframe.contentDocument.getElementById("rf-slider");
   slider.value = 300; slider.dispatchEvent(new Event("input"));
-}, 2500);
-</script></body></html>""" % (*(json.dumps(x).replace("</", "<\\/") for x in (esm, viewer.html())), viewer.frames),
-                    encoding="utf-8")
-    state = _open(host, "")
+}, 2500);""")
     assert state.get("inner") == "150"  # the Python side's frame, shown by the page
     assert state.get("saved") == "300" and state.get("shown") == "300"  # the slider's frame, back in the model
 
@@ -268,30 +276,13 @@ def test_the_page_packs_its_scripts_and_unpacks_them_whole(kane):
 def test_a_frame_sent_at_the_iframes_load_is_shown(kane, tmp_path):
     """The notebook widget sends its frame when the iframe loads: the page's scripts have unpacked and run by then
     (synchronously, where they stand), so the page shows that frame, not frame 0."""
-    import json
-
-    from rigidfem.viz.viewer import ASSETS
-
     *_, viewer, _ = kane
-    esm = (ASSETS / "widget.js").read_text(encoding="utf-8")
-    host = tmp_path / "host.html"
-    host.write_text("""<!DOCTYPE html><html><body><div id="host"></div>
-<script type="module">
-const esm = %s;
-const url = URL.createObjectURL(new Blob([esm], {type: "text/javascript"}));
-const widget = (await import(url)).default;
-const state = {page: %s, height: 300, frames: %d, frame: 250};
-const model = {get: (k) => state[k], set: (k, v) => { state[k] = v; }, on: () => {}, save_changes: () => {}};
-widget.render({model, el: document.getElementById("host")});
-const iframe = document.querySelector("iframe");
+    state = _widget_in_browser(viewer, tmp_path, 250, """
 setTimeout(() => {
   const inner = iframe.contentDocument.body.dataset;
   document.body.dataset.inner = inner.frame;
   document.body.dataset.innerReady = inner.ready;
-}, 2500);
-</script></body></html>""" % (*(json.dumps(x).replace("</", "<\\/") for x in (esm, viewer.html())), viewer.frames),
-                    encoding="utf-8")
-    state = _open(host, "")
+}, 2500);""")
     assert state.get("inner-ready") == "1" and state.get("inner") == "250"
 
 

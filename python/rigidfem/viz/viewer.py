@@ -183,6 +183,7 @@ def _packed() -> str:
 
 @functools.lru_cache(maxsize=1)
 def _packed_files(versions: tuple) -> str:
+    """_packed's work; ``versions`` (the files' modification times) is only the cache's key."""
     code = "\n;\n".join((ASSETS / name).read_text(encoding="utf-8") for name in SCRIPTS)
     return base64.b64encode(zlib.compress(code.encode("utf-8"), 9)).decode("ascii")
 
