@@ -63,9 +63,11 @@ def test_elementary_rotations_match_book_matrices(phi):
 def test_rotation_sines_and_cosines_are_within_an_ulp():
     """R1's cos φ and sin φ entries come from the core's own sin_cos, which every rotation of a joint
     uses: each within 0.9 ulp of the exact value (mpmath at 40 digits), from 1e-8 rad to 2^17 rad,
-    next to multiples of π/2 (where the reduction cancels) and beyond 2^17 rad (the library's)."""
+    next to multiples of π/2 (where the reduction cancels), on either side of 0.78 rad (below it no
+    reduction) and beyond 2^17 rad (the library's)."""
     rng = np.random.default_rng(7)
     angles = [0.0, -0.0, math.pi / 4, -math.pi / 4, 2.0**17, -(2.0**17), 3e5, -1e9]
+    angles += [s * x for s in (1, -1) for x in (0.78, math.nextafter(0.78, 0.0), math.nextafter(0.78, 1.0))]
     for scale in (1e-8, 1e-3, 0.5, 0.8, 2.0, 7.0, 100.0, 1e4, 2.0**17):
         angles += list(rng.uniform(-scale, scale, 300))
     for k in (1, 2, 3, 4, -5, 101, -2047, 65535, 83000):

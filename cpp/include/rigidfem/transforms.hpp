@@ -27,7 +27,39 @@ using RowMatX = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::Row
 /// dynamics). Alone, as the core is built (no FMA contraction), 8.8 ns a call against libm's 9.7-10.0 in the
 /// x86-64-v3 build and 10.1-10.8 against 9.9-10.5 in the portable one; in that forward dynamics 2-3 % less time
 /// in both. Beyond |x| = 2^17 rad, and for inf or NaN, the library's.
+namespace detail {
+
+// sin and cos of r + r_lo, |r| ≤ π/4, r_lo a correction of r's last bits (left out where there is none):
+// Taylor (the next terms r¹⁹/19! and r¹⁸/18! are below 1e-19), in z = r² by Estrin's scheme:
+// sin r = r + r z P(z), P = −1/3! + z/5! − ... + z⁷/17!; cos r = 1 − z/2 + z² Q(z), Q = 1/4! − z/6! + ... + z⁶/16!
+// (the factorials are exact doubles, so each coefficient is the quotient correctly rounded)
+template <bool with_lo>
+inline void sin_cos_reduced(double r, double r_lo, double& s, double& c) {
+  constexpr double s3 = -1.0 / 6, s5 = 1.0 / 120, s7 = -1.0 / 5040, s9 = 1.0 / 362880, s11 = -1.0 / 39916800,
+                   s13 = 1.0 / 6227020800.0, s15 = -1.0 / 1307674368000.0, s17 = 1.0 / 355687428096000.0;
+  constexpr double c4 = 1.0 / 24, c6 = -1.0 / 720, c8 = 1.0 / 40320, c10 = -1.0 / 3628800, c12 = 1.0 / 479001600,
+                   c14 = -1.0 / 87178291200.0, c16 = 1.0 / 20922789888000.0;
+  const double z = r * r, z2 = z * z, z4 = z2 * z2;
+  const double P = (s3 + z * s5) + z2 * (s7 + z * s9) + z4 * ((s11 + z * s13) + z2 * (s15 + z * s17));
+  const double Q = (c4 + z * c6) + z2 * (c8 + z * c10) + z4 * ((c12 + z * c14) + z2 * c16);
+  // with r_lo: sin(r + r_lo) ≈ sin r + r_lo cos r, cos(r + r_lo) ≈ cos r − r_lo r; 1 − z/2 as w plus its
+  // rounding error (1 − w) − z/2 (Kahan)
+  const double hz = 0.5 * z, w = 1.0 - hz;
+  if constexpr (with_lo) {
+    s = r + (r * z * P + r_lo * w);
+    c = w + (((1.0 - w) - hz) + (z2 * Q - r * r_lo));
+  } else {
+    s = r + r * z * P;
+    c = w + (((1.0 - w) - hz) + z2 * Q);
+  }
+}
+
+}  // namespace detail
+
 inline void sin_cos(double x, double& s, double& c) {
+  // |x| < 0.78 < π/4 (the angles of deformations and most joints): no reduction, which stood in the chain of
+  // dependent operations (the values are those of the reduction with k = 0, r = x, r_lo = 0).
+  if (std::abs(x) < 0.78) return detail::sin_cos_reduced<false>(x, 0.0, s, c);
   // x = k π/2 + r, |r| ≤ π/4, with π/2 = p1 + p2 + p3 (p1 and p2 of 33 bits, from π to 300 bits): x − k p1 and
   // k p2 are exact for |k| < 2^20, and x − k π/2 = r + r_lo by a two-sum. k by the shift 1.5·2^52, which rounds
   // |y| < 2^51 to the nearest integer.
@@ -40,21 +72,8 @@ inline void sin_cos(double x, double& s, double& c) {
   const double k = (x * two_over_pi + shift) - shift;
   const double r1 = x - k * p1, t = -k * p2, r = r1 + t, t1 = r - r1;
   const double r_lo = ((r1 - (r - t1)) + (t - t1)) - k * p3;
-  // Taylor on |r| ≤ π/4 (the next terms r¹⁹/19! and r¹⁸/18! are below 1e-19), in z = r² by Estrin's scheme:
-  // sin r = r + r z P(z), P = −1/3! + z/5! − ... + z⁷/17!; cos r = 1 − z/2 + z² Q(z), Q = 1/4! − z/6! + ... + z⁶/16!
-  // (the factorials are exact doubles, so each coefficient is the quotient correctly rounded)
-  constexpr double s3 = -1.0 / 6, s5 = 1.0 / 120, s7 = -1.0 / 5040, s9 = 1.0 / 362880, s11 = -1.0 / 39916800,
-                   s13 = 1.0 / 6227020800.0, s15 = -1.0 / 1307674368000.0, s17 = 1.0 / 355687428096000.0;
-  constexpr double c4 = 1.0 / 24, c6 = -1.0 / 720, c8 = 1.0 / 40320, c10 = -1.0 / 3628800, c12 = 1.0 / 479001600,
-                   c14 = -1.0 / 87178291200.0, c16 = 1.0 / 20922789888000.0;
-  const double z = r * r, z2 = z * z, z4 = z2 * z2;
-  const double P = (s3 + z * s5) + z2 * (s7 + z * s9) + z4 * ((s11 + z * s13) + z2 * (s15 + z * s17));
-  const double Q = (c4 + z * c6) + z2 * (c8 + z * c10) + z4 * ((c12 + z * c14) + z2 * c16);
-  // with r_lo: sin(r + r_lo) ≈ sin r + r_lo cos r, cos(r + r_lo) ≈ cos r − r_lo r; 1 − z/2 as w plus its
-  // rounding error (1 − w) − z/2 (Kahan)
-  const double hz = 0.5 * z, w = 1.0 - hz;
-  const double sr = r + (r * z * P + r_lo * w);
-  const double cr = w + (((1.0 - w) - hz) + (z2 * Q - r * r_lo));
+  double sr, cr;
+  detail::sin_cos_reduced<true>(r, r_lo, sr, cr);
   switch (static_cast<long long>(k) & 3) {  // the quadrant
     case 0: s = sr, c = cr; break;
     case 1: s = cr, c = -sr; break;
