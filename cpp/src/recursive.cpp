@@ -137,18 +137,29 @@ bool invert_spd(const SmallMat& D, SmallMat& Dinv) {
 }
 
 // D⁻¹ of a symmetric 3 × 3 D through its factors D = L diag(d) Lᵀ (L unit lower: Cholesky's arithmetic without its
-// square roots, which stood in the chain of dependent operations from one body to the next: measured, a
-// 3-rotation chain's forward dynamics 5–7 % faster), written out: N = L⁻¹, D⁻¹ = Nᵀ diag(1/d) N; false unless D is
-// positive definite.
+// square roots), written out: N = L⁻¹, D⁻¹ = Nᵀ diag(1/d) N; false unless D is positive definite. The pivots'
+// reciprocals come from leading minors, so that their three divisions run side by side instead of one after the
+// other (they stood in the chain of dependent operations from one body to the next): d₁ = p₁/d₀ with
+// p₁ = D₀₀ D₁₁ − D₁₀², d₂ = n/(d₀ p₁) with n = p₁ q − m² = D₀₀ det D (Desnanot–Jacobi), q = D₀₀ D₂₂ − D₂₀²,
+// m = D₀₀ D₂₁ − D₁₀ D₂₀: the same products as the elimination's, scaled, so the same accuracy (ε cond D: measured on
+// 1,800 random matrices of condition 1e2 to 1e12 against exact rational inverses, where the cofactors' det D gave up
+// to ε cond² D). Where n leaves [2⁻²⁵⁰, 2²⁵⁰] (entries beyond about 1e±18, or D close to singular) the
+// elimination's own order.
 bool invert_spd3(const Mat3& D, Mat3& Dinv) {
-  if (!(D(0, 0) > 0.0)) return false;
-  const double i0 = 1.0 / D(0, 0), l10 = D(1, 0) * i0, l20 = D(2, 0) * i0;
-  const double d1 = D(1, 1) - l10 * D(1, 0);
-  if (!(d1 > 0.0)) return false;
-  const double i1 = 1.0 / d1, e21 = D(2, 1) - l20 * D(1, 0), l21 = e21 * i1;
-  const double d2 = D(2, 2) - l20 * D(2, 0) - l21 * e21;
-  if (!(d2 > 0.0)) return false;
-  const double i2 = 1.0 / d2;
+  const double d0 = D(0, 0), b = D(1, 0), c = D(2, 0);
+  const double p1 = d0 * D(1, 1) - b * b, q = d0 * D(2, 2) - c * c, m = d0 * D(2, 1) - b * c;
+  const double n = p1 * q - m * m;
+  if (!(d0 > 0.0 && p1 > 0.0)) return false;
+  const double i0 = 1.0 / d0, r1 = 1.0 / p1, l10 = b * i0, l20 = c * i0;
+  const double i1 = d0 * r1, e21 = D(2, 1) - l20 * b, l21 = e21 * i1;
+  double i2;
+  if (n > 0x1p-250 && n < 0x1p250) {
+    i2 = (d0 * p1) * (1.0 / n);
+  } else {
+    const double d2 = D(2, 2) - l20 * c - l21 * e21;
+    if (!(d2 > 0.0)) return false;
+    i2 = 1.0 / d2;
+  }
   const double n10 = -l10, n21 = -l21, n20 = l21 * l10 - l20;
   Dinv(0, 0) = i0 + n10 * n10 * i1 + n20 * n20 * i2;
   Dinv(1, 0) = Dinv(0, 1) = n10 * i1 + n21 * n20 * i2;
