@@ -145,7 +145,12 @@ void frames_and_axes(const System& sys, Data& d) {
   for (int p = 0; p < sys.nbodies; ++p) {
     if (sys.parent[p] != p - 1) T = parent_value(sys, d.T, p, I4);
     Mat4 G;
-    compose(T, sys.B[p], G);
+    if (sys.shift_only[p]) {  // B_p = [[1, r], [0, 1]]: G = [[R, R r + o], [0, 1]] (compose's values, its M 1 left out)
+      G = T;
+      G.topRightCorner<3, 1>().noalias() += T.topLeftCorner<3, 3>() * sys.B[p].topRightCorner<3, 1>();
+    } else {
+      compose(T, sys.B[p], G);
+    }
     joint_frames(joint_uses(sys, p), d.qa, G, d.axes.data() + sys.use_start[p]);  // data(): valid for none
     d.T[p] = T = G;
   }

@@ -41,6 +41,7 @@ std::shared_ptr<const System> Model::compile(Algorithm algorithm) const {
     s.body_names.push_back(b.name);
     s.parent.push_back(b.parent);  // parent[p] < p: bodies are added after their parents
     s.B.push_back(b.placement);
+    s.shift_only.push_back(b.placement.topLeftCorner<3, 3>() == Mat3::Identity());
     s.H.push_back(pseudo_inertia(b.mass, b.com, b.inertia));
     s.mass.push_back(b.mass);
     s.com.push_back(b.com);

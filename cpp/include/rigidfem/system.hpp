@@ -52,6 +52,7 @@ class System : public std::enable_shared_from_this<System> {
   std::vector<std::string> body_names;  // (nbodies)
   std::vector<int> parent;              // (nbodies), −1 = ground, parent[p] < p
   std::vector<Mat4> B;                  // (nbodies) 4x4 joint placement in the parent frame
+  std::vector<char> shift_only;         // (nbodies) B's rotation is exactly the identity
   std::vector<Mat4> H;                  // (nbodies) 4x4 pseudo-inertia, body frame
   std::vector<double> mass;             // (nbodies)
   std::vector<Vec3> com;                // (nbodies) centre of mass, body frame
