@@ -22,11 +22,6 @@ using MatX = Eigen::MatrixXd;
 /// Row-major (N, n) arrays: one state per row, as numpy stores a trajectory.
 using RowMatX = Eigen::Matrix<double, Eigen::Dynamic, Eigen::Dynamic, Eigen::RowMajor>;
 
-/// sin x and cos x of one angle (rad), each within 0.9 ulp of the exact value (glibc's sincos: 0.5 ulp), without
-/// libm's save and restore of the rounding mode in every call (measured: 7.5 % of a 3-rotation chain's forward
-/// dynamics). Alone, as the core is built (no FMA contraction), 8.8 ns a call against libm's 9.7-10.0 in the
-/// x86-64-v3 build and 10.1-10.8 against 9.9-10.5 in the portable one; in that forward dynamics 2-3 % less time
-/// in both. Beyond |x| = 2^17 rad, and for inf or NaN, the library's.
 namespace detail {
 
 // sin and cos of r + r_lo, |r| ≤ π/4, r_lo a correction of r's last bits (left out where there is none):
@@ -56,6 +51,11 @@ inline void sin_cos_reduced(double r, double r_lo, double& s, double& c) {
 
 }  // namespace detail
 
+/// sin x and cos x of one angle (rad), each within 0.9 ulp of the exact value (glibc's sincos: 0.5 ulp), without
+/// libm's save and restore of the rounding mode in every call (measured: 7.5 % of a 3-rotation chain's forward
+/// dynamics). Alone, as the core is built (no FMA contraction), 8.8 ns a call against libm's 9.7-10.0 in the
+/// x86-64-v3 build and 10.1-10.8 against 9.9-10.5 in the portable one; in that forward dynamics 2-3 % less time
+/// in both. Beyond |x| = 2^17 rad, and for inf or NaN, the library's.
 inline void sin_cos(double x, double& s, double& c) {
   // |x| < 0.78 < π/4 (the angles of deformations and most joints): no reduction, which stood in the chain of
   // dependent operations (the values are those of the reduction with k = 0, r = x, r_lo = 0).
