@@ -28,6 +28,7 @@ std::shared_ptr<const System> Model::compile(Algorithm algorithm) const {
   s.body_names.reserve(nb);
   s.parent.reserve(nb);
   s.B.reserve(nb);
+  s.shift_only.reserve(nb);
   s.H.reserve(nb);
   s.mass.reserve(nb);
   s.com.reserve(nb);
