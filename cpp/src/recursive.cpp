@@ -149,24 +149,22 @@ bool invert_spd3(const Mat3& D, Mat3& Dinv) {
   const double d0 = D(0, 0), b = D(1, 0), c = D(2, 0);
   const double p1 = d0 * D(1, 1) - b * b, q = d0 * D(2, 2) - c * c, m = d0 * D(2, 1) - b * c;
   const double n = p1 * q - m * m;
+  const double i0 = 1.0 / d0, l10 = b * i0, l20 = c * i0, e21 = D(2, 1) - l20 * b;
   constexpr double lo = 0x1p-250, hi = 0x1p250;
-  double i0, i1, i2, l10, l20, l21;
+  double i1, i2;
   if (d0 > 0x1p-125 && d0 < 0x1p125 && p1 > lo && p1 < hi && n > lo && n < hi) {
     const double r1 = 1.0 / p1, rn = 1.0 / n;
-    i0 = 1.0 / d0, l10 = b * i0, l20 = c * i0;
-    i1 = d0 * r1, l21 = (D(2, 1) - l20 * b) * i1;
+    i1 = d0 * r1;
     i2 = (d0 * p1) * rn;
   } else {
-    if (!(d0 > 0.0)) return false;
-    i0 = 1.0 / d0, l10 = b * i0, l20 = c * i0;
     const double d1 = D(1, 1) - l10 * b;
-    if (!(d1 > 0.0)) return false;
-    const double e21 = D(2, 1) - l20 * b;
-    i1 = 1.0 / d1, l21 = e21 * i1;
-    const double d2 = D(2, 2) - l20 * c - l21 * e21;
+    if (!(d0 > 0.0 && d1 > 0.0)) return false;
+    i1 = 1.0 / d1;
+    const double d2 = D(2, 2) - l20 * c - (e21 * i1) * e21;
     if (!(d2 > 0.0)) return false;
     i2 = 1.0 / d2;
   }
+  const double l21 = e21 * i1;
   const double n10 = -l10, n21 = -l21, n20 = l21 * l10 - l20;
   Dinv(0, 0) = i0 + n10 * n10 * i1 + n20 * n20 * i2;
   Dinv(1, 0) = Dinv(0, 1) = n10 * i1 + n21 * n20 * i2;
