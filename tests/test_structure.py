@@ -116,7 +116,7 @@ def test_public_classes_and_functions_have_docstrings():
 # The C++ core's layers, bottom to top: a file includes headers of its own layer or below only.
 CPP = PACKAGE.parents[1] / "cpp"
 LAYERS = [
-    {"errors", "transforms", "profiles", "laws"},
+    {"errors", "transforms", "profiles", "laws", "dense_lu"},
     {"joint_motion", "loops", "force_elements", "coordinate_laws", "flows", "contact"},
     {"model"},
     {"system", "parameters"},                  # a compiled system, and its copies with other constants

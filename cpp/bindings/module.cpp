@@ -4,6 +4,7 @@
 #include <optional>
 
 #include "bindings.hpp"
+#include "rigidfem/dense_lu.hpp"
 #include "rigidfem/errors.hpp"
 #include "rigidfem/model.hpp"
 #include "rigidfem/profiles.hpp"
@@ -460,6 +461,22 @@ void bind_module(py::module_& m) {
       py::arg("system"), py::arg("t"), py::arg("q"), py::arg("qd"), py::arg("qdd"), py::arg("calls"),
       "Seconds per call of the parts of an implicit step (residual, tangent, LU factor and solve, the O(n)\n"
       "armature factor and solve), timed in C++.");
+  bench.def(
+      "dense_lu_solutions",
+      [](const Eigen::MatrixXcd& S, const Eigen::VectorXcd& b) {
+        rigidfem::DenseLU real;
+        rigidfem::ComplexLU complex;
+        real.compute(S.real());
+        complex.compute(S);
+        rigidfem::VecX x, xt;
+        Eigen::VectorXcd z, zt;
+        real.solve(b.real(), x), real.solve_transposed(b.real(), xt);
+        complex.solve(b, z), complex.solve_transposed(b, zt);
+        return py::make_tuple(x, xt, z, zt, real.pivots(), complex.pivots());
+      },
+      py::arg("S"), py::arg("b"),
+      "The dense Newton matrices' LU (dense_lu.hpp), for the tests: (x, x_T, z, z_T, u, u_c) with Re S x = Re b,\n"
+      "Re Sᵀ x_T = Re b, S z = b, Sᵀ z_T = b and the pivots of Re S and of S.");
 }
 
 }  // namespace rigidfem::bindings

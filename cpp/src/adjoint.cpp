@@ -218,10 +218,10 @@ class NewmarkSteps final : public Transposes {
     // step's own), or the sweep's own where that one took more than refresh_above_ iterations, until the sweep
     // reaches the steps of an earlier forward factorisation
     const auto it = std::upper_bound(made_at_.begin(), made_at_.end(), s.t);
-    const Eigen::PartialPivLU<MatX>* forward = it == made_at_.begin() ? nullptr : factors_[it - made_at_.begin() - 1].get();
+    const DenseLU* forward = it == made_at_.begin() ? nullptr : factors_[it - made_at_.begin() - 1].get();
     if (forward != forward_) forward_ = forward, own_ = false, last_iterations_ = 0;
     auto P = [&](const VecX& v, VecX& out) {
-      if (forward_ && !own_) out.noalias() = forward_->transpose().solve(v);
+      if (forward_ && !own_) forward_->solve_transposed(v, out);
       else matrix_->precondition_transposed(v, out);
     };
     auto refresh = [&] {
@@ -305,13 +305,13 @@ class NewmarkSteps final : public Transposes {
   double memory_;  // the adjoint's bytes: an eighth of it for the forward factorisations
   std::unique_ptr<NewmarkStepper> stepper_;
   NewmarkCoefficients k_;
-  std::vector<std::shared_ptr<const Eigen::PartialPivLU<MatX>>> factors_;  // the forward run's, in order
+  std::vector<std::shared_ptr<const DenseLU>> factors_;  // the forward run's, in order
   std::vector<double> made_at_;  // the end of the step that made each
   bool keeping_ = false;         // in the forward run (not a replay) and within memory
   bool in_forward_ = false;      // in the forward run
   long forward_steps_ = 0, forward_factors_ = 0;  // its steps and the dense factorisations it made
-  std::shared_ptr<const Eigen::PartialPivLU<MatX>> last_factor_;  // the last of them
-  const Eigen::PartialPivLU<MatX>* forward_ = nullptr;  // the forward factorisation in use
+  std::shared_ptr<const DenseLU> last_factor_;  // the last of them
+  const DenseLU* forward_ = nullptr;  // the forward factorisation in use
   bool own_ = false;             // the sweep's own factorisation preferred to forward_
 };
 

@@ -149,7 +149,7 @@ class NewmarkFamily final : public NewmarkStepper {
   StepControl control() const override { return {2, 5.0, false, 1.25}; }
 
   const NewmarkState& current() const override { return s_; }
-  std::shared_ptr<const Eigen::PartialPivLU<MatX>> dense_factor() const override { return matrix_->dense_factor(); }
+  std::shared_ptr<const DenseLU> dense_factor() const override { return matrix_->dense_factor(); }
   void restore(double t, const NewmarkState& s) override {
     s_ = s;
     y_.resize(2 * sys_.nq + sys_.nz);

@@ -7,6 +7,7 @@
 #include <vector>
 
 #include "rigidfem/arms.hpp"
+#include "rigidfem/dense_lu.hpp"
 #include "rigidfem/dynamics.hpp"
 #include "rigidfem/errors.hpp"
 #include "rigidfem/gmres.hpp"
@@ -31,6 +32,169 @@ MatX NewtonMatrix::solve(const MatX& B) {
   return X;
 }
 
+void DenseLU::compute(const MatX& S) {
+  const Eigen::Index n = S.rows();
+  if (n >= dense_lu_blocked_from) {
+    const Eigen::PartialPivLU<MatX> lu(S);
+    LU_ = lu.matrixLU();
+    P_ = lu.permutationP();
+    return;
+  }
+  LU_ = S;
+  Eigen::Transpositions<Eigen::Dynamic> swaps(n);
+  double* a = LU_.data();
+  for (Eigen::Index k = 0; k < n; ++k) {
+    double* lk = a + k * n;  // column k: u_kk, then l_ik below it
+    Eigen::Index p = k;
+    for (Eigen::Index i = k + 1; i < n; ++i)
+      if (std::abs(lk[i]) > std::abs(lk[p])) p = i;
+    swaps.indices()(k) = static_cast<int>(p);
+    if (p != k)
+      for (Eigen::Index j = 0; j < n; ++j) std::swap(a[k + j * n], a[p + j * n]);
+    if (lk[k] == 0.0) continue;  // singular: regularity reports it
+    const double r = 1.0 / lk[k];
+    for (Eigen::Index i = k + 1; i < n; ++i) lk[i] *= r;
+    // the trailing block less l u_k: column j less l u_kj
+    for (Eigen::Index j = k + 1; j < n; ++j) {
+      double* cj = a + j * n;
+      const double u = cj[k];
+      for (Eigen::Index i = k + 1; i < n; ++i) cj[i] -= lk[i] * u;
+    }
+  }
+  P_ = swaps;
+}
+
+void DenseLU::solve(const VecX& b, VecX& x) const {
+  x = P_ * b;
+  const Eigen::Index n = x.size();
+  double* y = x.data();
+  const double* a = LU_.data();
+  // L y = P b, column by column: y_i −= l_ik y_k below k
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double* c = a + k * n;
+    const double v = y[k];
+    for (Eigen::Index i = k + 1; i < n; ++i) y[i] -= c[i] * v;
+  }
+  // U x = y: x_k = y_k / u_kk, then y_i −= u_ik x_k above k
+  for (Eigen::Index k = n - 1; k >= 0; --k) {
+    const double* c = a + k * n;
+    const double v = y[k] /= c[k];
+    for (Eigen::Index i = 0; i < k; ++i) y[i] -= c[i] * v;
+  }
+}
+
+void DenseLU::solve_transposed(const VecX& b, VecX& x) const {
+  x = b;
+  LU_.transpose().triangularView<Eigen::Lower>().solveInPlace(x);      // Uᵀ z = b
+  LU_.transpose().triangularView<Eigen::UnitUpper>().solveInPlace(x);  // Lᵀ w = z
+  x = P_.transpose() * x;                                              // x = Pᵀ w
+}
+
+void ComplexLU::compute(const Eigen::MatrixXcd& S) {
+  const Eigen::Index n = S.rows();
+  re_ = S.real(), im_ = S.imag();
+  inverse_.resize(n);
+  Eigen::Transpositions<Eigen::Dynamic> swaps(n);
+  double *ar = re_.data(), *ai = im_.data();
+  for (Eigen::Index k = 0; k < n; ++k) {
+    double *rk = ar + k * n, *ik = ai + k * n;  // column k
+    Eigen::Index p = k;
+    double largest = std::abs(rk[k]) + std::abs(ik[k]);
+    for (Eigen::Index i = k + 1; i < n; ++i)
+      if (const double size = std::abs(rk[i]) + std::abs(ik[i]); size > largest) largest = size, p = i;
+    swaps.indices()(k) = static_cast<int>(p);
+    if (p != k)
+      for (Eigen::Index j = 0; j < n; ++j) std::swap(ar[k + j * n], ar[p + j * n]), std::swap(ai[k + j * n], ai[p + j * n]);
+    if (rk[k] == 0.0 && ik[k] == 0.0) {  // singular: regularity reports it
+      inverse_(k) = 0.0;
+      continue;
+    }
+    const cplx r = cplx(1.0) / cplx(rk[k], ik[k]);
+    inverse_(k) = r;
+    for (Eigen::Index i = k + 1; i < n; ++i) {  // l_ik = s_ik / u_kk
+      const double x = rk[i], y = ik[i];
+      rk[i] = x * r.real() - y * r.imag(), ik[i] = x * r.imag() + y * r.real();
+    }
+    // column j less l u_kj: (l_re + i l_im)(u_re + i u_im) in four real products
+    for (Eigen::Index j = k + 1; j < n; ++j) {
+      double *rj = ar + j * n, *ij = ai + j * n;
+      const double ur = rj[k], ui = ij[k];
+      for (Eigen::Index i = k + 1; i < n; ++i) {
+        rj[i] -= rk[i] * ur - ik[i] * ui;
+        ij[i] -= rk[i] * ui + ik[i] * ur;
+      }
+    }
+  }
+  P_ = swaps;
+}
+
+Eigen::VectorXcd ComplexLU::pivots() const {
+  Eigen::VectorXcd u(re_.rows());
+  u.real() = re_.diagonal(), u.imag() = im_.diagonal();
+  return u;
+}
+
+void ComplexLU::solve(const Eigen::VectorXcd& b, Eigen::VectorXcd& x) const {
+  const Eigen::Index n = b.size();
+  xr_.resize(n), xi_.resize(n);
+  const auto& to = P_.indices();
+  for (Eigen::Index i = 0; i < n; ++i) xr_(to(i)) = b(i).real(), xi_(to(i)) = b(i).imag();  // P b
+  double *yr = xr_.data(), *yi = xi_.data();
+  const double *ar = re_.data(), *ai = im_.data();
+  // L y = P b by columns
+  for (Eigen::Index k = 0; k < n; ++k) {
+    const double *rk = ar + k * n, *ik = ai + k * n, vr = yr[k], vi = yi[k];
+    for (Eigen::Index i = k + 1; i < n; ++i) {
+      yr[i] -= rk[i] * vr - ik[i] * vi;
+      yi[i] -= rk[i] * vi + ik[i] * vr;
+    }
+  }
+  // U x = y: x_k = y_k / u_kk (by the reciprocal), then y_i −= u_ik x_k above k
+  for (Eigen::Index k = n - 1; k >= 0; --k) {
+    const double *rk = ar + k * n, *ik = ai + k * n;
+    const cplx v = cplx(yr[k], yi[k]) * inverse_(k);
+    yr[k] = v.real(), yi[k] = v.imag();
+    for (Eigen::Index i = 0; i < k; ++i) {
+      yr[i] -= rk[i] * v.real() - ik[i] * v.imag();
+      yi[i] -= rk[i] * v.imag() + ik[i] * v.real();
+    }
+  }
+  x.resize(n);
+  x.real() = xr_, x.imag() = xi_;
+}
+
+void ComplexLU::solve_transposed(const Eigen::VectorXcd& b, Eigen::VectorXcd& x) const {
+  const Eigen::Index n = b.size();
+  xr_ = b.real(), xi_ = b.imag();
+  double *yr = xr_.data(), *yi = xi_.data();
+  const double *ar = re_.data(), *ai = im_.data();
+  // Uᵀ z = b: z_j = (b_j − Σ_{i<j} u_ij z_i) / u_jj, u_ij (i < j) in column j above the diagonal
+  for (Eigen::Index j = 0; j < n; ++j) {
+    const double *rj = ar + j * n, *ij = ai + j * n;
+    double sr = yr[j], si = yi[j];
+    for (Eigen::Index i = 0; i < j; ++i) {
+      sr -= rj[i] * yr[i] - ij[i] * yi[i];
+      si -= rj[i] * yi[i] + ij[i] * yr[i];
+    }
+    const cplx z = cplx(sr, si) * inverse_(j);
+    yr[j] = z.real(), yi[j] = z.imag();
+  }
+  // Lᵀ w = z: w_j = z_j − Σ_{i>j} l_ij w_i, l_ij in column j below the diagonal
+  for (Eigen::Index j = n - 1; j >= 0; --j) {
+    const double *rj = ar + j * n, *ij = ai + j * n;
+    double sr = yr[j], si = yi[j];
+    for (Eigen::Index i = j + 1; i < n; ++i) {
+      sr -= rj[i] * yr[i] - ij[i] * yi[i];
+      si -= rj[i] * yi[i] + ij[i] * yr[i];
+    }
+    yr[j] = sr, yi[j] = si;
+  }
+  // x = Pᵀ w: x_i = w_{to(i)}
+  x.resize(n);
+  const auto& to = P_.indices();
+  for (Eigen::Index i = 0; i < n; ++i) x(i) = cplx(yr[to(i)], yi[to(i)]);
+}
+
 namespace {
 
 /// What check_regular tests against 1e-15 for a factorisation with these pivots (the diagonal of U): their
@@ -49,55 +213,6 @@ double regularity(const Pivots& pivots, Rcond&& rcond) {
   const double spread = least / most;
   return spread > 1e-8 ? spread : rcond();
 }
-
-/// LU with partial pivoting of a complex S (P S = L U, P the row swaps in order), each column's pivot the entry
-/// of largest |re| + |im| (LAPACK's izamax) and its multipliers scaled by the pivot's reciprocal. Eigen's
-/// PartialPivLU takes |z| = hypot(re, im) for the pivot and divides each multiplier, which made radau5's complex
-/// factorisation on the crane (n = 21) cost twice its real one.
-class ComplexLU {
- public:
-  void compute(const Eigen::MatrixXcd& S) {
-    LU_ = S;
-    const Eigen::Index n = LU_.rows();
-    swaps_.resize(n);
-    for (Eigen::Index k = 0; k < n; ++k) {
-      Eigen::Index p = k;
-      double largest = -1.0;
-      for (Eigen::Index i = k; i < n; ++i)
-        if (const double size = std::abs(LU_(i, k).real()) + std::abs(LU_(i, k).imag()); size > largest)
-          largest = size, p = i;
-      swaps_(k) = p;
-      if (p != k) LU_.row(k).swap(LU_.row(p));
-      if (LU_(k, k) == cplx(0.0)) continue;  // singular: regularity reports it
-      // l_ik = s_ik / u_kk, and the trailing block less l u_k (row k of U)
-      const Eigen::Index m = n - k - 1;
-      LU_.col(k).tail(m) *= cplx(1.0) / LU_(k, k);
-      LU_.bottomRightCorner(m, m).noalias() -= LU_.col(k).tail(m) * LU_.row(k).tail(m);
-    }
-  }
-
-  auto pivots() const { return LU_.diagonal(); }
-
-  /// x = S⁻¹ b: L U x = P b.
-  void solve(const VecXc& b, VecXc& x) const {
-    x = b;
-    for (Eigen::Index k = 0; k < x.size(); ++k) std::swap(x(k), x(swaps_(k)));
-    LU_.triangularView<Eigen::UnitLower>().solveInPlace(x);
-    LU_.triangularView<Eigen::Upper>().solveInPlace(x);
-  }
-
-  /// x = S⁻ᵀ b (the transpose, not the adjoint): Uᵀ Lᵀ (P x) = b.
-  void solve_transposed(const VecXc& b, VecXc& x) const {
-    x = b;
-    LU_.transpose().triangularView<Eigen::Lower>().solveInPlace(x);
-    LU_.transpose().triangularView<Eigen::UnitUpper>().solveInPlace(x);
-    for (Eigen::Index k = x.size() - 1; k >= 0; --k) std::swap(x(k), x(swaps_(k)));
-  }
-
- private:
-  Eigen::MatrixXcd LU_;  // L below the diagonal (unit diagonal implied), U on and above it
-  Eigen::VectorXi swaps_;  // row k swapped with row swaps_(k) at step k
-};
 
 /// The dense form: M, C, K at the tangent, S by LU.
 class DenseNewtonMatrix final : public NewtonMatrix {
@@ -122,10 +237,11 @@ class DenseNewtonMatrix final : public NewtonMatrix {
   double factor(double c1, double c2, const VecX& e) override {
     S_ = M_ + c1 * C_ + c2 * K_;
     if (e.size()) S_.diagonal() += e;
-    auto lu = std::make_shared<Eigen::PartialPivLU<MatX>>(S_);
+    auto lu = std::make_shared<DenseLU>();
+    lu->compute(S_);
     lu_ = lu;
     ++stats_.factorizations;
-    return regularity(lu_->matrixLU().diagonal(), [&] { return lu_->rcond(); });
+    return regularity(lu_->pivots(), [&] { return Eigen::PartialPivLU<MatX>(S_).rcond(); });
   }
 
   double factor(cplx c1, cplx c2) override {
@@ -135,12 +251,12 @@ class DenseNewtonMatrix final : public NewtonMatrix {
     return regularity(luc_.pivots(), [&] { return Eigen::PartialPivLU<Eigen::MatrixXcd>(Sc_).rcond(); });
   }
 
-  void solve(const VecX& b, VecX& x) override { x.noalias() = lu_->solve(b); }
+  void solve(const VecX& b, VecX& x) override { lu_->solve(b, x); }
   void solve(const VecXc& b, VecXc& x) override { luc_.solve(b, x); }
-  void precondition_transposed(const VecX& b, VecX& x) override { x.noalias() = lu_->transpose().solve(b); }
+  void precondition_transposed(const VecX& b, VecX& x) override { lu_->solve_transposed(b, x); }
   void precondition_transposed(const VecXc& b, VecXc& x) override { luc_.solve_transposed(b, x); }
   bool krylov() const override { return false; }
-  std::shared_ptr<const Eigen::PartialPivLU<MatX>> dense_factor() const override { return lu_; }
+  std::shared_ptr<const DenseLU> dense_factor() const override { return lu_; }
 
  private:
   const System& sys_;
@@ -148,7 +264,7 @@ class DenseNewtonMatrix final : public NewtonMatrix {
   IntegratorStats& stats_;
   MatX K_, C_, M_, S_;
   Eigen::MatrixXcd Sc_;
-  std::shared_ptr<Eigen::PartialPivLU<MatX>> lu_;
+  std::shared_ptr<DenseLU> lu_;
   ComplexLU luc_;
 };
 

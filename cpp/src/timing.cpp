@@ -4,6 +4,7 @@
 #include <algorithm>
 #include <chrono>
 
+#include "rigidfem/dense_lu.hpp"
 #include "rigidfem/dynamics.hpp"
 #include "rigidfem/kinematics.hpp"
 
@@ -46,9 +47,9 @@ std::map<std::string, double> implicit_step_parts_seconds(const System& sys, dou
     mass_matrix(sys, d);
     S = d.A + 1e-4 * drdqd + 1e-6 * drdq;
   }, std::max(1, calls / 10));
-  Eigen::PartialPivLU<MatX> lu(sys.nq);
+  DenseLU lu;  // the dense Newton matrix's
   s["lu_factor"] = seconds_per_call([&] { lu.compute(S); }, std::max(1, calls / 10));
-  s["lu_solve"] = seconds_per_call([&] { x = lu.solve(r); }, calls);
+  s["lu_solve"] = seconds_per_call([&] { lu.solve(r, x); }, calls);
   const VecX armature = VecX::Constant(sys.nq, 1e-3);
   s["armature_factor"] = seconds_per_call([&] { factor_armature(sys, d, armature); }, calls);
   s["armature_solve"] = seconds_per_call([&] { solve_armature(sys, d, r, x); }, calls);

@@ -4,6 +4,7 @@
 
 #include <memory>
 
+#include "rigidfem/dense_lu.hpp"
 #include "rigidfem/stepper.hpp"
 
 namespace rigidfem {
@@ -29,7 +30,7 @@ class NewmarkStepper : public Stepper {
   virtual void restore(double t, const NewmarkState& s) = 0;
   virtual NewmarkCoefficients coefficients() const = 0;
   /// Its Newton matrix's dense factorisation now (NewtonMatrix::dense_factor), or none.
-  virtual std::shared_ptr<const Eigen::PartialPivLU<MatX>> dense_factor() const = 0;
+  virtual std::shared_ptr<const DenseLU> dense_factor() const = 0;
 };
 
 /// newmark, hht, generalized_alpha or implicit_spring by o.method.

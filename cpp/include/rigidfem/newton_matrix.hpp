@@ -18,6 +18,7 @@
 #include <complex>
 #include <memory>
 
+#include "rigidfem/dense_lu.hpp"
 #include "rigidfem/integrators.hpp"
 #include "rigidfem/system.hpp"
 
@@ -79,7 +80,7 @@ class NewtonMatrix {
   virtual bool krylov() const = 0;
   /// Slot 0's dense LU, shared (a new one at each factorisation: an old one stays valid for whoever keeps it), or
   /// none (Krylov): what the adjoint keeps of the forward run's Newton matrices to precondition its transposes.
-  virtual std::shared_ptr<const Eigen::PartialPivLU<MatX>> dense_factor() const { return nullptr; }
+  virtual std::shared_ptr<const DenseLU> dense_factor() const { return nullptr; }
 };
 
 }  // namespace rigidfem
