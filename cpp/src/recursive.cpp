@@ -209,11 +209,52 @@ bool fixed_size(int nf, F&& f) {
   }
 }
 
+// A ball body (System::ball) turns about one point o, the joint's origin, by three rotations about axes E = [e₁ e₂ e₃]
+// through it: S = Φ E with Φ = [1; [o]×] (each axis is (e, o × e)). Then U = P E and D = Eᵀ Q E with P = I^A Φ and
+// Q = Φᵀ I^A Φ, the articulated inertia about o, and U D⁻¹ Uᵀ = P Q⁻¹ Pᵀ (E cancels: a spherical joint's projection,
+// which its angles do not change). D is as ill-conditioned as E squared: near a gimbal lock (det E = cos φ2 of ZYX
+// angles → 0) inverting it lost digits of the accelerations, and 1e-6 rad from pitch π/2 its Sylvester test failed
+// (a spurious "singular" where the mass matrix is still positive definite), while Q stays well-conditioned. So
+// where |det E| < pivot_det the factors come from Q: D⁻¹ = E⁻¹ Q⁻¹ E⁻ᵀ, E⁻¹'s rows (e₂ × e₃, e₃ × e₁, e₁ × e₂) / det E,
+// and the passes use them as they stand.
+constexpr double pivot_det = 1e-2;
+
+// det E = e₁ · (e₂ × e₃) of a ball body's axes S = Φ E.
+double axes_volume(const Subspace& S) { return S.col(0).head<3>().dot(S.col(1).head<3>().cross(S.col(2).head<3>())); }
+
+// The ball body's inertia part from its factors about its pivot: U = P E, D⁻¹ = E⁻¹ Q⁻¹ E⁻ᵀ, I^a = I^A − P Q⁻¹ Pᵀ.
+// Out of line and in its own arithmetic (Cholesky's inverse, products in another order): sharing invert_spd3 and
+// Eigen's 6 × 3 product with fixed_inertia, GCC stopped inlining them there (measured 8-13 % slower).
+[[gnu::cold, gnu::noinline]] void pivot_inertia(const System& sys, Data& d, int p) {
+  const auto E = d.S[p].leftCols<3>().topRows<3>();
+  Mat3 N;  // E⁻¹ det E
+  N << E.col(1).cross(E.col(2)).transpose(), E.col(2).cross(E.col(0)).transpose(), E.col(0).cross(E.col(1)).transpose();
+  const double det = N.row(0).dot(E.col(0));
+  if (!(std::abs(det) > 0.0)) singular_articulated_inertia(sys, d, p);
+  const SmallMat Einv = N / det;
+  const Vec3 o = d.T[p].topRightCorner<3, 1>();
+  Mat6& IA = d.IA[p];
+  // P = I^A Φ = I^A_{:,ω} + I^A_{:,v} [o]× (column by column), Q = Φᵀ P = P_ω − [o]× P_v
+  Eigen::Matrix<double, 6, 3> P;
+  P.col(0) = IA.col(0) + IA.col(4) * o.z() - IA.col(5) * o.y();
+  P.col(1) = IA.col(1) + IA.col(5) * o.x() - IA.col(3) * o.z();
+  P.col(2) = IA.col(2) + IA.col(3) * o.y() - IA.col(4) * o.x();
+  SmallMat Q(3, 3), Qinv;
+  for (int j = 0; j < 3; ++j) Q.col(j) = P.col(j).head<3>() - o.cross(P.col(j).tail<3>());
+  if (!invert_spd(Q, Qinv)) singular_articulated_inertia(sys, d, p);
+  d.U6[p] = P * E;
+  d.Dinv[p] = Einv * (Qinv * Einv.transpose());
+  IA.noalias() -= P * (Qinv * P.transpose());
+}
+
 // ABA pass 2, inertia part, of a body with N = 1, 2 or 3 free coordinates (a revolute joint, an sde's two or
-// three rotations) in fixed-size arithmetic: U = I^A S, D = Sᵀ U + diag(δ), I^a = I^A − U D⁻¹ Uᵀ.
+// three rotations) in fixed-size arithmetic: U = I^A S, D = Sᵀ U + diag(δ), I^a = I^A − U D⁻¹ Uᵀ; a ball body near
+// a gimbal lock without an armature (with one D = Eᵀ Q E + diag(δ) does not factor through E) from its pivot's.
 template <int N>
 void fixed_inertia(const System& sys, Data& d, const VecX* armature, int p) {
   using MatN = Eigen::Matrix<double, N, N>;
+  if constexpr (N == 3)
+    if (sys.ball[p] && !armature && std::abs(axes_volume(d.S[p])) < pivot_det) return pivot_inertia(sys, d, p);
   const auto S = d.S[p].template leftCols<N>();
   const Eigen::Matrix<double, 6, N> U = d.IA[p] * S;
   MatN D = S.transpose() * U, Dinv;
