@@ -113,39 +113,49 @@ def test_spherical_joints_on_slender_bodies_equal_lagrange(slender, principal, s
                                    atol=max(1e-10, 1e-14 * cond) * np.abs(qdd).max())
 
 
-def spherical_chain(bodies=4):
-    """``bodies`` bodies on spherical joints (ZYX angles) with springs and dampers, under gravity."""
+def spherical_chain(bodies=4, driven=False):
+    """``bodies`` bodies on spherical joints (ZYX angles) with springs and dampers, under gravity; ``driven``:
+    each joint slides along x first by a prescribed harmonic motion (a flow's rfe alike)."""
     model = rf.Model(gravity=(0.0, 0.0, -9.81))
     parent = model.ground
     for k in range(bodies):
-        parent = model.add_body(f"b{k}", parent, rf.Joint.spherical(stiffness=5.0, damping=0.05),
+        joint = rf.Joint.custom(["x", "rz", "ry", "rx"], stiffness=[0, 5, 5, 5], damping=[0, 0.05, 0.05, 0.05]) \
+            if driven else rf.Joint.spherical(stiffness=5.0, damping=0.05)
+        parent = model.add_body(f"b{k}", parent, joint,
                                 mass=1.0, com=(0.3, 0.05, 0.0), inertia=np.diag([0.01, 0.02, 0.025]),
                                 placement=rf.transform(translation=(0.6, 0.0, 0.0)))
+        if driven:
+            model.prescribe(parent, rf.motion.harmonic(0.01, 3.0), "x")
     return model.compile("lagrange"), model.compile("recursive")
 
 
+@pytest.mark.parametrize("driven", [False, True])
 @pytest.mark.parametrize("offset", [1e-1, 1e-2, 1e-4, 1e-6])
-def test_spherical_chain_near_gimbal_lock_equals_lagrange(offset):
+def test_spherical_chain_near_gimbal_lock_equals_lagrange(offset, driven):
     """A chain of spherical joints within ``offset`` rad of pitch π/2, where the axes' matrix E has
-    determinant cos φ2 and D = Sᵀ I^A S = Eᵀ Q E of each body is ill-conditioned (check_gimbal_lock stops at
-    1e-9; within 1e-2 the articulated-body algorithm factorises such a body about its pivot, Q): the
-    accelerations still equal the Lagrange formulation's to round-off amplified by cond(A), and they
-    satisfy A q̈ = f to round-off (D's inverse left a residual of 4e-12 · |A| |q̈| at 1e-4 and failed its
-    Sylvester test at 1e-6)."""
+    |det E| = |cos φ2| and D = Sᵀ I^A S = Eᵀ Q E of each body is ill-conditioned (check_gimbal_lock stops at
+    1e-9; within 1e-2 the articulated-body algorithm factorises such a body about its pivot, Q), also behind
+    a prescribed slide: the accelerations equal the Lagrange formulation's to round-off amplified by cond(A)
+    and satisfy A q̈ = f to ε / |det E|, and their derivatives (factorised with a zero armature) equal the
+    Lagrange formulation's differences (D's own inverse failed its Sylvester test at 1e-6)."""
     rng = np.random.default_rng(11)
-    lag, rec = spherical_chain()
+    lag, rec = spherical_chain(driven=driven)
     q, qd = rng.uniform(-0.5, 0.5, rec.nq), rng.uniform(-1, 1, rec.nq)
     q[1::3] = np.pi / 2 - offset  # every joint's pitch φ2 (coordinates rz, ry, rx)
-    A = lag.mass_matrix(0.0, q)
+    t = 0.1
+    A = lag.mass_matrix(t, q)
     cond = np.linalg.cond(A)
     assert cond > 0.1 / offset**2
-    qdd = lag.forward_dynamics(0.0, q, qd)
-    np.testing.assert_allclose(rec.forward_dynamics(0.0, q, qd), qdd, rtol=0,
-                               atol=max(1e-10, 1e-14 * cond) * scale(qdd))
+    qdd = lag.forward_dynamics(t, q, qd)
+    x = rec.forward_dynamics(t, q, qd)
+    np.testing.assert_allclose(x, qdd, rtol=0, atol=max(1e-10, 1e-14 * cond) * scale(qdd))
     # the residual of the equations of motion, which cond(A) does not amplify the way it does q̈'s error
-    f = lag.generalized_forces(0.0, q, qd)
-    x = rec.forward_dynamics(0.0, q, qd)
-    assert np.abs(A @ x - f).max() <= 1e-12 * (np.abs(A).max() * np.abs(x).max() + np.abs(f).max())
+    f = lag.generalized_forces(t, q, qd)
+    assert np.abs(A @ x - f).max() <= max(1e-12, 1e-15 / offset) * (np.abs(A).max() * np.abs(x).max() + np.abs(f).max())
+    # the derivatives factorise with a zero armature; the Lagrange formulation's are central differences
+    # (test_derivatives.py holds them to max(1e-6, 1e-12 cond(A)))
+    for expected, got in zip(lag.acceleration_derivatives(t, q, qd), rec.acceleration_derivatives(t, q, qd)):
+        np.testing.assert_allclose(got, expected, rtol=0, atol=max(1e-6, 1e-12 * cond) * scale(expected))
 
 
 def test_spherical_chain_released_near_gimbal_lock_moves_as_lagrange():

@@ -107,11 +107,16 @@ std::shared_ptr<const System> Model::compile(Algorithm algorithm) const {
       if (s.coords[i].free_index >= 0) ++s.nq_of[p], ++k;
   }
   for (int i : s.free_coords) s.q_use.push_back(own_use(s, i));
+  // A ball: three free coordinates, all rotations, and no translation after a rotation (prescribed ones before,
+  // as a flow's x: the book's order), so that every free axis passes through the frame's final origin.
   s.ball.assign(s.nbodies, 0);
   for (int p = 0; p < s.nbodies; ++p) {
-    const int u0 = s.use_start[p];
-    bool ball = s.nq_of[p] == 3 && s.use_start[p + 1] - u0 == 3 && !s.joint[p].linear;
-    for (int u = u0; ball && u < u0 + 3; ++u) ball = s.use_q[u] >= 0 && is_rotation(s.use_axis[u]);
+    bool ball = s.nq_of[p] == 3 && !s.joint[p].linear, turned = false;
+    for (int u = s.use_start[p]; ball && u < s.use_start[p + 1]; ++u) {
+      const bool rotation = is_rotation(s.use_axis[u]);
+      ball = rotation ? true : !turned && s.use_q[u] < 0;
+      turned = turned || rotation;
+    }
     s.ball[p] = ball;
   }
   // ropes wound on drums and sheaves: each winding's coordinate, and on it the windings it takes

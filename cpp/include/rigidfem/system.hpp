@@ -66,8 +66,8 @@ class System : public std::enable_shared_from_this<System> {
   std::vector<int> q_index;             // (nbodies) first free coordinate of body p in q
   std::vector<int> nq_of;               // (nbodies) number of free coordinates of body p
   std::vector<int> q_use;               // (nq) the use (axis) of free coordinate k on its own body
-  std::vector<char> ball;               // (nbodies) moved by three free rotations alone (a spherical joint, an
-                                        // sde's three rotations): its axes turn about one point (recursive.cpp)
+  std::vector<char> ball;               // (nbodies) three free rotations (a spherical joint, an sde's three
+                                        // rotations), after any prescribed translation: axes through one point
   // Coordinate uses: the coordinates that move each body's joint, its own ones first
   // (so without couplings use u is coordinate u), then coupled ones (linear model).
   int nuses = 0;
