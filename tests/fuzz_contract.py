@@ -810,7 +810,10 @@ def events_consistent(res):
             # its outputs show)
             j = names.index(e.of)
             x, run = (f.qd[j], res.qd[:, j]) if e.rate else (f.q[j], res.q[:, j])
-            scale = 1.0 + abs(e.value) + float(np.max(np.abs(run))) if len(run) else 1.0
+            # the values the run reached: its outputs' and its roots' (a run blowing up and stopped by a terminal
+            # event has few outputs, all before the blow-up its roots show)
+            reached = np.concatenate([np.abs(run), [abs(r.qd[j] if e.rate else r.q[j]) for r in res.events]])
+            scale = 1.0 + abs(e.value) + float(np.max(reached, initial=0.0))
             span = float(res.run["t_end"] - res.run["t0"])
             with np.errstate(divide="ignore", invalid="ignore"):  # (outputs at one time twice: an inf slope)
                 slope = abs(float(f.qd[j])) if not e.rate else float(np.max(np.abs(np.diff(run) / np.diff(res.t)),
