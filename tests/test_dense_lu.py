@@ -58,3 +58,26 @@ def test_a_singular_matrix_leaves_a_pivot_at_round_off(n):
     Z = np.zeros((n, n), complex)  # every pivot exactly zero: no division by it, no NaN in the factors
     *_, u, uc = _bench.dense_lu_solutions(Z, b)
     assert np.all(u == 0) and np.all(uc == 0)
+
+
+@pytest.mark.parametrize("scale", [1.0, 1j, 3.0 - 0.5j])
+def test_the_pivot_is_the_largest_entry_not_the_first(scale):
+    # [[1e-17, 1], [1, 1]]: eliminated with the 1e-17 as pivot, the solution's error is of order 1; the largest
+    # entry of the column (by |re| + |im| for the complex one) keeps it at round-off
+    S = np.array([[1e-17, 1.0], [1.0, 1.0]]) * scale
+    b = np.array([1.0, 2.0]) * scale
+    x, xt, z, zt, u, uc = _bench.dense_lu_solutions(S, b)
+    if scale == 1.0:
+        _close(x, np.linalg.solve(S.real, b.real), S.real)
+        _close(xt, np.linalg.solve(S.real.T, b.real), S.real)
+        assert abs(u[0]) == 1.0
+    _close(z, np.linalg.solve(S, b), S)
+    _close(zt, np.linalg.solve(S.T, b), S)
+    assert abs(uc[0]) == pytest.approx(abs(scale))
+
+
+def test_bad_shapes_are_refused():
+    with pytest.raises(ValueError, match="^S: expected a square matrix, got 2 x 3"):
+        _bench.dense_lu_solutions(np.ones((2, 3)), np.ones(2))
+    with pytest.raises(ValueError, match=r"^b: expected 3 values \(S's rows\), got 5"):
+        _bench.dense_lu_solutions(np.eye(3), np.ones(5))

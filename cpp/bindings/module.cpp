@@ -464,6 +464,10 @@ void bind_module(py::module_& m) {
   bench.def(
       "dense_lu_solutions",
       [](const Eigen::MatrixXcd& S, const Eigen::VectorXcd& b) {
+        if (S.rows() != S.cols())
+          rigidfem::bad("S", "a square matrix", std::to_string(S.rows()) + " x " + std::to_string(S.cols()));
+        if (b.size() != S.rows())
+          rigidfem::bad("b", std::to_string(S.rows()) + " values (S's rows)", std::to_string(b.size()));
         rigidfem::DenseLU real;
         rigidfem::ComplexLU complex;
         real.compute(S.real());

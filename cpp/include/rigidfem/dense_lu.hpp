@@ -2,8 +2,9 @@
 /// lower, U upper, P the rows' permutation. Written out for the small systems the dense form mostly serves: at
 /// n = 21 (the crane) Eigen's blocked PartialPivLU took 2.1 µs where the column loops below take 1.1, and the
 /// complex factorisation in (re, im) pairs of complex<double> 4.5 µs where split into a real and an imaginary
-/// matrix it takes 3.3 (its solve 0.92 against 0.61 µs). Above dense_lu_blocked_from the real one is Eigen's
-/// (blocked: 52 against 80 µs at n = 100).
+/// matrix it takes 3.3 (its solve 0.92 against 0.61 µs). From dense_lu_blocked_from on the real one is Eigen's
+/// (blocked: 52 against 80 µs at n = 100). Unlike LAPACK's, the loops take every pivot's reciprocal, also below the
+/// smallest normal number (2.2e-308), where LAPACK divides: such matrices (unreachable for M + c₁ C + c₂ K) give NaN.
 #pragma once
 
 #include <complex>
@@ -16,8 +17,8 @@ namespace rigidfem {
 constexpr Eigen::Index dense_lu_blocked_from = 48;
 
 /// P S = L U of a real S: each column's pivot the entry of largest magnitude (LAPACK's dgetf2), L's column scaled
-/// by the pivot's reciprocal, then the trailing columns less l u_kj. A zero pivot is left in U (the caller tests
-/// regularity on the pivots).
+/// by the pivot's reciprocal, then the trailing columns less l u_kj. A zero pivot is left in U and its column's
+/// multipliers unscaled: the solves then return inf or NaN (the callers test regularity, rcond, before solving).
 class DenseLU {
  public:
   void compute(const MatX& S);
@@ -35,7 +36,8 @@ class DenseLU {
 
 /// P S = L U of a complex S kept as two real matrices (S = S_re + i S_im), each column's pivot the entry of
 /// largest |re| + |im| (LAPACK's izamax), its multipliers scaled by the pivot's reciprocal: a complex product
-/// l u is four real products over contiguous columns.
+/// l u is four real products over contiguous columns. A zero pivot's reciprocal is kept as 0: the solves then
+/// return finite values with that unknown 0 (the callers test regularity, rcond, before solving).
 class ComplexLU {
  public:
   using cplx = std::complex<double>;
