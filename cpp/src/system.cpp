@@ -113,9 +113,10 @@ std::shared_ptr<const System> Model::compile(Algorithm algorithm) const {
   for (int p = 0; p < s.nbodies; ++p) {
     bool ball = s.nq_of[p] == 3 && !s.joint[p].linear, turned = false;
     for (int u = s.use_start[p]; ball && u < s.use_start[p + 1]; ++u) {
-      const bool rotation = is_rotation(s.use_axis[u]);
-      ball = rotation ? true : !turned && s.use_q[u] < 0;
-      turned = turned || rotation;
+      if (is_rotation(s.use_axis[u]))
+        turned = true;
+      else
+        ball = !turned && s.use_q[u] < 0;  // a prescribed translation before the rotations
     }
     s.ball[p] = ball;
   }
