@@ -604,7 +604,7 @@ def settings(scene: Crane, quick: bool = False) -> dict:
     def steps(least: int = 1):
         return [scene.interval / k for k in divisors if k >= least]
 
-    rigid = [("auto", "rtol", rtols), ("radau5", "rtol", rtols), ("esdirk43", "rtol", rtols),
+    rigid = [("auto", "rtol", rtols), ("radau5", "rtol", rtols), ("radau9", "rtol", rtols), ("esdirk43", "rtol", rtols),
              ("dopri5", "rtol", rtols), ("rk4", "dt", steps(64)), ("generalized_alpha", "dt", steps()),
              ("generalized_alpha", "dt", steps(), {"newton_tol": 1e-13})]
     return {

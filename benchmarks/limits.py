@@ -3,7 +3,8 @@
     python -m benchmarks limits [--quick] [--output DIR]
 
 The rows: the whippy strip at m = 16 to 1e-6 m (``strip_peers``) and the crane to 1e-4 of the payload's motion
-(``crane_peers``), each run by radau5, rigidfem's cheapest method on both, over rtol (atol = rtol/100):
+(``crane_peers``), each run by rigidfem's cheapest methods there over rtol (atol = rtol/100): radau5 and radau9 on the
+strip, radau5 on the crane:
 
 - ``limits_runs``: per run its error against the scene's converged solution (radau5 at rtol 1e-11), its CPU
   time (least of 3), its counts (steps, Newton iterations, stage residuals, tangents, factorisations) and the
@@ -34,10 +35,12 @@ from ._common import report
 from .crane_peers import RigidfemCrane, crane, error
 from .strip_peers import RigidfemStrip, max_error, tip_position, whippy_strip
 
-RUN_COLUMNS = ("scene", "threshold", "rtol", "error", "cpu_ms", "steps", "newton_per_step", "residuals", "tangents",
+RUN_COLUMNS = ("scene", "method", "threshold", "rtol", "error", "cpu_ms", "steps", "newton_per_step", "residuals", "tangents",
                "factorizations", "residual_us", "tangent_us", "residuals_ms", "tangents_ms", "rest_ms", "order")
-MODE_COLUMNS = ("mode", "omega_rad_s", "tip_amplitude_m", "h_omega_at_1e-5_m", "h_omega_at_1e-6_m")
-STRIP_RTOLS = (1e-5, 5e-6, 2e-6, 1e-6)  #: strip_peers' grid about 1e-6 m (its run at 2e-6 may end just above it)
+MODE_COLUMNS = ("mode", "omega_rad_s", "tip_amplitude_m", "h_omega_radau5_at_1e-6_m", "h_omega_radau9_at_1e-6_m")
+#: strip_peers' grid about 1e-6 m (radau5's run at 2e-6 may end just above it; radau9's at 1e-5 just below)
+STRIP_RUNS = tuple(("radau5", rtol) for rtol in (1e-5, 5e-6, 2e-6, 1e-6)) + \
+    tuple(("radau9", rtol) for rtol in (5e-5, 2e-5, 1e-5, 5e-6))
 CRANE_RTOLS = (1e-3, 3e-4, 1e-4, 3e-5)
 
 
@@ -58,10 +61,11 @@ def _parts(system, q) -> dict:
     return {"residual_us": 1e6 * s["residual"], "tangent_us": 1e6 * s["tangent"]}
 
 
-def _row(scene: str, threshold: float, rtol: float, err: float, cpu: float, stats: dict, parts: dict) -> dict:
+def _row(scene: str, method: str, threshold: float, rtol: float, err: float, cpu: float, stats: dict,
+         parts: dict) -> dict:
     residuals_ms = 1e-3 * stats["rhs_evaluations"] * parts["residual_us"]
     tangents_ms = 1e-3 * stats["jacobians"] * parts["tangent_us"]
-    return {"scene": scene, "threshold": threshold, "rtol": rtol, "error": err, "cpu_ms": 1e3 * cpu,
+    return {"scene": scene, "method": method, "threshold": threshold, "rtol": rtol, "error": err, "cpu_ms": 1e3 * cpu,
             "steps": stats["steps"], "newton_per_step": stats["newton_iterations"] / stats["steps"],
             "residuals": stats["rhs_evaluations"], "tangents": stats["jacobians"],
             "factorizations": stats["factorizations"], **parts, "residuals_ms": residuals_ms,
@@ -69,14 +73,14 @@ def _row(scene: str, threshold: float, rtol: float, err: float, cpu: float, stat
 
 
 def _orders(rows: list) -> None:
-    """Each row's observed order in the step count against the previous row of its scene."""
+    """Each row's observed order in the step count against the previous row of its scene and method."""
     for prev, row in itertools.pairwise(rows):
-        if row["scene"] == prev["scene"] and row["steps"] != prev["steps"]:
+        if (row["scene"], row["method"]) == (prev["scene"], prev["method"]) and row["steps"] != prev["steps"]:
             row["order"] = math.log(prev["error"] / row["error"]) / math.log(row["steps"] / prev["steps"])
 
 
-def strip_study(m: int, rtols) -> tuple[list, Table]:
-    """The strip's radau5 runs (tip error, m) and its modes' share of the tip's motion."""
+def strip_study(m: int, runs) -> tuple[list, Table]:
+    """The strip's runs (method, rtol) (tip error, m) and its modes' share of the tip's motion."""
     s = whippy_strip(m)
     runner = RigidfemStrip(s)
     system = s.system
@@ -84,16 +88,16 @@ def strip_study(m: int, rtols) -> tuple[list, Table]:
     tip_ref = tip_position(s, q_ref)
     parts = _parts(system, np.zeros(system.nq))
     rows = []
-    for rtol in rtols:
-        cpu, result = _cpu(lambda rtol=rtol: runner.simulation("radau5", "rtol", rtol))
+    for method, rtol in runs:
+        cpu, result = _cpu(lambda method=method, rtol=rtol: runner.simulation(method, "rtol", rtol))
         err = max_error(tip_position(s, result.q), tip_ref)
-        rows.append(_row(f"strip m={m}", 1e-6, rtol, err, cpu, result.stats, parts))
+        rows.append(_row(f"strip m={m}", method, 1e-6, rtol, err, cpu, result.stats, parts))
     return rows, _modes(s, q_ref, rows)
 
 
 def _modes(s, q_ref, rows) -> Table:
     """Per linear mode at rest: ω, half the range of its part of the tip's height over the converged run, and
-    h̄ω at the mean step of the cheapest runs to 1e-5 and 1e-6 m."""
+    h̄ω at the mean step of radau5's and radau9's cheapest runs to 1e-6 m."""
     system = s.system
     modes = rf.modal_analysis(system)
     M = modes.M
@@ -102,17 +106,17 @@ def _modes(s, q_ref, rows) -> Table:
     J = np.array([(tip_position(s, (q0 + eps * e)[None])[0, 1] - tip_position(s, (q0 - eps * e)[None])[0, 1])
                   / (2 * eps) for e in np.eye(system.nq)])
 
-    def mean_step(threshold: float) -> float:
-        ok = [r for r in rows if r["error"] <= threshold]
+    def mean_step(method: str) -> float:
+        ok = [r for r in rows if r["error"] <= 1e-6 and r["method"] == method]
         return s.t_end / min(ok, key=lambda r: r["cpu_ms"])["steps"] if ok else math.nan
 
-    h5, h6 = mean_step(1e-5), mean_step(1e-6)
+    h5, h9 = mean_step("radau5"), mean_step("radau9")
     out = []
     for k, (omega, phi) in enumerate(zip(modes.omega, modes.shapes.T)):
         eta = (np.asarray(q_ref) @ (M @ phi)) / (phi @ M @ phi)
         part = (J @ phi) * eta
         out.append({"mode": k + 1, "omega_rad_s": float(omega), "tip_amplitude_m": float(np.ptp(part) / 2),
-                    "h_omega_at_1e-5_m": h5 * omega, "h_omega_at_1e-6_m": h6 * omega})
+                    "h_omega_radau5_at_1e-6_m": h5 * omega, "h_omega_radau9_at_1e-6_m": h9 * omega})
     return Table(out, MODE_COLUMNS)
 
 
@@ -127,20 +131,20 @@ def crane_study(rtols) -> list:
     for rtol in rtols:
         cpu, result = _cpu(lambda rtol=rtol: runner.simulation("radau5", "rtol", rtol))
         err = error(scene, np.asarray(result.q)[:, scene.payload_index], reference)
-        rows.append(_row(scene.name, 1e-4, rtol, err, cpu, result.stats, parts))
+        rows.append(_row(scene.name, "radau5", 1e-4, rtol, err, cpu, result.stats, parts))
     return rows
 
 
 def run(output_dir="bench", quick: bool = False) -> dict:
     """``python -m benchmarks limits``: the two tables of the module's docstring."""
-    strip_rows, modes = strip_study(8 if quick else 16, STRIP_RTOLS[::2] if quick else STRIP_RTOLS)
+    strip_rows, modes = strip_study(8 if quick else 16, STRIP_RUNS[::2] if quick else STRIP_RUNS)
     rows = strip_rows + crane_study(CRANE_RTOLS[1:3] if quick else CRANE_RTOLS)
     _orders(rows)
     return report({
-        "limits_runs": (("Where the cheapest runs go: radau5 on the strip (m = 16, tip error in m) and the crane "
-                         "(payload error relative to its motion), its counts and the time of its residuals and "
-                         "tangents at their cost per call"), Table(rows, RUN_COLUMNS)),
+        "limits_runs": (("Where the cheapest runs go: radau5 and radau9 on the strip (m = 16, tip error in m), "
+                         "radau5 on the crane (payload error relative to its motion), their counts and the time of "
+                         "their residuals and tangents at their cost per call"), Table(rows, RUN_COLUMNS)),
         "limits_strip_modes": (("The strip's modes in its motion: each linear mode at rest, half the range of its "
                                 "part of the tip's height over the converged run (m), and h ω at the mean step of "
-                                "radau5's cheapest runs to 1e-5 and 1e-6 m"), modes),
+                                "radau5's and radau9's cheapest runs to 1e-6 m"), modes),
     }, output_dir)

@@ -253,11 +253,12 @@ class RigidfemStrip(_OnTheChain):
         return [("radau5", "rtol", 1e-11, 1e-10)]
 
     def methods(self, quick: bool) -> list:
-        """auto (the default asked for a largest tip error E: atol = E, rtol = 0), radau5 over
-        rtol (atol = rtol/100), esdirk43 and dopri5 (holding the state), generalised-α and
+        """auto (the default asked for a largest tip error E: atol = E, rtol = 0), radau5 and
+        radau9 over rtol (atol = rtol/100), esdirk43 and dopri5 (holding the state), generalised-α and
         implicit_spring at fixed steps, rk4 from its stability limit."""
         tols = TOLERANCES[::3] if quick else TOLERANCES
-        return [("auto", "atol", tols), ("radau5", "rtol", tols), ("esdirk43", "rtol", tols[::3]),
+        return [("auto", "atol", tols), ("radau5", "rtol", tols), ("radau9", "rtol", tols),
+                ("esdirk43", "rtol", tols[::3]),
                 ("dopri5", "rtol", tols[::3]), ("generalized_alpha", "dt", _divisions(self.s, quick)),
                 ("implicit_spring", "dt", _divisions(self.s, quick)),
                 ("rk4", "dt", _explicit(self.s, 2.785 / self.omega_max, quick))]

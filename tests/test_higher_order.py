@@ -1,4 +1,4 @@
-"""The implicit Runge–Kutta methods of high order (esdirk43, radau5): orders observed by convergence
+"""The implicit Runge–Kutta methods of high order (esdirk43, radau5, radau9): orders observed by convergence
 in h on a nonlinear problem and on a stiff chain at h·ω ≫ 1, L-stability, the tolerance delivered
 on Kane's beam, prescribed drives at the stage times, dense output, the iteration matrices, the
 statistics, failures and bad options. References come from other solvers (SciPy's DOP853 and
@@ -12,8 +12,11 @@ import rigidfem as rf
 
 from conftest import DOUBLE_PENDULUM_Y0 as Y0  # the pendulum2 fixture's initial state
 
-METHODS = ["esdirk43", "radau5"]
-ORDER = {"esdirk43": 4, "radau5": 5}
+METHODS = ["esdirk43", "radau5", "radau9"]
+ORDER = {"esdirk43": 4, "radau5": 5, "radau9": 9}
+# Fixed steps whose errors stay above round-off at each method's order (radau9's are 1e-5 to 1e-11 here)
+STEPS = {"esdirk43": (0.1, 0.05, 0.025), "radau5": (0.1, 0.05, 0.025), "radau9": (0.4, 0.2, 0.1)}
+DRIVE_STEPS = {"esdirk43": (0.05, 0.025, 0.0125), "radau5": (0.05, 0.025, 0.0125), "radau9": (0.2, 0.1, 0.05)}
 # Fixed steps: Newton to near round-off, so that its error stays below the method's at the finest step.
 TIGHT = {"newton_tol": 1e-13, "newton_max_iterations": 50}
 
@@ -51,7 +54,8 @@ def _stiff_chain(k_stiff=1e8):
 
 @pytest.mark.parametrize("method", METHODS)
 def test_order_kept_at_large_h_omega_on_a_stiff_chain(method):
-    """Stiff accuracy: at h·ω from 1400 down to 350 the error still falls as h^p in every coordinate,
+    """Stiff accuracy: at h·ω from 1400 down to 350 (radau9 5600 to 1400) the error still falls as h^p in every
+    coordinate (radau9: 8.75, 9.06 and 8.75 measured),
     the stiff spring's quasi-static stretch included (no order reduction); generalised-α, second
     order, for contrast."""
     system = _stiff_chain()
@@ -59,7 +63,7 @@ def test_order_kept_at_large_h_omega_on_a_stiff_chain(method):
     ref = solve_ivp(system.rhs, (0, 2.0), y0, method="Radau", rtol=1e-13, atol=1e-15, jac=system.jacobian).y[:, -1]
     omega = np.max(np.abs(np.linalg.eigvals(system.jacobian(0.0, y0))))
     assert omega > 1e4
-    dts = (0.1, 0.05, 0.025)
+    dts = STEPS[method]
     errors = []
     for dt in dts:
         r = rf.simulate(system, 2.0, method=method, dt=dt, adaptive=False, **TIGHT)
@@ -105,8 +109,8 @@ def _tip_rms_error(result, h, tip_ref):
 def test_tolerance_delivered_on_kanes_beam(kane10, method, rtol):
     """The tip's RMS error (m) within 10× rtol times the tip's deflection (about 2 m) when atol is
     well below the sde angles (atol = 1e-3 rtol), and not wastefully far below it (measured:
-    0.02-0.2× for esdirk43, 0.006-0.009× for radau5); the hub is a prescribed drive, evaluated at
-    the stage times."""
+    0.02-0.2× for esdirk43, 0.72-1.08× for radau5, 0.18-0.45× for radau9); the hub is a prescribed drive,
+    evaluated at the stage times."""
     system, h, t, tip_ref = kane10
     scale = np.max(np.abs(tip_ref[:, 1]))
     r = rf.simulate(system, 20.0, method=method, rtol=rtol, atol=1e-3 * rtol, t_eval=t)
@@ -114,28 +118,28 @@ def test_tolerance_delivered_on_kanes_beam(kane10, method, rtol):
     assert 1e-3 * rtol * scale < error < 10 * rtol * scale, (error, rtol * scale)
     s = r.stats
     assert s["jacobians"] >= 1 and s["factorizations"] >= s["jacobians"]
-    stages_per_iteration = {"esdirk43": 1, "radau5": 3}[method]  # radau5 iterates on its 3 stages at once
+    stages_per_iteration = {"esdirk43": 1, "radau5": 3, "radau9": 5}[method]  # radau iterates on all its stages
     assert s["rhs_evaluations"] >= stages_per_iteration * s["newton_iterations"] >= s["steps"]
-    assert s["newton_iterations"] >= {"esdirk43": 5, "radau5": 1}[method] * s["steps"]
+    assert s["newton_iterations"] >= {"esdirk43": 5, "radau5": 1, "radau9": 1}[method] * s["steps"]
 
 
 @pytest.mark.parametrize("method", METHODS)
 def test_order_with_a_prescribed_drive(method):
     """The double pendulum's first joint driven, θ₁ = sin 3t: were the drive evaluated anywhere but
-    at each stage's time, the order would fall to 1 or 2."""
+    at each stage's time, the order would fall to 1 or 2 (radau9 measured 8.86 and 9.14)."""
     model, h = rf.samples.double_pendulum()
     model.prescribe(h["link1"], rf.motion.harmonic(1.0, 3.0))
     system = model.compile()
     ref = rf.simulate(system, 2.0, method="dopri5", rtol=1e-13, atol=1e-13, q0=[0.5], t_eval=[2.0])
     errors = []
-    for dt in (0.05, 0.025, 0.0125):
+    for dt in DRIVE_STEPS[method]:
         r = rf.simulate(system, 2.0, method=method, dt=dt, adaptive=False, q0=[0.5], t_eval=[2.0], **TIGHT)
         errors.append(np.max(np.abs(np.r_[r.q[-1] - ref.q[-1], r.qd[-1] - ref.qd[-1]])))
     observed = _observed_orders(errors)
     assert np.all(observed > ORDER[method] - 0.4), (observed, errors)
 
 
-@pytest.mark.parametrize("method", METHODS)
+@pytest.mark.parametrize("method", ["esdirk43", "radau5"])  # radau9's: test_radau9_dense_output_is_its_collocation...
 def test_dense_output_between_steps(pendulum2, method):
     system, ref = pendulum2
     t = np.linspace(0, 1.0, 37)
@@ -201,10 +205,26 @@ def test_bad_options(pendulum2, method):
         rf.simulate(system, 1.0, method=method[:-1], q0=Y0[:2])
 
 
-def test_radau_refuses_the_spring_matrix(pendulum2):
+@pytest.mark.parametrize("method", ["radau5", "radau9"])
+def test_radau_refuses_the_spring_matrix(pendulum2, method):
     system, _ = pendulum2
     with pytest.raises(ValueError, match="iteration_matrix.*spring"):
-        rf.simulate(system, 1.0, method="radau5", iteration_matrix="spring", q0=Y0[:2])
+        rf.simulate(system, 1.0, method=method, iteration_matrix="spring", q0=Y0[:2])
+
+
+def test_radau9_refusals(pendulum2):
+    """radau9 has no sensitivities, no adjoint and no Maxwell arms; each refusal names the argument. Its row of the
+    method table: order 9, adaptive."""
+    from test_viscoelastic import zener_oscillator
+
+    with pytest.raises(ValueError, match="method: 'radau9' does not integrate Maxwell arms"):
+        rf.simulate(zener_oscillator()[0].compile(), 1.0, method="radau9")
+    assert rf.methods()["radau9"].order == 9 and rf.methods()["radau9"].adaptive
+    system, _ = pendulum2
+    with pytest.raises(ValueError, match="^sensitivities: radau9 has no sensitivities; use radau5"):
+        rf.simulate(system, 1.0, method="radau9", q0=Y0[:2], sensitivities=["link1.mass"])
+    with pytest.raises(ValueError, match="^method: expected one of .*radau5.*the methods with an adjoint.*radau9"):
+        rf.gradient(system, 1.0, ["link1.mass"], method="radau9", dt=0.01, outputs=lambda t, q, qd: q[0])
 
 
 def test_radau_on_a_free_four_bar():
@@ -363,6 +383,111 @@ def test_radau5_renews_a_long_serving_tangent_when_newton_slows():
     r = rf.simulate(system, 2.0, method="radau5", rtol=1e-5, atol=1e-7, t_eval=t, stiffness_warning=False)
     s = r.stats
     assert s["jacobians"] >= 4 and s["newton_iterations"] < 2.1 * s["steps"], s
+    ref = rf.simulate(system, 2.0, method="radau5", rtol=1e-10, atol=1e-12, t_eval=t, stiffness_warning=False)
+    sag = np.max(np.abs(ref.position(beam.tip)[:, 1] - ref.position(beam.tip)[0, 1]))
+    assert np.max(np.abs(r.position(beam.tip) - ref.position(beam.tip))) < 10 * 1e-5 * sag
+
+
+def test_radau9_tableau_constants():
+    """radau.cpp writes every number of Radau IIA's 5-stage tableau as a hexadecimal constant. Computed here
+    independently: c the zeros of d⁴/dx⁴ (x⁴ (x − 1)⁵), a by the collocation conditions Σ_j a_ij c_j^(k−1) = c_i^k/k
+    (k = 1..5), b = a's last row, a = P diag(d) P⁻¹ with d(0) real and the pairs conjugate, and the estimate's
+    weights dd = a⁻ᵀ(b̂ − b)/d₀ for the order-5 quadrature b̂ on (0, c) whose weight at 0 is d₀ (radau5's dd come
+    out of the same rule: −(13 + 7√6)/3, (−13 + 7√6)/3, −1/3)."""
+    import re
+    from pathlib import Path
+
+    source = (Path(__file__).parents[1] / "cpp" / "src" / "radau.cpp").read_text()
+    source = source[source.index("Radau9Tableau::Radau9Tableau()"):]
+    source = source[:source.index("\n}\n")]
+
+    def reals(key, count):
+        block = re.search(rf"\b{key} << (.*?);", source, re.S).group(1)
+        values = [float.fromhex(x) for x in re.findall(r"[-+]?0x[0-9a-f.]+p[-+]?\d+", block)]
+        assert len(values) == count
+        return np.array(values)
+
+    def complexes(key, count):
+        block = re.search(rf"\b{key} << (.*?);", source, re.S).group(1)
+        pairs = re.findall(r"C\(([-+0-9a-fx.p]+), ([-+0-9a-fx.p]+)\)", block)
+        assert len(pairs) == count
+        return np.array([complex(float.fromhex(x), float.fromhex(y)) for x, y in pairs])
+
+    radau = np.polynomial.Legendre.basis(5) - np.polynomial.Legendre.basis(4)  # its zeros in [-1, 1]: 2c − 1
+    x = np.sort(radau.roots().real)
+    for _ in range(3):  # Newton on the zeros, to round-off
+        x = x - radau(x) / radau.deriv()(x)
+    c_ref = (x + 1.0) / 2.0
+    x4 = np.polynomial.Polynomial.fromroots([0.0] * 4 + [1.0] * 5).deriv(4)  # the same zeros, as the docstring says
+    assert np.abs(x4(c_ref)).max() < 1e-12 * np.abs(x4.coef).max()
+    V = np.vander(c_ref, 5, increasing=True)  # V_jk = c_j^k
+    a_ref = np.linalg.solve(V.T, (c_ref[:, None] ** np.arange(1, 6) / np.arange(1, 6)).T).T
+    c, a, dd = reals("c", 5), reals("a", 25).reshape(5, 5), reals("dd", 5)
+    d, P, Pinv = complexes("d", 5), complexes("P", 25).reshape(5, 5), complexes("Pinv", 25).reshape(5, 5)
+    np.testing.assert_allclose(c, c_ref, rtol=0, atol=1e-15)
+    np.testing.assert_allclose(a, a_ref, rtol=0, atol=1e-14)
+    assert d[0].imag == 0.0 and d[1].imag > 0.0 and d[3].imag > 0.0
+    assert d[2] == np.conj(d[1]) and d[4] == np.conj(d[3])
+    np.testing.assert_allclose(np.sort_complex(d), np.sort_complex(np.linalg.eigvals(a_ref)), rtol=0, atol=1e-14)
+    np.testing.assert_allclose(a_ref @ P, P @ np.diag(d), rtol=0, atol=1e-14)
+    np.testing.assert_allclose(P @ Pinv, np.eye(5), rtol=0, atol=1e-14)
+    d0 = d[0].real
+    W = np.vstack([np.r_[1.0, np.ones(5)], *[np.r_[0.0, c_ref**k] for k in range(1, 5)]])  # order 5 on (0, c)
+    bhat = np.linalg.lstsq(W[:, 1:], 1.0 / np.arange(1, 6) - np.r_[d0, 0, 0, 0, 0], rcond=None)[0]
+    np.testing.assert_allclose(dd, np.linalg.solve(a_ref.T, bhat - a_ref[-1]) / d0, rtol=1e-12, atol=0)
+
+
+def test_radau9_dense_output_is_its_collocation_polynomial(pendulum2):
+    """radau9's steps are long (20 to 56 over the double pendulum's second at rtol 1e-5 to 1e-9): the quintic Hermite
+    interpolant of radau5 left q 12-76 times less accurate between its steps than at them. Its q from the
+    collocation polynomial of q̇ is within 1.5 times (measured 1.00-1.20); q̇ itself, the collocation polynomial,
+    O(h⁶), within 60 times (3-49)."""
+    system, ref = pendulum2
+    t = np.linspace(0, 1.0, 37)
+    for rtol in (1e-5, 1e-7, 1e-9):
+        r = rf.simulate(system, 1.0, method="radau9", q0=Y0[:2], t_eval=t, rtol=rtol, atol=1e-2 * rtol)
+        steps = rf.simulate(system, 1.0, method="radau9", q0=Y0[:2], rtol=rtol, atol=1e-2 * rtol)
+        assert not np.isin(t[1:-1], steps.t).any()
+        for k, what, most in ((slice(0, 2), "q", 1.5), (slice(2, 4), "qd", 60)):
+            at_steps = np.max(np.abs(getattr(steps, what) - ref.sol(steps.t)[k].T))
+            between = np.max(np.abs(getattr(r, what) - ref.sol(t)[k].T))
+            assert between < most * at_steps, (rtol, what, between, at_steps)
+
+
+def test_radau9_on_a_free_four_bar():
+    """The four-bar of test_loops falling under gravity: radau9's stages hold the loop as radau5's do (the Schur
+    complement over 5 stages). At h = 20 ms its error is 1/500 of radau5's (measured 4.5e-9 and 2.3e-6 rad against
+    dopri5 at 1e-12), every output closes the loop, and adaptive runs hold rtol."""
+    from test_loops import closed_q, four_bar
+
+    system = four_bar()
+    q0, _ = system.assemble(closed_q(0.4))
+    ref = rf.simulate(system, 1.0, method="dopri5", q0=q0, rtol=1e-12, atol=1e-12, t_eval=[1.0])
+    errors = {}
+    for method in ("radau5", "radau9"):
+        r = rf.simulate(system, 1.0, method=method, q0=q0, dt=0.02, adaptive=False, **TIGHT)
+        errors[method] = np.abs(r.q[-1] - ref.q[-1]).max()
+        closure = [np.abs(system.loop_constraints(tk, qk, qdk)[0]).max() for tk, qk, qdk in zip(r.t, r.q, r.qd)]
+        assert max(closure) <= 1e-12
+    assert errors["radau9"] < 1e-2 * errors["radau5"], errors
+    for rtol, bound in ((1e-6, 2e-6), (1e-8, 6e-8)):  # measured 3.3e-7 (35 steps) and 3.9e-10 (61)
+        adaptive = rf.simulate(system, 1.0, method="radau9", q0=q0, rtol=rtol, atol=1e-2 * rtol, t_eval=[1.0])
+        assert np.abs(adaptive.q[-1] - ref.q[-1]).max() < bound
+
+
+def test_radau9_on_a_ringing_strip_iterates_twice_a_step():
+    """The strip of the test above with 16 rfes (the whippy strip of docs/peers.md) at radau9's long steps, where
+    modes ring at hω of 3 to 10: continuing the last step's polynomial started Newton far off (2.47 iterations a
+    step); the predictor that came closer on the last step, and a tangent renewed from θ > 0.02, keep it under
+    2.15 (measured 2.06), at the tolerance: the tip within 10 rtol of its sag of radau5 at rtol 1e-10."""
+    model = rf.Model(gravity=(0.0, -9.81, 0.0))
+    beam = model.add_beam("beam", model.ground, 1.0, rf.Material(E=2.1e11, rho=7850.0),
+                          rf.Section.rectangle(0.002, 0.02), 16, deform=("bend_z",))
+    system = model.compile()
+    t = np.linspace(0.0, 2.0, 201)
+    r = rf.simulate(system, 2.0, method="radau9", rtol=1e-5, atol=1e-7, t_eval=t, stiffness_warning=False)
+    s = r.stats
+    assert s["newton_iterations"] < 2.15 * s["steps"], s
     ref = rf.simulate(system, 2.0, method="radau5", rtol=1e-10, atol=1e-12, t_eval=t, stiffness_warning=False)
     sag = np.max(np.abs(ref.position(beam.tip)[:, 1] - ref.position(beam.tip)[0, 1]))
     assert np.max(np.abs(r.position(beam.tip) - ref.position(beam.tip))) < 10 * 1e-5 * sag

@@ -27,7 +27,8 @@ def large_beam(m, loop=False):
 
 @pytest.mark.parametrize("method,options", [("generalized_alpha", {"dt": 0.02}),
                                             ("esdirk43", {"rtol": 1e-7, "atol": 1e-10}),
-                                            ("radau5", {"rtol": 1e-7, "atol": 1e-7})])
+                                            ("radau5", {"rtol": 1e-7, "atol": 1e-7}),
+                                            ("radau9", {"rtol": 1e-7, "atol": 1e-7})])
 def test_krylov_gives_the_dense_tangents_solution_on_kanes_beam(method, options):
     """Kane's spin-up beam over the spin-up (the centrifugal stiffness the spring matrix leaves out):
     the tip with the matrix-free tangent is the dense tangent's to far below the tolerance."""
@@ -44,9 +45,10 @@ def test_krylov_gives_the_dense_tangents_solution_on_kanes_beam(method, options)
 def test_the_preconditioner_is_the_spring_matrix_in_real_and_complex_arithmetic():
     """On a cantilever the spring matrix M + diag(c1 b + c2 k) is the tangent but for gravity's and
     the load's small terms, so GMRES converges in one iteration per solve: radau5's real and complex
-    blocks (the complex articulated-body factorisation) and generalised-α's."""
+    blocks (the complex articulated-body factorisation; radau9's two complex blocks each their own) and
+    generalised-α's."""
     system, _ = large_beam(300)
-    for method, solves in (("radau5", 2), ("generalized_alpha", 1)):
+    for method, solves in (("radau5", 2), ("radau9", 3), ("generalized_alpha", 1)):
         res = rf.simulate(system, 0.01, method=method, dt=1e-3, adaptive=False, iteration_matrix="krylov")
         st = res.stats
         assert st["linear_iterations"] <= solves * st["newton_iterations"] * 1.05, (method, st)
@@ -64,7 +66,8 @@ def test_auto_takes_krylov_above_200_coordinates():
 
 @pytest.mark.parametrize("method,options", [("generalized_alpha", {"dt": 1e-3}),
                                             ("esdirk43", {"dt": 1e-3, "adaptive": False}),
-                                            ("radau5", {"dt": 1e-3, "adaptive": False})])
+                                            ("radau5", {"dt": 1e-3, "adaptive": False}),
+                                            ("radau9", {"dt": 1e-3, "adaptive": False})])
 def test_closed_loop_with_krylov(method, options):
     """The loops' Schur complement with GMRES solves: the dense tangent's solution, the loop closed."""
     system, tip = large_beam(40, loop=True)

@@ -383,19 +383,19 @@ class ImplicitRk : public Stepper {
   /// Newton's test after iteration `it` with the increment's size (increment_size): converged when
   /// η size <= 1, η = θ/(1 − θ) from the contraction rate θ (the sum of the remaining increments of
   /// a contraction; Hairer & Wanner IV.8), the last η on the first iteration; failed when
-  /// θ >= 0.99 or the iterations run out. A slow contraction asks for a fresh tangent: θ > 0.2 always, θ > 0.05
-  /// once the tangent has served `served_` steps, what it costs in stage residuals. One that serves long pays
+  /// θ >= 0.99 or the iterations run out. A slow contraction asks for a fresh tangent: θ > 0.2 always, θ > mild_
+  /// (0.05; radau9 0.02) once the tangent has served `served_` steps, what it costs in stage residuals. One that serves long pays
   /// for itself in iterations saved: strip m = 16, radau5 rtol 2e-6, 9 tangents instead of 1, 2.02 Newton
   /// iterations a step instead of 2.26, 10 % less time (with renewal by age too: 22 tangents, 1.98). One that
   /// serves a few steps does not: on the crane (tangents kept 2-8 steps) θ > 0.05 alone took 33 tangents
   /// instead of 13, and 33 % more time.
   Newton progress(int it, double size, double& previous) {
-    constexpr double slow = 0.2, mild = 0.05;
+    constexpr double slow = 0.2;
     double eta = eta_;
     if (it >= 1) {
       const double theta = size / previous;
       if (!(theta < 0.99)) return Newton::Failed;
-      if (theta > slow || (theta > mild && tangent_age_ >= served_)) slow_ = true;
+      if (theta > slow || (theta > mild_ && tangent_age_ >= served_)) slow_ = true;
       eta = theta / (1.0 - theta);
     }
     previous = size;
@@ -409,6 +409,11 @@ class ImplicitRk : public Stepper {
     }
     return Newton::Continue;
   }
+
+  /// Whether a step h needs Newton's matrix factorised anew, the last one factorised for `factored`: not where
+  /// they differ by round-off, as fixed steps to the grid t0 + k·dt do (t1 − t): gauss6 at h = 1 ms on the whippy
+  /// strip factorised at every other of its 2,000 steps.
+  static bool other_step(double h, double factored) { return std::abs(h - factored) > 1e-10 * h; }
 
   /// The singular-matrix failure of a factorisation by its reciprocal condition number (not the
   /// determinant, which under- or overflows for large n).
@@ -446,6 +451,8 @@ class ImplicitRk : public Stepper {
   // (rtol 1e-4, 3e-4) and the strip (m = 16 at rtol 2e-6 and 1e-6, m = 64 at 2e-4 and 2e-6) but for 3 at m = 64
   // and rtol 2e-6 (8 % slower): the rule stayed.
   const int served_ = std::max(20, 3 * n_ / 2);
+  /// progress: the contraction rate above which a tangent that has served `served_` steps is renewed.
+  double mild_ = 0.05;
   bool sensitivities_failed_ = false;  // the last solve's sensitivities did not converge (its state did)
   double eta_ = 1.0;          // Newton's η of the last converged stage
   double t_ = 0.0, h_ = 1.0;  // the last attempted step
@@ -473,7 +480,7 @@ class Esdirk final : public ImplicitRk {
 
   bool solve(double t, double h, const Tolerances* tol) override {
     const double gh = T::gamma * h;
-    if (!spring_ && (tangent(t) || gh != gh_)) factor(t, gh);
+    if (!spring_ && (tangent(t) || other_step(gh, gh_))) factor(t, gh);
     slow_ = false;
     V_.col(0) = v_, A_.col(0) = a_;
     if (sys_.nl > 0) Lam_.resize(sys_.nl, T::s), Lam_.col(0) = lambda_;
@@ -699,26 +706,58 @@ class Esdirk final : public ImplicitRk {
 
 /// Radau IIA of order 5 (Ehle; Hairer & Wanner IV.5, IV.8): c = ((4 − √6)/10, (4 + √6)/10, 1),
 /// stiffly accurate, L-stable. Its error estimate (Hairer & Wanner IV.8, (8.19)–(8.20)), of order 3,
-/// is filtered through (I − h d₁ J)⁻¹.
-/// The 3-stage collocation methods: Radau IIA (radau5: adaptive, the step ends at its last stage) and Gauss–Legendre
-/// (gauss6: fixed steps, the step ends at y_n + h Σ b_i f(Y_i)).
+/// is filtered through (I − h d₁ J)⁻¹. Radau IIA of order 9 (5 stages; Hairer & Wanner 1999) the same with its
+/// estimate of order 5.
+/// The collocation methods of S stages: Radau IIA (radau5, radau9: adaptive, the step ends at its last stage) and
+/// Gauss–Legendre (gauss6: fixed steps, the step ends at y_n + h Σ b_i f(Y_i)).
+template <int S>
 class Collocation final : public ImplicitRk, public RadauAccess {
   using cplx = std::complex<double>;
+  static constexpr int pairs = (S - 1) / 2;  // the complex pairs of a's eigenvalues, one complex block each
 
  public:
-  Collocation(const System& sys, const IntegratorOptions& o, IntegratorStats& stats, const CollocationTableau& tab)
-      : ImplicitRk(sys, o, stats), tab_(tab), A_(n_, 3), V_(n_, 3), Q_(n_, 3), R_(n_, 3), D_(n_, 3), dV_(n_, 3), dQ_(n_, 3),
-        Aprev_(n_, 3), z_(n_), zs_(n_), x_(n_), xs_(n_), zr_(n_), zi_(n_), b1_(n_), b2_(n_), qx_(n_), vx_(n_),
-        L_(sys.nl, 3), Cres_(sys.nl, 3), W_(3 * sys.nl, 3 * sys.nl),
-        w_(3 * sys.nl), E_(n_, 3), Z_(n_, 3) {
+  Collocation(const System& sys, const IntegratorOptions& o, IntegratorStats& stats, const CollocationTableau<S>& tab)
+      : ImplicitRk(sys, o, stats), tab_(tab), A_(n_, S), V_(n_, S), Q_(n_, S), R_(n_, S), D_(n_, S), dV_(n_, S),
+        dQ_(n_, S), Aprev_(n_, S), extrapolated_(n_, S), x_(n_), xs_(n_), b1_(n_), b2_(n_), qx_(n_), vx_(n_), L_(sys.nl, S),
+        Cres_(sys.nl, S), W_(S * sys.nl, S * sys.nl), w_(S * sys.nl), E_(n_, S), Z_(n_, S) {
+    for (int k = 0; k < pairs; ++k) z_[k].resize(n_), zs_[k].resize(n_), zr_[k].resize(n_), zi_[k].resize(n_);
     // gauss6: Newton to 1e-4 newton_tol (symmetric_tol), or newton_tol where it stops contracting or runs out of
     // iterations. A symmetric method keeps a conservative system's energy only with its equations solved well
     // below its step's error: Newton's leftovers have one sign and add up over the steps. The double pendulum at
     // h = 10 ms over 500 s: its energy drifted by 2.1e-6 J with the increments held to 1e-10 (1 + |y|), by 2e-8 J
     // at 1e-12; the Bricard linkage at h = 10 ms over 200 s: 8.2e-7 J at 1e-12, 1.2e-8 J at 1e-14.
     if (!tab_.stiffly_accurate) newton_tol_ *= symmetric_tol;
+    // radau9's further iteration costs 5 stage residuals where the tangent costs what radau5's does: renewed from
+    // θ > 0.02, it took 2.06 Newton iterations a step instead of 2.24 on the whippy strip (m = 16, rtol 1e-5),
+    // 10 % fewer residuals for 23 tangents instead of 15 (0.05 measured the same for radau5: 1.98 and 1.97).
+    if (S == 5) mild_ = 0.02;
     check_pairs();
+    dense_polynomials();
   }
+
+  /// radau9: q̇ by its collocation polynomial, q̇(t_n + θh) = q̇_n + h Σ_k A_k L1_k(θ), and q by its integral,
+  /// q_n + θh q̇_n + h² Σ_k A_k L2_k(θ) (L1_k = ∫₀^θ l_k, L2_k = ∫₀^θ L1_k, l_k Lagrange's basis on c), which
+  /// end at the step's (q, q̇)_n+1 (the Radau quadrature integrates L1_k exactly). radau5 and gauss6: the quintic
+  /// Hermite interpolant (ImplicitRk::dense).
+  VecX dense(double t) const override {
+    if (S == 3) return ImplicitRk::dense(t);
+    const double theta = (t - t_) / h_;
+    Eigen::Matrix<double, S, 1> w1, w2;
+    for (int k = 0; k < S; ++k) {  // Horner on the monomial coefficients
+      double p1 = 0.0, p2 = 0.0;
+      for (int m = S + 1; m >= 0; --m) p1 = p1 * theta + L1_(k, m), p2 = p2 * theta + L2_(k, m);
+      w1(k) = p1, w2(k) = p2;
+    }
+    VecX out(2 * n_);
+    out.tail(n_).noalias() = h_ * A_ * w1;
+    out.tail(n_) += vp_;
+    out.head(n_).noalias() = (h_ * h_) * A_ * w2;
+    out.head(n_) += qp_ + (theta * h_) * vp_;
+    return out;
+  }
+
+  /// The estimate is O(h^(S+1)) (order S): PI control as ImplicitRk's with that exponent.
+  StepControl control() const override { return {S + 1, 5.0, true, 1.2, 0.7, 0.4}; }
 
   void stages(MatX& Q, MatX& V, MatX& A) const override { Q = Q_, V = V_, A = A_; }
   void stage_multipliers(MatX& L) const override { L = L_; }
@@ -732,10 +771,10 @@ class Collocation final : public ImplicitRk, public RadauAccess {
   }
 
  private:
-  /// The stages by simplified Newton on the transformed system: R = [r_i] (nq, 3), R̃ = R P⁻ᵀ, each
+  /// The stages by simplified Newton on the transformed system: R = [r_i] (nq, S), R̃ = R P⁻ᵀ, each
   /// column solved with its block, ΔÃ_k = −S_k⁻¹ R̃_k, then ΔA = Re(ΔÃ Pᵀ).
   bool solve(double t, double h, const Tolerances* tol) override {
-    if (tangent(t) || h != h_factored_) factor(t, h);
+    if (tangent(t) || other_step(h, h_factored_)) factor(t, h);
     predict(h);
     predict_multipliers(h);
     basis_valid_ = full_ = lu_valid_ = false;  // the loops' row basis from this step's first stage
@@ -744,7 +783,7 @@ class Collocation final : public ImplicitRk, public RadauAccess {
     for (int it = 0;; ++it) {
       interruption_point();
       stage_values(h);
-      for (int i = 0; i < 3; ++i) {
+      for (int i = 0; i < S; ++i) {
         residual(t + tab_.c(i) * h, Q_.col(i), V_.col(i), A_.col(i));
         if (sys_.nl > 0) {  // r_i −= G_iᵀ λ_i; c_i = γ_i − G_i A_i (d_.gamma with d_.qdda = A_i)
           G_[i] = free_jacobian(sys_, d_);
@@ -763,7 +802,7 @@ class Collocation final : public ImplicitRk, public RadauAccess {
       dV_.noalias() = h * D_ * tab_.a.transpose();
       dQ_.noalias() = h * dV_ * tab_.a.transpose();
       double size = 0.0;
-      for (int i = 0; i < 3; ++i) size = std::max(size, increment_size(dQ_.col(i), dV_.col(i), tol));
+      for (int i = 0; i < S; ++i) size = std::max(size, increment_size(dQ_.col(i), dV_.col(i), tol));
       // gauss6 within newton_tol as asked, and at round-off (no longer contracting) or out of iterations
       if (!tab_.stiffly_accurate && it >= 1 && size * symmetric_tol <= 1.0 &&
           (size >= 0.5 * previous || it + 1 >= max_it_))
@@ -774,7 +813,7 @@ class Collocation final : public ImplicitRk, public RadauAccess {
     }
     stage_values(h);
     if (tab_.stiffly_accurate) {
-      q1_ = Q_.col(2), v1_ = V_.col(2), a1_ = A_.col(2);
+      q1_ = Q_.col(S - 1), v1_ = V_.col(S - 1), a1_ = A_.col(S - 1);
     } else {  // (q, q̇)_{n+1} = (q, q̇)_n + h Σ b_i (V_i, A_i), and q̈_{n+1} by the forward dynamics there
       q1_.noalias() = q_ + h * V_ * tab_.b;
       v1_.noalias() = v_ + h * A_ * tab_.b;
@@ -785,7 +824,7 @@ class Collocation final : public ImplicitRk, public RadauAccess {
     return !sensitivities_failed_;
   }
 
-  /// The sensitivities' stages (the staggered direct method) after the state's have converged: δA (nq, 3) with
+  /// The sensitivities' stages (the staggered direct method) after the state's have converged: δA (nq, S) with
   /// δV = δq̇_n 1ᵀ + h δA aᵀ, δQ = δq_n 1ᵀ + h δV aᵀ solving each stage's differentiated equations
   ///   R_i = K δQ_i + C δV_i + M δA_i − ∂(G_iᵀλ_i)/∂q δQ_i − G_iᵀ δλ_i + ∂r/∂p = 0   (loops: G_i δA_i = D(γ_i − G_i A_i))
   /// by simplified Newton with the step's matrix (solve_stages and, with loops, close_loops_correction), until
@@ -800,12 +839,12 @@ class Collocation final : public ImplicitRk, public RadauAccess {
     // ∂r/∂p's difference carries about ε |f| / h_p (difference_noise), which S₁⁻¹ carries into δA: 64 ε S₁⁻¹|f|
     // per unit of 1/h_p is as close as the corrections can come
     VecX noise(n_);
-    matrix_->solve(sens_->force_sizes(t + h, Q.col(2), V.col(2)), noise);
+    matrix_->solve(sens_->force_sizes(t + h, Q.col(S - 1), V.col(S - 1)), noise);
     const double round_off = 64.0 * std::numeric_limits<double>::epsilon() * max_abs(noise);
     if (nl > 0)
-      for (int i = 0; i < 3; ++i) loop_equations(sys_, d_, t + tab_.c(i) * h, Q.col(i), V.col(i)), G_[i] = free_jacobian(sys_, d_);
+      for (int i = 0; i < S; ++i) loop_equations(sys_, d_, t + tab_.c(i) * h, Q.col(i), V.col(i)), G_[i] = free_jacobian(sys_, d_);
     basis_valid_ = full_ = lu_valid_ = false;
-    MatX dA(n_, 3), dV(n_, 3), dQ(n_, 3), R(n_, 3), dL = MatX::Zero(nl, 3);
+    MatX dA(n_, S), dV(n_, S), dQ(n_, S), R(n_, S), dL = MatX::Zero(nl, S);
     for (int j = 0; j < P; ++j) {
       dA.colwise() = VecX(Sa_.col(j));
       dL.setZero();
@@ -821,7 +860,7 @@ class Collocation final : public ImplicitRk, public RadauAccess {
           L_ = L;
           return false;
         }
-        for (int i = 0; i < 3; ++i) {
+        for (int i = 0; i < S; ++i) {
           const double ti = t + tab_.c(i) * h;
           R.col(i) = sens_->residual_derivative(j, ti, Q.col(i), V.col(i), A.col(i), nl ? VecX(L.col(i)) : VecX(),
                                                 dQ.col(i), dV.col(i), dA.col(i), nl ? VecX(dL.col(i)) : VecX());
@@ -854,7 +893,7 @@ class Collocation final : public ImplicitRk, public RadauAccess {
       dV.colwise() += VecX(Sv_.col(j));
       dQ.noalias() = h * dV * tab_.a.transpose();
       dQ.colwise() += VecX(Sq_.col(j));
-      Sq1_.col(j) = dQ.col(2), Sv1_.col(j) = dV.col(2), Sa1_.col(j) = dA.col(2);
+      Sq1_.col(j) = dQ.col(S - 1), Sv1_.col(j) = dV.col(S - 1), Sa1_.col(j) = dA.col(S - 1);
     }
     L_ = L;
     return true;
@@ -871,30 +910,57 @@ class Collocation final : public ImplicitRk, public RadauAccess {
       continue_stages(h, lambda_start_, Lprev_, L_);
   }
 
-  /// Y = 𝒮⁻¹ X (nq, 3) for Newton's matrix 𝒮 = I⊗M + h a⊗C + h² a²⊗K on the stages (columns): X̃ = X P⁻ᵀ,
-  /// each column solved with its block (S₁ real, S₂ complex, the third the conjugate), Y = Re(Ỹ Pᵀ). With P's
-  /// first column and P⁻¹'s first row real and the others conjugate pairs (check_pairs), in real arithmetic:
-  /// x = X p̂₀ (p̂ⱼ = P⁻¹'s row j), z = X p̂₁, and Y = S₁⁻¹x p₀ᵀ + 2 Re(S₂⁻¹z p₁ᵀ) (pⱼ = P's column j).
+  /// Y = 𝒮⁻¹ X (nq, S) for Newton's matrix 𝒮 = I⊗M + h a⊗C + h² a²⊗K on the stages (columns): X̃ = X P⁻ᵀ,
+  /// each column solved with its block (S₀ real, then each pair's complex block, its conjugate's the conjugate),
+  /// Y = Re(Ỹ Pᵀ). With P's first column and P⁻¹'s first row real and the others conjugate pairs (check_pairs), in
+  /// real arithmetic: x = X p̂₀ (p̂ⱼ = P⁻¹'s row j), z_k = X p̂_{2k+1}, and
+  /// Y = S₀⁻¹x p₀ᵀ + Σ_k 2 Re(S_k⁻¹z_k p_{2k+1}ᵀ) (pⱼ = P's column j).
   void solve_stages(const MatX& X, MatX& Y) {
     x_.noalias() = X * pinv0_;
-    zr_.noalias() = X * pinv1_.real();
-    zi_.noalias() = X * pinv1_.imag();
-    z_.real() = zr_, z_.imag() = zi_;
+    for (int k = 0; k < pairs; ++k) {
+      zr_[k].noalias() = X * pinv_[k].real();
+      zi_[k].noalias() = X * pinv_[k].imag();
+      z_[k].real() = zr_[k], z_[k].imag() = zi_[k];
+    }
     matrix_->solve(x_, xs_);
-    matrix_->solve(z_, zs_);
-    zr_ = zs_.real(), zi_ = zs_.imag();
-    for (int j = 0; j < 3; ++j)
-      Y.col(j) = p0_(j) * xs_ + (2.0 * p1_(j).real()) * zr_ - (2.0 * p1_(j).imag()) * zi_;
+    for (int k = 0; k < pairs; ++k) {
+      matrix_->solve(z_[k], zs_[k], k);
+      zr_[k] = zs_[k].real(), zi_[k] = zs_[k].imag();
+    }
+    for (int j = 0; j < S; ++j) {
+      Y.col(j) = p0_(j) * xs_ + (2.0 * p_[0](j).real()) * zr_[0] - (2.0 * p_[0](j).imag()) * zi_[0];
+      for (int k = 1; k < pairs; ++k)
+        Y.col(j) += (2.0 * p_[k](j).real()) * zr_[k] - (2.0 * p_[k](j).imag()) * zi_[k];
+    }
+  }
+
+  /// L1_ and L2_ (S × (S + 2), monomial coefficients in θ, row k): ∫₀^θ l_k and ∫₀^θ∫₀^σ l_k for Lagrange's basis
+  /// l_k(θ) = Π_{j≠k} (θ − c_j)/(c_k − c_j) on the nodes (dense).
+  void dense_polynomials() {
+    L1_.setZero(S, S + 2), L2_.setZero(S, S + 2);
+    for (int k = 0; k < S; ++k) {
+      Eigen::VectorXd l = Eigen::VectorXd::Zero(S);  // l_k's coefficients, degree S − 1
+      l(0) = 1.0;
+      for (int j = 0, degree = 0; j < S; ++j) {
+        if (j == k) continue;
+        const double scale = 1.0 / (tab_.c(k) - tab_.c(j));
+        for (int m = ++degree; m >= 0; --m) l(m) = ((m > 0 ? l(m - 1) : 0.0) - tab_.c(j) * l(m)) * scale;
+      }
+      for (int m = 0; m < S; ++m) L1_(k, m + 1) = l(m) / (m + 1);
+      for (int m = 1; m <= S; ++m) L2_(k, m + 1) = L1_(k, m) / (m + 1);
+    }
   }
 
   /// The tableau's P and P⁻¹ in the form solve_stages takes: P's first column and P⁻¹'s first row real, the
   /// other two conjugate, as the decomposition of a real matrix with one real eigenvalue gives them.
   void check_pairs() {
-    const bool real = tab_.P.col(0).imag().isZero(0.0) && tab_.Pinv.row(0).imag().isZero(0.0);
-    const bool pairs = tab_.P.col(2) == tab_.P.col(1).conjugate() && tab_.Pinv.row(2) == tab_.Pinv.row(1).conjugate();
-    if (!real || !pairs) throw std::logic_error("collocation tableau: P and P⁻¹ are not in real-and-pair form");
-    p0_ = tab_.P.col(0).real(), p1_ = tab_.P.col(1);
-    pinv0_ = tab_.Pinv.row(0).real().transpose(), pinv1_ = tab_.Pinv.row(1).transpose();
+    bool form = tab_.P.col(0).imag().isZero(0.0) && tab_.Pinv.row(0).imag().isZero(0.0);
+    for (int k = 0; k < pairs; ++k)
+      form = form && tab_.P.col(2 * k + 2) == tab_.P.col(2 * k + 1).conjugate() &&
+             tab_.Pinv.row(2 * k + 2) == tab_.Pinv.row(2 * k + 1).conjugate();
+    if (!form) throw std::logic_error("collocation tableau: P and P⁻¹ are not in real-and-pair form");
+    p0_ = tab_.P.col(0).real(), pinv0_ = tab_.Pinv.row(0).real().transpose();
+    for (int k = 0; k < pairs; ++k) p_[k] = tab_.P.col(2 * k + 1), pinv_[k] = tab_.Pinv.row(2 * k + 1).transpose();
   }
 
   /// Loops, index 1 at each stage: M A_i − f_i − G_iᵀλ_i = 0 and G_i A_i = γ_i. With ΔA = −𝒮⁻¹R on entry
@@ -923,55 +989,55 @@ class Collocation final : public ImplicitRk, public RadauAccess {
       L_.setZero();
       return;
     }
-    for (int i = 0; i < 3; ++i) Gr_[i].noalias() = basis_.transpose() * G_[i];
+    for (int i = 0; i < S; ++i) Gr_[i].noalias() = basis_.transpose() * G_[i];
     if (!lu_valid_) schur(Gr_, r);
-    for (int i = 0; i < 3; ++i) w_.segment(i * r, r).noalias() = basis_.transpose() * (Cres_.col(i) - G_[i] * D_.col(i));
+    for (int i = 0; i < S; ++i) w_.segment(i * r, r).noalias() = basis_.transpose() * (Cres_.col(i) - G_[i] * D_.col(i));
     // the multipliers themselves, Ŵ μ⁺ = ĉ − 𝒢̂ ΔA + Ŵ μ, as below
-    mu_.resize(3 * r);
-    for (int i = 0; i < 3; ++i) mu_.segment(i * r, r).noalias() = basis_.transpose() * L_.col(i);
-    auto Wr = W_.topLeftCorner(3 * r, 3 * r);
-    w_.head(3 * r).noalias() += Wr * mu_;
+    mu_.resize(S * r);
+    for (int i = 0; i < S; ++i) mu_.segment(i * r, r).noalias() = basis_.transpose() * L_.col(i);
+    auto Wr = W_.topLeftCorner(S * r, S * r);
+    w_.head(S * r).noalias() += Wr * mu_;
     if (!lu_valid_) {  // Ŵ factorised once per solve, and its condition estimated then (a few solves)
       lu_.compute(Wr);
       lu_valid_ = true;
       full_ = !(lu_.rcond() > 1e-10);  // singular: the full W for the rest of this solve
     }
     if (full_) return close_loops_full();
-    mu1_ = lu_.solve(w_.head(3 * r));  // μ⁺
-    for (int i = 0; i < 3; ++i) E_.col(i).noalias() = Gr_[i].transpose() * (mu1_ - mu_).segment(i * r, r);
+    mu1_ = lu_.solve(w_.head(S * r));  // μ⁺
+    for (int i = 0; i < S; ++i) E_.col(i).noalias() = Gr_[i].transpose() * (mu1_ - mu_).segment(i * r, r);
     solve_stages(E_, Z_);
     D_ += Z_;
-    for (int i = 0; i < 3; ++i) L_.col(i).noalias() = basis_ * mu1_.segment(i * r, r);
+    for (int i = 0; i < S; ++i) L_.col(i).noalias() = basis_ * mu1_.segment(i * r, r);
   }
 
-  /// W (its leading 3k × 3k) = 𝒢 𝒮⁻¹ 𝒢ᵀ for the stages' rows G[i] (k, nq): one stage solve per row and stage.
+  /// W (its leading Sk × Sk) = 𝒢 𝒮⁻¹ 𝒢ᵀ for the stages' rows G[i] (k, nq): one stage solve per row and stage.
   void schur(const MatX* G, int k) {
-    for (int j = 0; j < 3; ++j)
+    for (int j = 0; j < S; ++j)
       for (int r = 0; r < k; ++r) {
         E_.setZero();
         E_.col(j) = G[j].row(r).transpose();
         solve_stages(E_, Z_);
-        for (int i = 0; i < 3; ++i) W_.block(i * k, j * k + r, k, 1).noalias() = G[i] * Z_.col(i);
+        for (int i = 0; i < S; ++i) W_.block(i * k, j * k + r, k, 1).noalias() = G[i] * Z_.col(i);
       }
   }
 
-  /// The same step with every row of G: W (3 nl × 3 nl) solved for its least-norm multipliers.
+  /// The same step with every row of G: W (S nl × S nl) solved for its least-norm multipliers.
   void close_loops_full() {
     const int nl = sys_.nl;
     schur(G_, nl);
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < S; ++i) {
       w_.segment(i * nl, nl) = Cres_.col(i);
       w_.segment(i * nl, nl).noalias() -= G_[i] * D_.col(i);
     }
     // The least-norm multipliers themselves, W Λ⁺ = c − 𝒢 ΔA + W Λ, not the least-norm increment: in a
     // direction where G lost rank W is blind to Λ, which must then be zero, not its prediction.
-    VecX L = Eigen::Map<const VecX>(L_.data(), 3 * nl);
+    VecX L = Eigen::Map<const VecX>(L_.data(), S * nl);
     w_.noalias() += W_ * L;
     const VecX dl = least_norm(W_, w_) - L;
-    for (int i = 0; i < 3; ++i) E_.col(i).noalias() = G_[i].transpose() * dl.segment(i * nl, nl);
+    for (int i = 0; i < S; ++i) E_.col(i).noalias() = G_[i].transpose() * dl.segment(i * nl, nl);
     solve_stages(E_, Z_);
     D_ += Z_;
-    for (int i = 0; i < 3; ++i) L_.col(i) += dl.segment(i * nl, nl);
+    for (int i = 0; i < S; ++i) L_.col(i) += dl.segment(i * nl, nl);
   }
 
   /// V = q̇_n 1ᵀ + h A aᵀ, Q = q_n 1ᵀ + h V aᵀ.
@@ -982,33 +1048,46 @@ class Collocation final : public ImplicitRk, public RadauAccess {
     Q_.colwise() += q_;
   }
 
-  /// The first iterate: the accelerations' collocation polynomial of the last step (through q̈_n−1
-  /// and its stages) continued to the new stage times, q̈_n at every stage on the first step.
+  /// The first iterate: the accelerations' collocation polynomial of the last step (through q̈_n−1 and its stages)
+  /// continued to the new stage times, or q̈_n at every stage, whichever came the closer to the last step's converged
+  /// stages (accepted); q̈_n at every stage on the first step. The polynomial wins where the steps resolve the motion;
+  /// where they step over modes that ring (hω of 3 to 10 on the whippy strip at radau9's steps), continuing a
+  /// polynomial of degree S beyond its interval multiplies what the last step left of them: there the first
+  /// increment of radau9 was 5-10 times the constant's, and Newton took 2.47 iterations a step instead of 2.27.
   void predict(double h) {
-    if (!have_previous_)
+    if (!have_previous_) {
       A_.colwise() = a_;
+      extrapolated_ = A_;
+      return;
+    }
+    continue_stages(h, ap_, Aprev_, extrapolated_);
+    if (extrapolate_)
+      A_ = extrapolated_;
     else
-      continue_stages(h, ap_, Aprev_, A_);
+      A_.colwise() = a_;
   }
 
-  /// The polynomial through x(t_{n−1}) = start and the last step's stages prev (nq or nl, 3), at this
-  /// step's stage times (step h): Lagrange's cubic in θ = (t − t_{n−1})/h_{n−1}, into out.
+  /// The polynomial through x(t_{n−1}) = start and the last step's stages prev (nq or nl, S), at this
+  /// step's stage times (step h): Lagrange's polynomial of degree S in θ = (t − t_{n−1})/h_{n−1}, into out.
   void continue_stages(double h, const VecX& start, const MatX& prev, MatX& out) const {
-    const double x[4] = {0.0, tab_.c(0), tab_.c(1), tab_.c(2)};
-    for (int i = 0; i < 3; ++i) {
+    double x[S + 1] = {0.0};
+    for (int k = 0; k < S; ++k) x[k + 1] = tab_.c(k);
+    for (int i = 0; i < S; ++i) {
       const double theta = 1.0 + tab_.c(i) * h / h_previous_;
-      double w[4];
-      for (int k = 0; k < 4; ++k) {
+      double w[S + 1];
+      for (int k = 0; k <= S; ++k) {
         w[k] = 1.0;
-        for (int j = 0; j < 4; ++j)
+        for (int j = 0; j <= S; ++j)
           if (j != k) w[k] *= (theta - x[j]) / (x[k] - x[j]);
       }
       out.col(i) = w[0] * start + w[1] * prev.col(0) + w[2] * prev.col(1) + w[3] * prev.col(2);
+      for (int k = 4; k <= S; ++k) out.col(i) += w[k] * prev.col(k - 1);
     }
   }
 
   /// Hairer's radau5: the estimate, of order 3, bounds an order-5 solution far below it, so on the state it
-  /// is held to rtol' = 0.1 rtol^(2/3), atol' = atol rtol'/rtol (on Kane's beam the error is then still
+  /// is held to rtol' = 0.1 rtol^(2/3), atol' = atol rtol'/rtol (radau9, its estimate of order 5: rtol^(3/5), the
+  /// exponent (S + 1)/2S of both) (on Kane's beam the error is then still
   /// 10-100× below rtol times the tip's deflection, against 100-2500× with the tolerances as asked). On
   /// outputs the tolerances stay as asked: there the estimate also stands for what a step loses of an
   /// oscillation it damps (about the mode's amplitude at hω ≫ 1: 0.7-1 times the step's error on
@@ -1019,13 +1098,15 @@ class Collocation final : public ImplicitRk, public RadauAccess {
     tol_ = asked;
     for (Eigen::Index i = 0; i < asked.rtol.size(); ++i) {
       if (!(asked.rtol(i) > 0.0)) continue;
-      tol_.rtol(i) = 0.1 * std::pow(asked.rtol(i), 2.0 / 3.0);
+      tol_.rtol(i) = 0.1 * std::pow(asked.rtol(i), (S + 1.0) / (2.0 * S));
       tol_.atol(i) = asked.atol(i) * tol_.rtol(i) / asked.rtol(i);
     }
     return tol_;
   }
 
   void accepted() override {
+    // the predictor for the next step (predict): the one nearer this step's stages (ap_ is q̈_n, a_ already q̈_n+1)
+    extrapolate_ = (A_ - extrapolated_).squaredNorm() <= (A_.colwise() - ap_).squaredNorm();
     Aprev_ = A_;
     Lprev_ = L_, lambda_start_ = lambda_;  // lambda_: still the step's start (project follows)
     h_previous_ = h_;
@@ -1044,7 +1125,7 @@ class Collocation final : public ImplicitRk, public RadauAccess {
     const bool refine = (!have_previous_ || rejected_) && !tol.measure;
     rejected_ = true;  // until accepted
     b1_ = v_, b2_ = a_;
-    for (int i = 0; i < 3; ++i) {
+    for (int i = 0; i < S; ++i) {
       b1_ += (tab_.dd(i) / h) * (Q_.col(i) - q_);
       b2_ += (tab_.dd(i) / h) * (V_.col(i) - v_);
     }
@@ -1071,56 +1152,65 @@ class Collocation final : public ImplicitRk, public RadauAccess {
     return tol.measure ? output_error(g, dy_, tol, h) : tol.norm(dy_, y_, y1_, h);
   }
 
-  /// The blocks M + h d_k C + (h d_k)² K: d₁ real, d₂ complex (d₃ its conjugate).
+  /// The blocks M + h d_k C + (h d_k)² K: d₁ real, then one complex block per pair (d₂, and radau9's d₄; their
+  /// conjugates' blocks the conjugates).
   void factor(double t, double h) {
     const double g = h * tab_.d(0).real();
     const double real = matrix_->factor(g, g * g, VecX());
-    const cplx gc = h * tab_.d(1);
-    const double complex = matrix_->factor(gc, gc * gc);
+    double complex[pairs];
+    for (int k = 0; k < pairs; ++k) {
+      const cplx gc = h * tab_.d(2 * k + 1);
+      complex[k] = matrix_->factor(gc, gc * gc, k);
+    }
     h_factored_ = h;
     check_regular(real, t, h, "M + h d₁ C + (h d₁)² K");
-    check_regular(complex, t, h, "M + h d₂ C + (h d₂)² K");
+    check_regular(complex[0], t, h, "M + h d₂ C + (h d₂)² K");
+    if (pairs > 1) check_regular(complex[pairs - 1], t, h, "M + h d₄ C + (h d₄)² K");
   }
 
   static constexpr double symmetric_tol = 1e-4;  // gauss6's Newton increments: 1e-4 newton_tol (1 + |y|)
-  const CollocationTableau tab_;
+  const CollocationTableau<S> tab_;
   Tolerances tol_;  // the tolerances the estimate is held to (controlled)
-  MatX A_, V_, Q_, R_, D_, dV_, dQ_, Aprev_;  // (nq, 3) stages, residuals, increments, last step's A
-  Eigen::VectorXcd z_, zs_;                   // (nq) the complex block's right-hand side and solution
+  MatX A_, V_, Q_, R_, D_, dV_, dQ_, Aprev_;  // (nq, S) stages, residuals, increments, last step's A
+  MatX extrapolated_;                         // (nq, S) the last step's polynomial continued to this step (predict)
+  MatX L1_, L2_;                              // (S, S + 2) the dense output's polynomials (dense_polynomials)
+  bool extrapolate_ = true;                   // predict: the polynomial (or q̈_n at every stage)
   VecX x_, xs_;                               // (nq) the real block's (and the error estimate's)
-  VecX zr_, zi_;                              // (nq) z's and S₂⁻¹z's real and imaginary parts
+  Eigen::VectorXcd z_[pairs], zs_[pairs];     // (nq) each complex block's right-hand side and solution
+  VecX zr_[pairs], zi_[pairs];                // (nq) z's and S_k⁻¹z's real and imaginary parts
   VecX b1_, b2_, qx_, vx_;                    // (nq) the error estimate's
-  Eigen::Vector3d p0_, pinv0_;                // P's first column, P⁻¹'s first row (real: check_pairs)
-  Eigen::Vector3cd p1_, pinv1_;               // P's second column, P⁻¹'s second row
+  typename CollocationTableau<S>::Real p0_, pinv0_;                 // P's first column, P⁻¹'s first row (real)
+  typename CollocationTableau<S>::Complex p_[pairs], pinv_[pairs];  // P's columns 2k + 1, P⁻¹'s rows 2k + 1
   double h_factored_ = 0.0, h_previous_ = 1.0;
   bool have_previous_ = false, rejected_ = false;
-  MatX G_[3];         // (nl, nq) the loops' Jacobian at each stage of the iterate
-  MatX L_, Cres_;     // (nl, 3) the stages' multipliers and constraint residuals γ_i − G_i A_i
-  MatX Lprev_;        // (nl, 3) the last step's stage multipliers
-  MatX W_;            // (3 nl, 3 nl) the Schur complement 𝒢 𝒮⁻¹ 𝒢ᵀ over the stages (or its 3r × 3r: 𝒢̂ 𝒮⁻¹ 𝒢̂ᵀ)
+  MatX G_[S];         // (nl, nq) the loops' Jacobian at each stage of the iterate
+  MatX L_, Cres_;     // (nl, S) the stages' multipliers and constraint residuals γ_i − G_i A_i
+  MatX Lprev_;        // (nl, S) the last step's stage multipliers
+  MatX W_;            // (S nl, S nl) the Schur complement 𝒢 𝒮⁻¹ 𝒢ᵀ over the stages (or its Sr × Sr: 𝒢̂ 𝒮⁻¹ 𝒢̂ᵀ)
   MatX basis_;        // (nl, r) orthonormal basis of the range of G at this solve's first stage (row_basis)
-  MatX Gr_[3];        // (r, nq) the stages' independent rows Bᵀ G_i
+  MatX Gr_[S];        // (r, nq) the stages' independent rows Bᵀ G_i
   Eigen::PartialPivLU<MatX> lu_;      // of 𝒢̂ 𝒮⁻¹ 𝒢̂ᵀ
-  VecX mu_, mu1_;                     // (3r) the stages' multipliers in the basis: the iterate's and the next
+  VecX mu_, mu1_;                     // (Sr) the stages' multipliers in the basis: the iterate's and the next
   bool basis_valid_ = false, full_ = false, lu_valid_ = false;  // basis_ is this solve's; the full W is needed in this solve
-  VecX w_;            // (3 nl) its right-hand side
-  MatX E_, Z_;        // (nq, 3) stage right-hand sides and their 𝒮⁻¹
+  VecX w_;            // (S nl) its right-hand side
+  MatX E_, Z_;        // (nq, S) stage right-hand sides and their 𝒮⁻¹
   VecX lambda_start_;  // (nl) the multipliers at the last step's start
 };
 
 }  // namespace
 
 std::unique_ptr<Stepper> make_implicit_rk(const System& sys, const IntegratorOptions& o, IntegratorStats& stats) {
-  if (o.method == Method::Radau5) return std::make_unique<Collocation>(sys, o, stats, RadauTableau());
-  if (o.method == Method::Gauss6) return std::make_unique<Collocation>(sys, o, stats, GaussTableau());
+  if (o.method == Method::Radau5) return std::make_unique<Collocation<3>>(sys, o, stats, RadauTableau());
+  if (o.method == Method::Radau9) return std::make_unique<Collocation<5>>(sys, o, stats, Radau9Tableau());
+  if (o.method == Method::Gauss6) return std::make_unique<Collocation<3>>(sys, o, stats, GaussTableau());
   return std::make_unique<Esdirk>(sys, o, stats);
 }
 
 namespace {
 
-// The collocation methods' own (radau5, gauss6): the exact tangent only, and no Maxwell arms, since their stages
+// The collocation methods' own (radau5, radau9, gauss6): the exact tangent only, and no Maxwell arms, since their stages
 // are coupled (esdirk43 takes both); gauss6 also no sensitivities (its step does not end at a stage, where the
-// staggered direct method takes them).
+// staggered direct method takes them), radau9 none either (radau5's are the ones checked against differences).
 void check_collocation(const System& sys, const IntegratorOptions& o) {
   const std::string name = method_name(o.method);
   if (sys.nz > 0)
@@ -1131,9 +1221,9 @@ void check_collocation(const System& sys, const IntegratorOptions& o) {
     throw std::invalid_argument("iteration_matrix: " + name + " takes the exact tangent ('auto', 'tangent' or "
                                 "'krylov'), got 'spring' ('krylov' is its O(n) form); use esdirk43 for the spring "
                                 "matrix");
-  if (o.method == Method::Gauss6 && !o.sensitivities.empty())
-    throw std::invalid_argument("sensitivities: gauss6 has no sensitivities; use radau5, esdirk43 or an explicit "
-                                "method");
+  if ((o.method == Method::Gauss6 || o.method == Method::Radau9) && !o.sensitivities.empty())
+    throw std::invalid_argument("sensitivities: " + name + " has no sensitivities; use radau5, esdirk43 or an "
+                                "explicit method");
 }
 
 }  // namespace
@@ -1148,6 +1238,11 @@ const std::vector<MethodInfo>& implicit_rk_methods() {
       {Method::Radau5, "radau5", "implicit Runge-Kutta", 5, true, true, true, true, method_options(true, true),
        "Radau IIA, 3 stages, order 5, L-stable, stiffly accurate; simplified Newton on all stages in the transformed "
        "real/complex form (exact tangent only), Hairer's filtered estimate, PI control, dense output quintic Hermite",
+       make_implicit_rk, check_collocation},
+      {Method::Radau9, "radau9", "implicit Runge-Kutta", 9, true, true, true, false, method_options(true, true),
+       "Radau IIA, 5 stages, order 9, L-stable, stiffly accurate; as radau5 with one real and two complex blocks "
+       "(exact tangent only), Hairer's filtered estimate of order 5, PI control; dense output q̇'s collocation "
+       "polynomial and its integral for q; no sensitivities or adjoint",
        make_implicit_rk, check_collocation},
       {Method::Gauss6, "gauss6", "implicit Runge-Kutta", 6, false, false, false, false, method_options(false, true),
        "Gauss-Legendre, 3 stages, order 6, fixed step: symmetric (time-reversible) and A-stable without damping "

@@ -244,17 +244,17 @@ class DenseNewtonMatrix final : public NewtonMatrix {
     return regularity(lu_->pivots(), [&] { return Eigen::PartialPivLU<MatX>(S_).rcond(); });
   }
 
-  double factor(cplx c1, cplx c2) override {
+  double factor(cplx c1, cplx c2, int slot) override {
     Sc_ = M_.cast<cplx>() + c1 * C_.cast<cplx>() + c2 * K_.cast<cplx>();
-    luc_.compute(Sc_);
+    luc_[slot].compute(Sc_);
     ++stats_.factorizations;
-    return regularity(luc_.pivots(), [&] { return Eigen::PartialPivLU<Eigen::MatrixXcd>(Sc_).rcond(); });
+    return regularity(luc_[slot].pivots(), [&] { return Eigen::PartialPivLU<Eigen::MatrixXcd>(Sc_).rcond(); });
   }
 
   void solve(const VecX& b, VecX& x) override { lu_->solve(b, x); }
-  void solve(const VecXc& b, VecXc& x) override { luc_.solve(b, x); }
+  void solve(const VecXc& b, VecXc& x, int slot) override { luc_[slot].solve(b, x); }
   void precondition_transposed(const VecX& b, VecX& x) override { lu_->solve_transposed(b, x); }
-  void precondition_transposed(const VecXc& b, VecXc& x) override { luc_.solve_transposed(b, x); }
+  void precondition_transposed(const VecXc& b, VecXc& x) override { luc_[0].solve_transposed(b, x); }
   bool krylov() const override { return false; }
   std::shared_ptr<const DenseLU> dense_factor() const override { return lu_; }
 
@@ -265,7 +265,7 @@ class DenseNewtonMatrix final : public NewtonMatrix {
   MatX K_, C_, M_, S_;
   Eigen::MatrixXcd Sc_;
   std::shared_ptr<DenseLU> lu_;
-  ComplexLU luc_;
+  ComplexLU luc_[complex_slots];
 };
 
 /// M + diag(δ) for complex δ factorised by the articulated-body recursion (recursive.hpp's aba_factor and
@@ -356,7 +356,7 @@ class KrylovNewtonMatrix final : public NewtonMatrix {
   static constexpr int max_iterations = 60;
 
   KrylovNewtonMatrix(const System& sys, IntegratorStats& stats)
-      : sys_(sys), d0_(sys), dp_(sys), stats_(stats), complex_(sys) {}
+      : sys_(sys), d0_(sys), dp_(sys), stats_(stats), complex_{ComplexArticulated(sys), ComplexArticulated(sys)} {}
 
   void linearize(double t, const VecX& q, const VecX& qd, const VecX& qdd, const VecX& s) override {
     t_ = t, q_ = q, qd_ = qd, qdd_ = qdd;
@@ -394,10 +394,10 @@ class KrylovNewtonMatrix final : public NewtonMatrix {
     return 1.0;  // a singular pivot of the recursion throws
   }
 
-  double factor(cplx c1, cplx c2) override {
-    z1_ = c1, z2_ = c2;
+  double factor(cplx c1, cplx c2, int slot) override {
+    z1_[slot] = c1, z2_[slot] = c2;
     spring_armature(sys_, d0_, c1, c2, delta_);
-    complex_.factor(d0_, delta_);
+    complex_[slot].factor(d0_, delta_);
     ++stats_.factorizations;
     return 1.0;
   }
@@ -415,10 +415,10 @@ class KrylovNewtonMatrix final : public NewtonMatrix {
 
   /// GMRES on S x = (K c₂ + C c₁ + M) x for complex x and shifts: S is real-linear in x, so each product is
   /// two directional derivatives, of the real and of the imaginary part.
-  void solve(const VecXc& b, VecXc& x) override {
+  void solve(const VecXc& b, VecXc& x, int slot) override {
     auto S = [&](const VecXc& v, VecXc& out) {
       out.resize(v.size());
-      zq_ = z2_ * v, zv_ = z1_ * v;
+      zq_ = z2_[slot] * v, zv_ = z1_[slot] * v;
       for (int part = 0; part < 2; ++part) {
         if (part == 0)
           cq_ = zq_.real(), cv_ = zv_.real(), ca_ = v.real();
@@ -431,12 +431,12 @@ class KrylovNewtonMatrix final : public NewtonMatrix {
           out.imag() = w_;
       }
     };
-    auto P = [&](const VecXc& v, VecXc& out) { complex_.solve(v, out); };
+    auto P = [&](const VecXc& v, VecXc& out) { complex_[slot].solve(v, out); };
     stats_.linear_iterations += gmresc_.solve(S, P, b, x, rtol, max_iterations);
   }
 
   void precondition_transposed(const VecX& b, VecX& x) override { solve_armature(sys_, d0_, b, x); }
-  void precondition_transposed(const VecXc& b, VecXc& x) override { complex_.solve(b, x); }
+  void precondition_transposed(const VecXc& b, VecXc& x) override { complex_[0].solve(b, x); }
   bool krylov() const override { return true; }
 
  private:
@@ -444,11 +444,11 @@ class KrylovNewtonMatrix final : public NewtonMatrix {
   Data d0_, dp_;  // the tangent's state; the perturbed states
   IntegratorStats& stats_;
   double t_ = 0.0, c1_ = 0.0, c2_ = 0.0;
-  cplx z1_, z2_;
+  cplx z1_[complex_slots], z2_[complex_slots];
   VecX q_, qd_, qdd_, r0_, qe_, qde_, qdde_, e_, cq_, cv_, ca_, w_;
   VecX real_delta_;      // the real shift's armature
   VecXc delta_, zq_, zv_;  // the complex shift's armature; c₂ x and c₁ x of a complex product
-  ComplexArticulated complex_;
+  ComplexArticulated complex_[complex_slots];  // a factorisation per complex slot
   Gmres<double> gmres_;
   Gmres<cplx> gmresc_;
 };

@@ -1,5 +1,5 @@
-/// The collocation tableaus (radau.hpp). Radau IIA's: c and a from √6, and the eigen-decomposition a = P diag(d) P⁻¹
-/// as constants.
+/// The collocation tableaus (radau.hpp). Radau IIA's of 3 stages: c and a from √6, and the eigen-decomposition
+/// a = P diag(d) P⁻¹ as constants.
 /// The decomposition's numbers are the bits that Eigen's EigenSolver<Matrix3d> and P.inverse() computed for this a
 /// in this library, written as hexadecimal literals (exact). The solver cost 7 s of compile time; every other way of
 /// writing the same decomposition (a closed form, eigenvectors in another complex phase, decimal digits from a
@@ -38,6 +38,52 @@ RadauTableau::RadauTableau() {
       C(0x1.5ef5dc29e1be4p-2, -0x1.efc22e02839a4p-3),
       C(0x1.1cfe2989c69b4p-3, -0x1.27aa99a27bcdep+1), C(-0x1.6c1b6ff2f4c66p+0, -0x1.87abc1224b8e4p-4),
       C(0x1.5ef5dc29e1be4p-2, 0x1.efc22e02839a4p-3);
+}
+
+// Radau IIA of 5 stages from a 60-digit computation (mpmath), each number rounded to the nearest double: c the zeros
+// of d⁴/dx⁴ (x⁴ (x − 1)⁵), a_ij = ∫₀^{c_i} l_j (l_j Lagrange's basis on c), b the last row of a; dd the embedded
+// estimate's weights, (b̂ − b)ᵀ a⁻¹/d₁ for the order-5 quadrature b̂ on (0, c) with b̂₀ = d₁ (as radau5's); the
+// real eigenvalue first, then the pairs with Im d > 0; P's columns unit eigenvectors whose largest component is real
+// and positive.
+Radau9Tableau::Radau9Tableau() {
+  using C = std::complex<double>;
+  c << 0x1.d3cc2dd8d6d32p-5, 0x1.1b7cbc26ceaaep-2, 0x1.2acc5d7a90e51p-1, 0x1.b8716522b33bep-1, 0x1.0000000000000p+0;
+  a << 0x1.2b00db6e3fa2dp-4, -0x1.b6081b30682a0p-6, 0x1.3200b8a1aa037p-6, -0x1.a605c5bc79bfcp-7, 0x1.4a7ccd96a885cp-8,  //
+      0x1.3aee82311a74fp-3, 0x1.2b72b35cc0671p-3, -0x1.2a8dccf20f1a7p-5, 0x1.5be1ebec3e8bdp-6, -0x1.040878141910fp-7,  //
+      0x1.1ed95fc4c15b4p-3, 0x1.3224706ef9eacp-2, 0x1.5736d75c3ae6dp-3, -0x1.16465e9a31545p-5, 0x1.669f591dfd1acp-7,  //
+      0x1.28be58d5a7ef5p-3, 0x1.1b22d582aaa26p-2, 0x1.4d9df880051b7p-2, 0x1.07b19ee2f3ab4p-3, -0x1.015ff99971365p-6,  //
+      0x1.26534b9cb85e2p-3, 0x1.201bca8e66374p-2, 0x1.3f4f73b8d3267p-2, 0x1.c8eab2b61c94ap-3, 0x1.47ae147ae147bp-5;
+  dd << -0x1.bc7eb4976180bp+4, 0x1.d21bf7a91ab27p+1, -0x1.40a6f7ab19c6fp+0, 0x1.2f1b0a045f3f9p-1,
+      -0x1.999999999999ap-3;
+  d << C(0x1.45c4503dd015ap-3, 0x0.0p+0), C(0x1.0a8269ef157e3p-4, 0x1.dd0e1a5a86e24p-4),
+      C(0x1.0a8269ef157e3p-4, -0x1.dd0e1a5a86e24p-4), C(0x1.10c0312270c45p-3, 0x1.332d71fb6de09p-4),
+      C(0x1.10c0312270c45p-3, -0x1.332d71fb6de09p-4);
+  P << C(0x1.9a2d1fb890948p-7, 0x0.0p+0), C(-0x1.17db4b4074e02p-7, 0x1.45a9e3de9eac1p-5),
+      C(-0x1.17db4b4074e02p-7, -0x1.45a9e3de9eac1p-5), C(-0x1.555c23db6aa42p-7, -0x1.a0efe084575a6p-7),
+      C(-0x1.555c23db6aa42p-7, 0x1.a0efe084575a6p-7), C(0x1.87084a1342ef1p-10, 0x0.0p+0),
+      C(0x1.56bc011e2390ap-5, -0x1.4231945a1be5ap-4), C(0x1.56bc011e2390ap-5, 0x1.4231945a1be5ap-4),
+      C(-0x1.c8208fac3b4c1p-8, 0x1.6f6793486bf33p-6), C(-0x1.c8208fac3b4c1p-8, -0x1.6f6793486bf33p-6),
+      C(0x1.2aef0b4499ccep-4, 0x0.0p+0), C(-0x1.89b53daec1bb1p-3, 0x1.5ec9300e7ec54p-4),
+      C(-0x1.89b53daec1bb1p-3, -0x1.5ec9300e7ec54p-4), C(0x1.20721d76582e4p-6, 0x1.30153972900bap-4),
+      C(0x1.20721d76582e4p-6, -0x1.30153972900bap-4), C(0x1.8536b0c138302p-2, 0x0.0p+0),
+      C(0x1.42ad70ca8dcb6p-2, 0x1.8e8b9750d7823p-2), C(0x1.42ad70ca8dcb6p-2, -0x1.8e8b9750d7823p-2),
+      C(0x1.7acd4faf2d941p-2, 0x1.7325ca79ebf08p-3), C(0x1.7acd4faf2d941p-2, -0x1.7325ca79ebf08p-3),
+      C(0x1.d80da0c71ef28p-1, 0x0.0p+0), C(0x1.aaf1222f365a6p-1, 0x0.0p+0), C(0x1.aaf1222f365a6p-1, 0x0.0p+0),
+      C(0x1.d0ac1fd8318aep-1, 0x0.0p+0), C(0x1.d0ac1fd8318aep-1, 0x0.0p+0);
+  Pinv << C(0x1.e0aa42ea49a39p+4, 0x0.0p+0), C(0x1.bbaef6abc6593p+3, 0x0.0p+0), C(0x1.bd70bb1dde069p+1, 0x0.0p+0),
+      C(-0x1.0831ba83d8022p+0, 0x0.0p+0), C(0x1.9bcd9bd554fe0p-1, 0x0.0p+0),
+      C(0x1.9a2b3d12c4b60p+1, -0x1.1faa5829c8758p+1), C(0x1.608fedceb19ffp+1, 0x1.31d919fb282a9p+1),
+      C(-0x1.d21591b3c467dp+0, 0x1.40a33b940e65ap-1), C(0x1.428e01e4956f6p-1, -0x1.6b85433d24adap-1),
+      C(-0x1.4ef968913f734p-3, 0x1.144052553e8aap-2), C(0x1.9a2b3d12c4b60p+1, 0x1.1faa5829c8758p+1),
+      C(0x1.608fedceb19ffp+1, -0x1.31d919fb282a9p+1), C(-0x1.d21591b3c467dp+0, -0x1.40a33b940e65ap-1),
+      C(0x1.428e01e4956f6p-1, 0x1.6b85433d24adap-1), C(-0x1.4ef968913f734p-3, -0x1.144052553e8aap-2),
+      C(-0x1.23420c209b1ddp+4, 0x1.2fa21140e03f2p+2), C(-0x1.325964baf6668p+3, -0x1.5603b29d8d636p+2),
+      C(-0x1.846cd2d7ba82dp-4, -0x1.0e0c2f8da4f2bp+0), C(-0x1.bf924cc9c20e9p-5, -0x1.552005ab4a2d2p+0),
+      C(0x1.2bb0f8ef8d931p-2, 0x1.27765508377dfp-1), C(-0x1.23420c209b1ddp+4, -0x1.2fa21140e03f2p+2),
+      C(-0x1.325964baf6668p+3, 0x1.5603b29d8d636p+2), C(-0x1.846cd2d7ba82dp-4, 0x1.0e0c2f8da4f2bp+0),
+      C(-0x1.bf924cc9c20e9p-5, 0x1.552005ab4a2d2p+0), C(0x1.2bb0f8ef8d931p-2, -0x1.27765508377dfp-1);
+  b = a.row(4).transpose();
+  stiffly_accurate = true;
 }
 
 // Gauss–Legendre's decomposition from a 60-digit eigen-decomposition (mpmath), each number rounded to the nearest

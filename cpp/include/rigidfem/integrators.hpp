@@ -35,6 +35,7 @@ enum class Method {
   Esdirk43,          ///< ESDIRK4(3)6L[2]SA (Kennedy & Carpenter), order 4, L-stable, adaptive
   Radau5,            ///< Radau IIA, 3 stages, order 5, L-stable, adaptive
   Gauss6,            ///< Gauss–Legendre, 3 stages, order 6, symmetric, A-stable, fixed step
+  Radau9,            ///< Radau IIA, 5 stages, order 9, L-stable, adaptive
   /// dopri5 while it is the faster, `stiff_method` (adaptive) while that is: where dopri5's steps look
   /// bounded by stability, the stiff method runs a trial and keeps the run if it does less work per simulated second.
   Auto,

@@ -63,16 +63,17 @@ class NewtonMatrix {
   /// regularity); 1 for Krylov's, whose recursion throws SimulationError at a singular pivot. The caller
   /// names the failure.
   virtual double factor(double c1, double c2, const VecX& e) = 0;
-  /// ... or slot 1 (complex, no e).
-  virtual double factor(cplx c1, cplx c2) = 0;
+  /// ... or a complex slot (no e): one per complex pair of eigenvalues of a collocation tableau (radau9's two).
+  static constexpr int complex_slots = 2;
+  virtual double factor(cplx c1, cplx c2, int slot = 0) = 0;
   /// x = S⁻¹ b with slot 0's matrix (x may not be b).
   virtual void solve(const VecX& b, VecX& x) = 0;
-  /// x = S⁻¹ b with slot 1's matrix.
-  virtual void solve(const VecXc& b, VecXc& x) = 0;
+  /// x = S⁻¹ b with a complex slot's matrix.
+  virtual void solve(const VecXc& b, VecXc& x, int slot = 0) = 0;
   /// x = P⁻ᵀ b with slot 0's factorisation P: S itself (dense), the preconditioner M + diag(c₁ b + c₂ k + e),
   /// symmetric (Krylov). The adjoint's preconditioner for Sᵀ (adjoint.cpp).
   virtual void precondition_transposed(const VecX& b, VecX& x) = 0;
-  /// ... with slot 1's (complex) factorisation.
+  /// ... with complex slot 0's factorisation.
   virtual void precondition_transposed(const VecXc& b, VecXc& x) = 0;
   /// X = S⁻¹ B column by column with slot 0's matrix.
   MatX solve(const MatX& B);
