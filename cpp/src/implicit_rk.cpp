@@ -737,8 +737,9 @@ class Collocation final : public ImplicitRk, public RadauAccess {
 
   /// radau9: q̇ by its collocation polynomial, q̇(t_n + θh) = q̇_n + h Σ_k A_k L1_k(θ), and q by its integral,
   /// q_n + θh q̇_n + h² Σ_k A_k L2_k(θ) (L1_k = ∫₀^θ l_k, L2_k = ∫₀^θ L1_k, l_k Lagrange's basis on c), which
-  /// end at the step's (q, q̇)_n+1 (the Radau quadrature integrates L1_k exactly). radau5 and gauss6: the quintic
-  /// Hermite interpolant (ImplicitRk::dense).
+  /// end at the step's (q, q̇)_n+1 (the Radau quadrature integrates L1_k exactly); with loops plus θ times what the
+  /// projection moved the end by, so that they end at the projected state. radau5 and gauss6: the quintic Hermite
+  /// interpolant (ImplicitRk::dense).
   VecX dense(double t) const override {
     if (S == 3) return ImplicitRk::dense(t);
     const double theta = (t - t_) / h_;
@@ -753,6 +754,10 @@ class Collocation final : public ImplicitRk, public RadauAccess {
     out.tail(n_) += vp_;
     out.head(n_).noalias() = (h_ * h_) * A_ * w2;
     out.head(n_) += qp_ + (theta * h_) * vp_;
+    if (sys_.nl > 0) {  // q_, v_ projected onto the loops (project), the stages not
+      out.head(n_) += theta * (q_ - Q_.col(S - 1));
+      out.tail(n_) += theta * (v_ - V_.col(S - 1));
+    }
     return out;
   }
 

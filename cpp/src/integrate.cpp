@@ -23,17 +23,24 @@ const char* iteration_matrices[] = {"auto", "tangent", "spring", "krylov"};
 
 using Clock = std::chrono::steady_clock;
 
-// auto's own checks: its stiff method is an implicit one with an error estimate, and radau5 takes no arms.
+// auto's own checks: its stiff method is an implicit one with an error estimate, and takes what that method takes
+// (its family's checks: the collocation methods no Maxwell arms, radau9 no sensitivities, ...).
 void check_auto(const System& sys, const IntegratorOptions& o) {
   const Method stiff = auto_stiff_method(sys, o);
-  if (stiff == Method::Radau5 && sys.nz > 0)
-    throw std::invalid_argument("method: 'radau5' does not integrate Maxwell arms (the system has " +
-                                std::to_string(sys.nz) + " arm forces as internal variables); use esdirk43, "
-                                "generalized_alpha or dopri5");
   const MethodInfo& m = method_info(stiff);
   if (!m.error_estimate || std::string(m.family) == "explicit Runge-Kutta" || stiff == Method::Auto)
     throw std::invalid_argument(std::string("stiff_method: expected an implicit method with an error estimate, got '") +
                                 m.name + "'");
+  if (m.check) {
+    IntegratorOptions as_run = o;
+    as_run.method = stiff;
+    try {
+      m.check(sys, as_run);
+    } catch (const std::invalid_argument& e) {
+      throw std::invalid_argument(std::string("stiff_method: auto's stiff method '") + m.name + "' refuses the run (" +
+                                  e.what() + ")");
+    }
+  }
 }
 
 }  // namespace
