@@ -6,7 +6,7 @@ Kane's spin-up beam (planar modified RFEM, Ω_s = 6 rad/s, T_s = 15 s, over 20 s
 elements: the tip's RMS error (m, in the hub's frame, at 51 output times) against dopri5 at
 rtol = 1e-12 on the same chain, and the least time of the C++ integration loop (of 3 runs after a
 warm-up) to reach 1e-4 m and 1e-6 m, for esdirk43 (the exact tangent and the O(n) spring matrix),
-radau5, generalised-α at fixed steps and dopri5. The tolerance-driven methods run with
+radau5, radau9, generalised-α at fixed steps and dopri5. The tolerance-driven methods run with
 atol = 1e-3 rtol (a tip moves by many small sde angles times their lever arms: see rf.simulate).
 """
 
@@ -30,7 +30,8 @@ def methods(quick: bool = False) -> list:
         return [(method, "rtol", [r], dict(options, atol=1e-3 * r)) for r in values]
 
     return [*tolerances("esdirk43", rtols), *tolerances("esdirk43", rtols, iteration_matrix="spring"),
-            *tolerances("radau5", rtols), *tolerances("dopri5", rtols[: 4 if quick else 11]),
+            *tolerances("radau5", rtols), *tolerances("radau9", rtols),
+            *tolerances("dopri5", rtols[: 4 if quick else 11]),
             ("generalized_alpha", "dt", dts)]
 
 
