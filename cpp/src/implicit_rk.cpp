@@ -384,8 +384,8 @@ class ImplicitRk : public Stepper {
   /// η size <= 1, η = θ/(1 − θ) from the contraction rate θ (the sum of the remaining increments of
   /// a contraction; Hairer & Wanner IV.8), the last η on the first iteration; failed when
   /// θ >= 0.99 or the iterations run out. A slow contraction asks for a fresh tangent: θ > 0.2 always, θ > mild_
-  /// (0.05; radau9 0.02) once the tangent has served `served_` steps, what it costs in stage residuals. One that serves long pays
-  /// for itself in iterations saved: strip m = 16, radau5 rtol 2e-6, 9 tangents instead of 1, 2.02 Newton
+  /// (0.05; radau9 0.02) once the tangent has served `served_` steps, what it costs in stage residuals. One that
+  /// serves long pays for itself in iterations saved: strip m = 16, radau5 rtol 2e-6, 9 tangents instead of 1, 2.02 Newton
   /// iterations a step instead of 2.26, 10 % less time (with renewal by age too: 22 tangents, 1.98). One that
   /// serves a few steps does not: on the crane (tangents kept 2-8 steps) θ > 0.05 alone took 33 tangents
   /// instead of 13, and 33 % more time.
