@@ -356,7 +356,9 @@ class KrylovNewtonMatrix final : public NewtonMatrix {
   static constexpr int max_iterations = 60;
 
   KrylovNewtonMatrix(const System& sys, IntegratorStats& stats)
-      : sys_(sys), d0_(sys), dp_(sys), stats_(stats), complex_{ComplexArticulated(sys), ComplexArticulated(sys)} {}
+      : sys_(sys), d0_(sys), dp_(sys), stats_(stats) {
+    complex_.emplace_back(sys);
+  }
 
   void linearize(double t, const VecX& q, const VecX& qd, const VecX& qdd, const VecX& s) override {
     t_ = t, q_ = q, qd_ = qd, qdd_ = qdd;
@@ -397,6 +399,7 @@ class KrylovNewtonMatrix final : public NewtonMatrix {
   double factor(cplx c1, cplx c2, int slot) override {
     z1_[slot] = c1, z2_[slot] = c2;
     spring_armature(sys_, d0_, c1, c2, delta_);
+    while (slot >= static_cast<int>(complex_.size())) complex_.emplace_back(sys_);  // radau9's second block
     complex_[slot].factor(d0_, delta_);
     ++stats_.factorizations;
     return 1.0;
@@ -448,7 +451,7 @@ class KrylovNewtonMatrix final : public NewtonMatrix {
   VecX q_, qd_, qdd_, r0_, qe_, qde_, qdde_, e_, cq_, cv_, ca_, w_;
   VecX real_delta_;      // the real shift's armature
   VecXc delta_, zq_, zv_;  // the complex shift's armature; c₂ x and c₁ x of a complex product
-  ComplexArticulated complex_[complex_slots];  // a factorisation per complex slot
+  std::vector<ComplexArticulated> complex_;  // a factorisation per complex slot used (one for radau5's runs)
   Gmres<double> gmres_;
   Gmres<cplx> gmresc_;
 };
