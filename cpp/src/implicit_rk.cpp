@@ -762,7 +762,11 @@ class Collocation final : public ImplicitRk, public RadauAccess {
   }
 
   /// The estimate is O(h^(S+1)) (order S): PI control as ImplicitRk's with that exponent.
-  StepControl control() const override { return {S + 1, 5.0, true, 1.2, 0.7, 0.4}; }
+  StepControl control() const override {
+    StepControl c = ImplicitRk::control();
+    c.k = S + 1;
+    return c;
+  }
 
   void stages(MatX& Q, MatX& V, MatX& A) const override { Q = Q_, V = V_, A = A_; }
   void stage_multipliers(MatX& L) const override { L = L_; }
