@@ -267,7 +267,16 @@ void fixed_inertia(const System& sys, Data& d, const VecX* armature, int p) {
   if (!invert_fixed<N>(D, Dinv)) singular_articulated_inertia(sys, d, p);
   d.U6[p] = U;
   d.Dinv[p] = Dinv;
-  d.IA[p].noalias() -= (U * Dinv) * U.transpose();
+  // I^A −= W Uᵀ with W = U D⁻¹, a column at a time: 6-vector operations where Eigen's lazy product looped over
+  // the columns (measured, C++ forward dynamics: 5 % less time on the 3-rotation cantilever at m = 10 and 100,
+  // 2.19 → 2.08 µs and 21.8 → 20.7 µs, and 4-7 % on the strip, 2.09 → 1.96 µs at m = 16)
+  const Eigen::Matrix<double, 6, N> W = U * Dinv;
+  Mat6& IA = d.IA[p];
+  for (int k = 0; k < 6; ++k) {
+    Vec6 t = W.col(0) * U(k, 0);
+    for (int j = 1; j < N; ++j) t += W.col(j) * U(k, j);
+    IA.col(k) -= t;
+  }
 }
 
 // ABA pass 2, inertia part (leaves to root): S the free axes, U = I^A S, D = Sᵀ U + diag(δ), and
