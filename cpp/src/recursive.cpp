@@ -267,9 +267,9 @@ void fixed_inertia(const System& sys, Data& d, const VecX* armature, int p) {
   if (!invert_fixed<N>(D, Dinv)) singular_articulated_inertia(sys, d, p);
   d.U6[p] = U;
   d.Dinv[p] = Dinv;
-  // I^A −= W Uᵀ with W = U D⁻¹, a column at a time: 6-vector operations where Eigen's lazy product looped over
-  // the columns (measured, C++ forward dynamics: 5 % less time on the 3-rotation cantilever at m = 10 and 100,
-  // 2.19 → 2.08 µs and 21.8 → 20.7 µs, and 4-7 % on the strip, 2.09 → 1.96 µs at m = 16)
+  // I^A −= W Uᵀ with W = U D⁻¹, written out column by column as 6-vector operations instead of Eigen's lazy
+  // product (measured, C++ forward dynamics, least of 11: the 3-rotation cantilever 2.20-2.24 → 2.09 µs at m = 10
+  // and 21.8 → 20.7-20.9 µs at m = 100; the strip 2.09-2.13 → 1.93-1.99 µs at m = 16, 8.08 → 7.79-7.97 at m = 64)
   const Eigen::Matrix<double, 6, N> W = U * Dinv;
   Mat6& IA = d.IA[p];
   for (int k = 0; k < 6; ++k) {
@@ -310,7 +310,10 @@ void fixed_bias(const System& sys, Data& d, const VecX& tau, int p, const Vec6& 
   const Eigen::Matrix<double, N, 1> u =
       tau.template segment<N>(sys.q_index[p]) - d.S[p].template leftCols<N>().transpose() * pA;
   d.u[p] = u;
-  pa.noalias() += d.U6[p].template leftCols<N>() * (Dinv * u);
+  // U (D⁻¹ u) and, in fixed_acceleration, S q̈ as sums of columns (measured: 1 % off the forward dynamics of the
+  // 3-rotation cantilever and of the strip at m = 64 against Eigen's products of blocks of dynamic matrices)
+  const Eigen::Matrix<double, N, 1> y = Dinv * u;
+  for (int j = 0; j < N; ++j) pa += d.U6[p].col(j) * y(j);
 }
 
 // The fixed-size accelerations of fixed_inertia's body: q̈ = D⁻¹ (u − Uᵀ a') into x, a' + S q̈ into a.
@@ -320,7 +323,7 @@ void fixed_acceleration(const System& sys, Data& d, int p, VecX& x, Vec6& a) {
   const Eigen::Matrix<double, N, 1> qdd =
       Dinv * (d.u[p].template head<N>() - d.U6[p].template leftCols<N>().transpose() * a);
   x.template segment<N>(sys.q_index[p]) = qdd;
-  a.noalias() += d.S[p].template leftCols<N>() * qdd;
+  for (int j = 0; j < N; ++j) a += d.S[p].col(j) * qdd(j);
 }
 
 // ABA pass 2, bias part, and pass 3, given the bias forces p^A (d.pA), joint biases c (d.c),
