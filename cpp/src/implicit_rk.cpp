@@ -1173,8 +1173,8 @@ class Collocation final : public ImplicitRk, public RadauAccess {
     }
     h_factored_ = h;
     check_regular(real, t, h, "M + h d₁ C + (h d₁)² K");
-    check_regular(complex[0], t, h, "M + h d₂ C + (h d₂)² K");
-    if (pairs > 1) check_regular(complex[pairs - 1], t, h, "M + h d₄ C + (h d₄)² K");
+    static const char* const blocks[] = {"M + h d₂ C + (h d₂)² K", "M + h d₄ C + (h d₄)² K"};  // one per pair
+    for (int k = 0; k < pairs; ++k) check_regular(complex[k], t, h, blocks[k]);
   }
 
   static constexpr double symmetric_tol = 1e-4;  // gauss6's Newton increments: 1e-4 newton_tol (1 + |y|)
